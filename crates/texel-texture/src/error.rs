@@ -1,0 +1,94 @@
+//! The one error type of texel-texture.
+
+use thiserror::Error;
+
+/// Everything that can go wrong when creating a texture or a sampler.
+///
+/// Sampling itself cannot fail: descriptors and images are validated once, at creation.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum TextureError {
+    /// Width or height is zero.
+    #[error("texture size {width}x{height} is empty: both sides must be at least 1")]
+    EmptySize {
+        /// Requested width in texels.
+        width: u32,
+        /// Requested height in texels.
+        height: u32,
+    },
+    /// A side exceeds [`crate::Limits::max_dimension`].
+    #[error("texture size {width}x{height} exceeds the limit of {max} texels per side")]
+    TooLarge {
+        /// Requested width in texels.
+        width: u32,
+        /// Requested height in texels.
+        height: u32,
+        /// The limit in texels.
+        max: u32,
+    },
+    /// The bytes the texture and its structures would take exceed [`crate::Limits::max_bytes`].
+    #[error("texture {width}x{height} would need {bytes} bytes with its mip pyramid, over the limit of {max} bytes")]
+    OverMemoryLimit {
+        /// Requested width in texels.
+        width: u32,
+        /// Requested height in texels.
+        height: u32,
+        /// Bytes needed.
+        bytes: u64,
+        /// The limit in bytes.
+        max: u64,
+    },
+    /// The data length does not match `width * height`.
+    #[error("texel data has {got} texels but a {width}x{height} texture needs {expected}")]
+    DataLength {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+        /// Texels expected (`width * height`).
+        expected: usize,
+        /// Texels given.
+        got: usize,
+    },
+    /// The image file could not be decoded (corrupt, truncated, unsupported).
+    #[error("cannot decode image: {0}")]
+    Decode(#[from] image::ImageError),
+    /// The image file could not be read.
+    #[error("cannot read image: {0}")]
+    Io(#[from] std::io::Error),
+    /// The decoded image has a pixel format texel does not sample.
+    #[error(
+        "unsupported pixel format {0:?}: texel samples 8-bit, 16-bit and float RGB(A)/luma images"
+    )]
+    UnsupportedFormat(image::ColorType),
+    /// `lod_min_clamp` is negative/NaN or greater than `lod_max_clamp`.
+    #[error("invalid lod clamp: lod_min_clamp = {lod_min_clamp}, lod_max_clamp = {lod_max_clamp} (need 0 <= min <= max, not NaN)")]
+    InvalidLodClamp {
+        /// The requested minimum.
+        lod_min_clamp: f32,
+        /// The requested maximum.
+        lod_max_clamp: f32,
+    },
+    /// `lod_bias` is not finite.
+    #[error("invalid lod bias {0}: must be finite")]
+    InvalidLodBias(f32),
+    /// `anisotropy_clamp` is outside `1..=64`.
+    #[error("invalid anisotropy_clamp {0}: must be between 1 and 64")]
+    InvalidAnisotropyClamp(u16),
+    /// Anisotropic filtering needs linear mag, min and mipmap filters (WebGPU rule).
+    #[error(
+        "anisotropy_clamp = {0} requires mag_filter, min_filter and mipmap_filter to be Linear"
+    )]
+    AnisotropyNeedsLinear(u16),
+    /// A cubic filter's (B, C) parameters are not finite.
+    #[error("invalid Mitchell-Netravali parameters B = {b}, C = {c}: must be finite")]
+    InvalidCubic {
+        /// The B parameter.
+        b: f32,
+        /// The C parameter.
+        c: f32,
+    },
+    /// A lab mode outside 1..=8.
+    #[error("unknown lab mode {0}: valid modes are 1 (nearest) to 8 (anisotropic 16x)")]
+    UnknownLabMode(u8),
+}

@@ -1,0 +1,164 @@
+//! How filters read texels: per-level [`Fetch`] views, the whole-pyramid [`Pyramid`] view, and the
+//! [`Counted`] wrapper that counts every texel read.
+//!
+//! Every filter is generic over these traits, so the same code serves 8-bit and float textures and the
+//! statistics mode: counting is a wrapper type, not a flag, and costs nothing when it is not used
+//! (the plain views monomorphise to a bare load).
+
+use std::cell::Cell;
+
+use glam::Vec4;
+
+use crate::color::{srgb_table, unorm8_table};
+use crate::texture::{F32Level, Format, LevelInfo, Storage, Texture, U8Level};
+
+pub(crate) use crate::texture::Fetch;
+
+/// All mip levels of a texture.
+pub(crate) trait Pyramid {
+    /// One level's view.
+    type Level<'a>: Fetch
+    where
+        Self: 'a;
+    /// Number of levels (at least 1).
+    fn level_count(&self) -> usize;
+    /// Level `k < level_count()`.
+    fn level(&self, k: usize) -> Self::Level<'_>;
+}
+
+/// The pyramid of an 8-bit texture.
+pub(crate) struct U8Pyramid<'a> {
+    pub levels: &'a [LevelInfo],
+    pub texels: &'a [[u8; 4]],
+    pub table: &'static [f32; 256],
+    pub alpha: &'static [f32; 256],
+}
+
+/// The pyramid of a float texture.
+pub(crate) struct F32Pyramid<'a> {
+    pub levels: &'a [LevelInfo],
+    pub texels: &'a [[f32; 4]],
+}
+
+fn level_slice<'t, T>(info: &LevelInfo, all: &'t [T]) -> &'t [T] {
+    &all[info.offset..info.offset + info.width as usize * info.height as usize]
+}
+
+impl Pyramid for U8Pyramid<'_> {
+    type Level<'b>
+        = U8Level<'b>
+    where
+        Self: 'b;
+    #[inline(always)]
+    fn level_count(&self) -> usize {
+        self.levels.len()
+    }
+    #[inline(always)]
+    fn level(&self, k: usize) -> U8Level<'_> {
+        let info = &self.levels[k];
+        U8Level {
+            width: info.width,
+            height: info.height,
+            texels: level_slice(info, self.texels),
+            table: self.table,
+            alpha: self.alpha,
+        }
+    }
+}
+
+impl Pyramid for F32Pyramid<'_> {
+    type Level<'b>
+        = F32Level<'b>
+    where
+        Self: 'b;
+    #[inline(always)]
+    fn level_count(&self) -> usize {
+        self.levels.len()
+    }
+    #[inline(always)]
+    fn level(&self, k: usize) -> F32Level<'_> {
+        let info = &self.levels[k];
+        F32Level {
+            width: info.width,
+            height: info.height,
+            texels: level_slice(info, self.texels),
+        }
+    }
+}
+
+/// A pyramid view that counts texel reads.
+pub(crate) struct Counted<P> {
+    pub inner: P,
+    pub count: Cell<u32>,
+}
+
+/// A level view that counts texel reads into its pyramid's counter.
+#[derive(Clone, Copy)]
+pub(crate) struct CountedLevel<'a, L> {
+    inner: L,
+    count: &'a Cell<u32>,
+}
+
+impl<L: Fetch> Fetch for CountedLevel<'_, L> {
+    #[inline(always)]
+    fn size(&self) -> (u32, u32) {
+        self.inner.size()
+    }
+    #[inline(always)]
+    fn texel(&self, i: u32, j: u32) -> Vec4 {
+        self.count.set(self.count.get().saturating_add(1));
+        self.inner.texel(i, j)
+    }
+}
+
+impl<P: Pyramid> Pyramid for Counted<P> {
+    type Level<'b>
+        = CountedLevel<'b, P::Level<'b>>
+    where
+        Self: 'b;
+    fn level_count(&self) -> usize {
+        self.inner.level_count()
+    }
+    fn level(&self, k: usize) -> Self::Level<'_> {
+        CountedLevel {
+            inner: self.inner.level(k),
+            count: &self.count,
+        }
+    }
+}
+
+/// Call `$body` with `$p` bound to the texture's pyramid view (8-bit or float), monomorphising once
+/// per storage format.
+macro_rules! with_pyramid {
+    ($tex:expr, |$p:ident| $body:expr) => {
+        match $crate::fetch::pyramid_of($tex) {
+            $crate::fetch::AnyPyramid::U8($p) => $body,
+            $crate::fetch::AnyPyramid::F32($p) => $body,
+        }
+    };
+}
+pub(crate) use with_pyramid;
+
+pub(crate) enum AnyPyramid<'a> {
+    U8(U8Pyramid<'a>),
+    F32(F32Pyramid<'a>),
+}
+
+pub(crate) fn pyramid_of(tex: &Texture) -> AnyPyramid<'_> {
+    match tex.storage() {
+        Storage::U8(v) => AnyPyramid::U8(U8Pyramid {
+            levels: tex.levels(),
+            texels: v,
+            table: if tex.format() == Format::Rgba8Srgb {
+                srgb_table()
+            } else {
+                unorm8_table()
+            },
+            alpha: unorm8_table(),
+        }),
+        Storage::F32(v) => AnyPyramid::F32(F32Pyramid {
+            levels: tex.levels(),
+            texels: v,
+        }),
+    }
+}

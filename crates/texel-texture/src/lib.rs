@@ -1,0 +1,50 @@
+//! texel-texture: texture images, address modes, mip pyramids and every classic texture filter,
+//! behind a WebGPU-style sampler.
+//!
+//! Conventions (fixed by the project's DESIGN.md): `uv` is normalised, `xy = (u * W, v * H)` is
+//! continuous texel space with texel `(i, j)` covering `[i, i+1) x [j, j+1)`, row 0 is the top of the
+//! image file. Colours returned by samplers are linear RGBA `f32`.
+//!
+//! ```
+//! use texel_texture::{AddressMode, ColorSpace, FilterMode, Footprint, Limits, MipmapFilterMode,
+//!                     Sampler, SamplerDescriptor, Texture};
+//!
+//! // A 2x2 linear texture: black, white / white, black.
+//! let b = [0, 0, 0, 255];
+//! let w = [255, 255, 255, 255];
+//! let tex = Texture::from_rgba8(2, 2, vec![b, w, w, b], ColorSpace::Linear, &Limits::default())?;
+//! let sampler = Sampler::new(SamplerDescriptor {
+//!     mag_filter: FilterMode::Linear,
+//!     min_filter: FilterMode::Linear,
+//!     mipmap_filter: MipmapFilterMode::Linear,
+//!     ..SamplerDescriptor::default().with_address_mode(AddressMode::Repeat)
+//! })?;
+//! // At the texture's centre, bilinear blends all four texels equally.
+//! let c = sampler.sample(&tex, &Footprint::point(0.5, 0.5));
+//! assert!((c[0] - 0.5).abs() < 1e-6);
+//! // A footprint covering the whole texture per pixel reads the 1x1 level: the mean.
+//! let (c, reads) = sampler.sample_counted(&tex, &Footprint::isotropic(0.3, 0.7, 1.0));
+//! assert!((c[0] - 0.5).abs() < 1e-6);
+//! assert_eq!(reads, 4); // bilinear in the 1x1 level (lod clamps to the last level)
+//! # Ok::<(), texel_texture::TextureError>(())
+//! ```
+
+pub mod address;
+pub mod bicubic;
+mod bilinear;
+pub mod color;
+mod error;
+mod fetch;
+pub mod footprint;
+pub mod mip;
+mod nearest;
+pub mod pyramid;
+pub mod sampler;
+pub mod texture;
+
+pub use address::{AddressMode, BorderColor};
+pub use bicubic::Cubic;
+pub use error::TextureError;
+pub use footprint::{Axes, Footprint};
+pub use sampler::{FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor};
+pub use texture::{ColorSpace, Format, LevelInfo, Limits, Texture};

@@ -1,0 +1,97 @@
+//! Mipmapped filtering: nearest level (`mip_nearest`) and trilinear.
+//!
+//! Level selection follows the Vulkan spec ("Level-of-Detail Operation" and "Image Level(s)
+//! Selection") with `level_base = 0` and `q` the last level: `d' = clamp(lod, 0, q)`;
+//! - nearest level: `d = ceil(d' + 1/2) - 1` (so `lod = 0.5` still picks level 0, `0.5 + eps` level 1);
+//! - linear: `d_hi = floor(d')`, `d_lo = min(d_hi + 1, q)`, `delta = fract(d')`, and the result is
+//!   `lerp(filter(d_hi), filter(d_lo), delta)`; the last level holds.
+//!
+//! When `delta == 0` the second level is not read (the lerp would return the first value exactly),
+//! which halves the reads on integer lods and at the last level.
+
+use glam::Vec4;
+
+use crate::address::Address;
+use crate::bicubic::bicubic;
+use crate::bilinear::bilinear;
+use crate::fetch::{Fetch, Pyramid};
+use crate::nearest::nearest;
+use crate::sampler::FilterMode;
+
+/// Filter one level with a within-level filter (Nearest, Linear or Cubic).
+#[inline(always)]
+pub(crate) fn filter_level<F: Fetch>(
+    mode: &FilterMode,
+    level: &F,
+    addr: &Address,
+    u: f32,
+    v: f32,
+) -> Vec4 {
+    match mode {
+        FilterMode::Nearest => nearest(level, addr, u, v),
+        FilterMode::Linear => bilinear(level, addr, u, v),
+        FilterMode::Cubic(c) => bicubic(level, addr, c, u, v),
+    }
+}
+
+/// The Vulkan nearest-level rule `ceil(lod + 1/2) - 1`, clamped to `[0, last]`.
+#[inline]
+pub fn mip_nearest_level(lod: f32, last: usize) -> usize {
+    let d = lod.clamp(0.0, last as f32);
+    ((d + 0.5).ceil() - 1.0).max(0.0) as usize
+}
+
+/// Nearest-level mipmapping: `mode` in level [`mip_nearest_level`].
+#[inline]
+pub(crate) fn mip_nearest<P: Pyramid>(
+    p: &P,
+    mode: &FilterMode,
+    addr: &Address,
+    u: f32,
+    v: f32,
+    lod: f32,
+) -> Vec4 {
+    let level = mip_nearest_level(lod, p.level_count() - 1);
+    filter_level(mode, &p.level(level), addr, u, v)
+}
+
+/// Trilinear (linear-between-levels) mipmapping at `lod` with `mode` inside each level.
+#[inline]
+pub(crate) fn trilinear<P: Pyramid>(
+    p: &P,
+    mode: &FilterMode,
+    addr: &Address,
+    u: f32,
+    v: f32,
+    lod: f32,
+) -> Vec4 {
+    let last = p.level_count() - 1;
+    let d = lod.clamp(0.0, last as f32);
+    let d_hi = d.floor();
+    let delta = d - d_hi;
+    let k = d_hi as usize;
+    let a = filter_level(mode, &p.level(k), addr, u, v);
+    if delta > 0.0 && k < last {
+        let b = filter_level(mode, &p.level(k + 1), addr, u, v);
+        a + (b - a) * delta
+    } else {
+        a
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vulkan_nearest_rounding() {
+        assert_eq!(mip_nearest_level(0.0, 10), 0);
+        assert_eq!(mip_nearest_level(0.5, 10), 0);
+        assert_eq!(mip_nearest_level(0.500_001, 10), 1);
+        assert_eq!(mip_nearest_level(1.49, 10), 1);
+        assert_eq!(mip_nearest_level(1.5, 10), 1);
+        assert_eq!(mip_nearest_level(1.51, 10), 2);
+        assert_eq!(mip_nearest_level(99.0, 10), 10);
+        assert_eq!(mip_nearest_level(-3.0, 10), 0);
+    }
+}

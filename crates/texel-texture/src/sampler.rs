@@ -1,0 +1,238 @@
+//! `SamplerDescriptor` (WebGPU vocabulary) validated once into a [`Sampler`].
+//!
+//! As wgpu's `create_sampler`, every check happens in [`Sampler::new`]; the per-sample path cannot
+//! fail and does not re-validate. The sampler resolves its technique once; per sample it only computes
+//! the lod and dispatches on that resolved choice.
+//!
+//! Mag/min selection (Vulkan spec, "Texel Filtering"): `lod <= 0` uses `mag_filter` at level 0,
+//! `lod > 0` uses `min_filter` with `mipmap_filter` choosing the level(s). `lod` is
+//! `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]` (see [`crate::footprint`]).
+
+use glam::Vec4;
+
+use crate::address::{Address, AddressMode, BorderColor};
+use crate::bicubic::Cubic;
+use crate::error::TextureError;
+use crate::fetch::{with_pyramid, Counted, Fetch, Pyramid};
+use crate::footprint::{lod_from_rho, Footprint};
+use crate::mip::{filter_level, mip_nearest, trilinear};
+use crate::texture::Texture;
+
+/// Filter used within one mip level (WebGPU `GPUFilterMode`, plus cubic).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum FilterMode {
+    /// The texel containing the sample point (1 read).
+    #[default]
+    Nearest,
+    /// Bilinear interpolation of the 2x2 nearest texel centres (4 reads).
+    Linear,
+    /// Bicubic Mitchell-Netravali with the given `(B, C)` over 4x4 texels (16 reads).
+    Cubic(Cubic),
+}
+
+/// How mip levels are chosen and combined when minifying (WebGPU `GPUMipmapFilterMode`, plus `None`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum MipmapFilterMode {
+    /// No mipmapping: minification filters level 0 only (OpenGL's `GL_LINEAR`/`GL_NEAREST` min filter).
+    None,
+    /// The nearest level (Vulkan rounding `ceil(lod + 1/2) - 1`).
+    #[default]
+    Nearest,
+    /// Linear blend of the two levels around `lod` (trilinear when the min filter is Linear).
+    Linear,
+}
+
+/// Everything that configures a [`Sampler`]. Field names follow WebGPU's `GPUSamplerDescriptor`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SamplerDescriptor {
+    /// Address mode along u (texture x).
+    pub address_mode_u: AddressMode,
+    /// Address mode along v (texture y).
+    pub address_mode_v: AddressMode,
+    /// Filter when `lod <= 0` (magnification).
+    pub mag_filter: FilterMode,
+    /// Filter within a level when `lod > 0` (minification).
+    pub min_filter: FilterMode,
+    /// How levels are chosen when minifying.
+    pub mipmap_filter: MipmapFilterMode,
+    /// Smallest lod used, `>= 0`. Default 0.
+    pub lod_min_clamp: f32,
+    /// Largest lod used, `>= lod_min_clamp`. Default 32 (levels beyond the last hold the last).
+    pub lod_max_clamp: f32,
+    /// Added to `log2(rho)` before clamping (Vulkan `mipLodBias`). Default 0.
+    pub lod_bias: f32,
+    /// Largest anisotropy ratio honoured, 1 to 64. Default 1 (isotropic).
+    pub anisotropy_clamp: u16,
+    /// Colour read outside the texture under [`AddressMode::ClampToBorder`].
+    pub border_color: BorderColor,
+}
+
+impl Default for SamplerDescriptor {
+    /// WebGPU's defaults: clamp to edge, nearest everywhere, lod in `[0, 32]`, no anisotropy.
+    fn default() -> Self {
+        SamplerDescriptor {
+            address_mode_u: AddressMode::ClampToEdge,
+            address_mode_v: AddressMode::ClampToEdge,
+            mag_filter: FilterMode::Nearest,
+            min_filter: FilterMode::Nearest,
+            mipmap_filter: MipmapFilterMode::Nearest,
+            lod_min_clamp: 0.0,
+            lod_max_clamp: 32.0,
+            lod_bias: 0.0,
+            anisotropy_clamp: 1,
+            border_color: BorderColor::TransparentBlack,
+        }
+    }
+}
+
+impl SamplerDescriptor {
+    /// The lab's numbered modes: 1 nearest, 2 bilinear, 3 bilinear with the nearest mip level,
+    /// 4 trilinear. Address modes are left at their defaults (set them with
+    /// [`SamplerDescriptor::with_address_mode`]).
+    ///
+    /// # Errors
+    /// [`TextureError::UnknownLabMode`] for other numbers.
+    pub fn lab_mode(mode: u8) -> Result<Self, TextureError> {
+        let linear = |mipmap_filter| SamplerDescriptor {
+            mag_filter: FilterMode::Linear,
+            min_filter: FilterMode::Linear,
+            mipmap_filter,
+            ..Default::default()
+        };
+        Ok(match mode {
+            1 => SamplerDescriptor {
+                mipmap_filter: MipmapFilterMode::None,
+                ..Default::default()
+            },
+            2 => linear(MipmapFilterMode::None),
+            3 => linear(MipmapFilterMode::Nearest),
+            4 => linear(MipmapFilterMode::Linear),
+            _ => return Err(TextureError::UnknownLabMode(mode)),
+        })
+    }
+
+    /// The same descriptor with `mode` on both axes.
+    pub fn with_address_mode(self, mode: AddressMode) -> Self {
+        SamplerDescriptor {
+            address_mode_u: mode,
+            address_mode_v: mode,
+            ..self
+        }
+    }
+}
+
+/// A validated sampler. Cheap to copy; sampling never fails.
+#[derive(Clone, Copy, Debug)]
+pub struct Sampler {
+    desc: SamplerDescriptor,
+    pub(crate) addr: Address,
+}
+
+impl Sampler {
+    /// Validate `desc` into a sampler.
+    ///
+    /// # Errors
+    /// [`TextureError::InvalidLodClamp`], [`TextureError::InvalidLodBias`],
+    /// [`TextureError::InvalidAnisotropyClamp`], [`TextureError::AnisotropyNeedsLinear`],
+    /// [`TextureError::InvalidCubic`].
+    pub fn new(desc: SamplerDescriptor) -> Result<Self, TextureError> {
+        let (lo, hi) = (desc.lod_min_clamp, desc.lod_max_clamp);
+        if lo.is_nan() || hi.is_nan() || lo < 0.0 || lo > hi {
+            return Err(TextureError::InvalidLodClamp {
+                lod_min_clamp: lo,
+                lod_max_clamp: hi,
+            });
+        }
+        if !desc.lod_bias.is_finite() {
+            return Err(TextureError::InvalidLodBias(desc.lod_bias));
+        }
+        if !(1..=64).contains(&desc.anisotropy_clamp) {
+            return Err(TextureError::InvalidAnisotropyClamp(desc.anisotropy_clamp));
+        }
+        for f in [desc.mag_filter, desc.min_filter] {
+            if let FilterMode::Cubic(c) = f {
+                if !c.b.is_finite() || !c.c.is_finite() {
+                    return Err(TextureError::InvalidCubic { b: c.b, c: c.c });
+                }
+            }
+        }
+        let border = desc.border_color.rgba();
+        Ok(Sampler {
+            desc,
+            addr: Address {
+                u: desc.address_mode_u,
+                v: desc.address_mode_v,
+                border: Vec4::from_array(border),
+            },
+        })
+    }
+
+    /// The descriptor this sampler was created from.
+    pub fn descriptor(&self) -> &SamplerDescriptor {
+        &self.desc
+    }
+
+    /// The lod this sampler uses for `footprint` on `texture` (before clamping to the last level):
+    /// `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]`.
+    pub fn lod(&self, texture: &Texture, footprint: &Footprint) -> f32 {
+        let d = &self.desc;
+        let rho = footprint.rho(texture.width(), texture.height());
+        lod_from_rho(rho, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp)
+    }
+
+    /// Sample `texture` over `footprint`; linear RGBA.
+    ///
+    /// Non-finite `u` or `v` sample at 0; non-finite derivatives select the coarsest level.
+    pub fn sample(&self, texture: &Texture, footprint: &Footprint) -> [f32; 4] {
+        with_pyramid!(texture, |p| self.sample_pyramid(&p, footprint)).to_array()
+    }
+
+    /// As [`Sampler::sample`], also returning how many texels the filter read.
+    pub fn sample_counted(&self, texture: &Texture, footprint: &Footprint) -> ([f32; 4], u32) {
+        with_pyramid!(texture, |p| {
+            let counted = Counted {
+                inner: p,
+                count: std::cell::Cell::new(0),
+            };
+            let c = self.sample_pyramid(&counted, footprint);
+            (c.to_array(), counted.count.get())
+        })
+    }
+
+    /// Sample many footprints at once: `out[k] = sample(texture, footprints[k])`. The texture's format
+    /// is dispatched once for the whole batch.
+    ///
+    /// # Panics
+    /// If `footprints.len() != out.len()` (a programming error, not bad input).
+    pub fn sample_batch(&self, texture: &Texture, footprints: &[Footprint], out: &mut [[f32; 4]]) {
+        assert_eq!(
+            footprints.len(),
+            out.len(),
+            "sample_batch: footprints and out differ in length"
+        );
+        with_pyramid!(texture, |p| {
+            for (o, f) in out.iter_mut().zip(footprints) {
+                *o = self.sample_pyramid(&p, f).to_array();
+            }
+        })
+    }
+
+    /// The whole per-sample path, generic over the texel storage (and the counting wrapper).
+    #[inline]
+    pub(crate) fn sample_pyramid<P: Pyramid>(&self, p: &P, fp: &Footprint) -> Vec4 {
+        let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
+        let (u, v) = (finite(fp.u), finite(fp.v));
+        let level0 = p.level(0);
+        let (w, h) = level0.size();
+        let d = &self.desc;
+        let lod = lod_from_rho(fp.rho(w, h), d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
+        if lod <= 0.0 {
+            return filter_level(&d.mag_filter, &level0, &self.addr, u, v);
+        }
+        match d.mipmap_filter {
+            MipmapFilterMode::None => filter_level(&d.min_filter, &level0, &self.addr, u, v),
+            MipmapFilterMode::Nearest => mip_nearest(p, &d.min_filter, &self.addr, u, v, lod),
+            MipmapFilterMode::Linear => trilinear(p, &d.min_filter, &self.addr, u, v, lod),
+        }
+    }
+}

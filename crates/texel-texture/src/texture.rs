@@ -1,0 +1,459 @@
+//! Texture images: RGBA8 (sRGB or linear) and RGBA32F, with their full mip pyramid.
+//!
+//! A [`Texture`] owns every mip level in one contiguous allocation of its own texel format
+//! (`[u8; 4]` or `[f32; 4]`), level 0 first, so that a filter reading two adjacent levels touches one
+//! buffer. The pyramid is built at creation (see [`crate::pyramid`]): level `k` is
+//! `max(1, W >> k) x max(1, H >> k)`, down to 1x1.
+//!
+//! Decision (recorded in ARCHITECTURE.md): levels below 0 are stored in the texture's own format, as a
+//! GPU stores them, so an 8-bit sRGB texture's pyramid costs 4/3 of level 0 and every level decodes
+//! through the same table. The reduction itself runs in linear `f32` from the previous *unquantised*
+//! level, so rounding does not accumulate down the chain.
+
+use std::path::Path;
+
+use glam::Vec4;
+
+use crate::color::{linear_to_srgb8, srgb_table, srgb_to_linear, unorm8, unorm8_table};
+use crate::error::TextureError;
+use crate::pyramid;
+
+/// How 8-bit colour channels are to be interpreted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ColorSpace {
+    /// RGB are sRGB-encoded and decoded to linear light before filtering (alpha is always linear).
+    /// Example: code 128 samples as 0.2159.
+    Srgb,
+    /// Bytes are linear values `b / 255` (a GPU sampling a `*Unorm` texture). Example: 128 -> 0.5020.
+    Linear,
+}
+
+/// Texel storage format of a [`Texture`] (and of every level of its pyramid).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// 8-bit RGBA, RGB sRGB-encoded, alpha linear. 4 bytes per texel.
+    Rgba8Srgb,
+    /// 8-bit RGBA, all channels linear `b / 255`. 4 bytes per texel.
+    Rgba8Unorm,
+    /// 32-bit float RGBA, linear. 16 bytes per texel.
+    Rgba32Float,
+}
+
+impl Format {
+    /// Bytes one texel occupies.
+    pub fn texel_bytes(self) -> u64 {
+        match self {
+            Format::Rgba8Srgb | Format::Rgba8Unorm => 4,
+            Format::Rgba32Float => 16,
+        }
+    }
+}
+
+/// Size and memory limits checked before anything is allocated (after image-rs `io/limits.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// Largest width or height in texels. Default 16384 (the common GPU maximum).
+    pub max_dimension: u32,
+    /// Largest number of bytes a texture may use: its pyramid plus the scratch the build needs
+    /// (an `f32` copy of levels 1 and below). Default 4 GiB.
+    pub max_bytes: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_dimension: 16384,
+            max_bytes: 4 << 30,
+        }
+    }
+}
+
+impl Limits {
+    /// Check a `width x height` texture of `format` against these limits.
+    ///
+    /// # Errors
+    /// [`TextureError::EmptySize`], [`TextureError::TooLarge`] or [`TextureError::OverMemoryLimit`].
+    pub fn check(&self, width: u32, height: u32, format: Format) -> Result<(), TextureError> {
+        if width == 0 || height == 0 {
+            return Err(TextureError::EmptySize { width, height });
+        }
+        if width > self.max_dimension || height > self.max_dimension {
+            return Err(TextureError::TooLarge {
+                width,
+                height,
+                max: self.max_dimension,
+            });
+        }
+        let texels = pyramid::pyramid_texels(width, height);
+        let level0 = u64::from(width) * u64::from(height);
+        let bytes = texels
+            .checked_mul(format.texel_bytes())
+            .and_then(|b| b.checked_add((texels - level0).checked_mul(16)?))
+            .unwrap_or(u64::MAX);
+        if bytes > self.max_bytes {
+            return Err(TextureError::OverMemoryLimit {
+                width,
+                height,
+                bytes,
+                max: self.max_bytes,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Where one mip level lives in the texture's storage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LevelInfo {
+    /// Width in texels: `max(1, W >> level)`.
+    pub width: u32,
+    /// Height in texels: `max(1, H >> level)`.
+    pub height: u32,
+    /// Index of the level's first texel in the contiguous storage.
+    pub offset: usize,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) enum Storage {
+    U8(Vec<[u8; 4]>),
+    F32(Vec<[f32; 4]>),
+}
+
+/// A 2D texture with its complete mip pyramid, ready to be sampled by a [`crate::Sampler`].
+///
+/// Any size from 1x1 up to [`Limits::max_dimension`], power of two or not.
+#[derive(Debug)]
+pub struct Texture {
+    format: Format,
+    levels: Vec<LevelInfo>,
+    storage: Storage,
+}
+
+impl Texture {
+    /// A texture from row-major 8-bit RGBA texels (row 0 is the top of the image), building its pyramid.
+    ///
+    /// # Errors
+    /// Size or memory limits ([`Limits::check`]) and [`TextureError::DataLength`].
+    pub fn from_rgba8(
+        width: u32,
+        height: u32,
+        texels: Vec<[u8; 4]>,
+        color: ColorSpace,
+        limits: &Limits,
+    ) -> Result<Self, TextureError> {
+        let format = match color {
+            ColorSpace::Srgb => Format::Rgba8Srgb,
+            ColorSpace::Linear => Format::Rgba8Unorm,
+        };
+        limits.check(width, height, format)?;
+        check_len(width, height, texels.len())?;
+        let table = match color {
+            ColorSpace::Srgb => srgb_table(),
+            ColorSpace::Linear => unorm8_table(),
+        };
+        let level0 = U8Level {
+            width,
+            height,
+            texels: &texels,
+            table,
+            alpha: unorm8_table(),
+        };
+        let (levels, below) = pyramid::build(width, height, |i, j| level0.texel(i, j));
+        let total = levels
+            .last()
+            .map_or(0, |l| l.offset + l.width as usize * l.height as usize);
+        let mut all = texels;
+        all.reserve_exact(total - all.len());
+        let encode = |c: Vec4| -> [u8; 4] {
+            match color {
+                ColorSpace::Srgb => [
+                    linear_to_srgb8(c.x),
+                    linear_to_srgb8(c.y),
+                    linear_to_srgb8(c.z),
+                    unorm8(c.w),
+                ],
+                ColorSpace::Linear => [unorm8(c.x), unorm8(c.y), unorm8(c.z), unorm8(c.w)],
+            }
+        };
+        all.extend(below.iter().map(|&c| encode(c)));
+        Ok(Texture {
+            format,
+            levels,
+            storage: Storage::U8(all),
+        })
+    }
+
+    /// A texture from row-major linear `f32` RGBA texels, building its pyramid.
+    ///
+    /// Non-finite texel values are accepted and propagate through filtering.
+    ///
+    /// # Errors
+    /// Size or memory limits ([`Limits::check`]) and [`TextureError::DataLength`].
+    pub fn from_rgba32f(
+        width: u32,
+        height: u32,
+        texels: Vec<[f32; 4]>,
+        limits: &Limits,
+    ) -> Result<Self, TextureError> {
+        limits.check(width, height, Format::Rgba32Float)?;
+        check_len(width, height, texels.len())?;
+        let level0 = F32Level {
+            width,
+            height,
+            texels: &texels,
+        };
+        let (levels, below) = pyramid::build(width, height, |i, j| level0.texel(i, j));
+        let mut all = texels;
+        all.extend(below.iter().map(|c| c.to_array()));
+        Ok(Texture {
+            format: Format::Rgba32Float,
+            levels,
+            storage: Storage::F32(all),
+        })
+    }
+
+    /// A texture whose texel `(i, j)` is `f(i, j)` (linear RGBA in `[0, 1]` for 8-bit formats),
+    /// stored in `format`. Handy for procedural textures and tests.
+    ///
+    /// # Errors
+    /// As [`Texture::from_rgba8`] / [`Texture::from_rgba32f`].
+    pub fn from_fn(
+        width: u32,
+        height: u32,
+        format: Format,
+        limits: &Limits,
+        f: impl Fn(u32, u32) -> [f32; 4],
+    ) -> Result<Self, TextureError> {
+        limits.check(width, height, format)?;
+        let coords = (0..height).flat_map(|j| (0..width).map(move |i| (i, j)));
+        match format {
+            Format::Rgba32Float => {
+                let texels = coords.map(|(i, j)| f(i, j)).collect();
+                Self::from_rgba32f(width, height, texels, limits)
+            }
+            Format::Rgba8Srgb | Format::Rgba8Unorm => {
+                let srgb = format == Format::Rgba8Srgb;
+                let texels = coords
+                    .map(|(i, j)| {
+                        let c = f(i, j);
+                        let rgb = |x: f32| if srgb { linear_to_srgb8(x) } else { unorm8(x) };
+                        [rgb(c[0]), rgb(c[1]), rgb(c[2]), unorm8(c[3])]
+                    })
+                    .collect();
+                let color = if srgb {
+                    ColorSpace::Srgb
+                } else {
+                    ColorSpace::Linear
+                };
+                Self::from_rgba8(width, height, texels, color, limits)
+            }
+        }
+    }
+
+    /// Decode an image file (PNG, JPEG, OpenEXR; format guessed from the content) into a texture.
+    ///
+    /// `color` applies to 8- and 16-bit images; float images (EXR) are always linear.
+    /// Dimension and allocation limits are enforced by the decoder and again by [`Limits::check`].
+    ///
+    /// # Errors
+    /// [`TextureError::Io`], [`TextureError::Decode`] (corrupt, truncated, over the decoder's
+    /// limits), [`TextureError::UnsupportedFormat`] and the size errors.
+    pub fn load(
+        path: impl AsRef<Path>,
+        color: ColorSpace,
+        limits: &Limits,
+    ) -> Result<Self, TextureError> {
+        let reader = image::ImageReader::open(path)?.with_guessed_format()?;
+        Self::decode_reader(reader, color, limits)
+    }
+
+    /// As [`Texture::load`], from bytes in memory.
+    ///
+    /// # Errors
+    /// As [`Texture::load`].
+    pub fn decode(bytes: &[u8], color: ColorSpace, limits: &Limits) -> Result<Self, TextureError> {
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format()?;
+        Self::decode_reader(reader, color, limits)
+    }
+
+    fn decode_reader<R: std::io::BufRead + std::io::Seek>(
+        mut reader: image::ImageReader<R>,
+        color: ColorSpace,
+        limits: &Limits,
+    ) -> Result<Self, TextureError> {
+        let mut l = image::Limits::default();
+        l.max_image_width = Some(limits.max_dimension);
+        l.max_image_height = Some(limits.max_dimension);
+        l.max_alloc = Some(limits.max_bytes);
+        reader.limits(l);
+        let img = reader.decode()?;
+        let (width, height) = (img.width(), img.height());
+        use image::ColorType as C;
+        match img.color() {
+            C::L8 | C::La8 | C::Rgb8 | C::Rgba8 => {
+                let texels = img.into_rgba8().pixels().map(|p| p.0).collect();
+                Self::from_rgba8(width, height, texels, color, limits)
+            }
+            C::L16 | C::La16 | C::Rgb16 | C::Rgba16 | C::Rgb32F | C::Rgba32F => {
+                let encoded =
+                    !matches!(img.color(), C::Rgb32F | C::Rgba32F) && color == ColorSpace::Srgb;
+                let texels = img
+                    .into_rgba32f()
+                    .pixels()
+                    .map(|p| {
+                        let [r, g, b, a] = p.0;
+                        if encoded {
+                            [srgb_to_linear(r), srgb_to_linear(g), srgb_to_linear(b), a]
+                        } else {
+                            [r, g, b, a]
+                        }
+                    })
+                    .collect();
+                Self::from_rgba32f(width, height, texels, limits)
+            }
+            other => Err(TextureError::UnsupportedFormat(other)),
+        }
+    }
+
+    /// The storage format.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// Width of level 0 in texels.
+    pub fn width(&self) -> u32 {
+        self.levels[0].width
+    }
+
+    /// Height of level 0 in texels.
+    pub fn height(&self) -> u32 {
+        self.levels[0].height
+    }
+
+    /// The mip levels, level 0 first, down to 1x1.
+    pub fn levels(&self) -> &[LevelInfo] {
+        &self.levels
+    }
+
+    /// Bytes the texels of all levels occupy (about 4/3 of level 0).
+    pub fn pyramid_bytes(&self) -> u64 {
+        let l = self.levels.last().expect("at least one level");
+        (l.offset as u64 + 1) * self.format.texel_bytes()
+    }
+
+    /// Texel `(i, j)` of `level`, decoded to linear RGBA. `None` if out of range.
+    pub fn texel(&self, level: usize, i: u32, j: u32) -> Option<[f32; 4]> {
+        let info = self.levels.get(level)?;
+        if i >= info.width || j >= info.height {
+            return None;
+        }
+        let idx = info.offset + j as usize * info.width as usize + i as usize;
+        Some(match &self.storage {
+            Storage::U8(v) => self.u8_table_decode(v[idx]),
+            Storage::F32(v) => v[idx],
+        })
+    }
+
+    fn u8_table_decode(&self, t: [u8; 4]) -> [f32; 4] {
+        let table = if self.format == Format::Rgba8Srgb {
+            srgb_table()
+        } else {
+            unorm8_table()
+        };
+        let a = unorm8_table();
+        [
+            table[t[0] as usize],
+            table[t[1] as usize],
+            table[t[2] as usize],
+            a[t[3] as usize],
+        ]
+    }
+
+    /// Mean of every texel of `level` in linear RGBA (`f64` accumulation).
+    pub fn level_mean(&self, level: usize) -> [f64; 4] {
+        let info = self.levels[level];
+        let mut sum = [0f64; 4];
+        for j in 0..info.height {
+            for i in 0..info.width {
+                let t = self.texel(level, i, j).expect("in range");
+                for c in 0..4 {
+                    sum[c] += f64::from(t[c]);
+                }
+            }
+        }
+        let n = f64::from(info.width) * f64::from(info.height);
+        sum.map(|s| s / n)
+    }
+
+    pub(crate) fn storage(&self) -> &Storage {
+        &self.storage
+    }
+}
+
+fn check_len(width: u32, height: u32, got: usize) -> Result<(), TextureError> {
+    let expected = width as usize * height as usize;
+    if got != expected {
+        return Err(TextureError::DataLength {
+            width,
+            height,
+            expected,
+            got,
+        });
+    }
+    Ok(())
+}
+
+/// One mip level of an 8-bit texture; decodes through a 256-entry table (alpha always linear).
+#[derive(Clone, Copy)]
+pub(crate) struct U8Level<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub texels: &'a [[u8; 4]],
+    pub table: &'static [f32; 256],
+    pub alpha: &'static [f32; 256],
+}
+
+/// One mip level of a float texture.
+#[derive(Clone, Copy)]
+pub(crate) struct F32Level<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub texels: &'a [[f32; 4]],
+}
+
+/// Read access to one mip level's texels by already-wrapped integer index.
+pub(crate) trait Fetch: Copy {
+    /// Level size in texels.
+    fn size(&self) -> (u32, u32);
+    /// Texel `(i, j)` in linear RGBA; `i < width`, `j < height`.
+    fn texel(&self, i: u32, j: u32) -> Vec4;
+}
+
+impl Fetch for U8Level<'_> {
+    #[inline(always)]
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+    #[inline(always)]
+    fn texel(&self, i: u32, j: u32) -> Vec4 {
+        let t = self.texels[j as usize * self.width as usize + i as usize];
+        let a = self.alpha;
+        Vec4::new(
+            self.table[t[0] as usize],
+            self.table[t[1] as usize],
+            self.table[t[2] as usize],
+            a[t[3] as usize],
+        )
+    }
+}
+
+impl Fetch for F32Level<'_> {
+    #[inline(always)]
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+    #[inline(always)]
+    fn texel(&self, i: u32, j: u32) -> Vec4 {
+        Vec4::from_array(self.texels[j as usize * self.width as usize + i as usize])
+    }
+}
