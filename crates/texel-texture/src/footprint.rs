@@ -82,9 +82,10 @@ impl Footprint {
     #[inline]
     pub fn rho(&self, width: u32, height: u32) -> f32 {
         let (px, py) = self.texel_axes(width, height);
-        let r = px.length_squared().max(py.length_squared()).sqrt();
-        if r.is_finite() {
-            r
+        let (a, b) = (px.length_squared(), py.length_squared());
+        // `f32::max` ignores NaN, so test both before combining.
+        if a.is_finite() && b.is_finite() {
+            a.max(b).sqrt()
         } else {
             f32::INFINITY
         }

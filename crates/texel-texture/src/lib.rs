@@ -22,9 +22,10 @@
 //! // At the texture's centre, bilinear blends all four texels equally.
 //! let c = sampler.sample(&tex, &Footprint::point(0.5, 0.5));
 //! assert!((c[0] - 0.5).abs() < 1e-6);
-//! // A footprint covering the whole texture per pixel reads the 1x1 level: the mean.
+//! // A footprint covering the whole texture per pixel reads the 1x1 level: the mean, 0.5,
+//! // stored as the 8-bit code 128 like every level of an 8-bit texture.
 //! let (c, reads) = sampler.sample_counted(&tex, &Footprint::isotropic(0.3, 0.7, 1.0));
-//! assert!((c[0] - 0.5).abs() < 1e-6);
+//! assert_eq!(c[0], 128.0 / 255.0);
 //! assert_eq!(reads, 4); // bilinear in the 1x1 level (lod clamps to the last level)
 //! # Ok::<(), texel_texture::TextureError>(())
 //! ```

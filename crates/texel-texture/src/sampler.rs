@@ -18,6 +18,9 @@ use crate::footprint::{lod_from_rho, Footprint};
 use crate::mip::{filter_level, mip_nearest, trilinear};
 use crate::texture::Texture;
 
+/// Largest |u| or |v| honoured (2^24): coordinates beyond are clamped to it.
+pub const UV_LIMIT: f32 = 16_777_216.0;
+
 /// Filter used within one mip level (WebGPU `GPUFilterMode`, plus cubic).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum FilterMode {
@@ -149,6 +152,12 @@ impl Sampler {
         if !(1..=64).contains(&desc.anisotropy_clamp) {
             return Err(TextureError::InvalidAnisotropyClamp(desc.anisotropy_clamp));
         }
+        let all_linear = desc.mag_filter == FilterMode::Linear
+            && desc.min_filter == FilterMode::Linear
+            && desc.mipmap_filter == MipmapFilterMode::Linear;
+        if desc.anisotropy_clamp > 1 && !all_linear {
+            return Err(TextureError::AnisotropyNeedsLinear(desc.anisotropy_clamp));
+        }
         for f in [desc.mag_filter, desc.min_filter] {
             if let FilterMode::Cubic(c) = f {
                 if !c.b.is_finite() || !c.c.is_finite() {
@@ -182,7 +191,8 @@ impl Sampler {
 
     /// Sample `texture` over `footprint`; linear RGBA.
     ///
-    /// Non-finite `u` or `v` sample at 0; non-finite derivatives select the coarsest level.
+    /// Non-finite `u` or `v` sample at 0, finite ones are clamped to `[-UV_LIMIT, UV_LIMIT]`;
+    /// non-finite derivatives select the coarsest level.
     pub fn sample(&self, texture: &Texture, footprint: &Footprint) -> [f32; 4] {
         with_pyramid!(texture, |p| self.sample_pyramid(&p, footprint)).to_array()
     }
@@ -220,7 +230,9 @@ impl Sampler {
     /// The whole per-sample path, generic over the texel storage (and the counting wrapper).
     #[inline]
     pub(crate) fn sample_pyramid<P: Pyramid>(&self, p: &P, fp: &Footprint) -> Vec4 {
-        let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
+        // NaN/inf sample at 0; beyond +-2^24 an f32 has no fractional bits left, so clamping there
+        // changes nothing a caller could rely on and keeps `u * W` finite for every level.
+        let finite = |x: f32| if x.is_finite() { x.clamp(-UV_LIMIT, UV_LIMIT) } else { 0.0 };
         let (u, v) = (finite(fp.u), finite(fp.v));
         let level0 = p.level(0);
         let (w, h) = level0.size();

@@ -1,0 +1,654 @@
+//! Properties of the core filters (nearest, bilinear, bicubic, mip-nearest, trilinear), the pyramid,
+//! texture loading and hostile inputs.
+
+use proptest::prelude::*;
+use texel_texture::{
+    AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Limits,
+    MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
+};
+
+const ADDRESS_MODES: [AddressMode; 5] = [
+    AddressMode::ClampToEdge,
+    AddressMode::Repeat,
+    AddressMode::MirrorRepeat,
+    AddressMode::ClampToBorder,
+    AddressMode::MirrorClampToEdge,
+];
+
+const FILTERS: [FilterMode; 5] = [
+    FilterMode::Nearest,
+    FilterMode::Linear,
+    FilterMode::Cubic(Cubic::CATMULL_ROM),
+    FilterMode::Cubic(Cubic::MITCHELL),
+    FilterMode::Cubic(Cubic::B_SPLINE),
+];
+
+const MIPMAPS: [MipmapFilterMode; 3] = [
+    MipmapFilterMode::None,
+    MipmapFilterMode::Nearest,
+    MipmapFilterMode::Linear,
+];
+
+fn sampler(mag: FilterMode, min: FilterMode, mip: MipmapFilterMode, addr: AddressMode) -> Sampler {
+    Sampler::new(SamplerDescriptor {
+        mag_filter: mag,
+        min_filter: min,
+        mipmap_filter: mip,
+        ..SamplerDescriptor::default().with_address_mode(addr)
+    })
+    .unwrap()
+}
+
+fn every_sampler(border: BorderColor) -> Vec<Sampler> {
+    let mut v = Vec::new();
+    for addr in ADDRESS_MODES {
+        for f in FILTERS {
+            for mip in MIPMAPS {
+                let mut d = SamplerDescriptor {
+                    mag_filter: f,
+                    min_filter: f,
+                    mipmap_filter: mip,
+                    ..SamplerDescriptor::default().with_address_mode(addr)
+                };
+                d.border_color = border;
+                v.push(Sampler::new(d).unwrap());
+            }
+        }
+    }
+    v
+}
+
+/// Deterministic noise in [0, 1) (SplitMix64), so tests need no RNG crate.
+fn noise(seed: u64) -> f32 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 40) as f32 / (1u64 << 24) as f32
+}
+
+fn noise_texture(w: u32, h: u32, format: Format) -> Texture {
+    Texture::from_fn(w, h, format, &Limits::default(), |i, j| {
+        let k = u64::from(j) * u64::from(w) + u64::from(i);
+        [noise(4 * k), noise(4 * k + 1), noise(4 * k + 2), 1.0]
+    })
+    .unwrap()
+}
+
+fn footprint_strategy() -> impl Strategy<Value = Footprint> {
+    let d = prop_oneof![Just(0.0f32), -0.5f32..0.5, -1e-3f32..1e-3, -20.0f32..20.0];
+    (
+        -3.0f32..3.0,
+        -3.0f32..3.0,
+        d.clone(),
+        d.clone(),
+        d.clone(),
+        d,
+    )
+        .prop_map(|(u, v, dudx, dudy, dvdx, dvdy)| Footprint {
+            u,
+            v,
+            dudx,
+            dudy,
+            dvdx,
+            dvdy,
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// A constant texture is constant under every filter, address mode and footprint
+    /// (the border colour is set to the same constant so ClampToBorder agrees too).
+    #[test]
+    fn constant_texture_is_constant(fp in footprint_strategy(), w in 1u32..40, h in 1u32..40) {
+        let c = [0.25f32, 0.5, 0.75, 1.0];
+        let float = Texture::from_fn(w, h, Format::Rgba32Float, &Limits::default(), |_, _| c).unwrap();
+        // 8-bit linear: 64/255 etc. are exact codes, so compare against the decoded constant.
+        let bytes = Texture::from_rgba8(w, h, vec![[64, 128, 191, 255]; (w * h) as usize], ColorSpace::Srgb, &Limits::default()).unwrap();
+        let c8 = bytes.texel(0, 0, 0).unwrap();
+        for s in every_sampler(BorderColor::Custom(c)) {
+            let got = s.sample(&float, &fp);
+            for k in 0..4 {
+                prop_assert!((got[k] - c[k]).abs() < 1e-5, "{:?} {:?} -> {:?}", s.descriptor(), fp, got);
+            }
+        }
+        for s in every_sampler(BorderColor::Custom(c8)) {
+            let got = s.sample(&bytes, &fp);
+            for k in 0..4 {
+                // Mip levels of an 8-bit texture are re-quantised; a constant survives exactly.
+                prop_assert!((got[k] - c8[k]).abs() < 1e-5, "{:?} {:?} -> {:?}", s.descriptor(), fp, got);
+            }
+        }
+    }
+
+    /// Nearest returns texel floor(xy) of level 0 (after wrapping) when magnifying.
+    #[test]
+    fn nearest_is_floor(u in -2.0f32..3.0, v in -2.0f32..3.0, addr in 0usize..5) {
+        let tex = noise_texture(13, 7, Format::Rgba32Float);
+        let mode = ADDRESS_MODES[addr];
+        let s = sampler(FilterMode::Nearest, FilterMode::Nearest, MipmapFilterMode::None, mode);
+        let got = s.sample(&tex, &Footprint::point(u, v));
+        let i = mode.wrap((u * 13.0).floor() as i64, 13);
+        let j = mode.wrap((v * 7.0).floor() as i64, 7);
+        let want = match (i, j) {
+            (Some(i), Some(j)) => tex.texel(0, i, j).unwrap(),
+            _ => [0.0; 4],
+        };
+        prop_assert_eq!(got, want);
+    }
+
+    /// Bilinear reproduces a linear ramp exactly between texel centres.
+    #[test]
+    fn bilinear_reproduces_ramp(x in 0.5f32..31.5, y in 0.5f32..15.5) {
+        let tex = Texture::from_fn(32, 16, Format::Rgba32Float, &Limits::default(), |i, j| {
+            [i as f32, j as f32, 2.0 * i as f32 + 3.0 * j as f32, 1.0]
+        }).unwrap();
+        let s = sampler(FilterMode::Linear, FilterMode::Linear, MipmapFilterMode::None, AddressMode::ClampToEdge);
+        let got = s.sample(&tex, &Footprint::point(x / 32.0, y / 16.0));
+        let (ex, ey) = (x - 0.5, y - 0.5);
+        prop_assert!((got[0] - ex).abs() < 1e-4, "{got:?} vs {ex}");
+        prop_assert!((got[1] - ey).abs() < 1e-4);
+        prop_assert!((got[2] - (2.0 * ex + 3.0 * ey)).abs() < 1e-3);
+    }
+
+    /// The cubic B-spline is a convex combination: never outside the texels' range.
+    #[test]
+    fn bspline_does_not_overshoot(u in -1.0f32..2.0, v in -1.0f32..2.0) {
+        let tex = noise_texture(9, 11, Format::Rgba32Float);
+        let s = sampler(FilterMode::Cubic(Cubic::B_SPLINE), FilterMode::Cubic(Cubic::B_SPLINE), MipmapFilterMode::None, AddressMode::Repeat);
+        let got = s.sample(&tex, &Footprint::point(u, v));
+        for (k, &g) in got.iter().enumerate().take(3) {
+            let (mut lo, mut hi) = (f32::MAX, f32::MIN);
+            for j in 0..11 { for i in 0..9 { let t = tex.texel(0, i, j).unwrap()[k]; lo = lo.min(t); hi = hi.max(t); } }
+            prop_assert!(g >= lo - 1e-6 && g <= hi + 1e-6);
+        }
+    }
+
+    /// `sample_batch` equals `sample` one by one.
+    #[test]
+    fn batch_equals_single(fps in proptest::collection::vec(footprint_strategy(), 1..20)) {
+        let tex = noise_texture(64, 32, Format::Rgba8Srgb);
+        let s = sampler(FilterMode::Linear, FilterMode::Cubic(Cubic::MITCHELL), MipmapFilterMode::Linear, AddressMode::MirrorRepeat);
+        let mut out = vec![[0.0; 4]; fps.len()];
+        s.sample_batch(&tex, &fps, &mut out);
+        for (f, o) in fps.iter().zip(&out) {
+            prop_assert_eq!(s.sample(&tex, f), *o);
+        }
+    }
+}
+
+/// Catmull-Rom interpolates: at every texel centre it returns the texel.
+#[test]
+fn catmull_rom_interpolates_at_centres() {
+    let tex = noise_texture(8, 5, Format::Rgba32Float);
+    let cr = FilterMode::Cubic(Cubic::CATMULL_ROM);
+    for addr in ADDRESS_MODES {
+        let s = sampler(cr, cr, MipmapFilterMode::None, addr);
+        for j in 0..5 {
+            for i in 0..8 {
+                let fp = Footprint::point((i as f32 + 0.5) / 8.0, (j as f32 + 0.5) / 5.0);
+                let got = s.sample(&tex, &fp);
+                let want = tex.texel(0, i, j).unwrap();
+                for k in 0..4 {
+                    assert!(
+                        (got[k] - want[k]).abs() < 1e-6,
+                        "{addr:?} ({i},{j}) {got:?} {want:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// A footprint with the given lod on a square `size` texture (isotropic, axis-aligned).
+fn at_lod(u: f32, v: f32, lod: f32, size: u32) -> Footprint {
+    Footprint::isotropic(u, v, lod.exp2() / size as f32)
+}
+
+/// Trilinear is continuous in lod across every level boundary.
+#[test]
+fn trilinear_continuous_across_levels() {
+    let tex = noise_texture(64, 64, Format::Rgba32Float);
+    let s = sampler(
+        FilterMode::Linear,
+        FilterMode::Linear,
+        MipmapFilterMode::Linear,
+        AddressMode::Repeat,
+    );
+    for k in 1..6 {
+        for p in 0..10 {
+            let (u, v) = (noise(100 + p), noise(200 + p));
+            let below = s.sample(&tex, &at_lod(u, v, k as f32 - 1e-4, 64));
+            let above = s.sample(&tex, &at_lod(u, v, k as f32 + 1e-4, 64));
+            for c in 0..4 {
+                assert!(
+                    (below[c] - above[c]).abs() < 2e-3,
+                    "level {k}: {below:?} vs {above:?}"
+                );
+            }
+        }
+    }
+}
+
+/// mip_nearest switches level at the Vulkan rounding point lod = k + 1/2.
+#[test]
+fn mip_nearest_switches_at_vulkan_point() {
+    let tex = noise_texture(64, 64, Format::Rgba32Float);
+    let s = sampler(
+        FilterMode::Linear,
+        FilterMode::Linear,
+        MipmapFilterMode::Nearest,
+        AddressMode::Repeat,
+    );
+    let forced = |level: f32| {
+        Sampler::new(SamplerDescriptor {
+            lod_min_clamp: level,
+            lod_max_clamp: level,
+            ..*s.descriptor()
+        })
+        .unwrap()
+    };
+    let (u, v) = (0.37, 0.61);
+    for k in 1..5 {
+        let at_half = s.sample(&tex, &at_lod(u, v, k as f32 + 0.5, 64));
+        let past_half = s.sample(&tex, &at_lod(u, v, k as f32 + 0.5 + 1e-3, 64));
+        let level_k = forced(k as f32).sample(&tex, &at_lod(u, v, 0.0, 64));
+        let level_k1 = forced(k as f32 + 1.0).sample(&tex, &at_lod(u, v, 0.0, 64));
+        assert_eq!(at_half, level_k, "lod {k}.5 reads level {k}");
+        assert_eq!(past_half, level_k1, "lod {k}.501 reads level {}", k + 1);
+        assert_ne!(level_k, level_k1);
+    }
+}
+
+/// Minifying a one-texel checkerboard 16x: trilinear gives the mean grey within 2 %, nearest aliases.
+#[test]
+fn minified_checkerboard_is_grey_with_trilinear_only() {
+    let tex = Texture::from_fn(256, 256, Format::Rgba8Srgb, &Limits::default(), |i, j| {
+        let c = ((i + j) % 2) as f32;
+        [c, c, c, 1.0]
+    })
+    .unwrap();
+    let tri = sampler(
+        FilterMode::Linear,
+        FilterMode::Linear,
+        MipmapFilterMode::Linear,
+        AddressMode::Repeat,
+    );
+    let near = sampler(
+        FilterMode::Nearest,
+        FilterMode::Nearest,
+        MipmapFilterMode::None,
+        AddressMode::Repeat,
+    );
+    let mut worst_tri = 0f32;
+    let mut worst_near = 0f32;
+    for y in 0..16 {
+        for x in 0..16 {
+            // 16 texels per pixel, plus an irrational offset so samples land anywhere in a texel.
+            let fp = Footprint::isotropic(
+                (x as f32 * 16.0 + 0.37) / 256.0,
+                (y as f32 * 16.0 + 0.71) / 256.0,
+                16.0 / 256.0,
+            );
+            worst_tri = worst_tri.max((tri.sample(&tex, &fp)[0] - 0.5).abs() / 0.5);
+            worst_near = worst_near.max((near.sample(&tex, &fp)[0] - 0.5).abs() / 0.5);
+        }
+    }
+    assert!(worst_tri < 0.02, "trilinear deviates {worst_tri}");
+    assert!(
+        worst_near > 0.9,
+        "nearest should alias to black/white, deviates only {worst_near}"
+    );
+}
+
+/// Texels read per sample, as each filter documents.
+#[test]
+fn texel_counts() {
+    let tex = noise_texture(64, 64, Format::Rgba8Srgb);
+    let cases = [
+        (FilterMode::Nearest, MipmapFilterMode::None, 0.0, 1),
+        (FilterMode::Linear, MipmapFilterMode::None, 0.0, 4),
+        (
+            FilterMode::Cubic(Cubic::CATMULL_ROM),
+            MipmapFilterMode::None,
+            0.0,
+            16,
+        ),
+        (FilterMode::Linear, MipmapFilterMode::Nearest, 2.3, 4),
+        (FilterMode::Linear, MipmapFilterMode::Linear, 2.3, 8),
+        (FilterMode::Linear, MipmapFilterMode::Linear, 2.0, 4),
+        // lod beyond the last level (6) holds the last level: one bilinear.
+        (FilterMode::Linear, MipmapFilterMode::Linear, 9.5, 4),
+    ];
+    for (f, mip, lod, want) in cases {
+        let s = sampler(f, f, mip, AddressMode::Repeat);
+        let (c, n) = s.sample_counted(&tex, &at_lod(0.3, 0.4, lod, 64));
+        assert_eq!(n, want, "{f:?} {mip:?} lod {lod}");
+        assert_eq!(c, s.sample(&tex, &at_lod(0.3, 0.4, lod, 64)));
+    }
+}
+
+/// The mean of every pyramid level equals the mean of level 0 (odd, even, non-square, 1xN, 1x1).
+#[test]
+fn pyramid_preserves_mean() {
+    for (w, h) in [
+        (64, 64),
+        (37, 19),
+        (5, 3),
+        (1, 300),
+        (300, 1),
+        (1, 1),
+        (2, 7),
+        (129, 130),
+    ] {
+        let tex = noise_texture(w, h, Format::Rgba32Float);
+        let m0 = tex.level_mean(0);
+        assert_eq!(
+            tex.levels().last().map(|l| (l.width, l.height)),
+            Some((1, 1))
+        );
+        for k in 1..tex.levels().len() {
+            let m = tex.level_mean(k);
+            for c in 0..4 {
+                assert!(
+                    (m[c] - m0[c]).abs() < 1e-5,
+                    "{w}x{h} level {k} channel {c}: {} vs {}",
+                    m[c],
+                    m0[c]
+                );
+            }
+        }
+        // 8-bit sRGB: the mean holds up to re-quantisation of each level.
+        let tex8 = noise_texture(w, h, Format::Rgba8Srgb);
+        let m0 = tex8.level_mean(0);
+        for k in 1..tex8.levels().len() {
+            let m = tex8.level_mean(k);
+            for c in 0..3 {
+                assert!(
+                    (m[c] - m0[c]).abs() < 4e-3,
+                    "{w}x{h} level {k}: {} vs {}",
+                    m[c],
+                    m0[c]
+                );
+            }
+        }
+    }
+}
+
+/// The pyramid costs about 4/3 of level 0 and its levels follow max(1, W >> k).
+#[test]
+fn pyramid_memory_and_sizes() {
+    let tex = noise_texture(1024, 512, Format::Rgba8Srgb);
+    let level0 = 1024 * 512 * 4;
+    let ratio = tex.pyramid_bytes() as f64 / level0 as f64;
+    assert!((ratio - 4.0 / 3.0).abs() < 0.01, "ratio {ratio}");
+    let sizes: Vec<_> = tex.levels().iter().map(|l| (l.width, l.height)).collect();
+    assert_eq!(sizes[..3], [(1024, 512), (512, 256), (256, 128)]);
+    assert_eq!(sizes[9..], [(2, 1), (1, 1)]);
+}
+
+/// NaN/inf/huge coordinates and derivatives, tiny textures: no panic, finite results.
+#[test]
+fn hostile_inputs_never_panic() {
+    let specials = [
+        0.0,
+        0.5,
+        -0.5,
+        1e9,
+        -1e9,
+        3.4e38,
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        1e-30,
+    ];
+    for (w, h) in [(1, 1), (1, 17), (17, 1), (16, 16)] {
+        let tex = noise_texture(w, h, Format::Rgba8Srgb);
+        for s in every_sampler(BorderColor::OpaqueWhite) {
+            for &a in &specials {
+                for &b in &specials {
+                    let fps = [
+                        Footprint {
+                            u: a,
+                            v: b,
+                            dudx: 0.01,
+                            dudy: 0.0,
+                            dvdx: 0.0,
+                            dvdy: 0.01,
+                        },
+                        Footprint {
+                            u: 0.3,
+                            v: 0.3,
+                            dudx: a,
+                            dudy: b,
+                            dvdx: b,
+                            dvdy: a,
+                        },
+                    ];
+                    for fp in fps {
+                        let c = s.sample(&tex, &fp);
+                        assert!(
+                            c.iter().all(|x| x.is_finite()),
+                            "{:?} {fp:?} {c:?}",
+                            s.descriptor()
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Non-finite derivatives select the coarsest level; zero derivatives select level 0.
+#[test]
+fn degenerate_derivatives_pick_levels() {
+    let tex = noise_texture(32, 32, Format::Rgba32Float);
+    let s = sampler(
+        FilterMode::Linear,
+        FilterMode::Linear,
+        MipmapFilterMode::Linear,
+        AddressMode::Repeat,
+    );
+    let nan = Footprint {
+        dudx: f32::NAN,
+        ..Footprint::point(0.2, 0.2)
+    };
+    let coarsest = tex.texel(5, 0, 0).unwrap();
+    let got = s.sample(&tex, &nan);
+    for c in 0..4 {
+        assert!((got[c] - coarsest[c]).abs() < 1e-6);
+    }
+    let bilinear0 = sampler(
+        FilterMode::Linear,
+        FilterMode::Linear,
+        MipmapFilterMode::None,
+        AddressMode::Repeat,
+    );
+    assert_eq!(
+        s.sample(&tex, &Footprint::point(0.2, 0.2)),
+        bilinear0.sample(&tex, &Footprint::point(0.2, 0.2))
+    );
+}
+
+/// Descriptor validation happens once, with the offending values in the error.
+#[test]
+fn invalid_descriptors_are_rejected() {
+    let bad = [
+        SamplerDescriptor {
+            lod_min_clamp: 3.0,
+            lod_max_clamp: 1.0,
+            ..Default::default()
+        },
+        SamplerDescriptor {
+            lod_min_clamp: f32::NAN,
+            ..Default::default()
+        },
+        SamplerDescriptor {
+            lod_min_clamp: -1.0,
+            ..Default::default()
+        },
+        SamplerDescriptor {
+            lod_bias: f32::INFINITY,
+            ..Default::default()
+        },
+        SamplerDescriptor {
+            anisotropy_clamp: 0,
+            ..Default::default()
+        },
+        SamplerDescriptor {
+            anisotropy_clamp: 65,
+            ..Default::default()
+        },
+        SamplerDescriptor {
+            anisotropy_clamp: 4,
+            ..Default::default()
+        },
+        SamplerDescriptor {
+            mag_filter: FilterMode::Cubic(Cubic {
+                b: f32::NAN,
+                c: 0.0,
+            }),
+            ..Default::default()
+        },
+    ];
+    for d in bad {
+        assert!(Sampler::new(d).is_err(), "{d:?} should be rejected");
+    }
+    let e = Sampler::new(SamplerDescriptor {
+        lod_min_clamp: 3.0,
+        lod_max_clamp: 1.0,
+        ..Default::default()
+    })
+    .unwrap_err();
+    assert!(e.to_string().contains("lod_min_clamp = 3"), "{e}");
+    assert!(matches!(
+        SamplerDescriptor::lab_mode(0),
+        Err(TextureError::UnknownLabMode(0))
+    ));
+    assert!(matches!(
+        SamplerDescriptor::lab_mode(99),
+        Err(TextureError::UnknownLabMode(99))
+    ));
+}
+
+/// The lab's modes 1-4.
+#[test]
+fn lab_modes() {
+    let m = |n| SamplerDescriptor::lab_mode(n).unwrap();
+    assert_eq!(
+        (m(1).min_filter, m(1).mipmap_filter),
+        (FilterMode::Nearest, MipmapFilterMode::None)
+    );
+    assert_eq!(
+        (m(2).min_filter, m(2).mipmap_filter),
+        (FilterMode::Linear, MipmapFilterMode::None)
+    );
+    assert_eq!(
+        (m(3).min_filter, m(3).mipmap_filter),
+        (FilterMode::Linear, MipmapFilterMode::Nearest)
+    );
+    assert_eq!(
+        (m(4).min_filter, m(4).mipmap_filter),
+        (FilterMode::Linear, MipmapFilterMode::Linear)
+    );
+}
+
+fn png_bytes(w: u32, h: u32, rgba: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(rgba, w, h, image::ExtendedColorType::Rgba8)
+        .unwrap();
+    out
+}
+use image::ImageEncoder;
+
+/// PNG decoding keeps every byte; sRGB/linear tagging decides the decode.
+#[test]
+fn png_round_trip() {
+    let rgba: Vec<u8> = (0..3 * 2 * 4).map(|k| (k * 10) as u8).collect();
+    let png = png_bytes(3, 2, &rgba);
+    let lin = Texture::decode(&png, ColorSpace::Linear, &Limits::default()).unwrap();
+    assert_eq!(
+        (lin.width(), lin.height(), lin.format()),
+        (3, 2, Format::Rgba8Unorm)
+    );
+    assert_eq!(
+        lin.texel(0, 1, 0).unwrap(),
+        [40.0 / 255.0, 50.0 / 255.0, 60.0 / 255.0, 70.0 / 255.0]
+    );
+    let srgb = Texture::decode(&png, ColorSpace::Srgb, &Limits::default()).unwrap();
+    let t = srgb.texel(0, 1, 0).unwrap();
+    assert!((t[0] - texel_texture::color::srgb_to_linear(40.0 / 255.0)).abs() < 1e-6);
+    assert_eq!(t[3], 70.0 / 255.0, "alpha stays linear");
+}
+
+/// Corrupt, truncated, empty and oversized inputs give typed errors.
+#[test]
+fn bad_images_are_errors() {
+    let png = png_bytes(4, 4, &[200; 64]);
+    let truncated = &png[..png.len() / 2];
+    assert!(matches!(
+        Texture::decode(truncated, ColorSpace::Srgb, &Limits::default()),
+        Err(TextureError::Decode(_))
+    ));
+    assert!(Texture::decode(b"not an image at all", ColorSpace::Srgb, &Limits::default()).is_err());
+    assert!(Texture::decode(&[], ColorSpace::Srgb, &Limits::default()).is_err());
+    let small = Limits {
+        max_dimension: 2,
+        ..Limits::default()
+    };
+    assert!(Texture::decode(&png, ColorSpace::Srgb, &small).is_err());
+    assert!(matches!(
+        Texture::from_rgba8(0, 4, vec![], ColorSpace::Srgb, &Limits::default()),
+        Err(TextureError::EmptySize {
+            width: 0,
+            height: 4
+        })
+    ));
+    assert!(matches!(
+        Texture::from_rgba8(2, 2, vec![[0; 4]; 3], ColorSpace::Srgb, &Limits::default()),
+        Err(TextureError::DataLength {
+            expected: 4,
+            got: 3,
+            ..
+        })
+    ));
+    // Nothing is allocated before the limits are checked: a 16384^2 float texture is refused at 1 GiB.
+    let tight = Limits {
+        max_bytes: 1 << 30,
+        ..Limits::default()
+    };
+    assert!(matches!(
+        Texture::from_fn(16384, 16384, Format::Rgba32Float, &tight, |_, _| [0.0; 4]),
+        Err(TextureError::OverMemoryLimit { .. })
+    ));
+    assert!(matches!(
+        Texture::from_fn(
+            20000,
+            1,
+            Format::Rgba8Srgb,
+            &Limits::default(),
+            |_, _| [0.0; 4]
+        ),
+        Err(TextureError::TooLarge { max: 16384, .. })
+    ));
+    // A PNG header claiming 100000 x 100000 is refused by the decoder's limits.
+    let mut huge = png.clone();
+    huge[16..20].copy_from_slice(&100_000u32.to_be_bytes());
+    huge[20..24].copy_from_slice(&100_000u32.to_be_bytes());
+    assert!(Texture::decode(&huge, ColorSpace::Srgb, &Limits::default()).is_err());
+}
+
+/// A missing file is an I/O error naming nothing in particular but never panicking.
+#[test]
+fn missing_file_is_io_error() {
+    assert!(matches!(
+        Texture::load(
+            "/definitely/not/here.png",
+            ColorSpace::Srgb,
+            &Limits::default()
+        ),
+        Err(TextureError::Io(_))
+    ));
+}
