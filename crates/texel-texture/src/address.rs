@@ -144,7 +144,7 @@ mod tests {
             (Repeat, -0.25, Some(0.75)),
             (Repeat, 1.25, Some(0.25)),
             (MirrorRepeat, -0.25, Some(0.0)), // texel 0 spans [0, 0.25)
-            (MirrorRepeat, 1.25, Some(0.5)), // mirrors to 0.75, the edge of texel [0.5, 0.75)
+            (MirrorRepeat, 1.25, Some(0.5)),  // mirrors to 0.75, the edge of texel [0.5, 0.75)
             (ClampToEdge, -0.25, Some(0.0)),
             (ClampToBorder, -0.25, None),
             (MirrorClampToEdge, -0.25, Some(0.0)),

@@ -42,6 +42,7 @@ mod nearest;
 pub mod pyramid;
 pub mod sampler;
 pub mod texture;
+pub mod warp;
 
 pub use address::{AddressMode, BorderColor};
 pub use bicubic::Cubic;

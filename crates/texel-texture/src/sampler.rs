@@ -232,7 +232,13 @@ impl Sampler {
     pub(crate) fn sample_pyramid<P: Pyramid>(&self, p: &P, fp: &Footprint) -> Vec4 {
         // NaN/inf sample at 0; beyond +-2^24 an f32 has no fractional bits left, so clamping there
         // changes nothing a caller could rely on and keeps `u * W` finite for every level.
-        let finite = |x: f32| if x.is_finite() { x.clamp(-UV_LIMIT, UV_LIMIT) } else { 0.0 };
+        let finite = |x: f32| {
+            if x.is_finite() {
+                x.clamp(-UV_LIMIT, UV_LIMIT)
+            } else {
+                0.0
+            }
+        };
         let (u, v) = (finite(fp.u), finite(fp.v));
         let level0 = p.level(0);
         let (w, h) = level0.size();
