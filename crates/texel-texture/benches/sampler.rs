@@ -5,6 +5,8 @@
 //! so the numbers are throughput with warm caches, not random-access latency.
 //! Run: `cargo bench -p texel-texture --bench sampler`.
 
+#![allow(missing_docs)] // criterion_group! generates undocumented items
+
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use texel_texture::{
     AddressMode, Cubic, FilterMode, Footprint, Format, Limits, MipmapFilterMode, Sampler,
@@ -29,7 +31,7 @@ fn footprints(texels_per_pixel: f32) -> Vec<Footprint> {
         .collect()
 }
 
-pub(crate) fn filters() -> Vec<(&'static str, SamplerDescriptor)> {
+fn filters() -> Vec<(&'static str, SamplerDescriptor)> {
     let d = |mag, min, mip| SamplerDescriptor {
         mag_filter: mag,
         min_filter: min,
