@@ -1,0 +1,51 @@
+//! `texel`: render textured scenes with every classic texture filter, measure each against a
+//! supersampled reference, warp images without aliasing and look at mip pyramids.
+//!
+//! The binary is thin (as ripgrep's `crates/core/main.rs`): argument parsing with clap derive, one
+//! function per command, anyhow with context at the top. The work lives in the texel libraries.
+
+mod cli;
+mod cmd_mips;
+mod cmd_warp;
+mod filters;
+mod output;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use cli::{Cli, Command};
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Warp(args) => cmd_warp::run(&args),
+        Command::Mips(args) => cmd_mips::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            // A closed pipe (`texel bench --json | head`) is not an error.
+            if err
+                .chain()
+                .any(|c| c.downcast_ref::<std::io::Error>().is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe))
+            {
+                return ExitCode::SUCCESS;
+            }
+            eprintln!("texel: error: {}", chain_line(&err));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The error and its causes on one line: `outer: cause: root cause`.
+fn chain_line(err: &anyhow::Error) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for cause in err.chain() {
+        let s = cause.to_string();
+        if !parts.last().is_some_and(|p| p.contains(&s)) {
+            parts.push(s);
+        }
+    }
+    parts.join(": ")
+}
