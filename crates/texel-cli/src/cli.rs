@@ -18,6 +18,21 @@ pub struct Cli {
 /// The commands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Render a scene with one texture filter (or a debug view) to a PNG.
+    ///
+    /// Example: texel render builtin:ground --filter trilinear -o ground.png
+    ///          texel render ../shared/scenes/ground.toml --lab-mode 8 --view aniso -o aniso.png
+    Render(RenderArgs),
+    /// Render the supersampled reference (ground truth) of a scene.
+    ///
+    /// Example: texel reference builtin:ground --spp 256 -o reference.png
+    Reference(ReferenceArgs),
+    /// Render every filter and the reference; write a report (Markdown, JSON, HTML) with images,
+    /// error heat maps, horizon crops and a quality/time chart.
+    ///
+    /// Example: texel compare builtin:ground --filters all --spp 256 --out report/
+    ///          texel compare scene.toml --extra gpu=gpu.png --out report/
+    Compare(CompareArgs),
     /// Perspective-warp an image without aliasing: the output's corners show four source points.
     ///
     /// Example: texel warp photo.jpg --corners 0,0,4000,300,4000,2700,0,3000 --size 800x600 -o out.png
@@ -26,6 +41,159 @@ pub enum Command {
     ///
     /// Example: texel mips brick.png --out mips/
     Mips(MipsArgs),
+    /// The embedded demo: compare every filter on the built-in scenes, with an index page.
+    ///
+    /// Example: texel demo --out demo/   (then open demo/index.html)
+    Demo(DemoArgs),
+    /// Time whole frames per filter (median over frames, textures and pyramids prepared beforehand).
+    ///
+    /// Example: texel bench ../shared/scenes/ground.toml --frames 10 --threads 2 --json
+    Bench(BenchArgs),
+}
+
+/// Where texture-space derivatives come from (see texel-raster).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum DerivativesArg {
+    /// Exact derivatives from the triangle's plane equations.
+    #[default]
+    Analytic,
+    /// Differences within 2x2 pixel quads, as GPUs compute them.
+    Quad,
+}
+
+/// Attribute interpolation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum PerspectiveArg {
+    /// Perspective-correct (interpolate a/w and 1/w).
+    #[default]
+    Correct,
+    /// Affine in screen space (the lectures' incorrect image).
+    Affine,
+}
+
+/// What each pixel shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ViewArg {
+    /// The textured image.
+    #[default]
+    Color,
+    /// fract(u) in red, fract(v) in green.
+    Uv,
+    /// Integer mip level, one colour per level.
+    Mip,
+    /// Continuous level of detail.
+    Lod,
+    /// Footprint anisotropy ratio.
+    Aniso,
+    /// Texels read per pixel (heat map).
+    Fetches,
+    /// Barycentric weights as RGB.
+    Barycentric,
+}
+
+/// The scene and colour options every rendering command shares.
+#[derive(Debug, Args)]
+pub struct SceneArgs {
+    /// Scene file (TOML) or built-in scene (builtin:ground, builtin:ground-rotated, builtin:zoneplate,
+    /// builtin:cube, builtin:sphere, builtin:triangle).
+    #[arg(default_value = "builtin:ground")]
+    pub scene: String,
+    /// Colour handling.
+    #[arg(long, value_enum, default_value_t)]
+    pub color: ColorArg,
+    /// Output size, overriding the scene's (e.g. 640x360).
+    #[arg(long)]
+    pub size: Option<Size>,
+}
+
+/// `texel render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Texture filter.
+    #[arg(long, default_value = "trilinear", conflicts_with = "lab_mode")]
+    pub filter: FilterName,
+    /// The lab's numbered filter modes: 1 nearest, 2 bilinear, 3 mip-nearest, 4 trilinear, 5-8 anisotropic 2x-16x.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8))]
+    pub lab_mode: Option<u8>,
+    /// Texture derivatives.
+    #[arg(long, value_enum, default_value_t)]
+    pub derivatives: DerivativesArg,
+    /// Attribute interpolation.
+    #[arg(long, value_enum, default_value_t)]
+    pub perspective: PerspectiveArg,
+    /// What each pixel shows.
+    #[arg(long, value_enum, default_value_t)]
+    pub view: ViewArg,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Output PNG.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// `texel reference`.
+#[derive(Debug, Args)]
+pub struct ReferenceArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Samples per pixel, stratified n x m with n*m = spp (256 = 16x16, 512 = 16x32).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: u32,
+    /// Output PNG.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// `texel compare`.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Filters to compare: comma-separated names, or all.
+    #[arg(long, default_value = "all")]
+    pub filters: String,
+    /// Reference samples per pixel.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: u32,
+    /// An image rendered elsewhere to score against the same reference: LABEL=PATH (repeatable).
+    #[arg(long, value_name = "LABEL=IMAGE")]
+    pub extra: Vec<String>,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `texel demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Output directory (created if missing).
+    #[arg(long, default_value = "texel-demo")]
+    pub out: PathBuf,
+}
+
+/// `texel bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Filters to time: comma-separated names, or all.
+    #[arg(long, default_value = "nearest,bilinear,mip-nearest,trilinear,aniso16,ewa")]
+    pub filters: String,
+    /// Timed frames per filter (the median is reported).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=10000))]
+    pub frames: u32,
+    /// Untimed warm-up frames per filter.
+    #[arg(long, default_value_t = 2)]
+    pub warmup: u32,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Print JSON in the shape of ../shared/peers/llvmpipe_bench.py.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// How 8-bit texture bytes and output bytes are interpreted.

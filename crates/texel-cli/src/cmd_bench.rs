@@ -1,0 +1,113 @@
+//! `texel bench`: median frame time per filter.
+//!
+//! What is timed: one call of `texel_raster::render` — clipping, rasterizing, sampling and shading a
+//! whole frame into a fresh linear buffer — with the textures, their pyramids and any ripmap or
+//! summed-area table built beforehand. No file I/O, no PNG encoding. The median of `--frames` timed
+//! frames after `--warmup` untimed ones, on a pool of `--threads` workers built once.
+
+use std::io::Write;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use texel_raster::render;
+
+use crate::cli::BenchArgs;
+use crate::filters::parse_list;
+use crate::prepare::Prepared;
+use crate::threads::{thread_count, with_threads};
+
+/// One filter's timings in milliseconds.
+pub struct Timing {
+    /// Filter name.
+    pub filter: &'static str,
+    /// Median of the timed frames.
+    pub median_ms: f64,
+    /// Fastest timed frame.
+    pub min_ms: f64,
+    /// Slowest timed frame.
+    pub max_ms: f64,
+}
+
+/// Median of a non-empty list.
+pub fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Run `texel bench`.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
+    let filters = parse_list(&args.filters)?;
+    let timings = with_threads(args.threads, || -> Result<Vec<Timing>> {
+        let mut out = Vec::new();
+        for filter in &filters {
+            let samplers = scene.samplers(*filter)?;
+            scene.prepare(&samplers)?;
+            let draws = scene.draws(&samplers);
+            let settings = scene.settings();
+            let mut times = Vec::with_capacity(args.frames as usize);
+            for k in 0..args.warmup + args.frames {
+                let t0 = Instant::now();
+                let frame = render(&settings, &draws)?;
+                let ms = t0.elapsed().as_secs_f64() * 1e3;
+                std::hint::black_box(&frame);
+                if k >= args.warmup {
+                    times.push(ms);
+                }
+            }
+            let (min_ms, max_ms) = times.iter().fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
+            out.push(Timing {
+                filter: filter.name(),
+                median_ms: median(&mut times),
+                min_ms,
+                max_ms,
+            });
+        }
+        Ok(out)
+    })??;
+    let threads = thread_count(args.threads);
+    let mut stdout = std::io::stdout().lock();
+    if args.json {
+        let entries: Vec<String> = timings
+            .iter()
+            .map(|t| format!("  \"{}\": {:.3}", t.filter, t.median_ms))
+            .collect();
+        writeln!(
+            stdout,
+            "{{\n \"renderer\": \"texel\",\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }}\n}}",
+            scene.width,
+            scene.height,
+            args.frames,
+            entries.join(",\n")
+        )
+        .context("cannot write to stdout")?;
+    } else {
+        writeln!(
+            stdout,
+            "texel bench: {} at {}x{}, {threads} threads, median of {} frames after {} warm-up",
+            args.scene.scene, scene.width, scene.height, args.frames, args.warmup
+        )?;
+        writeln!(stdout, "{:<12} {:>10} {:>10} {:>10}", "filter", "median ms", "min ms", "max ms")?;
+        for t in &timings {
+            writeln!(stdout, "{:<12} {:>10.3} {:>10.3} {:>10.3}", t.filter, t.median_ms, t.min_ms, t.max_ms)?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn medians() {
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert_eq!(median(&mut [7.0]), 7.0);
+    }
+}

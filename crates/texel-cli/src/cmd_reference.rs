@@ -1,0 +1,60 @@
+//! `texel reference`: the supersampled ground truth.
+
+use anyhow::Result;
+use texel_raster::reference::render_reference;
+
+use crate::cli::ReferenceArgs;
+use crate::filters::FilterName;
+use crate::output::write_png;
+use crate::prepare::Prepared;
+use crate::progress;
+
+/// Seed of the reference's jitter: fixed, so references are reproducible.
+pub const SEED: u64 = 0x7e_7e1;
+
+/// Split `spp` samples into an `n x m` stratification with `n <= m` as square as possible
+/// (256 -> 16 x 16, 512 -> 16 x 32, 7 -> 1 x 7).
+pub fn strata(spp: u32) -> (u32, u32) {
+    let mut n = (f64::from(spp).sqrt().floor() as u32).max(1);
+    while spp % n != 0 {
+        n -= 1;
+    }
+    (n, spp / n)
+}
+
+/// Render the reference of a prepared scene, with a progress bar on a terminal.
+pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame> {
+    // The reference samples level 0 bilinearly with each mesh's address modes; the filter only
+    // supplies those.
+    let samplers = scene.samplers(FilterName::Bilinear)?;
+    let draws = scene.draws(&samplers);
+    let settings = scene.settings();
+    let (n, m) = strata(spp);
+    let pb = progress::bar(1000, "reference");
+    let report = |done: u64, total: u64| pb.set_position(done * 1000 / total.max(1));
+    let frame = render_reference(&settings, &draws, (n, m), SEED, Some(&report))?;
+    pb.finish_and_clear();
+    Ok(frame)
+}
+
+/// Run `texel reference`.
+pub fn run(args: &ReferenceArgs) -> Result<()> {
+    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
+    let frame = reference_frame(&scene, args.spp)?;
+    write_png(&args.output, frame.width, frame.height, &frame.color, args.scene.color)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::strata;
+
+    #[test]
+    fn stratifications() {
+        assert_eq!(strata(256), (16, 16));
+        assert_eq!(strata(512), (16, 32));
+        assert_eq!(strata(1024), (32, 32));
+        assert_eq!(strata(1), (1, 1));
+        assert_eq!(strata(7), (1, 7));
+        assert_eq!(strata(12), (3, 4));
+    }
+}

@@ -1,0 +1,44 @@
+//! `texel render`: one filter (or a debug view), one PNG.
+
+use anyhow::Result;
+use texel_raster::{render, Derivatives, Perspective, View};
+
+use crate::cli::{ColorArg, DerivativesArg, PerspectiveArg, RenderArgs, ViewArg};
+use crate::filters::FilterName;
+use crate::output::write_png;
+use crate::prepare::Prepared;
+use crate::threads::with_threads;
+
+/// Run `texel render`.
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let filter = match args.lab_mode {
+        Some(m) => FilterName::from_lab_mode(m)?,
+        None => args.filter,
+    };
+    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
+    let samplers = scene.samplers(filter)?;
+    scene.prepare(&samplers)?;
+    let mut settings = scene.settings();
+    settings.derivatives = match args.derivatives {
+        DerivativesArg::Analytic => Derivatives::Analytic,
+        DerivativesArg::Quad => Derivatives::Quad,
+    };
+    settings.perspective = match args.perspective {
+        PerspectiveArg::Correct => Perspective::Correct,
+        PerspectiveArg::Affine => Perspective::Affine,
+    };
+    settings.view = match args.view {
+        ViewArg::Color => View::Color,
+        ViewArg::Uv => View::Uv,
+        ViewArg::Mip => View::Mip,
+        ViewArg::Lod => View::Lod,
+        ViewArg::Aniso => View::Aniso,
+        ViewArg::Fetches => View::Fetches,
+        ViewArg::Barycentric => View::Barycentric,
+    };
+    let draws = scene.draws(&samplers);
+    let frame = with_threads(args.threads, || render(&settings, &draws))??;
+    // Debug views hold display values meant for sRGB encoding whatever --color says.
+    let color = if settings.view == View::Color { args.scene.color } else { ColorArg::Srgb };
+    write_png(&args.output, frame.width, frame.height, &frame.color, color)
+}
