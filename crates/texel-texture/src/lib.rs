@@ -22,29 +22,38 @@
 //! // At the texture's centre, bilinear blends all four texels equally.
 //! let c = sampler.sample(&tex, &Footprint::point(0.5, 0.5));
 //! assert!((c[0] - 0.5).abs() < 1e-6);
-//! // A footprint covering the whole texture per pixel reads the 1x1 level: the mean.
+//! // A footprint covering the whole texture per pixel reads the 1x1 level: the mean, stored in
+//! // 8 bits like every level (128 / 255).
 //! let (c, reads) = sampler.sample_counted(&tex, &Footprint::isotropic(0.3, 0.7, 1.0));
-//! assert!((c[0] - 0.5).abs() < 1e-6);
+//! assert!((c[0] - 128.0 / 255.0).abs() < 1e-6);
 //! assert_eq!(reads, 4); // bilinear in the 1x1 level (lod clamps to the last level)
 //! # Ok::<(), texel_texture::TextureError>(())
 //! ```
 
 pub mod address;
+pub mod aniso;
 pub mod bicubic;
 mod bilinear;
 pub mod color;
 mod error;
+pub mod ewa;
 mod fetch;
 pub mod footprint;
 pub mod mip;
 mod nearest;
 pub mod pyramid;
+pub mod ripmap;
 pub mod sampler;
+pub mod sat;
 pub mod texture;
 
 pub use address::{AddressMode, BorderColor};
 pub use bicubic::Cubic;
 pub use error::TextureError;
 pub use footprint::{Axes, Footprint};
-pub use sampler::{FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor};
+pub use ripmap::Ripmap;
+pub use sampler::{
+    FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,
+};
+pub use sat::SummedAreaTable;
 pub use texture::{ColorSpace, Format, LevelInfo, Limits, Texture};
