@@ -88,6 +88,28 @@ pub enum TextureError {
         /// The C parameter.
         c: f32,
     },
+    /// [`crate::FilterMode::Ewa`], [`crate::FilterMode::Ripmap`] and
+    /// [`crate::FilterMode::SummedArea`] filter a minified footprint and are valid only as
+    /// `min_filter`; magnification (`lod <= 0`) uses `mag_filter`, which must be Nearest, Linear or
+    /// Cubic.
+    #[error("mag_filter {0:?} is a minification-only filter: use it as min_filter, with mag_filter Nearest, Linear or Cubic")]
+    MinificationOnlyFilter(crate::FilterMode),
+    /// An acceleration structure (ripmap, summed-area table) would exceed
+    /// [`crate::Limits::max_bytes`] together with the texture's pyramid and the other structures
+    /// already built.
+    #[error("the {structure} of a {width}x{height} texture would bring the texture to {bytes} bytes, over the limit of {max} bytes")]
+    StructureOverMemoryLimit {
+        /// `"ripmap"` or `"summed-area table"`.
+        structure: &'static str,
+        /// Width of level 0 in texels.
+        width: u32,
+        /// Height of level 0 in texels.
+        height: u32,
+        /// Bytes the texture would use with the structure (pyramid + structures + build scratch).
+        bytes: u64,
+        /// The limit in bytes.
+        max: u64,
+    },
     /// A lab mode outside 1..=8.
     #[error("unknown lab mode {0}: valid modes are 1 (nearest) to 8 (anisotropic 16x)")]
     UnknownLabMode(u8),

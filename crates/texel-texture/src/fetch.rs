@@ -24,10 +24,28 @@ pub(crate) trait Pyramid {
     fn level_count(&self) -> usize;
     /// Level `k < level_count()`.
     fn level(&self, k: usize) -> Self::Level<'_>;
+    /// The texture these levels belong to (for its lazily built ripmap and summed-area table).
+    fn texture(&self) -> &Texture;
+    /// A view of another image stored in the same format as these levels (a ripmap image), decoded
+    /// and counted exactly as the levels are. `info` locates the image inside `storage`.
+    ///
+    /// A storage of the other format (impossible for structures built from this texture) gives a
+    /// 1x1 transparent-black view instead of a panic.
+    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> Self::Level<'s>;
+    /// Record `n` reads of a structure that is not made of texels (summed-area table entries).
+    /// Free for the plain views; [`Counted`] adds `n` to its counter.
+    #[inline(always)]
+    fn note_reads(&self, _n: u32) {}
 }
+
+/// The fallback image of [`Pyramid::image`] for a storage of the wrong format.
+static BLACK_U8: [[u8; 4]; 1] = [[0; 4]];
+/// As [`BLACK_U8`], float.
+static BLACK_F32: [[f32; 4]; 1] = [[0.0; 4]];
 
 /// The pyramid of an 8-bit texture.
 pub(crate) struct U8Pyramid<'a> {
+    pub tex: &'a Texture,
     pub levels: &'a [LevelInfo],
     pub texels: &'a [[u8; 4]],
     pub table: &'static [f32; 256],
@@ -36,6 +54,7 @@ pub(crate) struct U8Pyramid<'a> {
 
 /// The pyramid of a float texture.
 pub(crate) struct F32Pyramid<'a> {
+    pub tex: &'a Texture,
     pub levels: &'a [LevelInfo],
     pub texels: &'a [[f32; 4]],
 }
@@ -64,6 +83,24 @@ impl Pyramid for U8Pyramid<'_> {
             alpha: self.alpha,
         }
     }
+    #[inline(always)]
+    fn texture(&self) -> &Texture {
+        self.tex
+    }
+    #[inline]
+    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> U8Level<'s> {
+        let (width, height, texels) = match storage {
+            Storage::U8(v) => (info.width, info.height, level_slice(info, v)),
+            Storage::F32(_) => (1, 1, &BLACK_U8[..]),
+        };
+        U8Level {
+            width,
+            height,
+            texels,
+            table: self.table,
+            alpha: self.alpha,
+        }
+    }
 }
 
 impl Pyramid for F32Pyramid<'_> {
@@ -82,6 +119,25 @@ impl Pyramid for F32Pyramid<'_> {
             width: info.width,
             height: info.height,
             texels: level_slice(info, self.texels),
+        }
+    }
+    #[inline(always)]
+    fn texture(&self) -> &Texture {
+        self.tex
+    }
+    #[inline]
+    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> F32Level<'s> {
+        match storage {
+            Storage::F32(v) => F32Level {
+                width: info.width,
+                height: info.height,
+                texels: level_slice(info, v),
+            },
+            Storage::U8(_) => F32Level {
+                width: 1,
+                height: 1,
+                texels: &BLACK_F32[..],
+            },
         }
     }
 }
@@ -125,6 +181,18 @@ impl<P: Pyramid> Pyramid for Counted<P> {
             count: &self.count,
         }
     }
+    fn texture(&self) -> &Texture {
+        self.inner.texture()
+    }
+    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> Self::Level<'s> {
+        CountedLevel {
+            inner: self.inner.image(info, storage),
+            count: &self.count,
+        }
+    }
+    fn note_reads(&self, n: u32) {
+        self.count.set(self.count.get().saturating_add(n));
+    }
 }
 
 /// Call `$body` with `$p` bound to the texture's pyramid view (8-bit or float), monomorphising once
@@ -147,6 +215,7 @@ pub(crate) enum AnyPyramid<'a> {
 pub(crate) fn pyramid_of(tex: &Texture) -> AnyPyramid<'_> {
     match tex.storage() {
         Storage::U8(v) => AnyPyramid::U8(U8Pyramid {
+            tex,
             levels: tex.levels(),
             texels: v,
             table: if tex.format() == Format::Rgba8Srgb {
@@ -157,6 +226,7 @@ pub(crate) fn pyramid_of(tex: &Texture) -> AnyPyramid<'_> {
             alpha: unorm8_table(),
         }),
         Storage::F32(v) => AnyPyramid::F32(F32Pyramid {
+            tex,
             levels: tex.levels(),
             texels: v,
         }),

@@ -31,16 +31,20 @@
 //! ```
 
 pub mod address;
+pub mod aniso;
 pub mod bicubic;
 mod bilinear;
 pub mod color;
 mod error;
+pub mod ewa;
 mod fetch;
 pub mod footprint;
 pub mod mip;
 mod nearest;
 pub mod pyramid;
+pub mod ripmap;
 pub mod sampler;
+pub mod sat;
 pub mod texture;
 pub mod warp;
 
@@ -48,5 +52,9 @@ pub use address::{AddressMode, BorderColor};
 pub use bicubic::Cubic;
 pub use error::TextureError;
 pub use footprint::{Axes, Footprint};
-pub use sampler::{FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor};
+pub use ripmap::Ripmap;
+pub use sampler::{
+    FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,
+};
+pub use sat::SummedAreaTable;
 pub use texture::{ColorSpace, Format, LevelInfo, Limits, Texture};

@@ -19,6 +19,10 @@ use crate::nearest::nearest;
 use crate::sampler::FilterMode;
 
 /// Filter one level with a within-level filter (Nearest, Linear or Cubic).
+///
+/// The minification-only filters (`Ewa`, `Ripmap`, `SummedArea`) never reach this function (the
+/// sampler dispatches them first and rejects them as `mag_filter`); should one arrive it is
+/// treated as Linear.
 #[inline(always)]
 pub(crate) fn filter_level<F: Fetch>(
     mode: &FilterMode,
@@ -31,6 +35,9 @@ pub(crate) fn filter_level<F: Fetch>(
         FilterMode::Nearest => nearest(level, addr, u, v),
         FilterMode::Linear => bilinear(level, addr, u, v),
         FilterMode::Cubic(c) => bicubic(level, addr, c, u, v),
+        FilterMode::Ewa | FilterMode::Ripmap | FilterMode::SummedArea => {
+            bilinear(level, addr, u, v)
+        }
     }
 }
 

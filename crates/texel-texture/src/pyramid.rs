@@ -39,7 +39,7 @@ pub fn pyramid_texels(width: u32, height: u32) -> u64 {
 }
 
 /// Box-reduction taps of one axis: for each destination texel, the first source index and the weights.
-fn axis_taps(n: u32, m: u32) -> Vec<(u32, Vec<f32>)> {
+pub(crate) fn axis_taps(n: u32, m: u32) -> Vec<(u32, Vec<f32>)> {
     let scale = f64::from(n) / f64::from(m);
     (0..m)
         .map(|k| {

@@ -7,15 +7,40 @@
 //! Mag/min selection (Vulkan spec, "Texel Filtering"): `lod <= 0` uses `mag_filter` at level 0,
 //! `lod > 0` uses `min_filter` with `mipmap_filter` choosing the level(s). `lod` is
 //! `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]` (see [`crate::footprint`]).
+//!
+//! Beyond the core filters, four anisotropic techniques are selected through the same descriptor:
+//!
+//! | technique | descriptor | module |
+//! |---|---|---|
+//! | hardware-style N x anisotropic | mag, min and mipmap filters `Linear`, `anisotropy_clamp` 2..=16 (up to 64 accepted); [`SamplerDescriptor::lab_mode`] 5-8 | [`crate::aniso`] |
+//! | EWA | `min_filter: FilterMode::Ewa` | [`crate::ewa`] |
+//! | ripmap | `min_filter: FilterMode::Ripmap` | [`crate::ripmap`] |
+//! | summed-area table | `min_filter: FilterMode::SummedArea` | [`crate::sat`] |
+//!
+//! Decisions for the three minification-only filters (`Ewa`, `Ripmap`, `SummedArea`):
+//! - magnification works as on a GPU: when the isotropic `lod` (from `rho`, the longer axis) is
+//!   `<= 0`, `mag_filter` runs at level 0. Using one of them as `mag_filter` is rejected with
+//!   [`TextureError::MinificationOnlyFilter`];
+//! - `mipmap_filter` is ignored: each technique chooses its own levels (EWA lerps two pyramid
+//!   levels, the ripmap blends four images, the summed-area table reads level 0 only);
+//! - `anisotropy_clamp` is EWA's eccentricity clamp; its WebGPU default of 1 ("not requested")
+//!   means the default of 16 for EWA ([`EWA_DEFAULT_ANISOTROPY`]). Ripmap and summed-area
+//!   table ignore it (their box has no eccentricity limit);
+//! - the ripmap and the summed-area table are built on first use, or by [`Texture::prepare`]; if
+//!   one would exceed the texture's [`crate::Limits`], sampling falls back to trilinear.
 
 use glam::Vec4;
 
 use crate::address::{Address, AddressMode, BorderColor};
+use crate::aniso::anisotropic;
 use crate::bicubic::Cubic;
 use crate::error::TextureError;
+use crate::ewa::ewa;
 use crate::fetch::{with_pyramid, Counted, Fetch, Pyramid};
 use crate::footprint::{lod_from_rho, Footprint};
 use crate::mip::{filter_level, mip_nearest, trilinear};
+use crate::ripmap::ripmap;
+use crate::sat::summed_area;
 use crate::texture::Texture;
 
 /// Largest |u| or |v| honoured (2^24): coordinates beyond are clamped to it.
@@ -31,7 +56,29 @@ pub enum FilterMode {
     Linear,
     /// Bicubic Mitchell-Netravali with the given `(B, C)` over 4x4 texels (16 reads).
     Cubic(Cubic),
+    /// Elliptically weighted average (Heckbert 1989, pbrt-v4 structure) over the footprint's
+    /// ellipse in two pyramid levels; `min_filter` only. See [`crate::ewa`].
+    Ewa,
+    /// Anisotropically reduced images `(W >> a) x (H >> b)` chosen from the footprint's
+    /// axis-aligned bounding box, four blended; `min_filter` only. See [`crate::ripmap`].
+    Ripmap,
+    /// Box mean over the footprint's axis-aligned bounding rectangle from a summed-area table
+    /// (Crow 1984); `min_filter` only. See [`crate::sat`].
+    SummedArea,
 }
+
+impl FilterMode {
+    /// Whether this filter is valid only as `min_filter` (`Ewa`, `Ripmap`, `SummedArea`).
+    pub fn is_minification_only(self) -> bool {
+        matches!(
+            self,
+            FilterMode::Ewa | FilterMode::Ripmap | FilterMode::SummedArea
+        )
+    }
+}
+
+/// EWA's eccentricity clamp when `anisotropy_clamp` is left at its WebGPU default of 1.
+pub const EWA_DEFAULT_ANISOTROPY: u16 = 16;
 
 /// How mip levels are chosen and combined when minifying (WebGPU `GPUMipmapFilterMode`, plus `None`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -64,7 +111,10 @@ pub struct SamplerDescriptor {
     pub lod_max_clamp: f32,
     /// Added to `log2(rho)` before clamping (Vulkan `mipLodBias`). Default 0.
     pub lod_bias: f32,
-    /// Largest anisotropy ratio honoured, 1 to 64. Default 1 (isotropic).
+    /// Largest anisotropy ratio honoured, 1 to 64. Default 1 (isotropic). Values above 1 with the
+    /// core filters need mag, min and mipmap filters `Linear` (WebGPU rule) and select the
+    /// hardware-style anisotropic filter ([`crate::aniso`]); with [`FilterMode::Ewa`] it is the
+    /// eccentricity clamp (1 means [`EWA_DEFAULT_ANISOTROPY`]).
     pub anisotropy_clamp: u16,
     /// Colour read outside the texture under [`AddressMode::ClampToBorder`].
     pub border_color: BorderColor,
@@ -90,8 +140,8 @@ impl Default for SamplerDescriptor {
 
 impl SamplerDescriptor {
     /// The lab's numbered modes: 1 nearest, 2 bilinear, 3 bilinear with the nearest mip level,
-    /// 4 trilinear. Address modes are left at their defaults (set them with
-    /// [`SamplerDescriptor::with_address_mode`]).
+    /// 4 trilinear, 5-8 anisotropic 2x/4x/8x/16x (trilinear probes). Address modes are left at
+    /// their defaults (set them with [`SamplerDescriptor::with_address_mode`]).
     ///
     /// # Errors
     /// [`TextureError::UnknownLabMode`] for other numbers.
@@ -110,8 +160,34 @@ impl SamplerDescriptor {
             2 => linear(MipmapFilterMode::None),
             3 => linear(MipmapFilterMode::Nearest),
             4 => linear(MipmapFilterMode::Linear),
+            5..=8 => Self::anisotropic(1 << (mode - 4)),
             _ => return Err(TextureError::UnknownLabMode(mode)),
         })
+    }
+
+    /// Hardware-style anisotropic filtering with at most `max_anisotropy` trilinear probes
+    /// (linear mag/min/mipmap filters). `max_anisotropy` 1 is plain trilinear; values outside
+    /// 1..=64 are rejected by [`Sampler::new`].
+    pub fn anisotropic(max_anisotropy: u16) -> Self {
+        SamplerDescriptor {
+            mag_filter: FilterMode::Linear,
+            min_filter: FilterMode::Linear,
+            mipmap_filter: MipmapFilterMode::Linear,
+            anisotropy_clamp: max_anisotropy,
+            ..Default::default()
+        }
+    }
+
+    /// `min_filter` set to one of the minification-only filters (`Ewa`, `Ripmap`, `SummedArea`)
+    /// with a bilinear `mag_filter`, linear `mipmap_filter` and `anisotropy_clamp` 16.
+    pub fn minification(min_filter: FilterMode) -> Self {
+        SamplerDescriptor {
+            mag_filter: FilterMode::Linear,
+            min_filter,
+            mipmap_filter: MipmapFilterMode::Linear,
+            anisotropy_clamp: EWA_DEFAULT_ANISOTROPY,
+            ..Default::default()
+        }
     }
 
     /// The same descriptor with `mode` on both axes.
@@ -124,10 +200,26 @@ impl SamplerDescriptor {
     }
 }
 
+/// The minification technique, resolved once in [`Sampler::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Technique {
+    /// `mipmap_filter` with `min_filter` inside the levels (nearest, bilinear, bicubic, trilinear).
+    Mip,
+    /// Hardware-style anisotropic with at most this many trilinear probes (2..=64).
+    Anisotropic(u32),
+    /// EWA with this eccentricity clamp (1..=64).
+    Ewa(f32),
+    /// Ripmap.
+    Ripmap,
+    /// Summed-area table.
+    SummedArea,
+}
+
 /// A validated sampler. Cheap to copy; sampling never fails.
 #[derive(Clone, Copy, Debug)]
 pub struct Sampler {
     desc: SamplerDescriptor,
+    technique: Technique,
     pub(crate) addr: Address,
 }
 
@@ -137,7 +229,7 @@ impl Sampler {
     /// # Errors
     /// [`TextureError::InvalidLodClamp`], [`TextureError::InvalidLodBias`],
     /// [`TextureError::InvalidAnisotropyClamp`], [`TextureError::AnisotropyNeedsLinear`],
-    /// [`TextureError::InvalidCubic`].
+    /// [`TextureError::InvalidCubic`], [`TextureError::MinificationOnlyFilter`].
     pub fn new(desc: SamplerDescriptor) -> Result<Self, TextureError> {
         let (lo, hi) = (desc.lod_min_clamp, desc.lod_max_clamp);
         if lo.is_nan() || hi.is_nan() || lo < 0.0 || lo > hi {
@@ -165,9 +257,34 @@ impl Sampler {
                 }
             }
         }
+        if desc.mag_filter.is_minification_only() {
+            return Err(TextureError::MinificationOnlyFilter(desc.mag_filter));
+        }
+        let clamp = desc.anisotropy_clamp;
+        let technique = match desc.min_filter {
+            FilterMode::Ewa => Technique::Ewa(f32::from(if clamp == 1 {
+                EWA_DEFAULT_ANISOTROPY
+            } else {
+                clamp
+            })),
+            FilterMode::Ripmap => Technique::Ripmap,
+            FilterMode::SummedArea => Technique::SummedArea,
+            _ if clamp > 1 => {
+                // WebGPU: anisotropy_clamp > 1 requires linear mag, min and mipmap filters.
+                if desc.mag_filter != FilterMode::Linear
+                    || desc.min_filter != FilterMode::Linear
+                    || desc.mipmap_filter != MipmapFilterMode::Linear
+                {
+                    return Err(TextureError::AnisotropyNeedsLinear(clamp));
+                }
+                Technique::Anisotropic(u32::from(clamp))
+            }
+            _ => Technique::Mip,
+        };
         let border = desc.border_color.rgba();
         Ok(Sampler {
             desc,
+            technique,
             addr: Address {
                 u: desc.address_mode_u,
                 v: desc.address_mode_v,
@@ -247,10 +364,22 @@ impl Sampler {
         if lod <= 0.0 {
             return filter_level(&d.mag_filter, &level0, &self.addr, u, v);
         }
-        match d.mipmap_filter {
-            MipmapFilterMode::None => filter_level(&d.min_filter, &level0, &self.addr, u, v),
-            MipmapFilterMode::Nearest => mip_nearest(p, &d.min_filter, &self.addr, u, v, lod),
-            MipmapFilterMode::Linear => trilinear(p, &d.min_filter, &self.addr, u, v, lod),
+        match self.technique {
+            Technique::Mip => match d.mipmap_filter {
+                MipmapFilterMode::None => filter_level(&d.min_filter, &level0, &self.addr, u, v),
+                MipmapFilterMode::Nearest => mip_nearest(p, &d.min_filter, &self.addr, u, v, lod),
+                MipmapFilterMode::Linear => trilinear(p, &d.min_filter, &self.addr, u, v, lod),
+            },
+            Technique::Anisotropic(max) => anisotropic(p, &self.addr, d, fp, u, v, lod, max),
+            Technique::Ewa(max) => ewa(p, &self.addr, d, fp, u, v, lod, max),
+            Technique::Ripmap => match p.texture().ripmap() {
+                Ok(r) => ripmap(p, r, &self.addr, d, fp, u, v),
+                Err(_) => trilinear(p, &FilterMode::Linear, &self.addr, u, v, lod),
+            },
+            Technique::SummedArea => match p.texture().summed_area_table() {
+                Ok(t) => summed_area(p, t, &self.addr, d, fp, u, v),
+                Err(_) => trilinear(p, &FilterMode::Linear, &self.addr, u, v, lod),
+            },
         }
     }
 }

@@ -11,12 +11,16 @@
 //! level, so rounding does not accumulate down the chain.
 
 use std::path::Path;
+use std::sync::OnceLock;
 
 use glam::Vec4;
 
 use crate::color::{linear_to_srgb8, srgb_table, srgb_to_linear, unorm8, unorm8_table};
 use crate::error::TextureError;
 use crate::pyramid;
+use crate::ripmap::Ripmap;
+use crate::sampler::{FilterMode, Sampler, SamplerDescriptor};
+use crate::sat::SummedAreaTable;
 
 /// How 8-bit colour channels are to be interpreted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -122,11 +126,21 @@ pub(crate) enum Storage {
 /// A 2D texture with its complete mip pyramid, ready to be sampled by a [`crate::Sampler`].
 ///
 /// Any size from 1x1 up to [`Limits::max_dimension`], power of two or not.
+///
+/// The ripmap and the summed-area table that [`FilterMode::Ripmap`] and
+/// [`FilterMode::SummedArea`] need are built from level 0 on first use (thread-safe, once; `Texture`
+/// is `Sync`), or ahead of time by [`Texture::prepare`]. Their size is checked against the
+/// [`Limits`] the texture was created with before anything is allocated.
 #[derive(Debug)]
 pub struct Texture {
     format: Format,
     levels: Vec<LevelInfo>,
     storage: Storage,
+    limits: Limits,
+    /// Built on first use; `Err(bytes)` records that it would have needed `bytes` (over the limit).
+    pub(crate) ripmap: OnceLock<Result<Ripmap, u64>>,
+    /// Built on first use; `Err(bytes)` as for `ripmap`.
+    pub(crate) sat: OnceLock<Result<SummedAreaTable, u64>>,
 }
 
 impl Texture {
@@ -176,11 +190,7 @@ impl Texture {
             }
         };
         all.extend(below.iter().map(|&c| encode(c)));
-        Ok(Texture {
-            format,
-            levels,
-            storage: Storage::U8(all),
-        })
+        Ok(Texture::assemble(format, levels, Storage::U8(all), limits))
     }
 
     /// A texture from row-major linear `f32` RGBA texels, building its pyramid.
@@ -205,11 +215,12 @@ impl Texture {
         let (levels, below) = pyramid::build(width, height, |i, j| level0.texel(i, j));
         let mut all = texels;
         all.extend(below.iter().map(|c| c.to_array()));
-        Ok(Texture {
-            format: Format::Rgba32Float,
+        Ok(Texture::assemble(
+            Format::Rgba32Float,
             levels,
-            storage: Storage::F32(all),
-        })
+            Storage::F32(all),
+            limits,
+        ))
     }
 
     /// A texture whose texel `(i, j)` is `f(i, j)` (linear RGBA in `[0, 1]` for 8-bit formats),
@@ -313,6 +324,54 @@ impl Texture {
             }
             other => Err(TextureError::UnsupportedFormat(other)),
         }
+    }
+
+    fn assemble(format: Format, levels: Vec<LevelInfo>, storage: Storage, limits: &Limits) -> Self {
+        Texture {
+            format,
+            levels,
+            storage,
+            limits: *limits,
+            ripmap: OnceLock::new(),
+            sat: OnceLock::new(),
+        }
+    }
+
+    /// The limits the texture was created with (they also bound its ripmap and summed-area table).
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// Build ahead of time whatever acceleration structure `sampler` needs (the ripmap for
+    /// [`FilterMode::Ripmap`], the summed-area table for [`FilterMode::SummedArea`]; nothing for the
+    /// other filters), so that later samples (and frame timings) do not pay for the build.
+    /// Idempotent and thread-safe.
+    ///
+    /// # Errors
+    /// [`TextureError::StructureOverMemoryLimit`] if the structure would exceed the texture's
+    /// [`Limits::max_bytes`]. Sampling still works then: it falls back to trilinear filtering.
+    pub fn prepare(&self, sampler: &Sampler) -> Result<(), TextureError> {
+        match sampler.descriptor().min_filter {
+            FilterMode::Ripmap => self.ripmap().map(|_| ()),
+            FilterMode::SummedArea => self.summed_area_table().map(|_| ()),
+            _ => Ok(()),
+        }
+    }
+
+    /// Bytes of the structures a sampler configured by `desc` reads: the mip pyramid
+    /// ([`Texture::pyramid_bytes`]), plus the ripmap ([`Ripmap::bytes_for`]) for
+    /// [`FilterMode::Ripmap`] or the summed-area table ([`SummedAreaTable::bytes_for`]) for
+    /// [`FilterMode::SummedArea`], whether already built or not. Saturates at `u64::MAX`.
+    pub fn structure_bytes(&self, desc: &SamplerDescriptor) -> u64 {
+        let (w, h) = (self.width(), self.height());
+        let extra = match desc.min_filter {
+            FilterMode::Ripmap => Ripmap::bytes_for(w, h, self.format),
+            FilterMode::SummedArea => SummedAreaTable::bytes_for(w, h),
+            _ => Some(0),
+        };
+        extra
+            .and_then(|e| e.checked_add(self.pyramid_bytes()))
+            .unwrap_or(u64::MAX)
     }
 
     /// The storage format.

@@ -1,0 +1,139 @@
+//! Hardware-style anisotropic filtering: N trilinear probes along the footprint's major axis.
+//!
+//! Formula (EXT_texture_filter_anisotropic, "Texture Minification"; also the lab's formula and
+//! DESIGN.md): with `Px = (dudx * W, dvdx * H)` and `Py = (dudy * W, dvdy * H)` in texels of level
+//! 0, `Pmax`/`Pmin` the longer/shorter of the two,
+//!
+//! ```text
+//! N   = min(ceil(|Pmax| / |Pmin|), anisotropy_clamp)
+//! lod = log2(|Pmax| / N) + lod_bias, clamped to [lod_min_clamp, lod_max_clamp]
+//! c   = 1/N * sum_{i=0}^{N-1} trilinear(uv + ((i + 0.5) / N - 0.5) * Pmax_uv, lod)
+//! ```
+//!
+//! where `Pmax_uv` is the same screen axis in uv units (`(dudx, dvdx)` or `(dudy, dvdy)`). The
+//! probes are spaced `|Pmax| / N` texels apart, so each probe's trilinear footprint (`2^lod =
+//! |Pmax| / N` texels) tiles the major axis without gaps.
+//!
+//! Decisions:
+//! - `N = 1` (an isotropic footprint, or `anisotropy_clamp = 1`) calls exactly the code path of
+//!   plain trilinear with the isotropic lod, so the result is bit for bit trilinear (tested).
+//! - The ratio is rounded up with a relative tolerance of [`RATIO_TOLERANCE`] (`1e-5`), so that a
+//!   rotated isotropic footprint whose two lengths differ by float rounding (`|Pmax| / |Pmin| =
+//!   1.0000001`) does not take two probes; an exact integer ratio `k (1 + eps)` likewise gives `k`.
+//! - The magnification/minification decision is the core sampler's, from the isotropic
+//!   `rho = |Pmax|`: `lod <= 0` uses the (linear) `mag_filter`. When minifying, the probes' lod may
+//!   fall below 0 (`|Pmax| / N < 1`); trilinear then clamps it to level 0 (bilinear probes).
+//! - Degenerate footprints: `|Pmin| = 0` gives `N = anisotropy_clamp`; `|Pmax| = 0` (reachable only
+//!   with `lod_min_clamp > 0`) and non-finite derivatives give one trilinear probe at the isotropic
+//!   lod (the coarsest allowed level for non-finite ones). `N` never exceeds `anisotropy_clamp`
+//!   (at most 64), so the loop is bounded. Probe positions that overflow to infinity are sampled
+//!   at 0, as the sampler treats non-finite `uv`.
+//!
+//! Cost: `N` trilinear probes, so at most `8 N` texel reads. Measured texels per sample and
+//! samples per second are in `benches/aniso.rs` and the table of [`crate::ewa`]'s module docs;
+//! quality against a brute-force Gaussian is recorded there too.
+
+use glam::Vec4;
+
+use crate::address::Address;
+use crate::fetch::{Fetch, Pyramid};
+use crate::footprint::{lod_from_rho, Footprint};
+use crate::mip::trilinear;
+use crate::sampler::{FilterMode, SamplerDescriptor};
+
+/// Relative tolerance applied to `|Pmax| / |Pmin|` before rounding up (see the module docs).
+pub const RATIO_TOLERANCE: f32 = 1e-5;
+
+/// The number of probes `N = min(ceil(major / minor), max_anisotropy)`, at least 1.
+///
+/// `major` and `minor` are axis lengths (any unit, `major >= minor >= 0`). `minor = 0` gives
+/// `max_anisotropy`; `0 / 0` and `inf / inf` give 1. Ratios within [`RATIO_TOLERANCE`] above an
+/// integer round down to it: `probe_count(4.00001, 1.0, 16) = 4`, `probe_count(4.1, 1.0, 16) = 5`.
+pub fn probe_count(major: f32, minor: f32, max_anisotropy: u32) -> u32 {
+    let ratio = major / minor;
+    if ratio.is_nan() {
+        return 1;
+    }
+    let n = (ratio * (1.0 - RATIO_TOLERANCE)).ceil();
+    if n >= max_anisotropy as f32 {
+        max_anisotropy.max(1)
+    } else if n >= 1.0 {
+        n as u32
+    } else {
+        1
+    }
+}
+
+/// Anisotropic filtering of `fp` (with `(u, v)` already made finite) at most `max` probes;
+/// `lod_iso` is the sampler's isotropic lod (already known to be `> 0`).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn anisotropic<P: Pyramid>(
+    p: &P,
+    addr: &Address,
+    d: &SamplerDescriptor,
+    fp: &Footprint,
+    u: f32,
+    v: f32,
+    lod_iso: f32,
+    max: u32,
+) -> Vec4 {
+    let (w, h) = p.level(0).size();
+    let axes = fp.axes(w, h);
+    let major = axes.major.length();
+    let n = if major.is_finite() && axes.major_uv.is_finite() {
+        probe_count(major, axes.minor.length(), max)
+    } else {
+        1
+    };
+    if n == 1 {
+        return trilinear(p, &FilterMode::Linear, addr, u, v, lod_iso);
+    }
+    let lod = lod_from_rho(
+        major / n as f32,
+        d.lod_bias,
+        d.lod_min_clamp,
+        d.lod_max_clamp,
+    );
+    let inv = 1.0 / n as f32;
+    let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
+    let mut sum = Vec4::ZERO;
+    for i in 0..n {
+        let t = (i as f32 + 0.5) * inv - 0.5;
+        let pu = finite(u + t * axes.major_uv.x);
+        let pv = finite(v + t * axes.major_uv.y);
+        sum += trilinear(p, &FilterMode::Linear, addr, pu, pv, lod);
+    }
+    sum * inv
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn probe_count_table() {
+        let cases: &[(f32, f32, u32, u32)] = &[
+            (4.0, 1.0, 16, 4),
+            (4.000_01, 1.0, 16, 4),
+            (4.1, 1.0, 16, 5),
+            (1.0, 1.0, 16, 1),
+            (1.000_000_1, 1.0, 16, 1),
+            (1.5, 1.0, 16, 2),
+            (100.0, 1.0, 16, 16),
+            (100.0, 1.0, 2, 2),
+            (3.0, 0.0, 8, 8),
+            (0.0, 0.0, 8, 1),
+            (f32::INFINITY, f32::INFINITY, 8, 1),
+            (1e6, 1.0, 64, 64),
+            (8.0, 2.0, 1, 1),
+        ];
+        for &(major, minor, max, want) in cases {
+            assert_eq!(
+                probe_count(major, minor, max),
+                want,
+                "{major}/{minor} max {max}"
+            );
+        }
+    }
+}
