@@ -1,0 +1,119 @@
+//! Frame-time benchmarks: the ground scene (`shared/scenes/ground.toml`) at 1280 x 720 with each
+//! filter the sampler has, on 1 and 2 threads; triangle throughput on a 100k-triangle mesh.
+//!
+//! Run: `CARGO_TARGET_DIR=/work/target-shared cargo bench -p texel-raster --bench frame`.
+
+// criterion_group! generates an undocumented public function.
+#![allow(missing_docs)]
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use common::{lab_sampler, screen_vertex, Ground};
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use glam::Mat4;
+use texel_raster::{render, DrawCall, RenderSettings};
+use texel_texture::{AddressMode, Format, Limits, Sampler, SamplerDescriptor, Texture};
+
+fn samplers() -> Vec<(&'static str, Sampler)> {
+    let aniso16 = Sampler::new(SamplerDescriptor {
+        anisotropy_clamp: 16,
+        ..SamplerDescriptor::lab_mode(4)
+            .unwrap()
+            .with_address_mode(AddressMode::Repeat)
+    })
+    .unwrap();
+    vec![
+        ("nearest", lab_sampler(1)),
+        ("bilinear", lab_sampler(2)),
+        ("mip_nearest", lab_sampler(3)),
+        ("trilinear", lab_sampler(4)),
+        // On this branch the sampler accepts anisotropy_clamp but filters trilinearly.
+        ("trilinear_aniso_clamp16", aniso16),
+    ]
+}
+
+fn ground(c: &mut Criterion) {
+    let (w, h) = (1280, 720);
+    let scene = Ground::new(w, h);
+    let mut group = c.benchmark_group("ground_1280x720");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(4));
+    for (name, sampler) in samplers() {
+        let draw = scene.draw(&sampler);
+        for threads in [1, 2] {
+            let settings = RenderSettings {
+                threads: Some(threads),
+                ..RenderSettings::new(w, h)
+            };
+            group.bench_with_input(BenchmarkId::new(name, threads), &settings, |b, s| {
+                b.iter(|| black_box(render(s, &[draw]).unwrap()))
+            });
+        }
+    }
+    group.finish();
+}
+
+fn mesh(c: &mut Criterion) {
+    let (w, h) = (1280, 720);
+    // 224 x 224 cells, two triangles each: 100 352 triangles over the whole frame (~9 px each).
+    let (nx, ny) = (224u32, 224u32);
+    let vertices: Vec<_> = (0..=ny)
+        .flat_map(|b| {
+            (0..=nx).map(move |a| {
+                screen_vertex(
+                    f64::from(a) * f64::from(w) / f64::from(nx),
+                    f64::from(b) * f64::from(h) / f64::from(ny),
+                    w,
+                    h,
+                )
+            })
+        })
+        .collect();
+    let triangles: Vec<[u32; 3]> = (0..ny)
+        .flat_map(|b| {
+            (0..nx).flat_map(move |a| {
+                let k = b * (nx + 1) + a;
+                [[k, k + 1, k + nx + 2], [k, k + nx + 2, k + nx + 1]]
+            })
+        })
+        .collect();
+    let texture = Texture::from_fn(64, 64, Format::Rgba8Srgb, &Limits::default(), |i, j| {
+        [i as f32 / 63.0, j as f32 / 63.0, 0.5, 1.0]
+    })
+    .unwrap();
+    let sampler = lab_sampler(4);
+    let draw = DrawCall {
+        vertices: &vertices,
+        triangles: &triangles,
+        texture: &texture,
+        sampler: &sampler,
+        clip_from_world: Mat4::IDENTITY,
+    };
+    let mut group = c.benchmark_group("mesh_100k_64x64_trilinear");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(4))
+        .throughput(Throughput::Elements(triangles.len() as u64));
+    for threads in [1, 2] {
+        let settings = RenderSettings {
+            threads: Some(threads),
+            ..RenderSettings::new(w, h)
+        };
+        group.bench_with_input(BenchmarkId::from_parameter(threads), &settings, |b, s| {
+            b.iter(|| black_box(render(s, &[draw]).unwrap()))
+        });
+    }
+    group.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default();
+    targets = ground, mesh
+}
+criterion_main!(benches);

@@ -1,0 +1,51 @@
+//! What is drawn: vertices, indexed triangles and the texture/sampler pair of one draw call.
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use texel_texture::{Sampler, Texture};
+
+/// One vertex of a mesh, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vertex {
+    /// World-space position.
+    pub position: Vec3,
+    /// Normalised texture coordinate (DESIGN.md: `(0, 0)` is the top-left of the image file; values
+    /// outside `[0, 1)` are resolved by the sampler's address modes).
+    pub uv: Vec2,
+    /// Linear RGBA colour multiplied into the texture colour (white for a plain textured mesh).
+    pub color: Vec4,
+    /// World-space normal, used by the optional Lambert light; need not be normalised (the
+    /// interpolated normal is normalised per pixel).
+    pub normal: Vec3,
+}
+
+impl Vertex {
+    /// A white vertex with normal `+y` at `position` with texture coordinate `uv`.
+    pub fn new(position: Vec3, uv: Vec2) -> Self {
+        Vertex {
+            position,
+            uv,
+            color: Vec4::ONE,
+            normal: Vec3::Y,
+        }
+    }
+}
+
+/// One draw call: an indexed triangle list, textured with one texture through one sampler.
+///
+/// Triangles whose indices are out of range make [`crate::render`] return
+/// [`crate::RasterError::IndexOutOfRange`]; triangles that are degenerate (zero projected area, NaN
+/// or infinite positions) are skipped silently.
+#[derive(Clone, Copy, Debug)]
+pub struct DrawCall<'a> {
+    /// The vertices the triangles index.
+    pub vertices: &'a [Vertex],
+    /// Triangles as three vertex indices. Front faces are counter-clockwise in NDC (OpenGL's default,
+    /// which appears counter-clockwise on screen too).
+    pub triangles: &'a [[u32; 3]],
+    /// The texture sampled for the diffuse colour.
+    pub texture: &'a Texture,
+    /// How the texture is sampled (filter, address modes, lod clamps).
+    pub sampler: &'a Sampler,
+    /// World to clip space: `perspective * look_at * world_from_model` (see [`crate::camera`]).
+    pub clip_from_world: Mat4,
+}

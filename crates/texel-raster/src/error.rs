@@ -1,0 +1,81 @@
+//! The one error type of texel-raster.
+
+use thiserror::Error;
+
+/// Everything that can go wrong when rendering.
+///
+/// Only bad input is an error: degenerate, non-finite or invisible triangles are not errors, they are
+/// skipped (as a GPU skips them).
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum RasterError {
+    /// Width or height is zero, or a side exceeds [`crate::MAX_DIMENSION`].
+    #[error("frame size {width}x{height} is invalid: each side must be in 1..={max}")]
+    InvalidSize {
+        /// Requested width in pixels.
+        width: u32,
+        /// Requested height in pixels.
+        height: u32,
+        /// The largest side allowed, in pixels.
+        max: u32,
+    },
+    /// The frame has more pixels than [`crate::MAX_PIXELS`] (its buffers would not fit in memory).
+    #[error("frame size {width}x{height} has {pixels} pixels, over the limit of {max}")]
+    TooManyPixels {
+        /// Requested width in pixels.
+        width: u32,
+        /// Requested height in pixels.
+        height: u32,
+        /// `width * height`.
+        pixels: u64,
+        /// The limit in pixels.
+        max: u64,
+    },
+    /// A triangle refers to a vertex that does not exist.
+    #[error("draw {draw}, triangle {triangle}: vertex index {index} out of range (the draw has {vertex_count} vertices)")]
+    IndexOutOfRange {
+        /// Index of the draw call in the slice passed to `render`.
+        draw: usize,
+        /// Index of the triangle within the draw.
+        triangle: usize,
+        /// The offending vertex index.
+        index: u32,
+        /// Number of vertices in the draw.
+        vertex_count: usize,
+    },
+    /// `threads` is `Some(0)`.
+    #[error("thread count must be at least 1, got {0}")]
+    InvalidThreadCount(usize),
+    /// The local rayon thread pool could not be built.
+    #[error("could not build a pool of {threads} threads: {message}")]
+    ThreadPool {
+        /// Requested threads.
+        threads: usize,
+        /// rayon's message.
+        message: String,
+    },
+    /// The background colour has a NaN or infinite channel.
+    #[error("background colour {0:?} is not finite")]
+    NonFiniteBackground([f32; 4]),
+    /// The light's direction, colour or ambient term is not finite.
+    #[error("directional light is not finite: direction {direction:?}, color {color:?}, ambient {ambient:?}")]
+    NonFiniteLight {
+        /// The light's direction.
+        direction: [f32; 3],
+        /// The light's colour.
+        color: [f32; 3],
+        /// The ambient term.
+        ambient: [f32; 3],
+    },
+    /// The reference renderer's samples per pixel side is outside `1..=MAX_SPP_SIDE`.
+    #[error("reference samples per pixel side {spp_side} is invalid: it must be in 1..={max}")]
+    InvalidSamplesPerPixel {
+        /// Requested samples per side (the pixel gets `spp_side^2` samples).
+        spp_side: u32,
+        /// The largest allowed.
+        max: u32,
+    },
+    /// A texture could not be created (the reference renderer builds its own sampler).
+    #[error(transparent)]
+    Texture(#[from] texel_texture::TextureError),
+}

@@ -1,0 +1,127 @@
+//! Per-pixel interpolation: barycentrics (perspective-correct or affine), their analytic screen
+//! derivatives, and the GPU-style 2x2 quad differences.
+//!
+//! Perspective-correct (DESIGN.md): with `q_k = lambda_k / w` and `r = 1 / w` linear in screen space
+//! (planes from [`crate::setup`]), `lambda_k = q_k / r` and, by the quotient rule,
+//! `d lambda_k / dx = (q_k,x r - q_k r_x) / r^2 = (q_k,x - lambda_k r_x) / r`. Any attribute
+//! `a = sum_k lambda_k a_k` then has `da/dx = sum_k a_k d lambda_k / dx`: this is exactly
+//! `du/dx = (q_x r - q r_x) / r^2` for `q = u / w`, evaluated in `f64`.
+//! Affine: `lambda_k` is itself a plane and its derivatives are constants.
+
+use glam::{DVec2, DVec3};
+
+use crate::settings::Perspective;
+use crate::setup::TriangleSetup;
+
+/// Barycentric coordinates of the original triangle at a point, with their screen derivatives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Barycentrics {
+    /// `(lambda_0, lambda_1, lambda_2)`, summing to 1.
+    pub lambda: DVec3,
+    /// `d lambda / dx` (per pixel to the right).
+    pub dx: DVec3,
+    /// `d lambda / dy` (per pixel down).
+    pub dy: DVec3,
+}
+
+impl Barycentrics {
+    /// The interpolated 2D attribute `sum_k lambda_k a_k`.
+    #[inline(always)]
+    pub fn interpolate2(&self, a: [DVec2; 3]) -> DVec2 {
+        a[0] * self.lambda.x + a[1] * self.lambda.y + a[2] * self.lambda.z
+    }
+
+    /// `(d/dx, d/dy)` of the interpolated 2D attribute.
+    #[inline(always)]
+    pub fn derivatives2(&self, a: [DVec2; 3]) -> (DVec2, DVec2) {
+        (
+            a[0] * self.dx.x + a[1] * self.dx.y + a[2] * self.dx.z,
+            a[0] * self.dy.x + a[1] * self.dy.y + a[2] * self.dy.z,
+        )
+    }
+}
+
+impl TriangleSetup {
+    /// Barycentrics at continuous pixel coordinates `(x, y)` (pixel centres are at `+0.5`), without
+    /// derivatives. Outside the triangle the planes extrapolate (as for a GPU's helper pixels); beyond
+    /// the horizon of the triangle's plane (`1/w <= 0`) the values are meaningless or non-finite.
+    #[inline(always)]
+    pub fn lambda_at(&self, x: f64, y: f64, perspective: Perspective) -> DVec3 {
+        match perspective {
+            Perspective::Correct => {
+                let inv_r = 1.0 / self.r.at(x, y);
+                DVec3::new(self.q[0].at(x, y), self.q[1].at(x, y), self.q[2].at(x, y)) * inv_r
+            }
+            Perspective::Affine => DVec3::new(
+                self.affine[0].at(x, y),
+                self.affine[1].at(x, y),
+                self.affine[2].at(x, y),
+            ),
+        }
+    }
+
+    /// Barycentrics at `(x, y)` with their analytic derivatives (see the module docs).
+    #[inline(always)]
+    pub fn barycentrics(&self, x: f64, y: f64, perspective: Perspective) -> Barycentrics {
+        match perspective {
+            Perspective::Correct => {
+                let inv_r = 1.0 / self.r.at(x, y);
+                let q = DVec3::new(self.q[0].at(x, y), self.q[1].at(x, y), self.q[2].at(x, y));
+                let lambda = q * inv_r;
+                let qx = DVec3::new(self.q[0].dx, self.q[1].dx, self.q[2].dx);
+                let qy = DVec3::new(self.q[0].dy, self.q[1].dy, self.q[2].dy);
+                Barycentrics {
+                    lambda,
+                    dx: (qx - lambda * self.r.dx) * inv_r,
+                    dy: (qy - lambda * self.r.dy) * inv_r,
+                }
+            }
+            Perspective::Affine => Barycentrics {
+                lambda: self.lambda_at(x, y, perspective),
+                dx: DVec3::new(self.affine[0].dx, self.affine[1].dx, self.affine[2].dx),
+                dy: DVec3::new(self.affine[0].dy, self.affine[1].dy, self.affine[2].dy),
+            },
+        }
+    }
+
+    /// NDC depth at `(x, y)` (always screen-linear, whatever the interpolation mode).
+    #[inline(always)]
+    pub fn depth_at(&self, x: f64, y: f64) -> f64 {
+        self.z.at(x, y)
+    }
+}
+
+/// Fine 2x2 quad differences of a value given at the quad's pixels `[top-left, top-right,
+/// bottom-left, bottom-right]`: for each pixel, `(d/dx, d/dy)` = (difference along its row, difference
+/// along its column).
+#[inline(always)]
+pub fn quad_differences(v: [DVec2; 4]) -> [(DVec2, DVec2); 4] {
+    let dx_top = v[1] - v[0];
+    let dx_bottom = v[3] - v[2];
+    let dy_left = v[2] - v[0];
+    let dy_right = v[3] - v[1];
+    [
+        (dx_top, dy_left),
+        (dx_top, dy_right),
+        (dx_bottom, dy_left),
+        (dx_bottom, dy_right),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad_difference_table() {
+        let v = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.5),
+            DVec2::new(0.25, 2.0),
+            DVec2::new(1.5, 3.0),
+        ];
+        let d = quad_differences(v);
+        assert_eq!(d[0], (DVec2::new(1.0, 0.5), DVec2::new(0.25, 2.0)));
+        assert_eq!(d[3], (DVec2::new(1.25, 1.0), DVec2::new(0.5, 2.5)));
+    }
+}

@@ -1,0 +1,96 @@
+//! texel-raster: a clipped, watertight, perspective-correct textured-triangle rasterizer on all
+//! cores, with debug views and the supersampled reference renderer every filter is judged against.
+//!
+//! Pipeline (conventions from the project's DESIGN.md): world-space [`Vertex`]es are transformed by
+//! a [`DrawCall`]'s `clip_from_world` ([`camera`]), clipped in homogeneous space against the near and
+//! far planes and a guard band ([`clip`]), set up once per triangle with fixed-point edge functions,
+//! the top-left fill rule and homogeneous plane equations ([`setup`]), binned to 64x64 tiles and
+//! rasterised in parallel ([`tile`]); every covered pixel gets perspective-correct barycentrics and
+//! `uv` derivatives ([`interp`]) that become the sampler's footprint, and is shaded ([`shade`]) or
+//! shown through a debug view ([`views`]). [`reference::render_reference`] supersamples the same
+//! geometry.
+//!
+//! ```
+//! use glam::{Mat4, Vec2, Vec3};
+//! use texel_raster::{render, DrawCall, RenderSettings, Vertex};
+//! use texel_texture::{Format, Limits, Sampler, SamplerDescriptor, Texture};
+//!
+//! // A white 1x1 texture on a triangle given directly in NDC (clip_from_world = identity, w = 1).
+//! let tex = Texture::from_fn(1, 1, Format::Rgba8Unorm, &Limits::default(), |_, _| [1.0; 4])?;
+//! let sampler = Sampler::new(SamplerDescriptor::default())?;
+//! let vertices = [
+//!     Vertex::new(Vec3::new(-1.0, -1.0, 0.0), Vec2::new(0.0, 1.0)),
+//!     Vertex::new(Vec3::new(1.0, -1.0, 0.0), Vec2::new(1.0, 1.0)),
+//!     Vertex::new(Vec3::new(-1.0, 1.0, 0.0), Vec2::new(0.0, 0.0)),
+//! ];
+//! let draw = DrawCall {
+//!     vertices: &vertices,
+//!     triangles: &[[0, 1, 2]],
+//!     texture: &tex,
+//!     sampler: &sampler,
+//!     clip_from_world: Mat4::IDENTITY,
+//! };
+//! let frame = render(&RenderSettings::new(8, 8), &[draw])?;
+//! // The lower-left half is white. The 8 diagonal pixel centres lie exactly on the hypotenuse, a
+//! // right edge under the top-left rule, so they belong to the (absent) upper-right neighbour.
+//! assert_eq!(frame.color[frame.index(0, 7)], [1.0; 4]);
+//! assert_eq!(frame.color[frame.index(7, 0)], [0.0, 0.0, 0.0, 1.0]);
+//! assert_eq!(frame.covered_pixels(), 28);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod camera;
+pub mod clip;
+mod draw;
+mod error;
+mod frame;
+pub mod interp;
+pub mod reference;
+mod rng;
+mod settings;
+pub mod setup;
+mod shade;
+pub mod tile;
+pub mod views;
+
+pub use draw::{DrawCall, Vertex};
+pub use error::RasterError;
+pub use frame::Frame;
+pub use reference::render_reference;
+pub use settings::{
+    Derivatives, DirectionalLight, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS,
+};
+
+/// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].
+///
+/// Tiles are rendered in parallel on rayon's global pool, or on a local pool of
+/// `settings.threads` threads; the result is bit for bit the same for every thread count.
+/// Degenerate, non-finite, back-facing (when culling) and invisible triangles are skipped.
+///
+/// # Errors
+/// Invalid settings ([`RenderSettings::validate`]), [`RasterError::IndexOutOfRange`],
+/// [`RasterError::ThreadPool`].
+pub fn render(settings: &RenderSettings, draws: &[DrawCall]) -> Result<Frame, RasterError> {
+    settings.validate()?;
+    setup::validate_draws(draws)?;
+    with_threads(settings.threads, || tile::render_frame(settings, draws))
+}
+
+/// Run `f` on rayon's global pool (`None`) or on a local pool of `n` threads.
+pub(crate) fn with_threads<T: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> Result<T, RasterError> + Send,
+) -> Result<T, RasterError> {
+    match threads {
+        None => f(),
+        Some(0) => Err(RasterError::InvalidThreadCount(0)),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| RasterError::ThreadPool {
+                threads: n,
+                message: e.to_string(),
+            })?
+            .install(f),
+    }
+}

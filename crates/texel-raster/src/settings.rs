@@ -1,0 +1,175 @@
+//! How a frame is rendered: size, background, derivative and interpolation modes, debug view, light,
+//! threads.
+
+use glam::Vec3;
+
+use crate::error::RasterError;
+
+/// The largest frame side in pixels (keeps fixed-point edge functions far from `i64` overflow,
+/// see [`crate::setup`]).
+pub const MAX_DIMENSION: u32 = 16384;
+
+/// The largest frame in pixels (`2^26`, about 67 M: the frame's buffers then take about 2 GiB).
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// How the screen-space derivatives of `uv` handed to the sampler are computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Derivatives {
+    /// Exact derivatives of the perspective-correct `uv` at the pixel centre, from the plane
+    /// equations: with `q = u/w` and `r = 1/w`, `du/dx = (q_x r - q r_x) / r^2` (DESIGN.md).
+    #[default]
+    Analytic,
+    /// GPU-style differences over aligned 2x2 quads ("fine" derivatives, D3D `ddx_fine`): for a pixel
+    /// in quad row `y`, `du/dx = u(right, y) - u(left, y)`; for quad column `x`,
+    /// `du/dy = u(x, bottom) - u(x, top)`. Pixels of the quad outside the triangle (helper pixels)
+    /// are evaluated from the same plane equations.
+    Quad,
+}
+
+/// How attributes are interpolated across a triangle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Perspective {
+    /// Perspective-correct: `a/w` and `1/w` are linear in screen space, `a = (a/w) / (1/w)`.
+    #[default]
+    Correct,
+    /// Affine (screen-space linear) interpolation of the attributes of each clipped triangle: the
+    /// "incorrect" image of the lectures (textures swim and bend). Depth stays correct.
+    Affine,
+}
+
+/// What each pixel shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum View {
+    /// Texture colour times vertex colour, optionally lit (the normal image).
+    #[default]
+    Color,
+    /// `fract(u)` in red, `fract(v)` in green (as displayed: 8-bit red = `fract(u) * 255`).
+    Uv,
+    /// The integer mip level the nearest-level rule reads (`ceil(lod + 1/2) - 1`), one colour per
+    /// level from [`crate::views::MIP_PALETTE`].
+    Mip,
+    /// The continuous lod: the palette of [`View::Mip`] interpolated between integer levels.
+    Lod,
+    /// The footprint's anisotropy `|Pmax| / |Pmin|` on a colour ramp, 1 to 16 on a log2 scale.
+    Aniso,
+    /// Texels the filter read for the pixel, as a heat map (log2 scale, see [`crate::views`]).
+    /// Turns on texel counting.
+    Fetches,
+    /// The perspective-correct barycentric weights of the original (unclipped) triangle as RGB.
+    Barycentric,
+}
+
+/// One directional light for Lambert shading: `colour = texture * vertex_colour * (ambient + color *
+/// max(0, n . l))`, with `n` the interpolated normal and `l` the normalised `direction`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLight {
+    /// World-space direction *towards* the light (need not be normalised; zero gives no diffuse term).
+    pub direction: Vec3,
+    /// Linear RGB intensity of the light.
+    pub color: Vec3,
+    /// Linear RGB ambient term added to the diffuse term.
+    pub ambient: Vec3,
+}
+
+/// Everything that configures one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Frame width in pixels, `1..=MAX_DIMENSION`.
+    pub width: u32,
+    /// Frame height in pixels, `1..=MAX_DIMENSION`.
+    pub height: u32,
+    /// Linear RGBA colour of pixels no triangle covers.
+    pub background: [f32; 4],
+    /// How `uv` derivatives are computed (ignored by the reference renderer, which samples level 0).
+    pub derivatives: Derivatives,
+    /// Perspective-correct or affine interpolation (the reference renderer is always correct).
+    pub perspective: Perspective,
+    /// What each pixel shows (the reference renderer always shades [`View::Color`]).
+    pub view: View,
+    /// Skip triangles that are clockwise in NDC (back faces, OpenGL's default front face is CCW).
+    pub cull_backfaces: bool,
+    /// Optional Lambert light; `None` shades unlit (texture times vertex colour).
+    pub light: Option<DirectionalLight>,
+    /// Worker threads: `None` uses rayon's global pool, `Some(n)` a local pool of `n >= 1` threads.
+    /// The image is identical for every thread count.
+    pub threads: Option<usize>,
+    /// Count the texels each pixel's filter reads into [`crate::Frame::texels_read`] (slower: uses
+    /// `Sampler::sample_counted`). Always on for [`View::Fetches`].
+    pub count_texels: bool,
+    /// Record each pixel's footprint (uv and derivatives) in [`crate::Frame::footprints`].
+    pub capture_footprints: bool,
+}
+
+impl RenderSettings {
+    /// Defaults for a `width x height` frame: opaque black background, analytic derivatives,
+    /// perspective-correct colour view, no culling, no light, rayon's global pool, no counting.
+    pub fn new(width: u32, height: u32) -> Self {
+        RenderSettings {
+            width,
+            height,
+            background: [0.0, 0.0, 0.0, 1.0],
+            derivatives: Derivatives::Analytic,
+            perspective: Perspective::Correct,
+            view: View::Color,
+            cull_backfaces: false,
+            light: None,
+            threads: None,
+            count_texels: false,
+            capture_footprints: false,
+        }
+    }
+
+    /// Whether texels are counted (`count_texels` or the fetches view).
+    pub fn counts_texels(&self) -> bool {
+        self.count_texels || self.view == View::Fetches
+    }
+
+    /// Check the settings.
+    ///
+    /// # Errors
+    /// [`RasterError::InvalidSize`], [`RasterError::TooManyPixels`],
+    /// [`RasterError::InvalidThreadCount`], [`RasterError::NonFiniteBackground`],
+    /// [`RasterError::NonFiniteLight`].
+    pub fn validate(&self) -> Result<(), RasterError> {
+        let (width, height) = (self.width, self.height);
+        if width == 0 || height == 0 || width > MAX_DIMENSION || height > MAX_DIMENSION {
+            return Err(RasterError::InvalidSize {
+                width,
+                height,
+                max: MAX_DIMENSION,
+            });
+        }
+        let pixels = u64::from(width) * u64::from(height);
+        if pixels > MAX_PIXELS {
+            return Err(RasterError::TooManyPixels {
+                width,
+                height,
+                pixels,
+                max: MAX_PIXELS,
+            });
+        }
+        if self.threads == Some(0) {
+            return Err(RasterError::InvalidThreadCount(0));
+        }
+        if !self.background.iter().all(|c| c.is_finite()) {
+            return Err(RasterError::NonFiniteBackground(self.background));
+        }
+        if let Some(l) = self.light {
+            if !(l.direction.is_finite() && l.color.is_finite() && l.ambient.is_finite()) {
+                return Err(RasterError::NonFiniteLight {
+                    direction: l.direction.to_array(),
+                    color: l.color.to_array(),
+                    ambient: l.ambient.to_array(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Default for RenderSettings {
+    /// [`RenderSettings::new`] at 1280 x 720.
+    fn default() -> Self {
+        RenderSettings::new(1280, 720)
+    }
+}

@@ -1,0 +1,141 @@
+//! Colour shading: the texture's colour as the diffuse colour, times the interpolated vertex colour,
+//! optionally lit by one directional light (Lambert), and the footprint handed to the sampler.
+//!
+//! `colour = texture * vertex_colour * (ambient + light_colour * max(0, n . l))` in linear light, with
+//! `n` the perspective-correct interpolated normal, normalised. Alpha is `texture.a * vertex.a`;
+//! there is no blending (the nearest fragment replaces the pixel).
+//!
+//! Footprints: `uv` is interpolated in `f64`. For periodic address modes the sampler's result does
+//! not change when a whole period is subtracted, so `u` (`v`) is reduced modulo 1 (Repeat) or 2
+//! (MirrorRepeat) in `f64` before the conversion to `f32`: far from the origin (the ground scene
+//! reaches `|u| = 250`, 256 000 texels) this keeps the texel position exact to `f32` precision
+//! instead of losing 1/64 texel.
+
+use glam::{DVec2, DVec3, Vec3, Vec4};
+use texel_texture::{AddressMode, Footprint, Sampler, Texture};
+
+use crate::draw::{DrawCall, Vertex};
+use crate::settings::DirectionalLight;
+use crate::setup::TriangleSetup;
+
+/// Per-draw state resolved once per frame.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct DrawContext<'a> {
+    pub texture: &'a Texture,
+    pub sampler: &'a Sampler,
+    pub vertices: &'a [Vertex],
+    /// Period of u and v under the sampler's address modes (0: not periodic).
+    period: DVec2,
+    /// Whether any vertex colour differs from opaque white (skips the multiply when not).
+    colored: bool,
+}
+
+fn period(mode: AddressMode) -> f64 {
+    match mode {
+        AddressMode::Repeat => 1.0,
+        AddressMode::MirrorRepeat => 2.0,
+        _ => 0.0,
+    }
+}
+
+#[inline(always)]
+fn reduce(x: f64, p: f64) -> f64 {
+    if p > 0.0 && x.is_finite() {
+        x - p * (x / p).floor()
+    } else {
+        x
+    }
+}
+
+impl<'a> DrawContext<'a> {
+    pub fn new(draw: &DrawCall<'a>) -> Self {
+        let d = draw.sampler.descriptor();
+        DrawContext {
+            texture: draw.texture,
+            sampler: draw.sampler,
+            vertices: draw.vertices,
+            period: DVec2::new(period(d.address_mode_u), period(d.address_mode_v)),
+            colored: draw.vertices.iter().any(|v| v.color != Vec4::ONE),
+        }
+    }
+
+    /// The triangle's vertices.
+    #[inline(always)]
+    pub fn vertices(&self, t: &TriangleSetup) -> [&'a Vertex; 3] {
+        t.indices.map(|k| &self.vertices[k as usize])
+    }
+
+    /// The triangle's texture coordinates in `f64`.
+    #[inline(always)]
+    pub fn uvs(&self, t: &TriangleSetup) -> [DVec2; 3] {
+        self.vertices(t).map(|v| v.uv.as_dvec2())
+    }
+
+    /// The footprint for the sampler: `uv` reduced by whole periods, derivatives as given.
+    #[inline(always)]
+    pub fn footprint(&self, uv: DVec2, duv_dx: DVec2, duv_dy: DVec2) -> Footprint {
+        Footprint {
+            u: reduce(uv.x, self.period.x) as f32,
+            v: reduce(uv.y, self.period.y) as f32,
+            dudx: duv_dx.x as f32,
+            dudy: duv_dy.x as f32,
+            dvdx: duv_dx.y as f32,
+            dvdy: duv_dy.y as f32,
+        }
+    }
+}
+
+/// A [`DirectionalLight`] with its direction normalised once.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lighting {
+    to_light: Vec3,
+    color: Vec3,
+    ambient: Vec3,
+}
+
+impl Lighting {
+    pub fn new(light: &DirectionalLight) -> Self {
+        Lighting {
+            to_light: light.direction.normalize_or_zero(),
+            color: light.color,
+            ambient: light.ambient,
+        }
+    }
+}
+
+/// The shaded colour of a fragment with texture colour `tex` (linear RGBA) and barycentrics `lambda`.
+#[inline(always)]
+pub(crate) fn shade(
+    ctx: &DrawContext,
+    verts: [&Vertex; 3],
+    lambda: DVec3,
+    tex: [f32; 4],
+    light: Option<&Lighting>,
+) -> [f32; 4] {
+    let l = lambda.as_vec3();
+    let mut c = Vec4::from_array(tex);
+    if ctx.colored {
+        c *= verts[0].color * l.x + verts[1].color * l.y + verts[2].color * l.z;
+    }
+    if let Some(light) = light {
+        let n = (verts[0].normal * l.x + verts[1].normal * l.y + verts[2].normal * l.z)
+            .normalize_or_zero();
+        let k = light.ambient + light.color * n.dot(light.to_light).max(0.0);
+        c = (c.truncate() * k).extend(c.w);
+    }
+    c.to_array()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn periodic_reduction() {
+        assert_eq!(reduce(250.25, 1.0), 0.25);
+        assert_eq!(reduce(-0.25, 1.0), 0.75);
+        assert_eq!(reduce(-0.25, 2.0), 1.75);
+        assert_eq!(reduce(3.5, 0.0), 3.5);
+        assert!(reduce(f64::NAN, 1.0).is_nan());
+    }
+}

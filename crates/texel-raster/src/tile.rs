@@ -1,0 +1,306 @@
+//! Screen tiles: binning triangles to 64x64 tiles and rasterising the tiles in parallel (rayon).
+//!
+//! Design decisions:
+//! - Every frame buffer is split, without copying, into per-tile row slices (`chunks_mut`), so tiles
+//!   are written in place by whichever thread renders them; no locks, no `unsafe`, no final copy.
+//! - Each tile processes its triangles in submission order (draw, then triangle, then sub-triangle)
+//!   and every per-pixel computation depends only on the pixel and the triangle, so the image is bit
+//!   for bit the same for any thread count and any scheduling.
+//! - Fragments are depth-tested (`z < depth`, `f32`, `+inf` cleared) before any interpolation or
+//!   sampling, so hidden fragments cost only their edge and depth test.
+//! - Coverage in the analytic mode steps the three integer edge functions incrementally along each
+//!   row (three adds per pixel); the quad mode evaluates 2x2 aligned quads (tiles have even origins,
+//!   so quads never straddle tiles) and interpolates all four pixels of a touched quad.
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+use texel_texture::Footprint;
+
+use crate::draw::DrawCall;
+use crate::frame::Frame;
+use crate::interp::quad_differences;
+use crate::settings::{Derivatives, RenderSettings, View};
+use crate::setup::{pixel_center_fixed, setup_draws, TriangleSetup, SUBPIXEL};
+use crate::shade::{shade, DrawContext, Lighting};
+use crate::views;
+use crate::RasterError;
+
+/// Tile side in pixels (even, so 2x2 quads never straddle tiles).
+pub const TILE: u32 = 64;
+
+/// Number of tiles across and down a `width x height` frame.
+pub(crate) fn tile_counts(width: u32, height: u32) -> (u32, u32) {
+    (width.div_ceil(TILE), height.div_ceil(TILE))
+}
+
+/// For each tile (row-major), the indices of the setups whose bounding box overlaps it, in order.
+pub(crate) fn bin(setups: &[TriangleSetup], width: u32, height: u32) -> Vec<Vec<u32>> {
+    let (tx, ty) = tile_counts(width, height);
+    let mut bins = vec![Vec::new(); (tx * ty) as usize];
+    for (s, t) in setups.iter().enumerate() {
+        let [i0, j0, i1, j1] = t.bbox;
+        for by in j0 / TILE..=j1 / TILE {
+            for bx in i0 / TILE..=i1 / TILE {
+                bins[(by * tx + bx) as usize].push(s as u32);
+            }
+        }
+    }
+    bins
+}
+
+/// Split a row-major `width`-wide buffer into per-tile lists of row slices (row-major tile order).
+/// An empty buffer gives empty lists.
+pub(crate) fn split_rows<T>(buf: &mut [T], width: u32, height: u32) -> Vec<Vec<&mut [T]>> {
+    let (tx, ty) = tile_counts(width, height);
+    let mut tiles: Vec<Vec<&mut [T]>> = (0..tx * ty).map(|_| Vec::new()).collect();
+    if buf.is_empty() {
+        return tiles;
+    }
+    for (j, row) in buf.chunks_mut(width as usize).enumerate() {
+        let band = j as u32 / TILE;
+        for (b, seg) in row.chunks_mut(TILE as usize).enumerate() {
+            tiles[(band * tx) as usize + b].push(seg);
+        }
+    }
+    tiles
+}
+
+/// One tile's share of the frame's buffers.
+struct TileTarget<'f> {
+    x0: u32,
+    y0: u32,
+    w: u32,
+    h: u32,
+    color: Vec<&'f mut [[f32; 4]]>,
+    depth: Vec<&'f mut [f32]>,
+    coverage: Vec<&'f mut [bool]>,
+    texels: Vec<&'f mut [u32]>,
+    footprints: Vec<&'f mut [Footprint]>,
+}
+
+/// Everything shared by the tiles of one frame.
+struct Context<'a> {
+    settings: &'a RenderSettings,
+    setups: &'a [TriangleSetup],
+    draws: Vec<DrawContext<'a>>,
+    light: Option<Lighting>,
+    counting: bool,
+    capture: bool,
+}
+
+/// What the fragment stage needs besides the pixel: barycentrics and the footprint's inputs.
+struct Fragment {
+    lambda: DVec3,
+    uv: DVec2,
+    duv_dx: DVec2,
+    duv_dy: DVec2,
+    z: f32,
+}
+
+/// Render a frame on the current rayon pool (validation is the caller's).
+pub(crate) fn render_frame(
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+) -> Result<Frame, RasterError> {
+    let (width, height) = (settings.width, settings.height);
+    let setups = setup_draws(settings, draws)?;
+    let bins = bin(&setups, width, height);
+    let n = width as usize * height as usize;
+    let counting = settings.counts_texels();
+    let capture = settings.capture_footprints;
+    let mut frame = Frame {
+        width,
+        height,
+        color: vec![settings.background; n],
+        texels_read: if counting { vec![0; n] } else { Vec::new() },
+        coverage: vec![false; n],
+        depth: vec![f32::INFINITY; n],
+        footprints: if capture {
+            vec![Footprint::default(); n]
+        } else {
+            Vec::new()
+        },
+    };
+    let ctx = Context {
+        settings,
+        setups: &setups,
+        draws: draws.iter().map(DrawContext::new).collect(),
+        light: settings.light.as_ref().map(Lighting::new),
+        counting,
+        capture,
+    };
+    let (tx, _) = tile_counts(width, height);
+    let mut color = split_rows(&mut frame.color, width, height).into_iter();
+    let mut depth = split_rows(&mut frame.depth, width, height).into_iter();
+    let mut coverage = split_rows(&mut frame.coverage, width, height).into_iter();
+    let mut texels = split_rows(&mut frame.texels_read, width, height).into_iter();
+    let mut footprints = split_rows(&mut frame.footprints, width, height).into_iter();
+    let mut tiles = Vec::with_capacity(bins.len());
+    for k in 0..bins.len() as u32 {
+        let (x0, y0) = ((k % tx) * TILE, (k / tx) * TILE);
+        tiles.push(TileTarget {
+            x0,
+            y0,
+            w: TILE.min(width - x0),
+            h: TILE.min(height - y0),
+            color: color.next().unwrap_or_default(),
+            depth: depth.next().unwrap_or_default(),
+            coverage: coverage.next().unwrap_or_default(),
+            texels: texels.next().unwrap_or_default(),
+            footprints: footprints.next().unwrap_or_default(),
+        });
+    }
+    tiles
+        .par_iter_mut()
+        .zip(bins.par_iter())
+        .with_max_len(1)
+        .for_each(|(tile, bin)| raster_tile(&ctx, tile, bin));
+    Ok(frame)
+}
+
+fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[u32]) {
+    for &s in bin {
+        let t = &ctx.setups[s as usize];
+        let [bi0, bj0, bi1, bj1] = t.bbox;
+        let (i_lo, i_hi) = (bi0.max(tile.x0), bi1.min(tile.x0 + tile.w - 1));
+        let (j_lo, j_hi) = (bj0.max(tile.y0), bj1.min(tile.y0 + tile.h - 1));
+        if i_lo > i_hi || j_lo > j_hi {
+            continue;
+        }
+        let range = [i_lo, j_lo, i_hi, j_hi];
+        match ctx.settings.derivatives {
+            Derivatives::Analytic => raster_pixels(ctx, tile, t, range),
+            Derivatives::Quad => raster_quads(ctx, tile, t, range),
+        }
+    }
+}
+
+/// Analytic derivatives: walk the pixels of `range`, stepping the edge functions along rows.
+fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: [u32; 4]) {
+    let [i_lo, j_lo, i_hi, j_hi] = range;
+    let dc = &ctx.draws[t.draw as usize];
+    let uvs = dc.uvs(t);
+    let step = t.edges.map(|e| e.a * SUBPIXEL);
+    let x_start = pixel_center_fixed(i_lo);
+    let perspective = ctx.settings.perspective;
+    for j in j_lo..=j_hi {
+        let y_fixed = pixel_center_fixed(j);
+        let mut e = t.edges.map(|e| e.at(x_start, y_fixed));
+        let y = f64::from(j) + 0.5;
+        let lj = (j - tile.y0) as usize;
+        for i in i_lo..=i_hi {
+            if (e[0] | e[1] | e[2]) >= 0 {
+                let x = f64::from(i) + 0.5;
+                let li = (i - tile.x0) as usize;
+                let z = t.depth_at(x, y) as f32;
+                if z < tile.depth[lj][li] {
+                    let b = t.barycentrics(x, y, perspective);
+                    let (duv_dx, duv_dy) = b.derivatives2(uvs);
+                    let f = Fragment {
+                        lambda: b.lambda,
+                        uv: b.interpolate2(uvs),
+                        duv_dx,
+                        duv_dy,
+                        z,
+                    };
+                    write_fragment(ctx, dc, t, tile, li, lj, &f);
+                }
+            }
+            e[0] += step[0];
+            e[1] += step[1];
+            e[2] += step[2];
+        }
+    }
+}
+
+/// Quad derivatives: walk aligned 2x2 quads; a quad with any covered pixel interpolates all four.
+fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: [u32; 4]) {
+    let [i_lo, j_lo, i_hi, j_hi] = range;
+    let dc = &ctx.draws[t.draw as usize];
+    let uvs = dc.uvs(t);
+    let perspective = ctx.settings.perspective;
+    for qj in (j_lo & !1..=j_hi).step_by(2) {
+        for qi in (i_lo & !1..=i_hi).step_by(2) {
+            let mut mask = 0u32;
+            let mut z = [0.0f32; 4];
+            for k in 0..4u32 {
+                let (i, j) = (qi + (k & 1), qj + (k >> 1));
+                if i < i_lo || i > i_hi || j < j_lo || j > j_hi {
+                    continue;
+                }
+                let (xf, yf) = (pixel_center_fixed(i), pixel_center_fixed(j));
+                if t.edges.iter().all(|e| e.at(xf, yf) >= 0) {
+                    let zk = t.depth_at(f64::from(i) + 0.5, f64::from(j) + 0.5) as f32;
+                    let (li, lj) = ((i - tile.x0) as usize, (j - tile.y0) as usize);
+                    if zk < tile.depth[lj][li] {
+                        mask |= 1 << k;
+                        z[k as usize] = zk;
+                    }
+                }
+            }
+            if mask == 0 {
+                continue;
+            }
+            let lambda: [DVec3; 4] = std::array::from_fn(|k| {
+                let x = f64::from(qi + (k as u32 & 1)) + 0.5;
+                let y = f64::from(qj + (k as u32 >> 1)) + 0.5;
+                t.lambda_at(x, y, perspective)
+            });
+            let uv = lambda.map(|l| uvs[0] * l.x + uvs[1] * l.y + uvs[2] * l.z);
+            let d = quad_differences(uv);
+            for k in 0..4usize {
+                if mask & (1 << k) != 0 {
+                    let (i, j) = (qi + (k as u32 & 1), qj + (k as u32 >> 1));
+                    let f = Fragment {
+                        lambda: lambda[k],
+                        uv: uv[k],
+                        duv_dx: d[k].0,
+                        duv_dy: d[k].1,
+                        z: z[k],
+                    };
+                    let (li, lj) = ((i - tile.x0) as usize, (j - tile.y0) as usize);
+                    write_fragment(ctx, dc, t, tile, li, lj, &f);
+                }
+            }
+        }
+    }
+}
+
+/// Shade a fragment that passed the depth test and write it to the tile.
+#[inline(always)]
+fn write_fragment(
+    ctx: &Context,
+    dc: &DrawContext,
+    t: &TriangleSetup,
+    tile: &mut TileTarget,
+    li: usize,
+    lj: usize,
+    f: &Fragment,
+) {
+    let fp = dc.footprint(f.uv, f.duv_dx, f.duv_dy);
+    let (tex, count) = if ctx.counting {
+        dc.sampler.sample_counted(dc.texture, &fp)
+    } else if ctx.settings.view == View::Color {
+        (dc.sampler.sample(dc.texture, &fp), 0)
+    } else {
+        ([0.0; 4], 0)
+    };
+    let color = match ctx.settings.view {
+        View::Color => shade(dc, dc.vertices(t), f.lambda, tex, ctx.light.as_ref()),
+        View::Uv => views::uv_color(f.uv.x, f.uv.y),
+        View::Mip => views::mip_color(dc.sampler, dc.texture, &fp),
+        View::Lod => views::lod_color(dc.sampler, dc.texture, &fp),
+        View::Aniso => views::aniso_color(dc.texture, &fp),
+        View::Fetches => views::fetches_color(count),
+        View::Barycentric => views::barycentric_color(f.lambda),
+    };
+    tile.color[lj][li] = color;
+    tile.depth[lj][li] = f.z;
+    tile.coverage[lj][li] = true;
+    if ctx.counting {
+        tile.texels[lj][li] = count;
+    }
+    if ctx.capture {
+        tile.footprints[lj][li] = fp;
+    }
+}

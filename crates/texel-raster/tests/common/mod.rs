@@ -1,0 +1,151 @@
+//! Shared test scenes: the ground plane of `shared/scenes/ground.toml`, built inline.
+#![allow(dead_code)]
+
+use glam::{DMat4, DVec2, DVec4, Mat4, Vec2, Vec3};
+use texel_raster::{camera, DrawCall, Vertex};
+use texel_texture::{AddressMode, ColorSpace, Limits, Sampler, SamplerDescriptor, Texture};
+
+/// The ground scene's camera.
+pub const EYE: Vec3 = Vec3::new(0.0, 1.0, 0.0);
+pub const TARGET: Vec3 = Vec3::new(0.0, 0.75, -10.0);
+
+/// A `size x size` checker of `checks x checks` squares; texel (0, 0) lies in a black check. sRGB.
+pub fn checker(size: u32, checks: u32) -> Texture {
+    let cell = size / checks;
+    let texels = (0..size * size)
+        .map(|k| {
+            let (i, j) = (k % size, k / size);
+            if (i / cell + j / cell) % 2 == 0 {
+                [0, 0, 0, 255]
+            } else {
+                [255, 255, 255, 255]
+            }
+        })
+        .collect();
+    Texture::from_rgba8(size, size, texels, ColorSpace::Srgb, &Limits::default()).unwrap()
+}
+
+/// A Repeat sampler from a lab mode (1 nearest, 2 bilinear, 3 mip nearest, 4 trilinear).
+pub fn lab_sampler(mode: u8) -> Sampler {
+    Sampler::new(
+        SamplerDescriptor::lab_mode(mode)
+            .unwrap()
+            .with_address_mode(AddressMode::Repeat),
+    )
+    .unwrap()
+}
+
+/// The ground scene's geometry and camera for a `width x height` frame.
+pub struct Ground {
+    pub vertices: Vec<Vertex>,
+    pub triangles: Vec<[u32; 3]>,
+    pub texture: Texture,
+    pub clip_from_world: Mat4,
+}
+
+impl Ground {
+    pub fn new(width: u32, height: u32) -> Self {
+        Self::with_texture(width, height, checker(1024, 8))
+    }
+
+    pub fn with_texture(width: u32, height: u32, texture: Texture) -> Self {
+        let positions = [
+            [-500.0, 0.0, 1.0],
+            [500.0, 0.0, 1.0],
+            [500.0, 0.0, -1000.0],
+            [-500.0, 0.0, -1000.0],
+        ];
+        let uvs = [
+            [-250.0, -0.5],
+            [250.0, -0.5],
+            [250.0, 500.0],
+            [-250.0, 500.0],
+        ];
+        let vertices = positions
+            .iter()
+            .zip(uvs)
+            .map(|(p, uv)| Vertex::new(Vec3::from_array(*p), Vec2::from_array(uv)))
+            .collect();
+        let proj = camera::perspective(
+            50f32.to_radians(),
+            width as f32 / height as f32,
+            0.05,
+            2000.0,
+        );
+        Ground {
+            vertices,
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            texture,
+            clip_from_world: proj * camera::look_at(EYE, TARGET, Vec3::Y),
+        }
+    }
+
+    pub fn draw<'a>(&'a self, sampler: &'a Sampler) -> DrawCall<'a> {
+        DrawCall {
+            vertices: &self.vertices,
+            triangles: &self.triangles,
+            texture: &self.texture,
+            sampler,
+            clip_from_world: self.clip_from_world,
+        }
+    }
+
+    /// The exact uv where the ray through pixel coordinates `(x, y)` meets the ground plane `y = 0`
+    /// (`u = X / 2`, `v = -Z / 2` from the scene's positions and uvs), or `None` above the horizon.
+    pub fn analytic_uv(&self, x: f64, y: f64, width: u32, height: u32) -> Option<DVec2> {
+        let world_from_clip: DMat4 = self.clip_from_world.as_dmat4().inverse();
+        let x_ndc = 2.0 * x / f64::from(width) - 1.0;
+        let y_ndc = 1.0 - 2.0 * y / f64::from(height);
+        let far = world_from_clip * DVec4::new(x_ndc, y_ndc, 1.0, 1.0);
+        let far = far.truncate() / far.w;
+        let eye = EYE.as_dvec3();
+        let dir = far - eye;
+        if dir.y >= 0.0 {
+            return None;
+        }
+        let t = -eye.y / dir.y;
+        let p = eye + dir * t;
+        Some(DVec2::new(p.x / 2.0, -p.z / 2.0))
+    }
+}
+
+/// A tiny deterministic generator for test geometry (SplitMix64).
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A vertex given in pixel coordinates of a `width x height` frame, for `clip_from_world = I`.
+pub fn screen_vertex(x: f64, y: f64, width: u32, height: u32) -> Vertex {
+    let xn = 2.0 * x / f64::from(width) - 1.0;
+    let yn = 1.0 - 2.0 * y / f64::from(height);
+    Vertex::new(
+        Vec3::new(xn as f32, yn as f32, 0.0),
+        Vec2::new(
+            (x / f64::from(width)) as f32,
+            (y / f64::from(height)) as f32,
+        ),
+    )
+}
+
+/// A 1x1 white texture and a nearest sampler.
+pub fn white() -> (Texture, Sampler) {
+    (
+        Texture::from_fn(
+            1,
+            1,
+            texel_texture::Format::Rgba8Unorm,
+            &Limits::default(),
+            |_, _| [1.0; 4],
+        )
+        .unwrap(),
+        Sampler::new(SamplerDescriptor::default()).unwrap(),
+    )
+}
