@@ -1,0 +1,358 @@
+//! The report as one self-contained `index.html`: no scripts, no external styles or fonts; the
+//! images are the PNG files next to it, the chart and legend are inline SVG written by hand.
+//!
+//! Every piece of text that comes from outside (scene name, filter names, labels, file names) goes
+//! through [`escape`], so a label like `<b>` is shown, never interpreted.
+//!
+//! The chart plots quality (PSNR over the covered pixels, dB, linear axis) against time
+//! (ms per frame, logarithmic axis, decades with 1-2-5 ticks), one labelled point per timed filter.
+//! External images have no time: each is drawn as a dashed horizontal line at its PSNR, labelled.
+//! Rows with infinite PSNR (identical to the reference) cannot be placed and are listed under it.
+
+use crate::heatmap::legend_svg;
+use crate::report::{fmt_psnr, row_cells, Report, TABLE_HEADER};
+
+/// Escape text for HTML/SVG text and attribute values: `& < > " '`.
+pub fn escape(s: &str) -> String {
+    let mut o = String::with_capacity(s.len());
+    for ch in s.chars() {
+        match ch {
+            '&' => o += "&amp;",
+            '<' => o += "&lt;",
+            '>' => o += "&gt;",
+            '"' => o += "&quot;",
+            '\'' => o += "&#39;",
+            c => o.push(c),
+        }
+    }
+    o
+}
+
+/// Chart geometry in SVG pixels.
+const CW: f64 = 760.0;
+const CH: f64 = 420.0;
+const LEFT: f64 = 64.0;
+const RIGHT: f64 = 170.0;
+const TOP: f64 = 20.0;
+const BOTTOM: f64 = 52.0;
+
+/// A "nice" tick step (1, 2 or 5 times a power of ten) giving at most about 8 ticks over `span`.
+fn nice_step(span: f64) -> f64 {
+    let raw = (span / 8.0).max(1e-9);
+    let p = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * p)
+        .find(|&s| s >= raw)
+        .unwrap_or(10.0 * p)
+}
+
+fn num(v: f64) -> String {
+    let s = format!("{v:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+/// The quality-against-time scatter chart of `report` as an SVG element (module docs).
+pub fn chart_svg(report: &Report) -> String {
+    let timed: Vec<(&str, f64, f64)> = report
+        .rows
+        .iter()
+        .filter_map(|r| match r.ms_per_frame {
+            Some(ms) if ms > 0.0 && ms.is_finite() && r.psnr_all.is_finite() => {
+                Some((r.name.as_str(), ms, r.psnr_all))
+            }
+            _ => None,
+        })
+        .collect();
+    let lines: Vec<(&str, f64)> = report
+        .rows
+        .iter()
+        .filter(|r| r.ms_per_frame.is_none() && r.psnr_all.is_finite())
+        .map(|r| (r.name.as_str(), r.psnr_all))
+        .collect();
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{CW}\" height=\"{CH}\" viewBox=\"0 0 {CW} {CH}\" role=\"img\" aria-label=\"PSNR against time per filter\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    );
+    if timed.is_empty() && lines.is_empty() {
+        s += &format!(
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">no rows with a finite PSNR to plot</text>\n</svg>\n",
+            CW / 2.0,
+            CH / 2.0
+        );
+        return s;
+    }
+    // x: decades around the timed points (one decade 1..10 ms when there are none).
+    let (mut lx0, mut lx1) = timed.iter().fold((f64::MAX, f64::MIN), |(a, b), t| {
+        (a.min(t.1.log10()), b.max(t.1.log10()))
+    });
+    if timed.is_empty() {
+        (lx0, lx1) = (0.0, 1.0);
+    }
+    let (dx0, mut dx1) = (lx0.floor(), lx1.ceil());
+    if dx1 <= dx0 {
+        dx1 = dx0 + 1.0;
+    }
+    // y: padded range of every PSNR shown, snapped to the tick step.
+    let ys = timed.iter().map(|t| t.2).chain(lines.iter().map(|l| l.1));
+    let (y0, y1) = ys.fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(y), b.max(y)));
+    let step = nice_step((y1 - y0).max(1.0) + 2.0);
+    let (ya, yb) = (
+        ((y0 - 1.0) / step).floor() * step,
+        ((y1 + 1.0) / step).ceil() * step,
+    );
+    let pw = CW - LEFT - RIGHT;
+    let ph = CH - TOP - BOTTOM;
+    let px = |ms: f64| LEFT + (ms.log10() - dx0) / (dx1 - dx0) * pw;
+    let py = |db: f64| TOP + (yb - db) / (yb - ya) * ph;
+    s += &format!(
+        "<rect x=\"{LEFT}\" y=\"{TOP}\" width=\"{pw}\" height=\"{ph}\" fill=\"#fff\" stroke=\"#888\"/>\n"
+    );
+    // x ticks: 1, 2, 5 per decade.
+    let mut d = dx0;
+    while d <= dx1 + 1e-9 {
+        for m in [1.0, 2.0, 5.0] {
+            let ms = m * 10f64.powf(d);
+            if ms.log10() > dx1 + 1e-9 {
+                continue;
+            }
+            let x = px(ms);
+            let major = m == 1.0;
+            s += &format!(
+                "<line x1=\"{x:.1}\" y1=\"{TOP}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"{}\"/>\n<text x=\"{x:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text>\n",
+                TOP + ph,
+                if major { "#ccc" } else { "#eee" },
+                TOP + ph + 16.0,
+                num(ms)
+            );
+        }
+        d += 1.0;
+    }
+    // y ticks.
+    let mut y = ya;
+    while y <= yb + 1e-9 {
+        let yy = py(y);
+        s += &format!(
+            "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#ddd\"/>\n<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>\n",
+            LEFT + pw,
+            LEFT - 6.0,
+            yy + 4.0,
+            num(y)
+        );
+        y += step;
+    }
+    s += &format!(
+        "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">time per frame (ms, log scale)</text>\n<text transform=\"translate(16 {:.1}) rotate(-90)\" text-anchor=\"middle\">PSNR over the covered pixels (dB)</text>\n",
+        LEFT + pw / 2.0,
+        CH - 10.0,
+        TOP + ph / 2.0
+    );
+    for (name, db) in &lines {
+        let yy = py(*db);
+        s += &format!(
+            "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#c0392b\" stroke-dasharray=\"6 4\"/>\n<text x=\"{:.1}\" y=\"{:.1}\" fill=\"#c0392b\">{} ({} dB, no time)</text>\n",
+            LEFT + pw,
+            LEFT + pw + 6.0,
+            yy + 4.0,
+            escape(name),
+            fmt_psnr(*db)
+        );
+    }
+    for (name, ms, db) in &timed {
+        let (x, yy) = (px(*ms), py(*db));
+        s += &format!(
+            "<circle cx=\"{x:.1}\" cy=\"{yy:.1}\" r=\"4\" fill=\"#1f77b4\"><title>{}: {} dB, {} ms</title></circle>\n<text x=\"{:.1}\" y=\"{:.1}\">{}</text>\n",
+            escape(name),
+            fmt_psnr(*db),
+            num(*ms),
+            x + 6.0,
+            yy - 6.0,
+            escape(name)
+        );
+    }
+    s += "</svg>\n";
+    s
+}
+
+fn img(src: &str, alt: &str) -> String {
+    format!(
+        "<img src=\"{}\" alt=\"{}\" loading=\"lazy\">",
+        escape(src),
+        escape(alt)
+    )
+}
+
+impl Report {
+    /// The self-contained HTML page (module docs): settings, the table, the chart, the heat-map
+    /// legend, then one card per image with its heat map and enlarged horizon crop.
+    pub fn to_html(&self) -> String {
+        let title = format!("texel filter report: {}", self.scene);
+        let mut s = format!(
+            "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>{}</title>\n<style>\n\
+             body {{ font-family: sans-serif; margin: 1.5em; color: #222; }}\n\
+             table {{ border-collapse: collapse; }}\n\
+             th, td {{ border: 1px solid #ccc; padding: 0.25em 0.6em; }}\n\
+             td {{ text-align: right; font-variant-numeric: tabular-nums; }}\n\
+             td:first-child {{ text-align: left; }}\n\
+             .grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}\n\
+             figure {{ margin: 0; max-width: 420px; }}\n\
+             figure img {{ width: 100%; image-rendering: pixelated; display: block; margin-bottom: 0.3em; }}\n\
+             figcaption {{ font-size: 0.9em; }}\n\
+             </style>\n</head>\n<body>\n<h1>{}</h1>\n",
+            escape(&title),
+            escape(&title)
+        );
+        s += &format!(
+            "<p>{}x{} pixels; reference: {} samples per pixel; colour: {}. PSNR and SSIM against the \
+             reference over the pixels the geometry covers; the band is the {} covered rows below the \
+             horizon (the top of the coverage in each column). Rows marked (extra) are images rendered \
+             elsewhere: they have no time, texel or memory numbers.</p>\n",
+            self.width,
+            self.height,
+            self.spp,
+            escape(&self.color),
+            self.band_rows
+        );
+        s += "<table>\n<tr>";
+        for h in TABLE_HEADER {
+            s += &format!("<th>{}</th>", escape(h));
+        }
+        s += "</tr>\n";
+        for r in &self.rows {
+            s += "<tr>";
+            for c in row_cells(r) {
+                s += &format!("<td>{}</td>", escape(&c));
+            }
+            s += "</tr>\n";
+        }
+        s += "</table>\n<h2>Quality against time</h2>\n";
+        s += &chart_svg(self);
+        let identical: Vec<&str> = self
+            .rows
+            .iter()
+            .filter(|r| r.psnr_all.is_infinite())
+            .map(|r| r.name.as_str())
+            .collect();
+        if !identical.is_empty() {
+            s += &format!(
+                "<p>Not plotted (identical to the reference, infinite PSNR): {}.</p>\n",
+                escape(&identical.join(", "))
+            );
+        }
+        s += &format!(
+            "<h2>Images</h2>\n<p>Each card: the image, its error heat map (mean absolute RGB error in \
+             8-bit units on the viridis ramp; black is not covered) and the horizon enlarged with \
+             nearest neighbour.</p>\n{}",
+            legend_svg(self.heat_map_max, 360)
+        );
+        s += "<div class=\"grid\">\n";
+        s += "<figure>";
+        s += &img(&self.reference_image, "reference");
+        if let Some(c) = &self.reference_crop {
+            s += &img(c, "reference, horizon enlarged");
+        }
+        s += &format!(
+            "<figcaption>reference ({} spp)</figcaption></figure>\n",
+            self.spp
+        );
+        for r in &self.rows {
+            s += "<figure>";
+            s += &img(&r.image, &r.name);
+            if let Some(h) = &r.heat_map {
+                s += &img(h, &format!("{}: error heat map", r.name));
+            }
+            if let Some(c) = &r.horizon_crop {
+                s += &img(c, &format!("{}: horizon enlarged", r.name));
+            }
+            s += &format!(
+                "<figcaption>{}{}: {} dB, band {} dB, SSIM {:.4}</figcaption></figure>\n",
+                escape(&r.name),
+                if r.extra { " (extra)" } else { "" },
+                fmt_psnr(r.psnr_all),
+                fmt_psnr(r.psnr_band),
+                r.ssim
+            );
+        }
+        s += "</div>\n</body>\n</html>\n";
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::tests::sample;
+
+    #[test]
+    fn escapes_everything() {
+        assert_eq!(
+            escape("<a href=\"x\">&'</a>"),
+            "&lt;a href=&quot;x&quot;&gt;&amp;&#39;&lt;/a&gt;"
+        );
+        let mut r = sample();
+        r.scene = "<script>alert(1)</script>".into();
+        r.rows[0].image = "a\"onerror=\"x.png".into();
+        let h = r.to_html();
+        assert!(!h.contains("<script>"));
+        assert!(h.contains("&lt;script&gt;"));
+        assert!(!h.contains("a\"onerror"));
+        assert!(h.contains("gpu &lt;a|b&gt;"));
+    }
+
+    #[test]
+    fn page_structure() {
+        let h = sample().to_html();
+        assert!(h.starts_with("<!DOCTYPE html>"));
+        assert!(h.trim_end().ends_with("</html>"));
+        assert!(
+            !h.contains("http://")
+                || h.matches("http://").count()
+                    == h.matches("xmlns=\"http://www.w3.org/2000/svg\"").count()
+        );
+        for f in [
+            "reference.png",
+            "reference_crop.png",
+            "trilinear.png",
+            "trilinear_error.png",
+            "trilinear_crop.png",
+            "extra_gpu.png",
+        ] {
+            assert!(h.contains(&format!("src=\"{f}\"")), "{f}");
+        }
+        assert_eq!(h.matches("<tr>").count(), 5);
+        assert!(h.contains("Not plotted (identical to the reference, infinite PSNR): self."));
+    }
+
+    #[test]
+    fn chart_places_points() {
+        let svg = chart_svg(&sample());
+        // Two timed finite rows, one dashed line for the extra.
+        assert_eq!(svg.matches("<circle").count(), 2);
+        assert_eq!(svg.matches("stroke-dasharray").count(), 1);
+        // Time 3 ms and 12.5 ms on decades 1..100: x = LEFT + log10(ms) / 2 * width.
+        let pw = CW - LEFT - RIGHT;
+        let want = LEFT + 3f64.log10() / 2.0 * pw;
+        assert!(svg.contains(&format!("cx=\"{want:.1}\"")), "{svg}");
+        // Higher PSNR is higher on the page (smaller y).
+        let cy = |name: &str| -> f64 {
+            let i = svg.find(&format!("<title>{name}:")).unwrap();
+            let pre = &svg[..i];
+            let c = pre.rfind("cy=\"").unwrap();
+            pre[c + 4..].split('"').next().unwrap().parse().unwrap()
+        };
+        assert!(cy("trilinear") < cy("nearest"));
+        let empty = Report {
+            rows: vec![],
+            ..sample()
+        };
+        assert!(chart_svg(&empty).contains("no rows"));
+    }
+
+    #[test]
+    fn nice_steps() {
+        assert_eq!(nice_step(8.0), 1.0);
+        assert_eq!(nice_step(15.0), 2.0);
+        assert_eq!(nice_step(30.0), 5.0);
+        assert_eq!(nice_step(0.8), 0.1);
+    }
+}

@@ -1,0 +1,298 @@
+//! [`Image8`]: the 8-bit RGBA display image every measurement in this crate works on.
+//!
+//! Decision: quality is measured on what a person sees and what the CLI writes to disk — the 8-bit
+//! encoded values — not on linear floats. A linear `f32` frame is first quantised exactly as the
+//! CLI quantises its output ([`Encoding::Srgb`]: `texel_texture::color::linear_to_srgb8`, or
+//! [`Encoding::Linear`] for `--color raw`: `unorm8`), so that scores recomputed from the PNG files
+//! equal the reported ones bit for bit.
+
+use std::path::Path;
+
+use texel_texture::color::{linear_to_srgb8, unorm8};
+
+use crate::error::QualityError;
+use crate::MAX_SIDE;
+
+/// How linear RGBA floats become 8-bit display values.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Encoding {
+    /// RGB through the sRGB OETF (IEC 61966-2-1), alpha linear. Linear 0.2159 -> code 128.
+    #[default]
+    Srgb,
+    /// Every channel `round(255 * x)`, clamped (the CLI's `--color raw`). 0.5 -> code 128.
+    Linear,
+}
+
+/// A row-major 8-bit RGBA image; row 0 is the top. Sides are `1..=MAX_SIDE`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image8 {
+    width: u32,
+    height: u32,
+    pixels: Vec<[u8; 4]>,
+}
+
+/// Check `width x height` against the size rules and return the pixel count.
+pub(crate) fn checked_len(width: u32, height: u32) -> Result<usize, QualityError> {
+    if width == 0 || height == 0 {
+        return Err(QualityError::EmptyImage { width, height });
+    }
+    if width > MAX_SIDE || height > MAX_SIDE {
+        return Err(QualityError::TooLarge {
+            width,
+            height,
+            max: MAX_SIDE,
+        });
+    }
+    Ok(width as usize * height as usize)
+}
+
+pub(crate) fn check_same(a: (u32, u32), b: (u32, u32)) -> Result<(), QualityError> {
+    if a != b {
+        return Err(QualityError::SizeMismatch {
+            a_width: a.0,
+            a_height: a.1,
+            b_width: b.0,
+            b_height: b.1,
+        });
+    }
+    Ok(())
+}
+
+impl Image8 {
+    /// An image from row-major pixels.
+    ///
+    /// # Errors
+    /// [`QualityError::EmptyImage`], [`QualityError::TooLarge`], [`QualityError::DataLength`].
+    pub fn new(width: u32, height: u32, pixels: Vec<[u8; 4]>) -> Result<Self, QualityError> {
+        let expected = checked_len(width, height)?;
+        if pixels.len() != expected {
+            return Err(QualityError::DataLength {
+                width,
+                height,
+                expected,
+                got: pixels.len(),
+            });
+        }
+        Ok(Image8 {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    /// An image from packed `RGBARGBA...` bytes (`4 * width * height` of them).
+    ///
+    /// # Errors
+    /// As [`Image8::new`]; the length is checked in bytes.
+    pub fn from_rgba_bytes(width: u32, height: u32, bytes: &[u8]) -> Result<Self, QualityError> {
+        let n = checked_len(width, height)?;
+        if bytes.len() != 4 * n {
+            return Err(QualityError::DataLength {
+                width,
+                height,
+                expected: 4 * n,
+                got: bytes.len(),
+            });
+        }
+        let pixels = bytes
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2], p[3]])
+            .collect();
+        Self::new(width, height, pixels)
+    }
+
+    /// Quantise a linear RGBA `f32` frame with `encoding` (see the module docs). Values outside
+    /// `[0, 1]` clamp; NaN becomes 0.
+    ///
+    /// # Errors
+    /// As [`Image8::new`].
+    pub fn from_linear(
+        width: u32,
+        height: u32,
+        pixels: &[[f32; 4]],
+        encoding: Encoding,
+    ) -> Result<Self, QualityError> {
+        let n = checked_len(width, height)?;
+        if pixels.len() != n {
+            return Err(QualityError::DataLength {
+                width,
+                height,
+                expected: n,
+                got: pixels.len(),
+            });
+        }
+        let px = pixels
+            .iter()
+            .map(|c| match encoding {
+                Encoding::Srgb => [
+                    linear_to_srgb8(c[0]),
+                    linear_to_srgb8(c[1]),
+                    linear_to_srgb8(c[2]),
+                    unorm8(c[3]),
+                ],
+                Encoding::Linear => [unorm8(c[0]), unorm8(c[1]), unorm8(c[2]), unorm8(c[3])],
+            })
+            .collect();
+        Self::new(width, height, px)
+    }
+
+    /// An image of one colour.
+    ///
+    /// # Errors
+    /// [`QualityError::EmptyImage`], [`QualityError::TooLarge`].
+    pub fn filled(width: u32, height: u32, rgba: [u8; 4]) -> Result<Self, QualityError> {
+        let n = checked_len(width, height)?;
+        Self::new(width, height, vec![rgba; n])
+    }
+
+    /// An image whose pixel `(x, y)` is `f(x, y)`.
+    ///
+    /// # Errors
+    /// [`QualityError::EmptyImage`], [`QualityError::TooLarge`].
+    pub fn from_fn(
+        width: u32,
+        height: u32,
+        f: impl Fn(u32, u32) -> [u8; 4],
+    ) -> Result<Self, QualityError> {
+        checked_len(width, height)?;
+        let px = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| f(x, y))
+            .collect();
+        Self::new(width, height, px)
+    }
+
+    /// Decode an image file (PNG, JPEG, ...; format from the content) to 8-bit RGBA — for images
+    /// rendered elsewhere (`--extra LABEL=IMAGE`). 16-bit files are reduced to 8 bits by the `image`
+    /// crate (`round(v / 257)`); grey and RGB gain opaque alpha.
+    ///
+    /// # Errors
+    /// [`QualityError::Io`] / [`QualityError::Image`] carrying the path; the size errors.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, QualityError> {
+        let path = path.as_ref();
+        let img_err = |source| QualityError::Image {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut reader = image::ImageReader::open(path)
+            .map_err(|source| QualityError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?
+            .with_guessed_format()
+            .map_err(|source| QualityError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(MAX_SIDE);
+        limits.max_image_height = Some(MAX_SIDE);
+        reader.limits(limits);
+        let img = reader.decode().map_err(img_err)?.into_rgba8();
+        let (w, h) = img.dimensions();
+        Self::from_rgba_bytes(w, h, img.as_raw())
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// `(width, height)` in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The pixels, row-major, row 0 at the top.
+    pub fn pixels(&self) -> &[[u8; 4]] {
+        &self.pixels
+    }
+
+    /// Pixel `(x, y)`, `None` outside the image.
+    pub fn pixel(&self, x: u32, y: u32) -> Option<[u8; 4]> {
+        (x < self.width && y < self.height)
+            .then(|| self.pixels[y as usize * self.width as usize + x as usize])
+    }
+
+    /// The pixels as packed `RGBARGBA...` bytes.
+    pub fn to_rgba_bytes(&self) -> Vec<u8> {
+        self.pixels.iter().flatten().copied().collect()
+    }
+
+    /// Encode as PNG in memory.
+    ///
+    /// # Errors
+    /// [`QualityError::Image`] (with an empty path) if the encoder fails.
+    pub fn to_png(&self) -> Result<Vec<u8>, QualityError> {
+        crate::atomic::encode_png(self.width, self.height, &self.to_rgba_bytes())
+    }
+
+    /// Write as PNG atomically ([`crate::write_png_atomic`]).
+    ///
+    /// # Errors
+    /// As [`crate::write_atomic`].
+    pub fn write_png(&self, path: impl AsRef<Path>) -> Result<(), QualityError> {
+        crate::atomic::write_atomic(path.as_ref(), &self.to_png()?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn from_linear_matches_encoders() {
+        let px = [[0.0, 0.215_860_53, 0.5, 1.0], [2.0, -1.0, f32::NAN, 0.5]];
+        let s = Image8::from_linear(2, 1, &px, Encoding::Srgb).unwrap();
+        assert_eq!(s.pixels()[0], [0, 128, 188, 255]);
+        assert_eq!(s.pixels()[1], [255, 0, 0, 128]);
+        let l = Image8::from_linear(2, 1, &px, Encoding::Linear).unwrap();
+        assert_eq!(l.pixels()[0], [0, 55, 128, 255]);
+    }
+
+    #[test]
+    fn size_errors() {
+        assert!(matches!(
+            Image8::new(0, 3, vec![]),
+            Err(QualityError::EmptyImage { .. })
+        ));
+        assert!(matches!(
+            Image8::new(2, 2, vec![[0; 4]; 3]),
+            Err(QualityError::DataLength {
+                expected: 4,
+                got: 3,
+                ..
+            })
+        ));
+        assert!(matches!(
+            Image8::filled(MAX_SIDE + 1, 1, [0; 4]),
+            Err(QualityError::TooLarge { .. })
+        ));
+        assert!(matches!(
+            Image8::from_rgba_bytes(1, 1, &[1, 2, 3]),
+            Err(QualityError::DataLength { expected: 4, .. })
+        ));
+    }
+
+    #[test]
+    fn png_round_trip() {
+        let img = Image8::from_fn(5, 3, |x, y| [x as u8 * 40, y as u8 * 90, 7, 200]).unwrap();
+        let dir = std::env::temp_dir().join(format!("texel-quality-png-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("a.png");
+        img.write_png(&p).unwrap();
+        assert_eq!(Image8::load(&p).unwrap(), img);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn load_reports_path() {
+        let e = Image8::load("/nonexistent/texel/x.png").unwrap_err();
+        assert!(e.to_string().contains("/nonexistent/texel/x.png"), "{e}");
+    }
+}

@@ -1,0 +1,63 @@
+//! texel-quality: how good is a filtered image against its reference, and the report that says so.
+//!
+//! - [`psnr`] / [`mse`] / [`psnr_band`]: PSNR over a mask (the geometry's coverage) or the horizon
+//!   band, per RGB channel on 8-bit encoded values, peak 255.
+//! - [`ssim`] / [`ssim_map`]: SSIM exactly per Wang et al. 2004 (11x11 Gaussian, sigma 1.5,
+//!   K1 = 0.01, K2 = 0.03, L = 255), per RGB channel, averaged.
+//! - [`horizon_band`]: the strip just below the horizon, where minification is extreme.
+//! - [`heat_map`], [`legend_svg`], [`crop_enlarge`], [`horizon_crop_rect`]: pictures of the error.
+//! - [`Report`] / [`FilterRow`]: JSON, Markdown and a self-contained `index.html` with a chart.
+//! - [`write_atomic`] / [`write_png_atomic`]: no truncated output after an interruption.
+//!
+//! Decision: quality is measured on the 8-bit display values (sRGB-encoded, or linear bytes under
+//! `--color raw`), i.e. exactly what is written to the PNG files and what a person sees, so that
+//! anyone can recompute the numbers from the images. A linear `f32` frame is quantised first with
+//! [`Image8::from_linear`].
+//!
+//! ```
+//! use texel_quality::{horizon_band, psnr, ssim, Image8, Mask};
+//!
+//! let reference = Image8::from_fn(32, 24, |x, y| [(x * 8) as u8, (y * 10) as u8, 128, 255])?;
+//! let mut pixels = reference.pixels().to_vec();
+//! pixels[5 * 32 + 7][0] ^= 16; // one channel of one pixel off by 16
+//! let image = Image8::new(32, 24, pixels)?;
+//! let covered = Mask::from_fn(32, 24, |_, y| y >= 4)?; // the geometry covers rows 4..24
+//!
+//! // MSE = 16^2 / (3 * 640) over the 640 covered pixels.
+//! let p = psnr(&reference, &image, Some(&covered))?;
+//! assert!((p - 10.0 * (255f64 * 255.0 * 3.0 * 640.0 / 256.0).log10()).abs() < 1e-9);
+//! // The error sits in row 5, inside an 8-row band below the horizon at row 4.
+//! let band = horizon_band(&covered, 8);
+//! assert!(band.get(7, 5) && band.count() == 32 * 8);
+//! assert!(ssim(&reference, &reference, Some(&covered))? == 1.0);
+//! assert!(ssim(&reference, &image, Some(&covered))? < 1.0);
+//! # Ok::<(), texel_quality::QualityError>(())
+//! ```
+
+mod atomic;
+mod band;
+mod crop;
+mod error;
+mod heatmap;
+pub mod html;
+mod image8;
+mod mask;
+mod psnr;
+mod report;
+mod scores;
+pub mod ssim;
+
+/// The largest image side, in pixels, any function here accepts (16384, the common GPU limit).
+pub const MAX_SIDE: u32 = 16384;
+
+pub use atomic::{write_atomic, write_png_atomic};
+pub use band::{default_band_rows, horizon_band};
+pub use crop::{crop_enlarge, horizon_crop_rect, Rect};
+pub use error::QualityError;
+pub use heatmap::{error_map, heat_map, legend_image, legend_svg, viridis, OUTSIDE, VIRIDIS};
+pub use image8::{Encoding, Image8};
+pub use mask::Mask;
+pub use psnr::{mse, psnr, psnr_band, psnr_from_mse, psnr_linear, PEAK};
+pub use report::{FilterRow, Report};
+pub use scores::Scores;
+pub use ssim::{ssim, ssim_map, SsimMap};

@@ -1,0 +1,324 @@
+//! The filter report: one row per filter (and per external image), as JSON and Markdown.
+//! The HTML page is in [`crate::html`].
+//!
+//! JSON numbers: PSNR is `+inf` for an image identical to the reference, which JSON cannot hold;
+//! it is written as the string `"inf"` (and read back from it). Rows for external images
+//! (`--extra LABEL=IMAGE`) have no timing, texel or memory numbers: those fields are `null`.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::atomic::write_atomic;
+use crate::error::QualityError;
+use crate::scores::Scores;
+
+/// A whole report: the scene, its settings and one row per filter or external image.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Report {
+    /// Scene name or path as the user gave it (e.g. `builtin:ground`).
+    pub scene: String,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel of the reference.
+    pub spp: u32,
+    /// Colour handling: `"srgb"` or `"raw"`.
+    pub color: String,
+    /// File name of the reference image, relative to the report's directory.
+    pub reference_image: String,
+    /// File name of the reference's enlarged horizon crop, if any.
+    #[serde(default)]
+    pub reference_crop: Option<String>,
+    /// Depth of the horizon band in rows ([`crate::horizon_band`]).
+    pub band_rows: u32,
+    /// Error (8-bit units) at the top of the heat maps' colour ramp.
+    pub heat_map_max: f32,
+    /// One row per filter, then the external images.
+    pub rows: Vec<FilterRow>,
+}
+
+/// One filter's (or one external image's) results.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilterRow {
+    /// Filter name (`trilinear`, `aniso16`, ...) or the external image's label.
+    pub name: String,
+    /// `true` for an image rendered elsewhere (`--extra`).
+    #[serde(default)]
+    pub extra: bool,
+    /// PSNR in dB over the covered pixels (`"inf"` in JSON when identical).
+    #[serde(with = "inf_f64")]
+    pub psnr_all: f64,
+    /// PSNR in dB over the horizon band.
+    #[serde(with = "inf_f64")]
+    pub psnr_band: f64,
+    /// Mean SSIM over the covered pixels.
+    pub ssim: f64,
+    /// Texels read per covered pixel, mean. `None` for external images.
+    pub texels_per_pixel_mean: Option<f64>,
+    /// Texels read per pixel, maximum. `None` for external images.
+    pub texels_per_pixel_max: Option<u64>,
+    /// Milliseconds per frame (median). `None` for external images.
+    pub ms_per_frame: Option<f64>,
+    /// Bytes of the texture structures the filter needs (pyramid, ripmap, SAT). `None` for
+    /// external images.
+    pub texture_bytes: Option<u64>,
+    /// The image's file name, relative to the report's directory.
+    pub image: String,
+    /// The error heat map's file name.
+    #[serde(default)]
+    pub heat_map: Option<String>,
+    /// The enlarged horizon crop's file name.
+    #[serde(default)]
+    pub horizon_crop: Option<String>,
+}
+
+impl FilterRow {
+    /// A row with `scores` and file name `image`, no timing/texel/memory numbers and no extra
+    /// images; set the other fields directly.
+    pub fn new(name: impl Into<String>, scores: Scores, image: impl Into<String>) -> Self {
+        FilterRow {
+            name: name.into(),
+            extra: false,
+            psnr_all: scores.psnr_all,
+            psnr_band: scores.psnr_band,
+            ssim: scores.ssim,
+            texels_per_pixel_mean: None,
+            texels_per_pixel_max: None,
+            ms_per_frame: None,
+            texture_bytes: None,
+            image: image.into(),
+            heat_map: None,
+            horizon_crop: None,
+        }
+    }
+}
+
+/// `f64` with `+inf`/`-inf` as the strings `"inf"`/`"-inf"` (JSON has no infinities).
+mod inf_f64 {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if *v == f64::INFINITY {
+            s.serialize_str("inf")
+        } else if *v == f64::NEG_INFINITY {
+            s.serialize_str("-inf")
+        } else {
+            s.serialize_f64(*v)
+        }
+    }
+
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Repr {
+        Num(f64),
+        Str(String),
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        match Repr::deserialize(d)? {
+            Repr::Num(v) => Ok(v),
+            Repr::Str(s) if s == "inf" => Ok(f64::INFINITY),
+            Repr::Str(s) if s == "-inf" => Ok(f64::NEG_INFINITY),
+            Repr::Str(s) => Err(serde::de::Error::custom(format!(
+                "expected a number, \"inf\" or \"-inf\", got {s:?}"
+            ))),
+        }
+    }
+}
+
+/// A PSNR for a table: two decimals, `inf` for identical.
+pub(crate) fn fmt_psnr(v: f64) -> String {
+    if v.is_infinite() {
+        if v > 0.0 { "inf" } else { "-inf" }.to_string()
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+/// An optional number for a table (`-` when absent).
+pub(crate) fn fmt_opt<T>(v: Option<T>, f: impl Fn(T) -> String) -> String {
+    v.map_or_else(|| "-".to_string(), f)
+}
+
+/// The table's cells for one row, in [`TABLE_HEADER`] order.
+pub(crate) fn row_cells(r: &FilterRow) -> [String; 8] {
+    [
+        if r.extra {
+            format!("{} (extra)", r.name)
+        } else {
+            r.name.clone()
+        },
+        fmt_psnr(r.psnr_all),
+        fmt_psnr(r.psnr_band),
+        format!("{:.4}", r.ssim),
+        fmt_opt(r.texels_per_pixel_mean, |v| format!("{v:.1}")),
+        fmt_opt(r.texels_per_pixel_max, |v| v.to_string()),
+        fmt_opt(r.ms_per_frame, |v| format!("{v:.2}")),
+        fmt_opt(r.texture_bytes, |v| v.to_string()),
+    ]
+}
+
+/// Column headers of the report table.
+pub(crate) const TABLE_HEADER: [&str; 8] = [
+    "filter",
+    "PSNR all (dB)",
+    "PSNR band (dB)",
+    "SSIM",
+    "texels/px mean",
+    "texels/px max",
+    "ms/frame",
+    "texture bytes",
+];
+
+/// Escape a Markdown table cell (`|`, `\`, newlines).
+fn md_cell(s: &str) -> String {
+    s.replace('\\', "\\\\")
+        .replace('|', "\\|")
+        .replace(['\n', '\r'], " ")
+}
+
+impl Report {
+    /// Pretty-printed JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a report always serialises") + "\n"
+    }
+
+    /// Parse JSON written by [`Report::to_json`].
+    ///
+    /// # Errors
+    /// [`QualityError::Json`] for malformed JSON, unknown fields or missing ones.
+    pub fn from_json(s: &str) -> Result<Report, QualityError> {
+        Ok(serde_json::from_str(s)?)
+    }
+
+    /// The Markdown table (GitHub flavour) with a one-paragraph header.
+    pub fn to_markdown(&self) -> String {
+        let mut s = format!(
+            "# texel filter report: {}\n\n{}x{} pixels, reference {} samples per pixel, colour {}. \
+             PSNR and SSIM against the reference over the covered pixels; the band is the {} rows \
+             below the horizon. Rows marked (extra) are external images: no time, texel or memory \
+             numbers.\n\n",
+            md_cell(&self.scene),
+            self.width,
+            self.height,
+            self.spp,
+            md_cell(&self.color),
+            self.band_rows
+        );
+        s += &format!("| {} |\n", TABLE_HEADER.join(" | "));
+        s += "|---|--:|--:|--:|--:|--:|--:|--:|\n";
+        for r in &self.rows {
+            let cells = row_cells(r).map(|c| md_cell(&c));
+            s += &format!("| {} |\n", cells.join(" | "));
+        }
+        s
+    }
+
+    /// Write `report.json`, `report.md` and `index.html` into `dir` (which must exist), each
+    /// atomically.
+    ///
+    /// # Errors
+    /// As [`write_atomic`].
+    pub fn write(&self, dir: &Path) -> Result<(), QualityError> {
+        write_atomic(&dir.join("report.json"), self.to_json().as_bytes())?;
+        write_atomic(&dir.join("report.md"), self.to_markdown().as_bytes())?;
+        write_atomic(&dir.join("index.html"), self.to_html().as_bytes())
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    pub(crate) fn sample() -> Report {
+        let mut tri = FilterRow::new(
+            "trilinear",
+            Scores {
+                psnr_all: 27.5,
+                psnr_band: 19.25,
+                ssim: 0.91,
+            },
+            "trilinear.png",
+        );
+        tri.texels_per_pixel_mean = Some(8.0);
+        tri.texels_per_pixel_max = Some(8);
+        tri.ms_per_frame = Some(12.5);
+        tri.texture_bytes = Some(5_592_404);
+        tri.heat_map = Some("trilinear_error.png".into());
+        tri.horizon_crop = Some("trilinear_crop.png".into());
+        let mut near = tri.clone();
+        near.name = "nearest".into();
+        near.psnr_all = 14.0;
+        near.ms_per_frame = Some(3.0);
+        let mut same = tri.clone();
+        same.name = "self".into();
+        same.psnr_all = f64::INFINITY;
+        same.psnr_band = f64::INFINITY;
+        let mut extra = FilterRow::new(
+            "gpu <a|b>",
+            Scores {
+                psnr_all: 21.3,
+                psnr_band: 15.0,
+                ssim: 0.8,
+            },
+            "extra_gpu.png",
+        );
+        extra.extra = true;
+        Report {
+            scene: "builtin:ground".into(),
+            width: 320,
+            height: 180,
+            spp: 256,
+            color: "srgb".into(),
+            reference_image: "reference.png".into(),
+            reference_crop: Some("reference_crop.png".into()),
+            band_rows: 18,
+            heat_map_max: 32.0,
+            rows: vec![near, tri, same, extra],
+        }
+    }
+
+    #[test]
+    fn json_round_trip_with_inf_and_nulls() {
+        let r = sample();
+        let j = r.to_json();
+        assert!(j.contains("\"psnr_all\": \"inf\""), "{j}");
+        assert!(j.contains("\"ms_per_frame\": null"));
+        assert_eq!(Report::from_json(&j).unwrap(), r);
+        let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+        assert_eq!(v["rows"][1]["psnr_all"], 27.5);
+        assert_eq!(v["rows"][3]["extra"], true);
+    }
+
+    #[test]
+    fn json_errors() {
+        let j = sample().to_json().replace("\"spp\"", "\"spp_typo\"");
+        assert!(matches!(Report::from_json(&j), Err(QualityError::Json(_))));
+        let j = sample().to_json().replacen("\"inf\"", "\"big\"", 1);
+        assert!(Report::from_json(&j).is_err());
+    }
+
+    #[test]
+    fn markdown_table() {
+        let md = sample().to_markdown();
+        let lines: Vec<&str> = md.lines().filter(|l| l.starts_with('|')).collect();
+        assert_eq!(lines.len(), 2 + 4);
+        assert_eq!(
+            lines[3],
+            "| trilinear | 27.50 | 19.25 | 0.9100 | 8.0 | 8 | 12.50 | 5592404 |"
+        );
+        assert!(lines[4].starts_with("| self | inf | inf |"));
+        assert_eq!(
+            lines[5],
+            "| gpu <a\\|b> (extra) | 21.30 | 15.00 | 0.8000 | - | - | - | - |"
+        );
+        // Every row has the header's number of cells (escaped pipes do not split).
+        for l in &lines {
+            assert_eq!(l.replace("\\|", "").matches('|').count(), 9, "{l}");
+        }
+    }
+}

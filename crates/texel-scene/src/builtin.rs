@@ -1,0 +1,302 @@
+//! Built-in scenes, available as `builtin:NAME`.
+//!
+//! `ground`, `zoneplate` and `triangle` are TOML files compiled into the crate (`src/builtin/`;
+//! `ground` is byte for byte `shared/scenes/ground.toml`); `ground-rotated`, `cube` and `sphere`
+//! are built in code.
+
+use std::f32::consts::PI;
+use std::path::Path;
+
+use glam::{Vec2, Vec3, Vec4};
+use texel_texture::{AddressMode, ColorSpace};
+
+use crate::camera::Camera;
+use crate::error::SceneError;
+use crate::model::{Mesh, Output, Scene, TextureSource, TextureSpec};
+use crate::procedural::Procedural;
+
+/// The ground plane TOML (identical to `shared/scenes/ground.toml`).
+pub const GROUND_TOML: &str = include_str!("builtin/ground.toml");
+/// The zone plate scene's TOML.
+pub const ZONEPLATE_TOML: &str = include_str!("builtin/zoneplate.toml");
+/// The barycentric triangle scene's TOML.
+pub const TRIANGLE_TOML: &str = include_str!("builtin/triangle.toml");
+
+/// Angle by which `ground-rotated` turns the ground's uvs, in degrees.
+pub const GROUND_ROTATION_DEG: f32 = 30.0;
+
+/// The names `builtin:NAME` accepts, in presentation order:
+/// - `ground`: a checkerboard plane receding to the horizon (= `shared/scenes/ground.toml`);
+/// - `ground-rotated`: the same with its uvs rotated by 30 degrees about uv (0, 0), so the checks
+///   run diagonally to the view (anisotropy off the screen axes);
+/// - `zoneplate`: a zone plate on a square seen at a grazing angle;
+/// - `cube`: a cube with a grid texture on each face, seen from above a corner;
+/// - `sphere`: a UV sphere with a latitude-longitude grid (15 degree cells), u wrapping;
+/// - `triangle`: the barycentric colour triangle (red, green, blue vertices, white texture).
+pub fn builtin_names() -> &'static [&'static str] {
+    &[
+        "ground",
+        "ground-rotated",
+        "zoneplate",
+        "cube",
+        "sphere",
+        "triangle",
+    ]
+}
+
+fn from_toml(name: &str, text: &str) -> Result<Scene, SceneError> {
+    Scene::from_toml_str(text, Path::new(&format!("builtin:{name}")))
+}
+
+/// The built-in scene `name` ([`builtin_names`]).
+///
+/// # Errors
+/// [`SceneError::UnknownBuiltin`].
+pub fn builtin(name: &str) -> Result<Scene, SceneError> {
+    match name {
+        "ground" => from_toml(name, GROUND_TOML),
+        "ground-rotated" => {
+            let mut s = from_toml("ground", GROUND_TOML)?;
+            let (sin, cos) = GROUND_ROTATION_DEG.to_radians().sin_cos();
+            for m in &mut s.meshes {
+                for uv in &mut m.uvs {
+                    *uv = Vec2::new(cos * uv.x - sin * uv.y, sin * uv.x + cos * uv.y);
+                }
+            }
+            Ok(s)
+        }
+        "zoneplate" => from_toml(name, ZONEPLATE_TOML),
+        "triangle" => from_toml(name, TRIANGLE_TOML),
+        "cube" => Ok(cube()),
+        "sphere" => Ok(sphere()),
+        _ => Err(SceneError::UnknownBuiltin {
+            name: name.to_string(),
+        }),
+    }
+}
+
+fn one_texture(name: &str, p: Procedural) -> std::collections::BTreeMap<String, TextureSpec> {
+    [(
+        name.to_string(),
+        TextureSpec {
+            source: TextureSource::Procedural(p),
+            color: ColorSpace::Srgb,
+        },
+    )]
+    .into()
+}
+
+/// A cube of side 2 centred at the origin; each face maps the whole texture (uv (0, 0) at the
+/// face's top-left seen from outside), triangles counter-clockwise from outside, face normals.
+fn cube() -> Scene {
+    // (normal, right, up) per face: the face's corners are normal +- right +- up.
+    let faces = [
+        (Vec3::X, Vec3::NEG_Z, Vec3::Y),
+        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+        (Vec3::Y, Vec3::X, Vec3::NEG_Z),
+        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+        (Vec3::Z, Vec3::X, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
+    ];
+    let mut mesh = Mesh {
+        positions: Vec::new(),
+        uvs: Vec::new(),
+        normals: Some(Vec::new()),
+        colors: None,
+        triangles: Vec::new(),
+        texture: "grid".into(),
+        address_mode_u: AddressMode::ClampToEdge,
+        address_mode_v: AddressMode::ClampToEdge,
+        filters: None,
+    };
+    for (n, r, u) in faces {
+        let base = mesh.positions.len() as u32;
+        // Bottom-left, bottom-right, top-right, top-left.
+        for (sr, su, uv) in [
+            (-1.0, -1.0, Vec2::new(0.0, 1.0)),
+            (1.0, -1.0, Vec2::new(1.0, 1.0)),
+            (1.0, 1.0, Vec2::new(1.0, 0.0)),
+            (-1.0, 1.0, Vec2::new(0.0, 0.0)),
+        ] {
+            mesh.positions.push(n + r * sr + u * su);
+            mesh.uvs.push(uv);
+            if let Some(ns) = &mut mesh.normals {
+                ns.push(n);
+            }
+        }
+        mesh.triangles
+            .extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+    }
+    Scene {
+        output: Output {
+            width: 960,
+            height: 540,
+            background: [0, 0, 0, 255],
+        },
+        camera: Camera {
+            eye: Vec3::new(3.2, 2.6, 4.2),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_deg: 40.0,
+            near: 0.1,
+            far: 100.0,
+        },
+        textures: one_texture(
+            "grid",
+            Procedural::Grid {
+                width: 512,
+                height: 512,
+                cells: 8,
+                line_width: 4.0,
+            },
+        ),
+        meshes: vec![mesh],
+    }
+}
+
+/// Longitude segments and latitude rings of the built-in sphere.
+const SPHERE_SEGMENTS: u32 = 64;
+const SPHERE_RINGS: u32 = 32;
+
+/// A unit UV sphere: vertex (s, r) at longitude `2 pi s / 64` and colatitude `pi r / 32`,
+/// uv = `(s / 64, r / 32)` (north pole at v = 0, the top row of the latitude-longitude map), with
+/// a duplicated seam column at u = 1; u repeats, v clamps.
+fn sphere() -> Scene {
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    for r in 0..=SPHERE_RINGS {
+        let theta = PI * r as f32 / SPHERE_RINGS as f32;
+        for s in 0..=SPHERE_SEGMENTS {
+            let phi = 2.0 * PI * s as f32 / SPHERE_SEGMENTS as f32;
+            // Longitude 0 faces +z (towards the camera); increasing eastwards (+x).
+            positions.push(Vec3::new(
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                theta.sin() * phi.cos(),
+            ));
+            uvs.push(Vec2::new(
+                s as f32 / SPHERE_SEGMENTS as f32,
+                r as f32 / SPHERE_RINGS as f32,
+            ));
+        }
+    }
+    let row = SPHERE_SEGMENTS + 1;
+    let mut triangles = Vec::new();
+    for r in 0..SPHERE_RINGS {
+        for s in 0..SPHERE_SEGMENTS {
+            let a = r * row + s; // top-left (north, west)
+            let b = a + row; // bottom-left
+                             // Counter-clockwise seen from outside: west-north, west-south, east-south, east-north.
+            if r != 0 {
+                triangles.push([a, b, a + 1]);
+            }
+            if r != SPHERE_RINGS - 1 {
+                triangles.push([a + 1, b, b + 1]);
+            }
+        }
+    }
+    let normals = Some(positions.clone());
+    Scene {
+        output: Output {
+            width: 960,
+            height: 540,
+            background: [0, 0, 0, 255],
+        },
+        camera: Camera {
+            eye: Vec3::new(0.0, 0.9, 3.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_deg: 45.0,
+            near: 0.1,
+            far: 100.0,
+        },
+        textures: one_texture(
+            "latlong",
+            Procedural::Grid {
+                width: 1024,
+                height: 512,
+                cells: 24,
+                line_width: 3.0,
+            },
+        ),
+        meshes: vec![Mesh {
+            positions,
+            uvs,
+            normals,
+            colors: None::<Vec<Vec4>>,
+            triangles,
+            texture: "latlong".into(),
+            address_mode_u: AddressMode::Repeat,
+            address_mode_v: AddressMode::ClampToEdge,
+            filters: None,
+        }],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_loads_and_validates() {
+        for name in builtin_names() {
+            let s = Scene::load(&format!("builtin:{name}")).unwrap();
+            s.validate().unwrap();
+            assert!(!s.meshes.is_empty(), "{name}");
+        }
+        let e = Scene::load("builtin:nope").unwrap_err();
+        assert!(e.to_string().contains("ground-rotated"), "{e}");
+    }
+
+    /// Signed volume of a closed mesh: positive when every triangle is counter-clockwise from
+    /// outside (divergence theorem).
+    fn volume(m: &Mesh) -> f32 {
+        m.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| m.positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn cube_and_sphere_are_closed_and_outward() {
+        let c = cube();
+        assert!((volume(&c.meshes[0]) - 8.0).abs() < 1e-4);
+        let s = sphere();
+        let v = volume(&s.meshes[0]);
+        // A 64 x 32 UV sphere has a little less volume than 4/3 pi.
+        assert!(v > 4.0 && v < 4.0 / 3.0 * PI, "{v}");
+        // Each triangle faces outwards: its normal agrees with its centroid direction.
+        for m in [&c.meshes[0], &s.meshes[0]] {
+            for t in &m.triangles {
+                let [a, b, cc] = t.map(|i| m.positions[i as usize]);
+                assert!((b - a).cross(cc - a).dot(a + b + cc) > 0.0);
+            }
+        }
+        // Cube face uvs: the +z face's top-left corner (-1, 1, 1) has uv (0, 0).
+        let m = &c.meshes[0];
+        let i = m
+            .positions
+            .iter()
+            .zip(&m.normals.as_ref().unwrap()[..])
+            .position(|(p, n)| *p == Vec3::new(-1.0, 1.0, 1.0) && *n == Vec3::Z)
+            .unwrap();
+        assert_eq!(m.uvs[i], Vec2::ZERO);
+    }
+
+    #[test]
+    fn rotated_ground_turns_uvs_by_30_degrees() {
+        let g = builtin("ground").unwrap();
+        let r = builtin("ground-rotated").unwrap();
+        for (a, b) in g.meshes[0].uvs.iter().zip(&r.meshes[0].uvs) {
+            assert!((a.length() - b.length()).abs() < 1e-3 * a.length().max(1.0));
+            if a.length() > 1.0 {
+                let angle = a.angle_to(*b).to_degrees();
+                assert!((angle - 30.0).abs() < 1e-3, "{angle}");
+            }
+        }
+        assert_eq!(g.meshes[0].positions, r.meshes[0].positions);
+    }
+}

@@ -1,0 +1,85 @@
+//! The camera: a right-handed look-at view and an OpenGL perspective projection (DESIGN.md).
+
+use glam::{Mat4, Vec3};
+
+/// A perspective camera looking from `eye` towards `target`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position, world units.
+    pub eye: Vec3,
+    /// The point looked at, world units.
+    pub target: Vec3,
+    /// The world's up direction (not necessarily perpendicular to the view direction).
+    pub up: Vec3,
+    /// Vertical field of view in degrees, in `(0, 180)`.
+    pub fovy_deg: f32,
+    /// Near plane distance, `> 0`.
+    pub near: f32,
+    /// Far plane distance, `> near`.
+    pub far: f32,
+}
+
+impl Camera {
+    /// The view matrix: world to camera space (right-handed, the camera looks down -z).
+    pub fn view_from_world(&self) -> Mat4 {
+        Mat4::look_at_rh(self.eye, self.target, self.up)
+    }
+
+    /// The OpenGL perspective projection for `aspect = width / height` (NDC z in `[-1, 1]`,
+    /// `gluPerspective`).
+    pub fn clip_from_view(&self, aspect: f32) -> Mat4 {
+        Mat4::perspective_rh_gl(self.fovy_deg.to_radians(), aspect, self.near, self.far)
+    }
+
+    /// `clip_from_view(aspect) * view_from_world()`: world positions to clip space.
+    pub fn clip_from_world(&self, aspect: f32) -> Mat4 {
+        self.clip_from_view(aspect) * self.view_from_world()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec4;
+
+    #[test]
+    fn target_projects_to_centre_and_planes_to_ndc_bounds() {
+        let cam = Camera {
+            eye: Vec3::new(1.0, 2.0, 3.0),
+            target: Vec3::new(-2.0, 0.5, -4.0),
+            up: Vec3::Y,
+            fovy_deg: 60.0,
+            near: 0.5,
+            far: 100.0,
+        };
+        let m = cam.clip_from_world(16.0 / 9.0);
+        let dir = (cam.target - cam.eye).normalize();
+        let ndc = |p: Vec3| {
+            let c = m * p.extend(1.0);
+            c.truncate() / c.w
+        };
+        let t = ndc(cam.target);
+        assert!(t.x.abs() < 1e-5 && t.y.abs() < 1e-5);
+        assert!((ndc(cam.eye + dir * cam.near).z + 1.0).abs() < 1e-4);
+        assert!((ndc(cam.eye + dir * cam.far).z - 1.0).abs() < 1e-3);
+        // w is the distance along the view direction.
+        let c = m * (cam.eye + dir * 7.0).extend(1.0);
+        assert!((c.w - 7.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn fov_edge_maps_to_ndc_one() {
+        let cam = Camera {
+            eye: Vec3::ZERO,
+            target: Vec3::NEG_Z,
+            up: Vec3::Y,
+            fovy_deg: 90.0,
+            near: 0.1,
+            far: 10.0,
+        };
+        let c = cam.clip_from_world(2.0) * Vec4::new(0.0, 1.0, -1.0, 1.0);
+        assert!((c.y / c.w - 1.0).abs() < 1e-6);
+        let c = cam.clip_from_world(2.0) * Vec4::new(2.0, 0.0, -1.0, 1.0);
+        assert!((c.x / c.w - 1.0).abs() < 1e-6);
+    }
+}

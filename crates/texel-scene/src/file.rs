@@ -1,0 +1,404 @@
+//! Scene files: TOML, as `shared/scenes/ground.toml` shows, parsed with serde.
+//!
+//! ```toml
+//! [output]                      # width, height (1..=16384); background = [r, g, b, a] sRGB 8-bit
+//! width = 1280                  #   (default [0, 0, 0, 255])
+//! height = 720
+//! [camera]                      # eye, target, up (default [0, 1, 0]), fovy_deg, near, far
+//! eye = [0.0, 1.0, 0.0]
+//! target = [0.0, 0.75, -10.0]
+//! fovy_deg = 50.0
+//! near = 0.05
+//! far = 2000.0
+//! [textures.checker]            # path = "file.png" (relative to the scene file) or
+//! procedural = "checker"        # procedural = checker | zoneplate | grid | uv | solid;
+//! size = 1024                   # color = "srgb" (default) | "linear"; see `Procedural` for each
+//! checks = 8                    # kind's parameters (size or width + height, checks, cells,
+//! color = "srgb"                # line_width, rgba)
+//! [[meshes]]                    # texture = NAME; address_mode (both axes), address_mode_u/_v:
+//! texture = "checker"           # repeat | mirror-repeat | clamp-to-edge | clamp-to-border |
+//! address_mode = "repeat"       # mirror-clamp-to-edge (default repeat, or the glTF sampler's)
+//! positions = [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+//! uvs = [[0.0, 1.0], [1.0, 1.0], [0.5, 0.0]]
+//! triangles = [[0, 1, 2]]       # optional: normals = [[x, y, z], ...], colors = [[r, g, b, a], ...]
+//! # or: obj = "file.obj"  /  gltf = "file.gltf" or "file.glb" (relative to the scene file)
+//! ```
+//!
+//! Every table denies unknown keys; a syntax or type error is reported with its line and column.
+//! Semantic checks (sizes, indices, finiteness, camera) follow in [`Scene::validate`].
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3, Vec4};
+use serde::Deserialize;
+use texel_texture::{AddressMode, ColorSpace};
+
+use crate::camera::Camera;
+use crate::error::SceneError;
+use crate::model::{Mesh, Output, Scene, TextureSource, TextureSpec};
+use crate::procedural::Procedural;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScene {
+    output: RawOutput,
+    camera: RawCamera,
+    #[serde(default)]
+    textures: BTreeMap<String, RawTexture>,
+    #[serde(default)]
+    meshes: Vec<RawMesh>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    width: u32,
+    height: u32,
+    #[serde(default = "opaque_black")]
+    background: [u8; 4],
+}
+
+fn opaque_black() -> [u8; 4] {
+    [0, 0, 0, 255]
+}
+
+fn y_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCamera {
+    eye: [f32; 3],
+    target: [f32; 3],
+    #[serde(default = "y_up")]
+    up: [f32; 3],
+    fovy_deg: f32,
+    near: f32,
+    far: f32,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
+#[serde(rename_all = "lowercase")]
+enum Kind {
+    Checker,
+    Zoneplate,
+    Grid,
+    Uv,
+    Solid,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum ColorName {
+    Srgb,
+    Linear,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawTexture {
+    path: Option<String>,
+    procedural: Option<Kind>,
+    color: Option<ColorName>,
+    size: Option<u32>,
+    width: Option<u32>,
+    height: Option<u32>,
+    checks: Option<u32>,
+    cells: Option<u32>,
+    line_width: Option<f32>,
+    rgba: Option<[u8; 4]>,
+}
+
+/// Address mode names in scene files (kebab-case WebGPU names).
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+enum ModeName {
+    Repeat,
+    MirrorRepeat,
+    ClampToEdge,
+    ClampToBorder,
+    MirrorClampToEdge,
+}
+
+impl From<ModeName> for AddressMode {
+    fn from(m: ModeName) -> Self {
+        match m {
+            ModeName::Repeat => AddressMode::Repeat,
+            ModeName::MirrorRepeat => AddressMode::MirrorRepeat,
+            ModeName::ClampToEdge => AddressMode::ClampToEdge,
+            ModeName::ClampToBorder => AddressMode::ClampToBorder,
+            ModeName::MirrorClampToEdge => AddressMode::MirrorClampToEdge,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMesh {
+    texture: String,
+    address_mode: Option<ModeName>,
+    address_mode_u: Option<ModeName>,
+    address_mode_v: Option<ModeName>,
+    positions: Option<Vec<[f32; 3]>>,
+    uvs: Option<Vec<[f32; 2]>>,
+    normals: Option<Vec<[f32; 3]>>,
+    colors: Option<Vec<[f32; 4]>>,
+    triangles: Option<Vec<[u32; 3]>>,
+    obj: Option<String>,
+    gltf: Option<String>,
+}
+
+/// 1-based line and column (in characters) of byte offset `at` in `text`.
+pub(crate) fn line_column(text: &str, at: usize) -> (usize, usize) {
+    let at = at.min(text.len());
+    let before = text.get(..at).unwrap_or(text);
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, SceneError> {
+    let bad = |reason: String| SceneError::InvalidTexture {
+        name: name.to_string(),
+        reason,
+    };
+    let color = match t.color.unwrap_or(ColorName::Srgb) {
+        ColorName::Srgb => ColorSpace::Srgb,
+        ColorName::Linear => ColorSpace::Linear,
+    };
+    let given: Vec<&str> = [
+        ("size", t.size.is_some()),
+        ("width", t.width.is_some()),
+        ("height", t.height.is_some()),
+        ("checks", t.checks.is_some()),
+        ("cells", t.cells.is_some()),
+        ("line_width", t.line_width.is_some()),
+        ("rgba", t.rgba.is_some()),
+    ]
+    .iter()
+    .filter(|p| p.1)
+    .map(|p| p.0)
+    .collect();
+    let source = match (t.path, t.procedural) {
+        (Some(_), Some(_)) => return Err(bad("give either path or procedural, not both".into())),
+        (None, None) => return Err(bad("give path = \"FILE\" or procedural = \"KIND\"".into())),
+        (Some(p), None) => {
+            if let Some(k) = given.first() {
+                return Err(bad(format!(
+                    "{k} is a parameter of procedural textures, not of a file"
+                )));
+            }
+            TextureSource::File(base.join(p))
+        }
+        (None, Some(kind)) => {
+            let allowed: &[&str] = match kind {
+                Kind::Checker => &["size", "width", "height", "checks"],
+                Kind::Zoneplate => &["size"],
+                Kind::Grid => &["size", "width", "height", "cells", "line_width"],
+                Kind::Uv => &["size", "width", "height"],
+                Kind::Solid => &["size", "width", "height", "rgba"],
+            };
+            if let Some(k) = given.iter().find(|k| !allowed.contains(k)) {
+                return Err(bad(format!(
+                    "{k} is not a parameter of {} (it takes {})",
+                    format!("{kind:?}").to_lowercase(),
+                    allowed.join(", ")
+                )));
+            }
+            let default_size = match kind {
+                Kind::Checker | Kind::Zoneplate | Kind::Grid => 1024,
+                Kind::Uv => 256,
+                Kind::Solid => 1,
+            };
+            let (width, height) = match (t.size, t.width, t.height) {
+                (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+                    return Err(bad("give size or width and height, not both".into()))
+                }
+                (Some(s), None, None) => (s, s),
+                (None, Some(w), Some(h)) => (w, h),
+                (None, None, None) => (default_size, default_size),
+                _ => return Err(bad("width and height go together".into())),
+            };
+            let positive = |v: Option<u32>, key: &str, default: u32| match v {
+                Some(0) => Err(bad(format!("{key} must be at least 1"))),
+                Some(v) => Ok(v),
+                None => Ok(default),
+            };
+            TextureSource::Procedural(match kind {
+                Kind::Checker => Procedural::Checker {
+                    width,
+                    height,
+                    checks: positive(t.checks, "checks", 8)?,
+                },
+                Kind::Zoneplate => Procedural::ZonePlate { size: width },
+                Kind::Grid => {
+                    let line_width = t.line_width.unwrap_or(2.0);
+                    if !(line_width.is_finite() && line_width >= 0.0) {
+                        return Err(bad(format!(
+                            "line_width = {line_width} must be finite and >= 0"
+                        )));
+                    }
+                    Procedural::Grid {
+                        width,
+                        height,
+                        cells: positive(t.cells, "cells", 8)?,
+                        line_width,
+                    }
+                }
+                Kind::Uv => Procedural::Uv { width, height },
+                Kind::Solid => Procedural::Solid {
+                    width,
+                    height,
+                    rgba: t.rgba.unwrap_or([255; 4]),
+                },
+            })
+        }
+    };
+    Ok(TextureSpec { source, color })
+}
+
+fn meshes(index: usize, m: RawMesh, base: &Path) -> Result<Vec<Mesh>, SceneError> {
+    let src = |reason| SceneError::MeshSource {
+        mesh: index,
+        reason,
+    };
+    let sources = [m.positions.is_some(), m.obj.is_some(), m.gltf.is_some()]
+        .iter()
+        .filter(|&&b| b)
+        .count();
+    if sources != 1 {
+        return Err(src(
+            "give exactly one geometry source: inline positions, obj = \"FILE\" or gltf = \"FILE\"",
+        ));
+    }
+    let both = m.address_mode.map(AddressMode::from);
+    let mode_u = m.address_mode_u.map(AddressMode::from).or(both);
+    let mode_v = m.address_mode_v.map(AddressMode::from).or(both);
+    let mut out = if let Some(positions) = m.positions {
+        let (Some(uvs), Some(triangles)) = (m.uvs, m.triangles) else {
+            return Err(src("inline meshes need positions, uvs and triangles"));
+        };
+        vec![Mesh {
+            positions: positions.into_iter().map(Vec3::from).collect(),
+            uvs: uvs.into_iter().map(Vec2::from).collect(),
+            normals: m.normals.map(|v| v.into_iter().map(Vec3::from).collect()),
+            colors: m.colors.map(|v| v.into_iter().map(Vec4::from).collect()),
+            triangles,
+            texture: m.texture.clone(),
+            address_mode_u: AddressMode::Repeat,
+            address_mode_v: AddressMode::Repeat,
+            filters: None,
+        }]
+    } else {
+        if m.uvs.is_some() || m.triangles.is_some() || m.normals.is_some() || m.colors.is_some() {
+            return Err(src(
+                "uvs, triangles, normals and colors are only allowed with inline positions",
+            ));
+        }
+        if let Some(obj) = m.obj {
+            vec![crate::obj::load_obj(&base.join(obj), &m.texture)?]
+        } else {
+            let path = base.join(m.gltf.expect("one source"));
+            crate::gltf_import::load_gltf(&path, &m.texture)?
+        }
+    };
+    for mesh in &mut out {
+        if let Some(u) = mode_u {
+            mesh.address_mode_u = u;
+        }
+        if let Some(v) = mode_v {
+            mesh.address_mode_v = v;
+        }
+    }
+    Ok(out)
+}
+
+impl Scene {
+    /// Parse a scene from TOML text. `path` names the file in error messages and its directory is
+    /// the base for relative texture, OBJ and glTF paths. The scene is validated
+    /// ([`Scene::validate`]).
+    ///
+    /// # Errors
+    /// [`SceneError::Toml`] with line and column; mesh file errors; validation errors.
+    pub fn from_toml_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        let raw: RawScene = toml::from_str(text).map_err(|e| {
+            let (line, column) = e.span().map_or((0, 0), |s| line_column(text, s.start));
+            SceneError::Toml {
+                path: path.to_path_buf(),
+                line,
+                column,
+                message: e.message().trim().to_string(),
+            }
+        })?;
+        let base = path.parent().map_or_else(PathBuf::new, Path::to_path_buf);
+        let textures = raw
+            .textures
+            .into_iter()
+            .map(|(name, t)| texture_spec(&name, t, &base).map(|s| (name, s)))
+            .collect::<Result<_, _>>()?;
+        let mut all = Vec::new();
+        for (i, m) in raw.meshes.into_iter().enumerate() {
+            all.extend(meshes(i, m, &base)?);
+        }
+        let scene = Scene {
+            output: Output {
+                width: raw.output.width,
+                height: raw.output.height,
+                background: raw.output.background,
+            },
+            camera: Camera {
+                eye: raw.camera.eye.into(),
+                target: raw.camera.target.into(),
+                up: raw.camera.up.into(),
+                fovy_deg: raw.camera.fovy_deg,
+                near: raw.camera.near,
+                far: raw.camera.far,
+            },
+            textures,
+            meshes: all,
+        };
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Read and parse a scene file ([`Scene::from_toml_str`]).
+    ///
+    /// # Errors
+    /// [`SceneError::Io`] with the path, and those of [`Scene::from_toml_str`].
+    pub fn from_path(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml_str(&text, path)
+    }
+
+    /// A scene from a command-line argument: `builtin:NAME` ([`crate::builtin_names`]) or a path
+    /// to a TOML file.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownBuiltin`], and those of [`Scene::from_path`].
+    pub fn load(arg: &str) -> Result<Scene, SceneError> {
+        match arg.strip_prefix("builtin:") {
+            Some(name) => crate::builtin::builtin(name),
+            None => Self::from_path(arg),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_column_counts_chars() {
+        let t = "ab\ncdé\nx";
+        assert_eq!(line_column(t, 0), (1, 1));
+        assert_eq!(line_column(t, 3), (2, 1));
+        assert_eq!(line_column(t, 8), (3, 1));
+        assert_eq!(line_column(t, 7), (2, 4)); // after "cdé"
+    }
+}

@@ -1,0 +1,232 @@
+//! Procedural textures: checker, zone plate, grid, uv and solid.
+//!
+//! Each generator gives the 8-bit code of every texel (`code(i, j)`, row 0 at the top); the texture
+//! is then made with `Texture::from_rgba8` and the spec's colour space, so `color = "srgb"` decodes
+//! the codes through the sRGB curve and `color = "linear"` reads them as `code / 255`. Grey levels
+//! in the formulas below are codes in `[0, 255]`; alpha is 255.
+
+use texel_texture::{ColorSpace, Format, Limits, Texture, TextureError};
+
+/// A generated texture and its parameters (the TOML keys have the same names).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Procedural {
+    /// Black and white squares of side `width / checks` texels: texel `(i, j)` is black when
+    /// `floor(i / s) + floor(j / s)` is even, with `s = width / checks` (real), so texel (0, 0)
+    /// lies in a black check. `width = height = size = 1024`, `checks = 8` by default
+    /// (8 x 8 checks of 128 texels).
+    Checker {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+        /// Number of checks along the width (`>= 1`).
+        checks: u32,
+    },
+    /// The zone plate `code = round(255 * (0.5 + 0.5 cos(pi r^2 / size)))`, `r` the distance in
+    /// texels from the texture centre to the texel centre:
+    /// `r^2 = (i + 0.5 - size/2)^2 + (j + 0.5 - size/2)^2`. Its local frequency `r / size` cycles
+    /// per texel grows linearly from 0 at the centre to 0.5 (Nyquist) at the middle of each edge.
+    /// Square; `size = 1024` by default.
+    ZonePlate {
+        /// Side in texels.
+        size: u32,
+    },
+    /// Black lines `line_width` texels wide on white, one every `width / cells` texels
+    /// (real) in both directions: texel `(i, j)` is black when `i mod p < line_width` or
+    /// `j mod p < line_width`, `p = width / cells`. Defaults: `size = 1024`, `cells = 8`,
+    /// `line_width = 2`.
+    Grid {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+        /// Number of cells along the width (`>= 1`).
+        cells: u32,
+        /// Line width in texels (`>= 0`, finite).
+        line_width: f32,
+    },
+    /// Texture coordinates as colour: `R = round(255 (i + 0.5) / width)`,
+    /// `G = round(255 (j + 0.5) / height)`, `B = 0`. `size = 256` by default.
+    Uv {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+    },
+    /// One colour everywhere (8-bit codes, `rgba = [255, 255, 255, 255]` and `size = 1` by default).
+    Solid {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+        /// The colour's 8-bit codes.
+        rgba: [u8; 4],
+    },
+}
+
+impl Procedural {
+    /// Width and height in texels.
+    pub fn size(&self) -> (u32, u32) {
+        match *self {
+            Procedural::Checker { width, height, .. }
+            | Procedural::Grid { width, height, .. }
+            | Procedural::Uv { width, height }
+            | Procedural::Solid { width, height, .. } => (width, height),
+            Procedural::ZonePlate { size } => (size, size),
+        }
+    }
+
+    /// The 8-bit code of texel `(i, j)` (formulas in the variant docs).
+    pub fn code(&self, i: u32, j: u32) -> [u8; 4] {
+        let grey = |v: u8| [v, v, v, 255];
+        match *self {
+            Procedural::Checker { width, checks, .. } => {
+                let s = f64::from(width) / f64::from(checks);
+                let a = (f64::from(i) / s).floor() as u64 + (f64::from(j) / s).floor() as u64;
+                grey(if a % 2 == 0 { 0 } else { 255 })
+            }
+            Procedural::ZonePlate { size } => {
+                let c = f64::from(size) / 2.0;
+                let (x, y) = (f64::from(i) + 0.5 - c, f64::from(j) + 0.5 - c);
+                let v =
+                    0.5 + 0.5 * (std::f64::consts::PI * (x * x + y * y) / f64::from(size)).cos();
+                grey((255.0 * v).round() as u8)
+            }
+            Procedural::Grid {
+                width,
+                cells,
+                line_width,
+                ..
+            } => {
+                let p = f64::from(width) / f64::from(cells);
+                let lw = f64::from(line_width);
+                let on = f64::from(i) % p < lw || f64::from(j) % p < lw;
+                grey(if on { 0 } else { 255 })
+            }
+            Procedural::Uv { width, height } => {
+                let r = (255.0 * (f64::from(i) + 0.5) / f64::from(width)).round() as u8;
+                let g = (255.0 * (f64::from(j) + 0.5) / f64::from(height)).round() as u8;
+                [r, g, 0, 255]
+            }
+            Procedural::Solid { rgba, .. } => rgba,
+        }
+    }
+
+    /// Generate the texture (with its mip pyramid) in colour space `color`. The size is checked
+    /// against `limits` before anything is allocated.
+    ///
+    /// # Errors
+    /// The size errors of [`Limits::check`].
+    pub fn generate(&self, color: ColorSpace, limits: &Limits) -> Result<Texture, TextureError> {
+        let (w, h) = self.size();
+        let format = match color {
+            ColorSpace::Srgb => Format::Rgba8Srgb,
+            ColorSpace::Linear => Format::Rgba8Unorm,
+        };
+        limits.check(w, h, format)?;
+        let texels = (0..h)
+            .flat_map(|j| (0..w).map(move |i| (i, j)))
+            .map(|(i, j)| self.code(i, j))
+            .collect();
+        Texture::from_rgba8(w, h, texels, color, limits)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use texel_texture::color::srgb_table;
+
+    #[test]
+    fn checker_layout() {
+        let c = Procedural::Checker {
+            width: 1024,
+            height: 1024,
+            checks: 8,
+        };
+        assert_eq!(c.code(0, 0), [0, 0, 0, 255]);
+        assert_eq!(c.code(127, 127), [0, 0, 0, 255]);
+        assert_eq!(c.code(128, 0), [255, 255, 255, 255]);
+        assert_eq!(c.code(0, 128), [255, 255, 255, 255]);
+        assert_eq!(c.code(128, 128), [0, 0, 0, 255]);
+        assert_eq!(c.code(1023, 1023), [0, 0, 0, 255]); // (7 + 7) even
+                                                        // Non-divisible: 10 texels, 3 checks of 3.33 texels.
+        let odd = Procedural::Checker {
+            width: 10,
+            height: 10,
+            checks: 3,
+        };
+        let row: Vec<u8> = (0..10).map(|i| odd.code(i, 0)[0]).collect();
+        assert_eq!(row, vec![0, 0, 0, 0, 255, 255, 255, 0, 0, 0]);
+    }
+
+    #[test]
+    fn zone_plate_formula() {
+        let z = Procedural::ZonePlate { size: 64 };
+        // Centre texel (32, 32): r^2 = 0.5, 0.5 + 0.5 cos(pi * 0.5 / 64) = 0.99985 -> 255.
+        assert_eq!(z.code(32, 32)[0], 255);
+        // (40, 32): r^2 = 8.5^2 + 0.5^2 = 72.5; 0.5 + 0.5 cos(pi * 72.5 / 64) = 0.042895 -> 11.
+        let v = 0.5 + 0.5 * (std::f64::consts::PI * 72.5 / 64.0).cos();
+        assert!((v - 0.042_895_12).abs() < 1e-8);
+        assert_eq!(z.code(40, 32)[0], 11);
+        // Corner (0, 0): r^2 = 2 * 31.5^2 = 1984.5; 1984.5 / 64 = 31.0078 -> cos(31.0078 pi) ~ -1 -> 0.
+        assert_eq!(z.code(0, 0)[0], 0);
+        // Local frequency at the edge: phase step between (63, 32) and (62, 32) is about pi.
+        let phase = |i: f64| std::f64::consts::PI * ((i + 0.5 - 32.0).powi(2) + 0.25) / 64.0;
+        assert!((phase(63.0) - phase(62.0) - std::f64::consts::PI * 62.0 / 64.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn grid_uv_solid() {
+        let g = Procedural::Grid {
+            width: 16,
+            height: 16,
+            cells: 4,
+            line_width: 1.0,
+        };
+        assert_eq!(g.code(0, 7)[0], 0);
+        assert_eq!(g.code(4, 7)[0], 0);
+        assert_eq!(g.code(5, 7)[0], 255);
+        assert_eq!(g.code(5, 8)[0], 0);
+        let uv = Procedural::Uv {
+            width: 256,
+            height: 128,
+        };
+        assert_eq!(uv.code(0, 0), [0, 1, 0, 255]);
+        assert_eq!(uv.code(255, 127), [255, 254, 0, 255]);
+        let s = Procedural::Solid {
+            width: 2,
+            height: 3,
+            rgba: [1, 2, 3, 4],
+        };
+        assert_eq!(s.code(1, 2), [1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn generate_applies_colour_space_and_limits() {
+        let c = Procedural::Checker {
+            width: 8,
+            height: 8,
+            checks: 2,
+        };
+        let t = c.generate(ColorSpace::Srgb, &Limits::default()).unwrap();
+        assert_eq!(t.texel(0, 0, 0).unwrap(), [0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(t.texel(0, 4, 0).unwrap(), [1.0; 4]);
+        // Level 3 (1x1) averages half black, half white in linear light.
+        assert!((t.texel(3, 0, 0).unwrap()[0] - 0.5).abs() < 0.003);
+        let z = Procedural::ZonePlate { size: 64 };
+        let ts = z.generate(ColorSpace::Srgb, &Limits::default()).unwrap();
+        let tl = z.generate(ColorSpace::Linear, &Limits::default()).unwrap();
+        assert_eq!(ts.texel(0, 40, 32).unwrap()[0], srgb_table()[11]);
+        assert_eq!(tl.texel(0, 40, 32).unwrap()[0], 11.0 / 255.0);
+        let big = Procedural::Checker {
+            width: 100_000,
+            height: 100_000,
+            checks: 8,
+        };
+        assert!(matches!(
+            big.generate(ColorSpace::Srgb, &Limits::default()),
+            Err(TextureError::TooLarge { .. })
+        ));
+    }
+}

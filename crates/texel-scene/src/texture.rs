@@ -1,0 +1,79 @@
+//! From a [`TextureSpec`] to a sampled [`Texture`].
+
+use std::collections::BTreeMap;
+
+use texel_texture::{ColorSpace, Limits, Texture};
+
+use crate::error::SceneError;
+use crate::model::{Scene, TextureSource, TextureSpec};
+
+impl TextureSpec {
+    /// The colour space used: `color_override` (the CLI's `--color raw` passes
+    /// `Some(ColorSpace::Linear)`) or the spec's own.
+    pub fn color_space(&self, color_override: Option<ColorSpace>) -> ColorSpace {
+        color_override.unwrap_or(self.color)
+    }
+
+    /// Load or generate the texture (with its mip pyramid). `name` is used in error messages.
+    ///
+    /// # Errors
+    /// [`SceneError::Texture`] carrying the name (and the path for files): missing or unreadable
+    /// file, corrupt image, size or memory over `limits`.
+    pub fn load(
+        &self,
+        name: &str,
+        color_override: Option<ColorSpace>,
+        limits: &Limits,
+    ) -> Result<Texture, SceneError> {
+        let color = self.color_space(color_override);
+        match &self.source {
+            TextureSource::File(path) => {
+                Texture::load(path, color, limits).map_err(|source| SceneError::Texture {
+                    name: name.to_string(),
+                    path: Some(path.clone()),
+                    source,
+                })
+            }
+            TextureSource::Procedural(p) => {
+                p.generate(color, limits)
+                    .map_err(|source| SceneError::Texture {
+                        name: name.to_string(),
+                        path: None,
+                        source,
+                    })
+            }
+        }
+    }
+}
+
+impl Scene {
+    /// Load every texture the meshes use (unused ones are skipped), by name.
+    ///
+    /// # Errors
+    /// As [`TextureSpec::load`].
+    pub fn load_textures(
+        &self,
+        color_override: Option<ColorSpace>,
+        limits: &Limits,
+    ) -> Result<BTreeMap<String, Texture>, SceneError> {
+        let mut out = BTreeMap::new();
+        for (mi, m) in self.meshes.iter().enumerate() {
+            if out.contains_key(&m.texture) {
+                continue;
+            }
+            let spec = self
+                .textures
+                .get(&m.texture)
+                .ok_or_else(|| SceneError::UnknownTexture {
+                    mesh: mi,
+                    name: m.texture.clone(),
+                    defined: self.textures.keys().cloned().collect::<Vec<_>>().join(", "),
+                })?;
+            out.insert(
+                m.texture.clone(),
+                spec.load(&m.texture, color_override, limits)?,
+            );
+        }
+        Ok(out)
+    }
+}
