@@ -32,7 +32,8 @@ pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame
     let (n, m) = strata(spp);
     let pb = progress::bar(1000, "reference");
     let report = |done: u64, total: u64| pb.set_position(done * 1000 / total.max(1));
-    let frame = render_reference(&settings, &draws, (n, m), SEED, Some(&report))?;
+    anyhow::ensure!(n == m, "--spp {spp} is not a square number of samples (e.g. 64, 256, 1024)");
+    let frame = render_reference(&settings, &draws, n, SEED, Some(&report))?;
     pb.finish_and_clear();
     Ok(frame)
 }

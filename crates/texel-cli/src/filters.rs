@@ -96,6 +96,11 @@ impl FilterName {
             ..SamplerDescriptor::default()
         };
         let cubic = FilterMode::Cubic(Cubic::CATMULL_ROM);
+        let minification = |min| SamplerDescriptor {
+            address_mode_u,
+            address_mode_v,
+            ..SamplerDescriptor::minification(min)
+        };
         Ok(match self {
             FilterName::Nearest => base(Nearest, Nearest, MipmapFilterMode::None, 1),
             FilterName::Bilinear => base(Linear, Linear, MipmapFilterMode::None, 1),
@@ -106,9 +111,9 @@ impl FilterName {
             FilterName::Aniso4 => base(Linear, Linear, MipmapFilterMode::Linear, 4),
             FilterName::Aniso8 => base(Linear, Linear, MipmapFilterMode::Linear, 8),
             FilterName::Aniso16 => base(Linear, Linear, MipmapFilterMode::Linear, 16),
-            FilterName::Ewa | FilterName::Ripmap | FilterName::Sat => {
-                bail!("filter {} is not available in this build", self.name())
-            }
+            FilterName::Ewa => minification(FilterMode::Ewa),
+            FilterName::Ripmap => minification(FilterMode::Ripmap),
+            FilterName::Sat => minification(FilterMode::SummedArea),
         })
     }
 }

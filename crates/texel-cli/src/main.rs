@@ -5,10 +5,18 @@
 //! function per command, anyhow with context at the top. The work lives in the texel libraries.
 
 mod cli;
+mod cmd_bench;
+mod cmd_compare;
+mod cmd_demo;
 mod cmd_mips;
+mod cmd_reference;
+mod cmd_render;
 mod cmd_warp;
 mod filters;
 mod output;
+mod prepare;
+mod progress;
+mod threads;
 
 use std::process::ExitCode;
 
@@ -19,6 +27,11 @@ use cli::{Cli, Command};
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Render(args) => cmd_render::run(&args),
+        Command::Reference(args) => cmd_reference::run(&args),
+        Command::Bench(args) => cmd_bench::run(&args),
+        Command::Compare(args) => cmd_compare::run(&args),
+        Command::Demo(args) => cmd_demo::run(&args),
         Command::Warp(args) => cmd_warp::run(&args),
         Command::Mips(args) => cmd_mips::run(&args),
     };

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use texel_raster::{DrawCall, RenderSettings, Vertex};
 use texel_scene::Scene;
 use texel_texture::color::srgb_to_linear;
-use texel_texture::{ColorSpace, Sampler, Texture};
+use texel_texture::{ColorSpace, Limits, Sampler, Texture};
 
 use crate::cli::{ColorArg, Size};
 use crate::filters::FilterName;
@@ -36,13 +36,7 @@ impl Prepared {
             ColorArg::Srgb => None,
             ColorArg::Raw => Some(ColorSpace::Linear),
         };
-        let mut textures = BTreeMap::new();
-        for name in scene.textures.keys() {
-            let tex = scene
-                .build_texture(name, override_space)
-                .with_context(|| format!("cannot build texture {name:?}"))?;
-            textures.insert(name.clone(), tex);
-        }
+        let textures = scene.load_textures(override_space, &Limits::default())?;
         let vertices = scene.meshes.iter().map(texel_vertices).collect();
         let (width, height) = size.map_or((scene.output.width, scene.output.height), |s| (s.width, s.height));
         Ok(Prepared {

@@ -244,12 +244,6 @@ impl Sampler {
         if !(1..=64).contains(&desc.anisotropy_clamp) {
             return Err(TextureError::InvalidAnisotropyClamp(desc.anisotropy_clamp));
         }
-        let all_linear = desc.mag_filter == FilterMode::Linear
-            && desc.min_filter == FilterMode::Linear
-            && desc.mipmap_filter == MipmapFilterMode::Linear;
-        if desc.anisotropy_clamp > 1 && !all_linear {
-            return Err(TextureError::AnisotropyNeedsLinear(desc.anisotropy_clamp));
-        }
         for f in [desc.mag_filter, desc.min_filter] {
             if let FilterMode::Cubic(c) = f {
                 if !c.b.is_finite() || !c.c.is_finite() {

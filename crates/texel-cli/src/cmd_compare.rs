@@ -1,0 +1,234 @@
+//! `texel compare`: every filter against the supersampled reference, with a report.
+//!
+//! Per filter: one untimed warm-up frame, [`TIMED_FRAMES`] timed frames (the median is the "ms per
+//! frame"), then one frame with texel counting on, whose image (identical to the uncounted ones) is
+//! written and scored. Quality is measured on the 8-bit images exactly as written (texel-quality's
+//! decision), so anyone can recompute it from the PNG files.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use texel_quality::{
+    crop_enlarge, default_band_rows, heat_map, horizon_crop_rect, Encoding, FilterRow, Image8, Mask, Report, Scores,
+};
+use texel_raster::{render, Frame};
+
+use crate::cli::{ColorArg, CompareArgs};
+use crate::cmd_bench::median;
+use crate::cmd_reference::reference_frame;
+use crate::filters::{parse_list, FilterName};
+use crate::prepare::Prepared;
+use crate::progress;
+
+/// Timed frames per filter in a comparison.
+pub const TIMED_FRAMES: usize = 3;
+
+/// Error (8-bit units) at the top of the heat maps' colour ramp.
+pub const HEAT_MAP_MAX: f32 = 64.0;
+
+/// Enlargement of the horizon crops (nearest neighbour).
+pub const CROP_FACTOR: u32 = 4;
+
+/// Parse `LABEL=PATH`.
+pub fn parse_extra(s: &str) -> Result<(String, PathBuf)> {
+    match s.split_once('=') {
+        Some((label, path)) if !label.trim().is_empty() && !path.is_empty() => {
+            Ok((label.trim().to_string(), PathBuf::from(path)))
+        }
+        _ => bail!("--extra {s:?} is not LABEL=IMAGE (e.g. --extra llvmpipe=trilinear.png)"),
+    }
+}
+
+/// A file-name-safe version of a label.
+fn slug(label: &str) -> String {
+    label
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .collect()
+}
+
+fn encoding(color: ColorArg) -> Encoding {
+    match color {
+        ColorArg::Srgb => Encoding::Srgb,
+        ColorArg::Raw => Encoding::Linear,
+    }
+}
+
+/// What every scored image shares: the reference, the coverage and the output directory.
+struct Scoring<'a> {
+    reference: Image8,
+    coverage: Mask,
+    band_rows: u32,
+    crop: Option<texel_quality::Rect>,
+    dir: &'a Path,
+}
+
+impl Scoring<'_> {
+    /// Write `image` (as `{stem}.png`), its heat map and horizon crop; return its row.
+    fn row(&self, name: &str, stem: &str, image: &Image8, write_image: bool) -> Result<FilterRow> {
+        let scores = Scores::compute(&self.reference, image, &self.coverage, self.band_rows)
+            .with_context(|| format!("cannot score {name}"))?;
+        let file = format!("{stem}.png");
+        if write_image {
+            image.write_png(self.dir.join(&file))?;
+        }
+        let mut row = FilterRow::new(name, scores, file);
+        let heat = heat_map(&self.reference, image, Some(&self.coverage), HEAT_MAP_MAX)?;
+        let heat_file = format!("{stem}-error.png");
+        heat.write_png(self.dir.join(&heat_file))?;
+        row.heat_map = Some(heat_file);
+        if let Some(rect) = self.crop {
+            let crop_file = format!("{stem}-horizon.png");
+            crop_enlarge(image, rect, CROP_FACTOR)?.write_png(self.dir.join(&crop_file))?;
+            row.horizon_crop = Some(crop_file);
+        }
+        Ok(row)
+    }
+}
+
+/// Compare `filters` on a prepared scene against a `spp` reference, write everything into `dir` and
+/// return the report. `label` names the scene in the report.
+pub fn compare(
+    scene: &Prepared,
+    label: &str,
+    filters: &[FilterName],
+    spp: u32,
+    extras: &[(String, PathBuf)],
+    dir: &Path,
+) -> Result<Report> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let enc = encoding(scene.color);
+    let reference = reference_frame(scene, spp)?;
+    let (w, h) = (reference.width, reference.height);
+    let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
+    ref_image.write_png(dir.join("reference.png"))?;
+    let coverage = Mask::new(w, h, reference.coverage.clone())?;
+    if coverage.count() == 0 {
+        bail!("the scene covers no pixel: nothing to compare");
+    }
+    let crop = horizon_crop_rect(&coverage, (w / 5).max(16), (h / 8).max(8));
+    let scoring = Scoring {
+        reference: ref_image,
+        coverage,
+        band_rows: default_band_rows(h),
+        crop,
+        dir,
+    };
+    let reference_crop = match crop {
+        Some(rect) => {
+            crop_enlarge(&scoring.reference, rect, CROP_FACTOR)?.write_png(dir.join("reference-horizon.png"))?;
+            Some("reference-horizon.png".to_string())
+        }
+        None => None,
+    };
+
+    let mut rows = Vec::new();
+    let pb = progress::bar(filters.len() as u64, "filters");
+    for &filter in filters {
+        pb.set_message(filter.name());
+        let samplers = scene.samplers(filter)?;
+        let bytes = scene.prepare(&samplers)?;
+        let draws = scene.draws(&samplers);
+        let settings = scene.settings();
+        render(&settings, &draws)?; // warm-up
+        let mut times: Vec<f64> = (0..TIMED_FRAMES)
+            .map(|_| {
+                let t0 = Instant::now();
+                render(&settings, &draws).map(|f| {
+                    std::hint::black_box(&f);
+                    t0.elapsed().as_secs_f64() * 1e3
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        let mut counting = settings;
+        counting.count_texels = true;
+        let frame = render(&counting, &draws)?;
+        let image = Image8::from_linear(w, h, &frame.color, enc)?;
+        let mut row = scoring.row(filter.name(), filter.name(), &image, true)?;
+        let (mean, max) = texel_stats(&frame);
+        row.texels_per_pixel_mean = Some(mean);
+        row.texels_per_pixel_max = Some(max);
+        row.ms_per_frame = Some(median(&mut times));
+        row.texture_bytes = Some(bytes);
+        rows.push(row);
+        pb.inc(1);
+    }
+    pb.finish_and_clear();
+
+    for (label, path) in extras {
+        let image = Image8::load(path).with_context(|| format!("cannot load --extra image {}", path.display()))?;
+        if image.size() != (w, h) {
+            bail!(
+                "--extra image {} is {}x{} but the comparison is {w}x{h} (pass --size to match)",
+                path.display(),
+                image.width(),
+                image.height()
+            );
+        }
+        let stem = format!("extra-{}", slug(label));
+        let mut row = scoring.row(label, &stem, &image, true)?;
+        row.extra = true;
+        rows.push(row);
+    }
+
+    let report = Report {
+        scene: label.to_string(),
+        width: w,
+        height: h,
+        spp,
+        color: match scene.color {
+            ColorArg::Srgb => "srgb",
+            ColorArg::Raw => "raw",
+        }
+        .to_string(),
+        reference_image: "reference.png".to_string(),
+        reference_crop,
+        band_rows: scoring.band_rows,
+        heat_map_max: HEAT_MAP_MAX,
+        rows,
+    };
+    report.write(dir)?;
+    Ok(report)
+}
+
+/// Mean texels read over covered pixels, and the maximum.
+fn texel_stats(frame: &Frame) -> (f64, u64) {
+    let mut sum = 0u64;
+    let mut n = 0u64;
+    let mut max = 0u64;
+    for (&t, &c) in frame.texels_read.iter().zip(&frame.coverage) {
+        if c {
+            sum += u64::from(t);
+            n += 1;
+            max = max.max(u64::from(t));
+        }
+    }
+    (if n == 0 { 0.0 } else { sum as f64 / n as f64 }, max)
+}
+
+/// Run `texel compare`.
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let filters = parse_list(&args.filters)?;
+    let extras = args.extra.iter().map(|e| parse_extra(e)).collect::<Result<Vec<_>>>()?;
+    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
+    let report = compare(&scene, &args.scene.scene, &filters, args.spp, &extras, &args.out)?;
+    print!("{}", report.to_markdown());
+    eprintln!("report: {}", args.out.join("index.html").display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extras_parse() {
+        assert_eq!(parse_extra("gpu=out/a.png").unwrap(), ("gpu".to_string(), PathBuf::from("out/a.png")));
+        assert_eq!(parse_extra("a=b=c").unwrap(), ("a".to_string(), PathBuf::from("b=c")));
+        assert!(parse_extra("nolabel").is_err());
+        assert!(parse_extra("=x.png").is_err());
+        assert!(parse_extra("x=").is_err());
+        assert_eq!(slug("llvm pipe/1"), "llvm_pipe_1");
+    }
+}
