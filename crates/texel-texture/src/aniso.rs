@@ -29,9 +29,11 @@
 //!   (at most 64), so the loop is bounded. Probe positions that overflow to infinity are sampled
 //!   at 0, as the sampler treats non-finite `uv`.
 //!
-//! Cost: `N` trilinear probes, so at most `8 N` texel reads. Measured texels per sample and
-//! samples per second are in `benches/aniso.rs` and the table of [`crate::ewa`]'s module docs;
-//! quality against a brute-force Gaussian is recorded there too.
+//! Cost: `N` trilinear probes, so at most `8 N` texel reads. Measured (benches/aniso.rs,
+//! 2048x2048 sRGB RGBA8, minor axis 2 texels, random angles, 2-core VM, shared), texels per sample
+//! and samples per second for 16x: ratio 1: 4.7, 10.3 M/s; ratio 4: 18.9, 4.8 M/s; ratio 16: 76,
+//! 1.9 M/s; ratio 64: 64, 2.0 M/s (trilinear: 4 to 4.7 texels, 10.5 to 20 M/s). Quality against a
+//! brute-force Gaussian (RMS error 0.0138 for 16x vs 0.0230 for trilinear) is in [`crate::ewa`].
 
 use glam::Vec4;
 
