@@ -7,6 +7,7 @@
 //! The chart plots quality (PSNR over the covered pixels, dB, linear axis) against time
 //! (ms per frame, logarithmic axis, decades with 1-2-5 ticks), one labelled point per timed filter.
 //! External images have no time: each is drawn as a dashed horizontal line at its PSNR, labelled.
+//! Point labels go to the first of four places around their point that overlaps no point and no earlier label.
 //! Rows with infinite PSNR (identical to the reference) cannot be placed and are listed under it.
 
 use crate::heatmap::legend_svg;
@@ -29,10 +30,10 @@ pub fn escape(s: &str) -> String {
 }
 
 /// Chart geometry in SVG pixels.
-const CW: f64 = 760.0;
+const CW: f64 = 640.0;
 const CH: f64 = 420.0;
 const LEFT: f64 = 64.0;
-const RIGHT: f64 = 170.0;
+const RIGHT: f64 = 24.0;
 const TOP: f64 = 20.0;
 const BOTTOM: f64 = 52.0;
 
@@ -152,21 +153,41 @@ pub fn chart_svg(report: &Report) -> String {
         s += &format!(
             "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#c0392b\" stroke-dasharray=\"6 4\"/>\n<text x=\"{:.1}\" y=\"{:.1}\" fill=\"#c0392b\">{} ({} dB, no time)</text>\n",
             LEFT + pw,
-            LEFT + pw + 6.0,
-            yy + 4.0,
+            LEFT + 6.0,
+            yy - 5.0,
             escape(name),
             fmt_psnr(*db)
         );
     }
+    // Labels: the first of four places around the point (right-above, right-below, left-above,
+    // left-below) that overlaps no point and no label placed before; text width estimated at 7 px a character.
+    // Every point is an obstacle too.
+    let mut placed: Vec<(f64, f64, f64, f64)> = timed
+        .iter()
+        .map(|t| (px(t.1) - 5.0, py(t.2) - 5.0, px(t.1) + 5.0, py(t.2) + 5.0))
+        .collect();
     for (name, ms, db) in &timed {
         let (x, yy) = (px(*ms), py(*db));
+        let tw = 7.0 * name.chars().count() as f64;
+        let boxes = [
+            (x + 6.0, yy - 18.0),
+            (x + 6.0, yy + 4.0),
+            (x - 6.0 - tw, yy - 18.0),
+            (x - 6.0 - tw, yy + 4.0),
+        ];
+        let free = |&(bx, by): &(f64, f64)| {
+            placed.iter().all(|&(px0, py0, px1, py1)| {
+                bx + tw <= px0 || bx >= px1 || by + 14.0 <= py0 || by >= py1
+            })
+        };
+        let (bx, by) = boxes.iter().copied().find(|b| free(b)).unwrap_or(boxes[0]);
+        placed.push((bx, by, bx + tw, by + 14.0));
         s += &format!(
-            "<circle cx=\"{x:.1}\" cy=\"{yy:.1}\" r=\"4\" fill=\"#1f77b4\"><title>{}: {} dB, {} ms</title></circle>\n<text x=\"{:.1}\" y=\"{:.1}\">{}</text>\n",
+            "<circle cx=\"{x:.1}\" cy=\"{yy:.1}\" r=\"4\" fill=\"#1f77b4\"><title>{}: {} dB, {} ms</title></circle>\n<text x=\"{bx:.1}\" y=\"{:.1}\">{}</text>\n",
             escape(name),
             fmt_psnr(*db),
             num(*ms),
-            x + 6.0,
-            yy - 6.0,
+            by + 11.0,
             escape(name)
         );
     }

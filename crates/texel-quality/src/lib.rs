@@ -2,7 +2,7 @@
 //!
 //! - [`psnr`] / [`mse`] / [`psnr_band`]: PSNR over a mask (the geometry's coverage) or the horizon
 //!   band, per RGB channel on 8-bit encoded values, peak 255.
-//! - [`ssim`] / [`ssim_map`]: SSIM exactly per Wang et al. 2004 (11x11 Gaussian, sigma 1.5,
+//! - [`ssim()`] / [`ssim_map`]: SSIM exactly per Wang et al. 2004 (11x11 Gaussian, sigma 1.5,
 //!   K1 = 0.01, K2 = 0.03, L = 255), per RGB channel, averaged.
 //! - [`horizon_band`]: the strip just below the horizon, where minification is extreme.
 //! - [`heat_map`], [`legend_svg`], [`crop_enlarge`], [`horizon_crop_rect`]: pictures of the error.

@@ -14,7 +14,7 @@ pub struct Scores {
     pub psnr_all: f64,
     /// PSNR in dB over the horizon band ([`crate::horizon_band`]).
     pub psnr_band: f64,
-    /// Mean SSIM over the covered pixels at least 5 from the image edge ([`crate::ssim`]).
+    /// Mean SSIM over the covered pixels at least 5 from the image edge ([`crate::ssim()`]).
     pub ssim: f64,
 }
 

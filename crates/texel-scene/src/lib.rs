@@ -2,7 +2,7 @@
 //! meshes, procedural textures and built-in demo scenes. Independent of the rasterizer.
 //!
 //! - [`Scene::load`] takes `builtin:NAME` ([`builtin_names`]) or a path to a TOML file
-//!   (format: [`file`]), and validates it ([`Scene::validate`]).
+//!   (format: [`mod@file`]), and validates it ([`Scene::validate`]).
 //! - [`Camera::clip_from_world`] gives the OpenGL-style clip transform.
 //! - [`TextureSpec::load`] / [`Scene::load_textures`] build `texel_texture::Texture`s, with an
 //!   optional colour-space override (the CLI's `--color raw`).
