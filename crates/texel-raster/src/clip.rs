@@ -32,7 +32,7 @@ pub const W_MIN: f64 = 1e-12;
 /// Number of clip planes.
 const PLANES: usize = 7;
 
-/// Most vertices a triangle clipped by [`PLANES`] planes can have (3 + one per plane).
+/// Most vertices a triangle clipped by the seven planes can have (3 + one per plane).
 pub const MAX_CLIPPED: usize = 3 + PLANES;
 
 /// A vertex during clipping: its clip-space position and its barycentric coordinates with respect to

@@ -6,7 +6,7 @@
 //! far planes and a guard band ([`clip`]), set up once per triangle with fixed-point edge functions,
 //! the top-left fill rule and homogeneous plane equations ([`setup`]), binned to 64x64 tiles and
 //! rasterised in parallel ([`tile`]); every covered pixel gets perspective-correct barycentrics and
-//! `uv` derivatives ([`interp`]) that become the sampler's footprint, and is shaded ([`shade`]) or
+//! `uv` derivatives ([`interp`]) that become the sampler's footprint, and is shaded (`shade.rs`) or
 //! shown through a debug view ([`views`]). [`reference::render_reference`] supersamples the same
 //! geometry.
 //!

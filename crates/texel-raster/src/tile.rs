@@ -11,6 +11,13 @@
 //! - Coverage in the analytic mode steps the three integer edge functions incrementally along each
 //!   row (three adds per pixel); the quad mode evaluates 2x2 aligned quads (tiles have even origins,
 //!   so quads never straddle tiles) and interpolates all four pixels of a touched quad.
+//!
+//! Measurements (2-core VM shared with other builds, `examples/frame_table.rs`, min of 30 runs):
+//! the ground scene at 1280 x 720 takes 18.9 ms with nearest on 1 thread and 10.1 ms on 2; `perf`
+//! attributes about 60% of the nearest frame to the sampler (`sample_pyramid`, `log2f`, `floorf`)
+//! and about 30% to rasterisation and interpolation. A 100k-triangle mesh over the whole frame
+//! renders at about 1.2 M triangles/s (frame included) and does not yet scale to 2 threads: setup
+//! output is concatenated and binned serially (`memmove` and page faults were 9% of its profile).
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
