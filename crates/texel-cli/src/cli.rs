@@ -172,11 +172,11 @@ pub struct DemoArgs {
     /// Output directory (created if missing).
     #[arg(long, default_value = "texel-demo")]
     pub out: PathBuf,
-    /// Image size of every scene.
-    #[arg(long, default_value = "640x360")]
-    pub size: Size,
+    /// Image size of every scene (default: each scene's own, e.g. 1280x720 for the ground plane).
+    #[arg(long)]
+    pub size: Option<Size>,
     /// Reference samples per pixel (a square number).
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub spp: u32,
 }
 
