@@ -1,7 +1,7 @@
 //! `texel reference`: the supersampled ground truth.
 
 use anyhow::Result;
-use texel_raster::reference::render_reference;
+use texel_raster::render_reference_strata;
 
 use crate::cli::ReferenceArgs;
 use crate::filters::FilterName;
@@ -32,8 +32,12 @@ pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame
     let (n, m) = strata(spp);
     let pb = progress::bar(1000, "reference");
     let report = |done: u64, total: u64| pb.set_position(done * 1000 / total.max(1));
-    anyhow::ensure!(n == m, "--spp {spp} is not a square number of samples (e.g. 64, 256, 1024)");
-    let frame = render_reference(&settings, &draws, n, SEED, Some(&report))?;
+    let max = texel_raster::reference::MAX_SPP_SIDE;
+    anyhow::ensure!(
+        m <= max,
+        "--spp {spp} stratifies as {n} x {m}, over {max} per side: choose a number with a divisor near its square root (e.g. 256, 512, 1024)"
+    );
+    let frame = render_reference_strata(&settings, &draws, [n, m], SEED, Some(&report))?;
     pb.finish_and_clear();
     Ok(frame)
 }
@@ -42,7 +46,13 @@ pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame
 pub fn run(args: &ReferenceArgs) -> Result<()> {
     let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
     let frame = reference_frame(&scene, args.spp)?;
-    write_png(&args.output, frame.width, frame.height, &frame.color, args.scene.color)
+    write_png(
+        &args.output,
+        frame.width,
+        frame.height,
+        &frame.color,
+        args.scene.color,
+    )
 }
 
 #[cfg(test)]

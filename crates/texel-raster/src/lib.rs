@@ -56,7 +56,7 @@ pub mod views;
 pub use draw::{DrawCall, Vertex};
 pub use error::RasterError;
 pub use frame::Frame;
-pub use reference::render_reference;
+pub use reference::{render_reference, render_reference_strata};
 pub use settings::{
     Derivatives, DirectionalLight, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS,
 };

@@ -5,7 +5,7 @@ mod common;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use common::{lab_sampler, Ground};
-use texel_raster::{render, render_reference, Frame, RenderSettings};
+use texel_raster::{render, render_reference, render_reference_strata, Frame, RenderSettings};
 use texel_texture::{Format, Limits, Texture};
 
 /// Mean absolute difference over all channels.
@@ -34,6 +34,33 @@ fn reference_converges_on_the_ground() {
     assert!(d1 < 4.0 * d2, "d(8,16) = {d1}, d(16,32) = {d2}");
     assert!(d1 > 0.0);
     eprintln!("d(8,16) = {d1}, d(16,32) = {d2}");
+}
+
+/// Square strata through `render_reference_strata` are `render_reference` bit for bit; a 16 x 32
+/// (512-sample) reference lies closer to a 32 x 32 one than an 8 x 8 reference does.
+#[test]
+fn rectangular_strata() {
+    let (w, h) = (96, 54);
+    let scene = Ground::new(w, h);
+    let sampler = lab_sampler(4);
+    let s = RenderSettings::new(w, h);
+    let d = [scene.draw(&sampler)];
+    let square = render_reference(&s, &d, 6, 9, None).unwrap();
+    assert_eq!(
+        render_reference_strata(&s, &d, [6, 6], 9, None).unwrap(),
+        square
+    );
+    let r512 = render_reference_strata(&s, &d, [16, 32], 9, None).unwrap();
+    let r1024 = render_reference(&s, &d, 32, 10, None).unwrap();
+    let r64 = render_reference(&s, &d, 8, 9, None).unwrap();
+    assert!(
+        mad(&r512, &r1024) < mad(&r64, &r1024),
+        "{} vs {}",
+        mad(&r512, &r1024),
+        mad(&r64, &r1024)
+    );
+    assert!(render_reference_strata(&s, &d, [0, 4], 9, None).is_err());
+    assert!(render_reference_strata(&s, &d, [4, 65], 9, None).is_err());
 }
 
 #[test]
