@@ -652,3 +652,37 @@ fn missing_file_is_io_error() {
         Err(TextureError::Io(_))
     ));
 }
+
+/// OpenEXR (float) images decode to linear RGBA32F, ignoring the colour-space tag.
+#[test]
+fn exr_round_trip() {
+    let pixels: Vec<f32> = (0..4 * 3 * 2).map(|k| k as f32 * 0.37 - 1.0).collect();
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image::codecs::openexr::OpenExrEncoder::new(&mut bytes)
+        .write_image(
+            bytemuck_f32(&pixels).as_slice(),
+            3,
+            2,
+            image::ExtendedColorType::Rgba32F,
+        )
+        .unwrap();
+    let tex = Texture::decode(bytes.get_ref(), ColorSpace::Srgb, &Limits::default()).unwrap();
+    assert_eq!(
+        (tex.width(), tex.height(), tex.format()),
+        (3, 2, Format::Rgba32Float)
+    );
+    for j in 0..2 {
+        for i in 0..3 {
+            let k = 4 * (j * 3 + i) as usize;
+            assert_eq!(
+                tex.texel(0, i, j).unwrap(),
+                [pixels[k], pixels[k + 1], pixels[k + 2], pixels[k + 3]]
+            );
+        }
+    }
+}
+
+/// Native-endian bytes of `f32`s, as image-rs's encoders take them.
+fn bytemuck_f32(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_ne_bytes()).collect()
+}
