@@ -10,8 +10,8 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use texel_quality::{
-    crop_enlarge, default_band_rows, heat_map, horizon_crop_rect, Encoding, FilterRow, Image8,
-    Mask, Report, Scores,
+    crop_enlarge, default_band_rows, heat_map, horizon_crop_rect, FilterRow, Image8, Mask, Report,
+    Scores,
 };
 use texel_raster::{render, Frame};
 
@@ -19,6 +19,7 @@ use crate::cli::{ColorArg, CompareArgs};
 use crate::cmd_bench::median;
 use crate::cmd_reference::reference_frame;
 use crate::filters::{parse_list, FilterName};
+use crate::output::encoding;
 use crate::prepare::Prepared;
 use crate::progress;
 
@@ -53,13 +54,6 @@ fn slug(label: &str) -> String {
             }
         })
         .collect()
-}
-
-fn encoding(color: ColorArg) -> Encoding {
-    match color {
-        ColorArg::Srgb => Encoding::Srgb,
-        ColorArg::Raw => Encoding::Linear,
-    }
 }
 
 /// What every scored image shares: the reference, the coverage and the output directory.
