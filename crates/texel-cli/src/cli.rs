@@ -21,7 +21,8 @@ pub enum Command {
     /// Render a scene with one texture filter (or a debug view) to a PNG.
     ///
     /// Example: texel render builtin:ground --filter trilinear -o ground.png
-    ///          texel render ../shared/scenes/ground.toml --lab-mode 8 --view aniso -o aniso.png
+    ///
+    /// Example: texel render ../shared/scenes/ground.toml --lab-mode 8 --view aniso -o aniso.png
     Render(RenderArgs),
     /// Render the supersampled reference (ground truth) of a scene.
     ///
@@ -31,7 +32,8 @@ pub enum Command {
     /// error heat maps, horizon crops and a quality/time chart.
     ///
     /// Example: texel compare builtin:ground --filters all --spp 256 --out report/
-    ///          texel compare scene.toml --extra gpu=gpu.png --out report/
+    ///
+    /// Example: texel compare scene.toml --extra gpu=gpu.png --out report/
     Compare(CompareArgs),
     /// Perspective-warp an image without aliasing: the output's corners show four source points.
     ///
@@ -139,7 +141,7 @@ pub struct RenderArgs {
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Samples per pixel, stratified n x m with n*m = spp (256 = 16x16, 512 = 16x32).
+    /// Samples per pixel, stratified n x m with n*m = spp as square as possible (256 = 16x16, 512 = 16x32).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub spp: u32,
     /// Output PNG.
@@ -252,6 +254,35 @@ impl std::str::FromStr for Size {
     }
 }
 
+/// Four source points `x0,y0,x1,y1,x2,y2,x3,y3` (pixels), parsed from one comma-separated value.
+///
+/// One value rather than clap's `value_delimiter` with `num_args = 8`: clap counts the 8 values
+/// before splitting at commas, so it rejected the documented `--corners 0,0,4000,300,...`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Corners(pub [f64; 8]);
+
+impl std::str::FromStr for Corners {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let items: Vec<&str> = s.split(',').map(str::trim).collect();
+        if items.len() != 8 {
+            return Err(format!(
+                "{s:?} has {} numbers; give 8: x0,y0,x1,y1,x2,y2,x3,y3 (e.g. 0,0,4000,300,4000,2700,0,3000)",
+                items.len()
+            ));
+        }
+        let mut out = [0.0; 8];
+        for (o, t) in out.iter_mut().zip(&items) {
+            *o = t
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("{t:?} in {s:?} is not a finite number"))?;
+        }
+        Ok(Corners(out))
+    }
+}
+
 /// `texel warp`.
 #[derive(Debug, Args)]
 pub struct WarpArgs {
@@ -259,14 +290,8 @@ pub struct WarpArgs {
     pub input: PathBuf,
     /// Source pixel positions shown at the output's top-left, top-right, bottom-right and
     /// bottom-left corners: x0,y0,x1,y1,x2,y2,x3,y3 (pixels; (0,0) is the source's top-left corner).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        num_args = 8,
-        required = true,
-        allow_negative_numbers = true
-    )]
-    pub corners: Vec<f64>,
+    #[arg(long, allow_hyphen_values = true)]
+    pub corners: Corners,
     /// Output size; defaults to the source size.
     #[arg(long)]
     pub size: Option<Size>,

@@ -17,7 +17,7 @@ pub fn run(args: &WarpArgs) -> Result<()> {
     };
     let tex = Texture::load(&args.input, color, &Limits::default())
         .with_context(|| format!("cannot load image {}", args.input.display()))?;
-    let c = &args.corners;
+    let c = &args.corners.0;
     let corners = [0, 2, 4, 6].map(|k| DVec2::new(c[k], c[k + 1]));
     let (w, h) = args
         .size
