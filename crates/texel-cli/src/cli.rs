@@ -113,9 +113,9 @@ pub struct SceneArgs {
 pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Texture filter.
-    #[arg(long, default_value = "trilinear", conflicts_with = "lab_mode")]
-    pub filter: FilterName,
+    /// Texture filter for every mesh (default: a glTF mesh's own sampler filters, else trilinear).
+    #[arg(long, conflicts_with = "lab_mode")]
+    pub filter: Option<FilterName>,
     /// The lab's numbered filter modes: 1 nearest, 2 bilinear, 3 mip-nearest, 4 trilinear, 5-8 anisotropic 2x-16x.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8))]
     pub lab_mode: Option<u8>,

@@ -12,11 +12,14 @@ use crate::threads::with_threads;
 /// Run `texel render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let filter = match args.lab_mode {
-        Some(m) => FilterName::from_lab_mode(m)?,
+        Some(m) => Some(FilterName::from_lab_mode(m)?),
         None => args.filter,
     };
     let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
-    let samplers = scene.samplers(filter)?;
+    let samplers = match filter {
+        Some(f) => scene.samplers(f)?,
+        None => scene.default_samplers()?,
+    };
     scene.prepare(&samplers)?;
     let mut settings = scene.settings();
     settings.derivatives = match args.derivatives {

@@ -64,6 +64,26 @@ impl Prepared {
             .collect()
     }
 
+    /// One sampler per mesh when the user names no filter: a glTF mesh's own sampler filters
+    /// (`magFilter`/`minFilter`; what the glTF leaves unspecified is linear, as for trilinear),
+    /// and trilinear for every other mesh.
+    pub fn default_samplers(&self) -> Result<Vec<Sampler>> {
+        self.scene
+            .meshes
+            .iter()
+            .map(|m| {
+                let mut desc =
+                    FilterName::Trilinear.descriptor(m.address_mode_u, m.address_mode_v)?;
+                if let Some(f) = &m.filters {
+                    desc.mag_filter = f.mag_filter.unwrap_or(desc.mag_filter);
+                    desc.min_filter = f.min_filter.unwrap_or(desc.min_filter);
+                    desc.mipmap_filter = f.mipmap_filter.unwrap_or(desc.mipmap_filter);
+                }
+                Sampler::new(desc).context("invalid sampler from the glTF file")
+            })
+            .collect()
+    }
+
     /// Build the acceleration structures `samplers` need (ripmaps, summed-area tables) ahead of
     /// timing, and return the bytes of every structure the frame uses (pyramids included), counting
     /// each texture once.

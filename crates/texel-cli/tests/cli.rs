@@ -534,6 +534,57 @@ fn obj_and_gltf_meshes_render_like_the_inline_quad() {
     assert!(inside.contains(&[0, 0, 0, 255]) && inside.contains(&[255, 255, 255, 255]));
 }
 
+/// Without `--filter`, a glTF mesh is sampled with its own sampler's filters: a glTF asking for
+/// NEAREST renders like `--filter nearest`, and differently from the trilinear default.
+#[test]
+fn gltf_sampler_filters_are_used_without_filter_flag() {
+    let d = Dir::new("gltf-sampler");
+    d.write("quad.bin", quad_buffer());
+    let gltf = quad_gltf("quad.bin")
+        .replace(r#""indices": 2}"#, r#""indices": 2, "material": 0}"#)
+        .replace(
+            r#""buffers":"#,
+            r#""samplers": [{"magFilter": 9728, "minFilter": 9728}],
+  "images": [{"uri": "never-loaded.png"}],
+  "textures": [{"sampler": 0, "source": 0}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+  "buffers":"#,
+        );
+    d.write("nearest.gltf", gltf);
+    d.write(
+        "nearest.toml",
+        format!("{HEAD}\n[[meshes]]\ntexture = \"t\"\ngltf = \"nearest.gltf\"\n"),
+    );
+    d.write(
+        "plain.toml",
+        format!("{HEAD}\n[[meshes]]\ntexture = \"t\"\ngltf = \"quad.gltf\"\n"),
+    );
+    d.write("quad.gltf", quad_gltf("quad.bin"));
+    let render = |scene: &str, filter: Option<&str>, out: &str| {
+        let mut args = vec!["render".to_string(), d.arg(scene)];
+        if let Some(f) = filter {
+            args.extend(["--filter".to_string(), f.to_string()]);
+        }
+        args.extend(["-o".to_string(), d.arg(out)]);
+        ok(&args);
+        file_bytes(&d.arg(out))
+    };
+    let own = render("nearest.toml", None, "own.png");
+    assert_eq!(
+        own,
+        render("nearest.toml", Some("nearest"), "forced-nearest.png")
+    );
+    assert_ne!(
+        own,
+        render("nearest.toml", Some("trilinear"), "forced-trilinear.png")
+    );
+    // A glTF without a sampler gets the trilinear default.
+    assert_eq!(
+        render("plain.toml", None, "plain.png"),
+        render("plain.toml", Some("trilinear"), "plain-trilinear.png")
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // reference
 // ---------------------------------------------------------------------------------------------
