@@ -567,7 +567,7 @@ fn gltf_sampler_filters_are_used_without_filter_flag() {
         }
         args.extend(["-o".to_string(), d.arg(out)]);
         ok(&args);
-        file_bytes(&d.arg(out))
+        file_bytes(d.arg(out))
     };
     let own = render("nearest.toml", None, "own.png");
     assert_eq!(
