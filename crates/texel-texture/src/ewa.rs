@@ -56,6 +56,14 @@
 //! centroid and effective blur vary with the sub-texel position; a level one finer would cost 4x the
 //! reads.
 //!
+//! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
+//! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
+//! anisotropic 16x there (ground scene, 640x360, 256 spp: EWA 23.5 dB, aniso16 29.8 dB). Matching the
+//! box's variance (`ALPHA = 6`, sigma^2 = 1/12 pixel^2) raised EWA to 27.5 dB but left only about one
+//! texel per standard deviation at the chosen level: rotation invariance fell to 1.5 % RMS (worst 7 %)
+//! and the RMS error against its own brute-force Gaussian rose from 0.0119 to 0.0196, behind aniso16.
+//! Keeping it would need a level one finer (4x the reads); pbrt's falloff stays.
+//!
 //! Cost (benches/aniso.rs, 2048x2048 sRGB RGBA8, minor axis 2 texels, random angles, 2-core VM,
 //! shared): ratio 1: 6.6 texels, 3.7 M samples/s; ratio 4: 19.4, 2.8 M/s; ratio 16: 75, 0.75 M/s;
 //! ratio 64 (clamped to 16): 71, 0.68 M/s.
