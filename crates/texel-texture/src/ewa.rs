@@ -56,6 +56,12 @@
 //! centroid and effective blur vary with the sub-texel position; a level one finer would cost 4x the
 //! reads.
 //!
+//! Inner loop: texels arrive in runs along a row with `r^2` updated by forward differences; runs
+//! inside the level read texels without address wrapping; `floor`/`ceil` avoid libm calls (16 % of
+//! the frame before). Ground scene, 1280 x 720, one thread, `texel bench --filters ewa --threads 1`:
+//! 557 ms -> 487 ms per frame (trilinear 42 ms in both runs). Images change by at most 1 in 8 bits
+//! (`r^2` now in `f64`).
+//!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
 //! anisotropic 16x there (ground scene, 640x360, 256 spp: EWA 23.5 dB, aniso16 29.8 dB). Matching the
@@ -205,30 +211,44 @@ impl LevelEllipse {
     /// the ellipse centred at continuous texel position `(x, y)`, with its unnormalised LUT weight.
     /// Visits at most [`MAX_VISITS`] texels and rows together; returns how many it visited.
     pub fn for_each_weight(&self, x: f32, y: f32, mut f: impl FnMut(i64, i64, f32)) -> u32 {
+        self.for_each_run(x, y, |i0, j, weights| {
+            for (k, &w) in weights.iter().enumerate() {
+                if w > 0.0 {
+                    f(i0.saturating_add(k as i64), j, w);
+                }
+            }
+        })
+    }
+
+    /// As [`LevelEllipse::for_each_weight`], a run of consecutive texels at a time: `f(i0, j, w)`
+    /// covers texels `i0 .. i0 + w.len()` of row `j` (unwrapped), with weight 0 for the rare centre
+    /// that rounding puts just outside the ellipse. Runs are at most [`RUN`] texels long.
+    ///
+    /// Along a row, `r^2` is a quadratic in the column offset and is updated by forward differences
+    /// (two additions per texel) instead of being re-evaluated.
+    pub fn for_each_run(&self, x: f32, y: f32, mut f: impl FnMut(i64, i64, &[f32])) -> u32 {
         let lut = weight_lut();
         let (q00, q01, q11, det) = (self.q00, self.q01, self.q11, self.det);
         if !(det > 0.0 && q11 > 0.0 && q00 > 0.0 && det.is_finite()) {
             return 0;
         }
         // r^2 = (q11 dx^2 - 2 q01 dx dy + q00 dy^2) / det.
-        let (ca, cb, cc) = (
-            (q11 / det) as f32,
-            (-2.0 * q01 / det) as f32,
-            (q00 / det) as f32,
-        );
-        let (xf, yf) = (x.floor(), y.floor());
-        let (fx, fy) = (f64::from(x - xf), f64::from(y - yf));
+        let (ca, cb, cc) = (q11 / det, -2.0 * q01 / det, q00 / det);
+        let (xf, yf) = (floor_f64(f64::from(x)), floor_f64(f64::from(y)));
+        let (fx, fy) = (f64::from(x) - xf, f64::from(y) - yf);
         let (xi, yi) = (xf as i64, yf as i64);
         // Rows: centre offset dy = m + 0.5 - fy with |dy| <= sqrt(q11).
         let hy = q11.sqrt();
-        let m0 = (fy - 0.5 - hy).ceil();
-        let m1 = (fy - 0.5 + hy).floor();
+        let m0 = ceil_f64(fy - 0.5 - hy);
+        let m1 = floor_f64(fy - 0.5 + hy);
         if !(m0.is_finite() && m1.is_finite()) {
             return 0;
         }
         // Integer loop counters (an f64 `m += 1` would stall at 2^53); rows count as visits too.
         let rows = (m1 - m0 + 1.0).clamp(0.0, f64::from(MAX_VISITS)) as u32;
         let mut visits = 0u32;
+        let mut buf = [0.0f32; RUN];
+        let inv_q11 = 1.0 / q11;
         for r in 0..rows {
             if visits >= MAX_VISITS {
                 break;
@@ -242,29 +262,68 @@ impl LevelEllipse {
                 continue;
             }
             let sd = disc.sqrt();
-            let lo = (q01 * dy - sd) / q11;
-            let hi = (q01 * dy + sd) / q11;
-            let n0 = (fx - 0.5 + lo).ceil();
-            let n1 = (fx - 0.5 + hi).floor();
+            let lo = (q01 * dy - sd) * inv_q11;
+            let hi = (q01 * dy + sd) * inv_q11;
+            let n0 = ceil_f64(fx - 0.5 + lo);
+            let n1 = floor_f64(fx - 0.5 + hi);
             let cols = (n1 - n0 + 1.0).clamp(0.0, f64::from(MAX_VISITS - visits)) as u32;
-            let j = yi.saturating_add(m as i64);
-            let dyf = dy as f32;
-            for c in 0..cols {
-                let n = n0 + f64::from(c);
-                let dx = (n + 0.5 - fx) as f32;
-                let r2 = ca * dx * dx + cb * dx * dyf + cc * dyf * dyf;
-                if r2 < 1.0 {
-                    let k = ((r2 * LUT_SIZE as f32) as usize).min(LUT_SIZE - 1);
-                    f(xi.saturating_add(n as i64), j, lut[k]);
-                }
-            }
             visits += cols;
+            let j = yi.saturating_add(m as i64);
+            let i_first = xi.saturating_add(n0 as i64);
+            // r^2 at the first column and its forward differences (exact in f64, then f32).
+            let dx0 = n0 + 0.5 - fx;
+            let mut r2 = ca * dx0 * dx0 + cb * dx0 * dy + cc * dy * dy;
+            let mut step = ca * (2.0 * dx0 + 1.0) + cb * dy;
+            let step2 = 2.0 * ca;
+            let mut done = 0u32;
+            while done < cols {
+                let len = (cols - done).min(RUN as u32) as usize;
+                for w in &mut buf[..len] {
+                    *w = if r2 < 1.0 {
+                        lut[((r2 * LUT_SIZE as f64) as usize).min(LUT_SIZE - 1)]
+                    } else {
+                        0.0
+                    };
+                    r2 += step;
+                    step += step2;
+                }
+                f(i_first.saturating_add(i64::from(done)), j, &buf[..len]);
+                done += len as u32;
+            }
         }
         visits
     }
 }
 
+/// `floor` without a libm call (the x86-64 baseline has no rounding instruction, and `floor`/`ceil`
+/// were 16 % of an EWA frame's profile). Exact for `|x| < 2^63`; NaN stays NaN; beyond that range
+/// the result saturates, which the callers' visit bounds absorb.
+#[inline(always)]
+fn floor_f64(x: f64) -> f64 {
+    if x.is_nan() {
+        return x;
+    }
+    let t = x as i64 as f64;
+    if t > x {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
+/// `ceil` as [`floor_f64`]: `-floor(-x)`.
+#[inline(always)]
+fn ceil_f64(x: f64) -> f64 {
+    -floor_f64(-x)
+}
+
+/// Longest run of texels [`LevelEllipse::for_each_run`] hands over at once.
+pub const RUN: usize = 64;
+
 /// EWA in one level; `None` if no texel got a weight.
+///
+/// Runs that lie inside the level read their texels directly; only runs crossing an edge wrap each
+/// index through the address modes.
 #[inline]
 fn ewa_level<F: Fetch>(
     level: &F,
@@ -277,10 +336,24 @@ fn ewa_level<F: Fetch>(
     let (x, y) = (u * w as f32, v * h as f32);
     let mut sum = Vec4::ZERO;
     let mut wsum = 0.0f32;
-    q.for_each_weight(x, y, |i, j, wt| {
-        let t = texel_or_border(level, addr, addr.u.wrap(i, w), addr.v.wrap(j, h));
-        sum += t * wt;
-        wsum += wt;
+    q.for_each_run(x, y, |i0, j, weights| {
+        let jw = addr.v.wrap(j, h);
+        let inside = i0 >= 0 && i0.saturating_add(weights.len() as i64) <= i64::from(w);
+        match jw {
+            Some(jw) if inside => {
+                for (k, &wt) in weights.iter().enumerate() {
+                    sum += level.texel(i0 as u32 + k as u32, jw) * wt;
+                    wsum += wt;
+                }
+            }
+            _ => {
+                for (k, &wt) in weights.iter().enumerate() {
+                    let i = addr.u.wrap(i0.saturating_add(k as i64), w);
+                    sum += texel_or_border(level, addr, i, jw) * wt;
+                    wsum += wt;
+                }
+            }
+        }
     });
     (wsum > 0.0).then(|| sum / wsum)
 }
@@ -338,6 +411,27 @@ pub(crate) fn ewa<P: Pyramid>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn integer_floor_and_ceil_match_libm() {
+        for x in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.999,
+            -2.999,
+            1e15 + 0.5,
+            -1e15 - 0.5,
+            4.0e18,
+        ] {
+            assert_eq!(floor_f64(x), x.floor(), "floor {x}");
+            assert_eq!(ceil_f64(x), x.ceil(), "ceil {x}");
+        }
+        assert!(floor_f64(f64::NAN).is_nan() && ceil_f64(f64::NAN).is_nan());
+    }
 
     #[test]
     fn lut_matches_generator_and_decreases() {
