@@ -148,23 +148,45 @@ pub fn chart_svg(report: &Report) -> String {
         CH - 10.0,
         TOP + ph / 2.0
     );
+    // Dashed-line labels sit just above their line, at the left end, or at the right end (or
+    // staggered upwards) when an earlier line's label is in the way.
+    let mut line_labels: Vec<(f64, f64, f64, f64)> = Vec::new();
     for (name, db) in &lines {
         let yy = py(*db);
+        let text = format!("{} ({} dB, no time)", escape(name), fmt_psnr(*db));
+        let tw = 7.0
+            * format!("{name} ({} dB, no time)", fmt_psnr(*db))
+                .chars()
+                .count() as f64;
+        let free = |bx: f64, by: f64| {
+            line_labels
+                .iter()
+                .all(|&(x0, y0, x1, y1)| bx + tw <= x0 || bx >= x1 || by + 14.0 <= y0 || by >= y1)
+        };
+        let (left, right) = (LEFT + 6.0, LEFT + pw - 6.0 - tw);
+        let (bx, by) = (0..4)
+            .flat_map(|k| {
+                [
+                    (left, yy - 17.0 - 14.0 * k as f64),
+                    (right, yy - 17.0 - 14.0 * k as f64),
+                ]
+            })
+            .find(|&(bx, by)| free(bx, by))
+            .unwrap_or((left, yy - 17.0));
+        line_labels.push((bx, by, bx + tw, by + 14.0));
         s += &format!(
-            "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#c0392b\" stroke-dasharray=\"6 4\"/>\n<text x=\"{:.1}\" y=\"{:.1}\" fill=\"#c0392b\">{} ({} dB, no time)</text>\n",
+            "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#c0392b\" stroke-dasharray=\"6 4\"/>\n<text x=\"{bx:.1}\" y=\"{:.1}\" fill=\"#c0392b\">{text}</text>\n",
             LEFT + pw,
-            LEFT + 6.0,
-            yy - 5.0,
-            escape(name),
-            fmt_psnr(*db)
+            by + 12.0,
         );
     }
     // Labels: the first of four places around the point (right-above, right-below, left-above,
     // left-below) that overlaps no point and no label placed before; text width estimated at 7 px a character.
-    // Every point is an obstacle too.
+    // Every point is an obstacle too, and so is every dashed line's label.
     let mut placed: Vec<(f64, f64, f64, f64)> = timed
         .iter()
         .map(|t| (px(t.1) - 5.0, py(t.2) - 5.0, px(t.1) + 5.0, py(t.2) + 5.0))
+        .chain(line_labels.iter().copied())
         .collect();
     for (name, ms, db) in &timed {
         let (x, yy) = (px(*ms), py(*db));
