@@ -37,7 +37,7 @@ use crate::bicubic::Cubic;
 use crate::error::TextureError;
 use crate::ewa::ewa;
 use crate::fetch::{with_pyramid, Counted, Fetch, Pyramid};
-use crate::footprint::{lod_from_rho, Footprint};
+use crate::footprint::{lod_from_rho_squared, rho_squared, Footprint};
 use crate::mip::{filter_level, mip_nearest, trilinear};
 use crate::ripmap::ripmap;
 use crate::sat::summed_area;
@@ -293,11 +293,13 @@ impl Sampler {
     }
 
     /// The lod this sampler uses for `footprint` on `texture` (before clamping to the last level):
-    /// `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]`.
+    /// `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]`, computed as
+    /// `0.5 * log2(rho^2)` with [`crate::footprint::fast_log2`] (within about one
+    /// unit in the last place of [`crate::footprint::lod_from_rho`]; exact on integer lods), the same value the sampling path uses.
     pub fn lod(&self, texture: &Texture, footprint: &Footprint) -> f32 {
         let d = &self.desc;
-        let rho = footprint.rho(texture.width(), texture.height());
-        lod_from_rho(rho, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp)
+        let rho2 = rho_squared(footprint, texture.width(), texture.height());
+        lod_from_rho_squared(rho2, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp)
     }
 
     /// Sample `texture` over `footprint`; linear RGBA.
@@ -354,7 +356,12 @@ impl Sampler {
         let level0 = p.level(0);
         let (w, h) = level0.size();
         let d = &self.desc;
-        let lod = lod_from_rho(fp.rho(w, h), d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
+        let lod = lod_from_rho_squared(
+            rho_squared(fp, w, h),
+            d.lod_bias,
+            d.lod_min_clamp,
+            d.lod_max_clamp,
+        );
         if lod <= 0.0 {
             return filter_level(&d.mag_filter, &level0, &self.addr, u, v);
         }
