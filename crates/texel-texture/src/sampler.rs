@@ -43,6 +43,9 @@ use crate::ripmap::ripmap;
 use crate::sat::summed_area;
 use crate::texture::Texture;
 
+/// Footprints [`Sampler::sample_batch`] prepares (lods) at once before filtering them.
+const BATCH_CHUNK: usize = 64;
+
 /// Largest |u| or |v| honoured (2^24): coordinates beyond are clamped to it.
 pub const UV_LIMIT: f32 = 16_777_216.0;
 
@@ -322,8 +325,11 @@ impl Sampler {
         })
     }
 
-    /// Sample many footprints at once: `out[k] = sample(texture, footprints[k])`. The texture's format
-    /// is dispatched once for the whole batch.
+    /// Sample many footprints at once: `out[k] = sample(texture, footprints[k])`, bit for bit. The
+    /// texture's format is dispatched once for the whole batch, and the lods of up to 64
+    /// footprints are computed in one loop before any is filtered (independent iterations that
+    /// pipeline, instead of one long dependency chain per sample). A rasterizer should hand it a
+    /// row span at a time.
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
@@ -334,8 +340,19 @@ impl Sampler {
             "sample_batch: footprints and out differ in length"
         );
         with_pyramid!(texture, |p| {
-            for (o, f) in out.iter_mut().zip(footprints) {
-                *o = self.sample_pyramid(&p, f).to_array();
+            let (w, h) = p.level(0).size();
+            // Two stages per chunk (see `prepare`): all lods first, then all filters.
+            let mut pre = [(0.0f32, 0.0f32, 0.0f32); BATCH_CHUNK];
+            for (fps, outs) in footprints
+                .chunks(BATCH_CHUNK)
+                .zip(out.chunks_mut(BATCH_CHUNK))
+            {
+                for (q, f) in pre.iter_mut().zip(fps) {
+                    *q = self.prepare(w, h, f);
+                }
+                for ((o, f), &(u, v, lod)) in outs.iter_mut().zip(fps).zip(&pre) {
+                    *o = self.filter(&p, f, u, v, lod).to_array();
+                }
             }
         })
     }
@@ -343,6 +360,18 @@ impl Sampler {
     /// The whole per-sample path, generic over the texel storage (and the counting wrapper).
     #[inline]
     pub(crate) fn sample_pyramid<P: Pyramid>(&self, p: &P, fp: &Footprint) -> Vec4 {
+        let (w, h) = p.level(0).size();
+        let (u, v, lod) = self.prepare(w, h, fp);
+        self.filter(p, fp, u, v, lod)
+    }
+
+    /// First stage of a sample: `(u, v)` made finite and the lod, for a `w x h` level 0.
+    ///
+    /// Split from [`Sampler::filter`] so that [`Sampler::sample_batch`] can run it over many
+    /// footprints in a short, independent loop: the lod is a long dependency chain (square, log2,
+    /// clamp) that pipelines across footprints there instead of stalling each sample.
+    #[inline(always)]
+    fn prepare(&self, w: u32, h: u32, fp: &Footprint) -> (f32, f32, f32) {
         // NaN/inf sample at 0; beyond +-2^24 an f32 has no fractional bits left, so clamping there
         // changes nothing a caller could rely on and keeps `u * W` finite for every level.
         let finite = |x: f32| {
@@ -352,9 +381,6 @@ impl Sampler {
                 0.0
             }
         };
-        let (u, v) = (finite(fp.u), finite(fp.v));
-        let level0 = p.level(0);
-        let (w, h) = level0.size();
         let d = &self.desc;
         let lod = lod_from_rho_squared(
             rho_squared(fp, w, h),
@@ -362,12 +388,21 @@ impl Sampler {
             d.lod_min_clamp,
             d.lod_max_clamp,
         );
+        (finite(fp.u), finite(fp.v), lod)
+    }
+
+    /// Second stage of a sample: the filter at finite `(u, v)` and `lod` (from [`Sampler::prepare`]).
+    #[inline(always)]
+    fn filter<P: Pyramid>(&self, p: &P, fp: &Footprint, u: f32, v: f32, lod: f32) -> Vec4 {
+        let d = &self.desc;
         if lod <= 0.0 {
-            return filter_level(&d.mag_filter, &level0, &self.addr, u, v);
+            return filter_level(&d.mag_filter, &p.level(0), &self.addr, u, v);
         }
         match self.technique {
             Technique::Mip => match d.mipmap_filter {
-                MipmapFilterMode::None => filter_level(&d.min_filter, &level0, &self.addr, u, v),
+                MipmapFilterMode::None => {
+                    filter_level(&d.min_filter, &p.level(0), &self.addr, u, v)
+                }
                 MipmapFilterMode::Nearest => mip_nearest(p, &d.min_filter, &self.addr, u, v, lod),
                 MipmapFilterMode::Linear => trilinear(p, &d.min_filter, &self.addr, u, v, lod),
             },
