@@ -41,6 +41,32 @@ pub(crate) fn filter_level<F: Fetch>(
     }
 }
 
+/// A within-level filter, as a type: [`Linear`] (bilinear) is resolved at compile time, so the mip
+/// paths built on it carry no per-call dispatch on [`FilterMode`]; `&FilterMode` dispatches at run
+/// time.
+pub(crate) trait LevelFilter: Copy {
+    /// Filter `level` at `(u, v)`.
+    fn apply<F: Fetch>(self, level: &F, addr: &Address, u: f32, v: f32) -> Vec4;
+}
+
+/// Bilinear inside each level.
+#[derive(Clone, Copy)]
+pub(crate) struct Linear;
+
+impl LevelFilter for Linear {
+    #[inline(always)]
+    fn apply<F: Fetch>(self, level: &F, addr: &Address, u: f32, v: f32) -> Vec4 {
+        bilinear(level, addr, u, v)
+    }
+}
+
+impl LevelFilter for &FilterMode {
+    #[inline(always)]
+    fn apply<F: Fetch>(self, level: &F, addr: &Address, u: f32, v: f32) -> Vec4 {
+        filter_level(self, level, addr, u, v)
+    }
+}
+
 /// The Vulkan nearest-level rule `ceil(lod + 1/2) - 1`, clamped to `[0, last]`.
 #[inline]
 pub fn mip_nearest_level(lod: f32, last: usize) -> usize {
@@ -53,23 +79,23 @@ pub fn mip_nearest_level(lod: f32, last: usize) -> usize {
 
 /// Nearest-level mipmapping: `mode` in level [`mip_nearest_level`].
 #[inline]
-pub(crate) fn mip_nearest<P: Pyramid>(
+pub(crate) fn mip_nearest<P: Pyramid, L: LevelFilter>(
     p: &P,
-    mode: &FilterMode,
+    mode: L,
     addr: &Address,
     u: f32,
     v: f32,
     lod: f32,
 ) -> Vec4 {
     let level = mip_nearest_level(lod, p.level_count() - 1);
-    filter_level(mode, &p.level(level), addr, u, v)
+    mode.apply(&p.level(level), addr, u, v)
 }
 
 /// Trilinear (linear-between-levels) mipmapping at `lod` with `mode` inside each level.
 #[inline]
-pub(crate) fn trilinear<P: Pyramid>(
+pub(crate) fn trilinear<P: Pyramid, L: LevelFilter>(
     p: &P,
-    mode: &FilterMode,
+    mode: L,
     addr: &Address,
     u: f32,
     v: f32,
@@ -81,9 +107,9 @@ pub(crate) fn trilinear<P: Pyramid>(
     // which reads level 0 only.
     let k = d as usize;
     let delta = d - k as f32;
-    let a = filter_level(mode, &p.level(k), addr, u, v);
+    let a = mode.apply(&p.level(k), addr, u, v);
     if delta > 0.0 && k < last {
-        let b = filter_level(mode, &p.level(k + 1), addr, u, v);
+        let b = mode.apply(&p.level(k + 1), addr, u, v);
         a + (b - a) * delta
     } else {
         a
