@@ -223,6 +223,9 @@ enum Technique {
 pub struct Sampler {
     desc: SamplerDescriptor,
     technique: Technique,
+    /// The result does not depend on the lod (no mipmapping and `mag_filter == min_filter`), so
+    /// the per-sample lod computation is skipped.
+    lod_free: bool,
     pub(crate) addr: Address,
 }
 
@@ -279,9 +282,13 @@ impl Sampler {
             _ => Technique::Mip,
         };
         let border = desc.border_color.rgba();
+        let lod_free = technique == Technique::Mip
+            && desc.mipmap_filter == MipmapFilterMode::None
+            && desc.mag_filter == desc.min_filter;
         Ok(Sampler {
             desc,
             technique,
+            lod_free,
             addr: Address {
                 u: desc.address_mode_u,
                 v: desc.address_mode_v,
@@ -382,12 +389,18 @@ impl Sampler {
             }
         };
         let d = &self.desc;
-        let lod = lod_from_rho_squared(
-            rho_squared(fp, w, h),
-            d.lod_bias,
-            d.lod_min_clamp,
-            d.lod_max_clamp,
-        );
+        let lod = if self.lod_free {
+            // Both branches of `filter` read level 0 with the same filter: any lod gives the
+            // same result, so skip the square, log2 and clamp (nearest and bilinear without mips).
+            0.0
+        } else {
+            lod_from_rho_squared(
+                rho_squared(fp, w, h),
+                d.lod_bias,
+                d.lod_min_clamp,
+                d.lod_max_clamp,
+            )
+        };
         (finite(fp.u), finite(fp.v), lod)
     }
 
