@@ -297,6 +297,13 @@ impl Sampler {
         })
     }
 
+    /// Whether samples depend on the footprint's derivatives. `false` when there is no
+    /// mipmapping and `mag_filter == min_filter` (the lod cannot change the result): a caller
+    /// may then pass zero derivatives and skip computing them.
+    pub fn uses_derivatives(&self) -> bool {
+        !self.lod_free
+    }
+
     /// The descriptor this sampler was created from.
     pub fn descriptor(&self) -> &SamplerDescriptor {
         &self.desc
