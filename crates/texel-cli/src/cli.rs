@@ -186,10 +186,7 @@ pub struct BenchArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Filters to time: comma-separated names, or all.
-    #[arg(
-        long,
-        default_value = "nearest,bilinear,mip-nearest,trilinear,aniso16,ewa"
-    )]
+    #[arg(long, default_value = "nearest,bilinear,mip-nearest,trilinear,aniso16,ewa")]
     pub filters: String,
     /// Timed frames per filter (the median is reported).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=10000))]
@@ -234,14 +231,9 @@ impl std::str::FromStr for Size {
             .split_once(['x', 'X'])
             .ok_or_else(|| format!("size {s:?} is not WIDTHxHEIGHT (e.g. 640x360)"))?;
         let side = |t: &str| -> Result<u32, String> {
-            let v: u32 = t
-                .trim()
-                .parse()
-                .map_err(|_| format!("size {s:?}: {t:?} is not a whole number"))?;
+            let v: u32 = t.trim().parse().map_err(|_| format!("size {s:?}: {t:?} is not a whole number"))?;
             if v == 0 || v > MAX_SIDE {
-                return Err(format!(
-                    "size {s:?}: each side must be between 1 and {MAX_SIDE}"
-                ));
+                return Err(format!("size {s:?}: each side must be between 1 and {MAX_SIDE}"));
             }
             Ok(v)
         };
@@ -259,13 +251,7 @@ pub struct WarpArgs {
     pub input: PathBuf,
     /// Source pixel positions shown at the output's top-left, top-right, bottom-right and
     /// bottom-left corners: x0,y0,x1,y1,x2,y2,x3,y3 (pixels; (0,0) is the source's top-left corner).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        num_args = 8,
-        required = true,
-        allow_negative_numbers = true
-    )]
+    #[arg(long, value_delimiter = ',', num_args = 8, required = true, allow_negative_numbers = true)]
     pub corners: Vec<f64>,
     /// Output size; defaults to the source size.
     #[arg(long)]

@@ -60,9 +60,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     times.push(ms);
                 }
             }
-            let (min_ms, max_ms) = times
-                .iter()
-                .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
+            let (min_ms, max_ms) = times.iter().fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
             out.push(Timing {
                 filter: filter.name(),
                 median_ms: median(&mut times),
@@ -94,17 +92,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             "texel bench: {} at {}x{}, {threads} threads, median of {} frames after {} warm-up",
             args.scene.scene, scene.width, scene.height, args.frames, args.warmup
         )?;
-        writeln!(
-            stdout,
-            "{:<12} {:>10} {:>10} {:>10}",
-            "filter", "median ms", "min ms", "max ms"
-        )?;
+        writeln!(stdout, "{:<12} {:>10} {:>10} {:>10}", "filter", "median ms", "min ms", "max ms")?;
         for t in &timings {
-            writeln!(
-                stdout,
-                "{:<12} {:>10.3} {:>10.3} {:>10.3}",
-                t.filter, t.median_ms, t.min_ms, t.max_ms
-            )?;
+            writeln!(stdout, "{:<12} {:>10.3} {:>10.3} {:>10.3}", t.filter, t.median_ms, t.min_ms, t.max_ms)?;
         }
     }
     Ok(())

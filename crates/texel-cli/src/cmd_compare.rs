@@ -10,8 +10,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use texel_quality::{
-    crop_enlarge, default_band_rows, heat_map, horizon_crop_rect, Encoding, FilterRow, Image8,
-    Mask, Report, Scores,
+    crop_enlarge, default_band_rows, heat_map, horizon_crop_rect, Encoding, FilterRow, Image8, Mask, Report, Scores,
 };
 use texel_raster::{render, Frame};
 
@@ -45,13 +44,7 @@ pub fn parse_extra(s: &str) -> Result<(String, PathBuf)> {
 fn slug(label: &str) -> String {
     label
         .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
         .collect()
 }
 
@@ -124,8 +117,7 @@ pub fn compare(
     };
     let reference_crop = match crop {
         Some(rect) => {
-            crop_enlarge(&scoring.reference, rect, CROP_FACTOR)?
-                .write_png(dir.join("reference-horizon.png"))?;
+            crop_enlarge(&scoring.reference, rect, CROP_FACTOR)?.write_png(dir.join("reference-horizon.png"))?;
             Some("reference-horizon.png".to_string())
         }
         None => None,
@@ -165,8 +157,7 @@ pub fn compare(
     pb.finish_and_clear();
 
     for (label, path) in extras {
-        let image = Image8::load(path)
-            .with_context(|| format!("cannot load --extra image {}", path.display()))?;
+        let image = Image8::load(path).with_context(|| format!("cannot load --extra image {}", path.display()))?;
         if image.size() != (w, h) {
             bail!(
                 "--extra image {} is {}x{} but the comparison is {w}x{h} (pass --size to match)",
@@ -219,20 +210,9 @@ fn texel_stats(frame: &Frame) -> (f64, u64) {
 /// Run `texel compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
     let filters = parse_list(&args.filters)?;
-    let extras = args
-        .extra
-        .iter()
-        .map(|e| parse_extra(e))
-        .collect::<Result<Vec<_>>>()?;
+    let extras = args.extra.iter().map(|e| parse_extra(e)).collect::<Result<Vec<_>>>()?;
     let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
-    let report = compare(
-        &scene,
-        &args.scene.scene,
-        &filters,
-        args.spp,
-        &extras,
-        &args.out,
-    )?;
+    let report = compare(&scene, &args.scene.scene, &filters, args.spp, &extras, &args.out)?;
     print!("{}", report.to_markdown());
     eprintln!("report: {}", args.out.join("index.html").display());
     Ok(())
@@ -244,14 +224,8 @@ mod tests {
 
     #[test]
     fn extras_parse() {
-        assert_eq!(
-            parse_extra("gpu=out/a.png").unwrap(),
-            ("gpu".to_string(), PathBuf::from("out/a.png"))
-        );
-        assert_eq!(
-            parse_extra("a=b=c").unwrap(),
-            ("a".to_string(), PathBuf::from("b=c"))
-        );
+        assert_eq!(parse_extra("gpu=out/a.png").unwrap(), ("gpu".to_string(), PathBuf::from("out/a.png")));
+        assert_eq!(parse_extra("a=b=c").unwrap(), ("a".to_string(), PathBuf::from("b=c")));
         assert!(parse_extra("nolabel").is_err());
         assert!(parse_extra("=x.png").is_err());
         assert!(parse_extra("x=").is_err());

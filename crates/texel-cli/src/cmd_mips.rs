@@ -14,17 +14,14 @@ pub fn run(args: &MipsArgs) -> Result<()> {
     };
     let tex = Texture::load(&args.texture, color, &Limits::default())
         .with_context(|| format!("cannot load texture {}", args.texture.display()))?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let levels = tex.levels();
     for (k, l) in levels.iter().enumerate() {
         let pixels: Vec<[f32; 4]> = (0..l.height)
             .flat_map(|j| (0..l.width).map(move |i| (i, j)))
             .map(|(i, j)| tex.texel(k, i, j).expect("in range"))
             .collect();
-        let path = args
-            .out
-            .join(format!("level-{k:02}-{}x{}.png", l.width, l.height));
+        let path = args.out.join(format!("level-{k:02}-{}x{}.png", l.width, l.height));
         write_png(&path, l.width, l.height, &pixels, args.color)?;
     }
     // The classic layout: level 0 on the left, levels 1.. stacked top to bottom to its right.

@@ -32,10 +32,7 @@ pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame
     let (n, m) = strata(spp);
     let pb = progress::bar(1000, "reference");
     let report = |done: u64, total: u64| pb.set_position(done * 1000 / total.max(1));
-    anyhow::ensure!(
-        n == m,
-        "--spp {spp} is not a square number of samples (e.g. 64, 256, 1024)"
-    );
+    anyhow::ensure!(n == m, "--spp {spp} is not a square number of samples (e.g. 64, 256, 1024)");
     let frame = render_reference(&settings, &draws, n, SEED, Some(&report))?;
     pb.finish_and_clear();
     Ok(frame)
@@ -45,13 +42,7 @@ pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame
 pub fn run(args: &ReferenceArgs) -> Result<()> {
     let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
     let frame = reference_frame(&scene, args.spp)?;
-    write_png(
-        &args.output,
-        frame.width,
-        frame.height,
-        &frame.color,
-        args.scene.color,
-    )
+    write_png(&args.output, frame.width, frame.height, &frame.color, args.scene.color)
 }
 
 #[cfg(test)]

@@ -39,10 +39,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let draws = scene.draws(&samplers);
     let frame = with_threads(args.threads, || render(&settings, &draws))??;
     // Debug views hold display values meant for sRGB encoding whatever --color says.
-    let color = if settings.view == View::Color {
-        args.scene.color
-    } else {
-        ColorArg::Srgb
-    };
+    let color = if settings.view == View::Color { args.scene.color } else { ColorArg::Srgb };
     write_png(&args.output, frame.width, frame.height, &frame.color, color)
 }

@@ -19,12 +19,8 @@ pub fn run(args: &WarpArgs) -> Result<()> {
         .with_context(|| format!("cannot load image {}", args.input.display()))?;
     let c = &args.corners;
     let corners = [0, 2, 4, 6].map(|k| DVec2::new(c[k], c[k + 1]));
-    let (w, h) = args
-        .size
-        .map_or((tex.width(), tex.height()), |s| (s.width, s.height));
-    let mut desc = args
-        .filter
-        .descriptor(AddressMode::ClampToBorder, AddressMode::ClampToBorder)?;
+    let (w, h) = args.size.map_or((tex.width(), tex.height()), |s| (s.width, s.height));
+    let mut desc = args.filter.descriptor(AddressMode::ClampToBorder, AddressMode::ClampToBorder)?;
     desc.border_color = texel_texture::BorderColor::TransparentBlack;
     let sampler = Sampler::new(desc)?;
     let pixels = warp_perspective(&tex, &sampler, corners, w, h).context("invalid --corners")?;

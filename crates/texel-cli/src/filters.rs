@@ -79,18 +79,12 @@ impl FilterName {
             6 => FilterName::Aniso4,
             7 => FilterName::Aniso8,
             8 => FilterName::Aniso16,
-            _ => {
-                bail!("unknown lab mode {mode}: valid modes are 1 (nearest) to 8 (anisotropic 16x)")
-            }
+            _ => bail!("unknown lab mode {mode}: valid modes are 1 (nearest) to 8 (anisotropic 16x)"),
         })
     }
 
     /// The sampler descriptor for this filter with the given address modes.
-    pub fn descriptor(
-        self,
-        address_mode_u: AddressMode,
-        address_mode_v: AddressMode,
-    ) -> Result<SamplerDescriptor> {
+    pub fn descriptor(self, address_mode_u: AddressMode, address_mode_v: AddressMode) -> Result<SamplerDescriptor> {
         use FilterMode::{Linear, Nearest};
         let base = |mag, min, mipmap_filter, anisotropy_clamp| SamplerDescriptor {
             address_mode_u,
@@ -133,10 +127,7 @@ pub fn parse_list(list: &str) -> Result<Vec<FilterName>> {
     for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let f = FilterName::from_str(item, true).map_err(|_| {
             let valid: Vec<&str> = FilterName::ALL.iter().map(|f| f.name()).collect();
-            anyhow::anyhow!(
-                "unknown filter {item:?}: valid filters are {}, or all",
-                valid.join(", ")
-            )
+            anyhow::anyhow!("unknown filter {item:?}: valid filters are {}, or all", valid.join(", "))
         })?;
         if !out.contains(&f) {
             out.push(f);

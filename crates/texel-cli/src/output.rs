@@ -40,11 +40,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let name = path
         .file_name()
         .with_context(|| format!("cannot write {}: not a file path", path.display()))?;
-    let tmp = dir.join(format!(
-        ".{}.tmp{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    let tmp = dir.join(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
     let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -53,13 +49,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Encode and atomically write a linear RGBA frame as PNG.
-pub fn write_png(
-    path: &Path,
-    width: u32,
-    height: u32,
-    pixels: &[[f32; 4]],
-    color: ColorArg,
-) -> Result<()> {
+pub fn write_png(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]], color: ColorArg) -> Result<()> {
     let bytes = png_bytes(width, height, &encode_rgba8(pixels, color))?;
     write_atomic(path, &bytes)
 }

@@ -38,9 +38,7 @@ impl Prepared {
         };
         let textures = scene.load_textures(override_space, &Limits::default())?;
         let vertices = scene.meshes.iter().map(texel_vertices).collect();
-        let (width, height) = size.map_or((scene.output.width, scene.output.height), |s| {
-            (s.width, s.height)
-        });
+        let (width, height) = size.map_or((scene.output.width, scene.output.height), |s| (s.width, s.height));
         Ok(Prepared {
             scene,
             textures,
@@ -58,8 +56,7 @@ impl Prepared {
             .iter()
             .map(|m| {
                 let desc = filter.descriptor(m.address_mode_u, m.address_mode_v)?;
-                Sampler::new(desc)
-                    .with_context(|| format!("invalid sampler for filter {}", filter.name()))
+                Sampler::new(desc).with_context(|| format!("invalid sampler for filter {}", filter.name()))
             })
             .collect()
     }
@@ -71,8 +68,7 @@ impl Prepared {
         let mut bytes = BTreeMap::new();
         for (mesh, sampler) in self.scene.meshes.iter().zip(samplers) {
             let tex = &self.textures[&mesh.texture];
-            tex.prepare(sampler)
-                .with_context(|| format!("cannot prepare texture {:?}", mesh.texture))?;
+            tex.prepare(sampler).with_context(|| format!("cannot prepare texture {:?}", mesh.texture))?;
             let b = tex.structure_bytes(sampler.descriptor());
             let e = bytes.entry(mesh.texture.clone()).or_insert(0u64);
             *e = (*e).max(b);
@@ -107,12 +103,7 @@ impl Prepared {
             ColorArg::Srgb => srgb_to_linear(f32::from(b) / 255.0),
             ColorArg::Raw => f32::from(b) / 255.0,
         };
-        s.background = [
-            decode(bg[0]),
-            decode(bg[1]),
-            decode(bg[2]),
-            f32::from(bg[3]) / 255.0,
-        ];
+        s.background = [decode(bg[0]), decode(bg[1]), decode(bg[2]), f32::from(bg[3]) / 255.0];
         s
     }
 }
