@@ -45,6 +45,42 @@ fn one_and_two_threads_give_identical_frames() {
     }
 }
 
+/// The colour view samples a row span at a time (`sample_batch`) unless texels are counted, which
+/// takes the per-pixel path: both give the same image, bit for bit, for every lab filter, with and
+/// without captured footprints.
+#[test]
+fn batched_and_per_pixel_sampling_give_identical_frames() {
+    let (w, h) = (300, 170);
+    let scene = Ground::new(w, h);
+    // Without captured footprints, nearest and bilinear (lab modes 1 and 2) also skip derivatives.
+    for (mode, capture_footprints) in (1..=8).flat_map(|m| [(m, true), (m, false)]) {
+        let sampler = lab_sampler(mode);
+        let settings = |count_texels| RenderSettings {
+            count_texels,
+            threads: Some(2),
+            capture_footprints,
+            ..RenderSettings::new(w, h)
+        };
+        let batched = render(&settings(false), &[scene.draw(&sampler)]).unwrap();
+        let single = render(&settings(true), &[scene.draw(&sampler)]).unwrap();
+        assert!(batched.covered_pixels() > 0);
+        let bits = |f: &texel_raster::Frame| {
+            f.color
+                .iter()
+                .flat_map(|c| c.map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            bits(&batched),
+            bits(&single),
+            "lab mode {mode} {capture_footprints}"
+        );
+        assert_eq!(batched.depth, single.depth);
+        assert_eq!(batched.coverage, single.coverage);
+        assert_eq!(batched.footprints, single.footprints);
+    }
+}
+
 #[test]
 fn reference_is_identical_for_any_thread_count_and_deterministic() {
     let (w, h) = (140, 80);

@@ -1,5 +1,7 @@
 //! Samples per second of the core filters on one thread, on a 1024 x 1024 sRGB RGBA8 texture, for
-//! magnified (0.25 texel per pixel), 1:1, 4x and 64x minified isotropic footprints.
+//! magnified (0.25 texel per pixel), 1:1, 3x, 4x and 64x minified isotropic footprints. The 3x case
+//! has a fractional lod (`log2 3 = 1.585`), so trilinear reads two levels there; 4x and 64x sit on
+//! integer lods, where trilinear reads one level only.
 //!
 //! Access is coherent: a 64 x 64 block of "pixels" walks the texture like a rasterizer's tile would,
 //! so the numbers are throughput with warm caches, not random-access latency.
@@ -81,6 +83,7 @@ fn bench(c: &mut Criterion) {
     for (label, scale) in [
         ("magnified", 0.25f32),
         ("1to1", 1.0),
+        ("minified3x", 3.0),
         ("minified4x", 4.0),
         ("minified64x", 64.0),
     ] {

@@ -95,9 +95,15 @@ pub(crate) struct Address {
 }
 
 /// Texel coordinate: from continuous `xy` (float) to an `i64` index, saturating; NaN gives 0.
+///
+/// Equal to `x.floor() as i64` for every `x`, but computed by truncating conversion and a compare:
+/// on the x86-64 baseline (no SSE4.1 `roundss`) `f32::floor` is a call into libm, measured at 10%
+/// of a trilinear ground frame. For `|x| < 2^63` the result converts back to `x.floor()` exactly
+/// (below 2^24 every integer is an `f32`; above, `x` is itself an integer).
 #[inline(always)]
 pub(crate) fn floor_index(x: f32) -> i64 {
-    x.floor() as i64
+    let t = x as i64; // truncates toward zero, saturates, NaN -> 0
+    t.saturating_sub(i64::from((t as f32) > x))
 }
 
 #[cfg(test)]
@@ -176,5 +182,41 @@ mod tests {
         }
         assert_eq!(floor_index(f32::NAN), 0);
         assert_eq!(floor_index(f32::INFINITY), i64::MAX);
+        assert_eq!(floor_index(f32::NEG_INFINITY), i64::MIN);
+    }
+
+    /// The integer floor agrees with `f32::floor` on every kind of value, edges included.
+    #[test]
+    fn floor_index_matches_floor() {
+        let mut xs = vec![
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            0.999_999_9,
+            -0.999_999_9,
+            1e-30,
+            -1e-30,
+            16_777_215.5,
+            -16_777_215.5,
+            16_777_216.0,
+            -16_777_217.0,
+            2.5e11,
+            -2.5e11,
+            1e18,
+            -1e18,
+            9.2e18,
+            -9.2e18,
+        ];
+        // A sweep of quarter steps and of values just below integers.
+        for k in -2000..2000 {
+            xs.push(k as f32 * 0.25);
+            xs.push(f32::from_bits((k as f32).to_bits().wrapping_sub(1)));
+        }
+        for x in xs {
+            assert_eq!(floor_index(x), x.floor() as i64, "x = {x}");
+        }
     }
 }

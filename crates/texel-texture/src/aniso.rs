@@ -34,14 +34,19 @@
 //! and samples per second for 16x: ratio 1: 4.7, 10.3 M/s; ratio 4: 18.9, 4.8 M/s; ratio 16: 76,
 //! 1.9 M/s; ratio 64: 64, 2.0 M/s (trilinear: 4 to 4.7 texels, 10.5 to 20 M/s). Quality against a
 //! brute-force Gaussian (RMS error 0.0138 for 16x vs 0.0230 for trilinear) is in [`crate::ewa`].
+//!
+//! The probes call the trilinear filter specialised to bilinear at compile time
+//! ([`crate::mip`]'s `Linear`), not through the run-time `FilterMode` dispatch: ground scene,
+//! 1280 x 720, 2 threads, `texel bench --filters aniso16 --frames 10`, 80 -> 65 ms; images
+//! bit-identical.
 
 use glam::Vec4;
 
 use crate::address::Address;
 use crate::fetch::{Fetch, Pyramid};
 use crate::footprint::{lod_from_rho, Footprint};
-use crate::mip::trilinear;
-use crate::sampler::{FilterMode, SamplerDescriptor};
+use crate::mip::{trilinear, Linear};
+use crate::sampler::SamplerDescriptor;
 
 /// Relative tolerance applied to `|Pmax| / |Pmin|` before rounding up (see the module docs).
 pub const RATIO_TOLERANCE: f32 = 1e-5;
@@ -89,7 +94,7 @@ pub(crate) fn anisotropic<P: Pyramid>(
         1
     };
     if n == 1 {
-        return trilinear(p, &FilterMode::Linear, addr, u, v, lod_iso);
+        return trilinear(p, Linear, addr, u, v, lod_iso);
     }
     let lod = lod_from_rho(
         major / n as f32,
@@ -104,7 +109,7 @@ pub(crate) fn anisotropic<P: Pyramid>(
         let t = (i as f32 + 0.5) * inv - 0.5;
         let pu = finite(u + t * axes.major_uv.x);
         let pv = finite(v + t * axes.major_uv.y);
-        sum += trilinear(p, &FilterMode::Linear, addr, pu, pv, lod);
+        sum += trilinear(p, Linear, addr, pu, pv, lod);
     }
     sum * inv
 }

@@ -3,7 +3,7 @@
 //! Formulas: IEC 61966-2-1 (sRGB), as used by the Vulkan spec, "Colour space conversions"
 //! (sRGB EOTF): `linear = c / 12.92` for `c <= 0.04045`, else `((c + 0.055) / 1.055)^2.4`.
 //!
-//! 8-bit sRGB texels are decoded through [`SRGB_TO_LINEAR`], a table built once by
+//! 8-bit sRGB texels are decoded through [`srgb_table`], a table built once by
 //! [`srgb_to_linear`] at first use (the generating code sits beside the table, as pbrt-v4 keeps its
 //! LUTs). Decoding by table costs one load per channel instead of a `powf`.
 

@@ -165,6 +165,11 @@ impl<L: Fetch> Fetch for CountedLevel<'_, L> {
         self.count.set(self.count.get().saturating_add(1));
         self.inner.texel(i, j)
     }
+    #[inline(always)]
+    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
+        self.count.set(self.count.get().saturating_add(4));
+        self.inner.quad(i, j)
+    }
 }
 
 impl<P: Pyramid> Pyramid for Counted<P> {

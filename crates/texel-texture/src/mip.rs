@@ -41,32 +41,61 @@ pub(crate) fn filter_level<F: Fetch>(
     }
 }
 
+/// A within-level filter, as a type: [`Linear`] (bilinear) is resolved at compile time, so the mip
+/// paths built on it carry no per-call dispatch on [`FilterMode`]; `&FilterMode` dispatches at run
+/// time.
+pub(crate) trait LevelFilter: Copy {
+    /// Filter `level` at `(u, v)`.
+    fn apply<F: Fetch>(self, level: &F, addr: &Address, u: f32, v: f32) -> Vec4;
+}
+
+/// Bilinear inside each level.
+#[derive(Clone, Copy)]
+pub(crate) struct Linear;
+
+impl LevelFilter for Linear {
+    #[inline(always)]
+    fn apply<F: Fetch>(self, level: &F, addr: &Address, u: f32, v: f32) -> Vec4 {
+        bilinear(level, addr, u, v)
+    }
+}
+
+impl LevelFilter for &FilterMode {
+    #[inline(always)]
+    fn apply<F: Fetch>(self, level: &F, addr: &Address, u: f32, v: f32) -> Vec4 {
+        filter_level(self, level, addr, u, v)
+    }
+}
+
 /// The Vulkan nearest-level rule `ceil(lod + 1/2) - 1`, clamped to `[0, last]`.
 #[inline]
 pub fn mip_nearest_level(lod: f32, last: usize) -> usize {
-    let d = lod.clamp(0.0, last as f32);
-    ((d + 0.5).ceil() - 1.0).max(0.0) as usize
+    let e = lod.clamp(0.0, last as f32) + 0.5;
+    // ceil(e) - 1 for e in [0.5, last + 0.5] (NaN clamps to NaN and converts to level 0), by
+    // truncating conversion: no libm `ceilf` call on the x86-64 baseline.
+    let t = e as usize;
+    (t + usize::from((t as f32) < e)).saturating_sub(1)
 }
 
 /// Nearest-level mipmapping: `mode` in level [`mip_nearest_level`].
 #[inline]
-pub(crate) fn mip_nearest<P: Pyramid>(
+pub(crate) fn mip_nearest<P: Pyramid, L: LevelFilter>(
     p: &P,
-    mode: &FilterMode,
+    mode: L,
     addr: &Address,
     u: f32,
     v: f32,
     lod: f32,
 ) -> Vec4 {
     let level = mip_nearest_level(lod, p.level_count() - 1);
-    filter_level(mode, &p.level(level), addr, u, v)
+    mode.apply(&p.level(level), addr, u, v)
 }
 
 /// Trilinear (linear-between-levels) mipmapping at `lod` with `mode` inside each level.
 #[inline]
-pub(crate) fn trilinear<P: Pyramid>(
+pub(crate) fn trilinear<P: Pyramid, L: LevelFilter>(
     p: &P,
-    mode: &FilterMode,
+    mode: L,
     addr: &Address,
     u: f32,
     v: f32,
@@ -74,12 +103,13 @@ pub(crate) fn trilinear<P: Pyramid>(
 ) -> Vec4 {
     let last = p.level_count() - 1;
     let d = lod.clamp(0.0, last as f32);
-    let d_hi = d.floor();
-    let delta = d - d_hi;
-    let k = d_hi as usize;
-    let a = filter_level(mode, &p.level(k), addr, u, v);
+    // d >= 0, so truncation is the floor (no libm `floorf`); NaN gives level 0 and delta NaN,
+    // which reads level 0 only.
+    let k = d as usize;
+    let delta = d - k as f32;
+    let a = mode.apply(&p.level(k), addr, u, v);
     if delta > 0.0 && k < last {
-        let b = filter_level(mode, &p.level(k + 1), addr, u, v);
+        let b = mode.apply(&p.level(k + 1), addr, u, v);
         a + (b - a) * delta
     } else {
         a
@@ -100,5 +130,19 @@ mod tests {
         assert_eq!(mip_nearest_level(1.51, 10), 2);
         assert_eq!(mip_nearest_level(99.0, 10), 10);
         assert_eq!(mip_nearest_level(-3.0, 10), 0);
+        assert_eq!(mip_nearest_level(f32::NAN, 10), 0);
+    }
+
+    /// The integer rounding equals the float formula `ceil(clamp(lod) + 1/2) - 1` everywhere.
+    #[test]
+    fn nearest_level_matches_float_formula() {
+        for k in -100..1400 {
+            let lod = k as f32 * 0.01;
+            for lod in [lod, f32::from_bits(lod.to_bits() + 1)] {
+                let d = lod.clamp(0.0, 12.0);
+                let want = ((d + 0.5).ceil() - 1.0).max(0.0) as usize;
+                assert_eq!(mip_nearest_level(lod, 12), want, "lod = {lod}");
+            }
+        }
     }
 }

@@ -12,9 +12,12 @@ use crate::fetch::Fetch;
 #[inline(always)]
 pub(crate) fn nearest<F: Fetch>(level: &F, addr: &Address, u: f32, v: f32) -> Vec4 {
     let (w, h) = level.size();
-    let i = addr.u.wrap(floor_index(u * w as f32), w);
-    let j = addr.v.wrap(floor_index(v * h as f32), h);
-    match (i, j) {
+    let (i, j) = (floor_index(u * w as f32), floor_index(v * h as f32));
+    if (0..i64::from(w)).contains(&i) && (0..i64::from(h)).contains(&j) {
+        // Inside the level every address mode is the identity.
+        return level.texel(i as u32, j as u32);
+    }
+    match (addr.u.wrap(i, w), addr.v.wrap(j, h)) {
         (Some(i), Some(j)) => level.texel(i, j),
         _ => addr.border,
     }

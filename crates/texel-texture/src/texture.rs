@@ -486,6 +486,26 @@ pub(crate) trait Fetch: Copy {
     fn size(&self) -> (u32, u32);
     /// Texel `(i, j)` in linear RGBA; `i < width`, `j < height`.
     fn texel(&self, i: u32, j: u32) -> Vec4;
+    /// The 2x2 texels `[(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]`; `i + 1 < width`,
+    /// `j + 1 < height` (no wrapping). The storage views read them as two 2-texel row slices,
+    /// so a bilinear lookup inside the level pays two bounds checks instead of four.
+    #[inline(always)]
+    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
+        [
+            self.texel(i, j),
+            self.texel(i + 1, j),
+            self.texel(i, j + 1),
+            self.texel(i + 1, j + 1),
+        ]
+    }
+}
+
+/// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level.
+#[inline(always)]
+fn rows2<T>(texels: &[T], width: u32, i: u32, j: u32) -> (&[T], &[T]) {
+    let w = width as usize;
+    let k = j as usize * w + i as usize;
+    (&texels[k..k + 2], &texels[k + w..k + w + 2])
 }
 
 impl Fetch for U8Level<'_> {
@@ -495,13 +515,30 @@ impl Fetch for U8Level<'_> {
     }
     #[inline(always)]
     fn texel(&self, i: u32, j: u32) -> Vec4 {
-        let t = self.texels[j as usize * self.width as usize + i as usize];
-        let a = self.alpha;
+        self.decode(self.texels[j as usize * self.width as usize + i as usize])
+    }
+    #[inline(always)]
+    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
+        let (r0, r1) = rows2(self.texels, self.width, i, j);
+        [
+            self.decode(r0[0]),
+            self.decode(r0[1]),
+            self.decode(r1[0]),
+            self.decode(r1[1]),
+        ]
+    }
+}
+
+impl U8Level<'_> {
+    /// One packed texel to linear RGBA: one table load per channel (RGB through the level's colour
+    /// table, alpha always `b / 255`).
+    #[inline(always)]
+    fn decode(&self, t: [u8; 4]) -> Vec4 {
         Vec4::new(
             self.table[t[0] as usize],
             self.table[t[1] as usize],
             self.table[t[2] as usize],
-            a[t[3] as usize],
+            self.alpha[t[3] as usize],
         )
     }
 }
@@ -514,5 +551,10 @@ impl Fetch for F32Level<'_> {
     #[inline(always)]
     fn texel(&self, i: u32, j: u32) -> Vec4 {
         Vec4::from_array(self.texels[j as usize * self.width as usize + i as usize])
+    }
+    #[inline(always)]
+    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
+        let (r0, r1) = rows2(self.texels, self.width, i, j);
+        [r0[0], r0[1], r1[0], r1[1]].map(Vec4::from_array)
     }
 }

@@ -138,6 +138,24 @@ proptest! {
         prop_assert_eq!(got, want);
     }
 
+    /// Without mipmapping and with `mag_filter == min_filter` the sampler skips the lod: its result
+    /// equals the min filter at level 0 forced by a lod clamp of `[0.25, 0.25]` (nearest level 0),
+    /// for every footprint, filter and address mode.
+    #[test]
+    fn lod_free_samplers_equal_forced_min_filter(fp in footprint_strategy(), addr in 0usize..5, f in 0usize..3) {
+        let tex = noise_texture(13, 7, Format::Rgba8Srgb);
+        let filter = [FilterMode::Nearest, FilterMode::Linear, FilterMode::Cubic(Cubic::MITCHELL)][f];
+        let mode = ADDRESS_MODES[addr];
+        let free = sampler(filter, filter, MipmapFilterMode::None, mode);
+        let forced = Sampler::new(SamplerDescriptor {
+            lod_min_clamp: 0.25,
+            lod_max_clamp: 0.25,
+            ..*sampler(filter, filter, MipmapFilterMode::Nearest, mode).descriptor()
+        })
+        .unwrap();
+        prop_assert_eq!(free.sample(&tex, &fp), forced.sample(&tex, &fp));
+    }
+
     /// Bilinear reproduces a linear ramp exactly between texel centres.
     #[test]
     fn bilinear_reproduces_ramp(x in 0.5f32..31.5, y in 0.5f32..15.5) {
@@ -165,9 +183,9 @@ proptest! {
         }
     }
 
-    /// `sample_batch` equals `sample` one by one.
+    /// `sample_batch` equals `sample` one by one (lengths beyond the 64-footprint chunk included).
     #[test]
-    fn batch_equals_single(fps in proptest::collection::vec(footprint_strategy(), 1..20)) {
+    fn batch_equals_single(fps in proptest::collection::vec(footprint_strategy(), 1..150)) {
         let tex = noise_texture(64, 32, Format::Rgba8Srgb);
         let s = sampler(FilterMode::Linear, FilterMode::Cubic(Cubic::MITCHELL), MipmapFilterMode::Linear, AddressMode::MirrorRepeat);
         let mut out = vec![[0.0; 4]; fps.len()];
