@@ -12,11 +12,11 @@ mod common;
 use std::hint::black_box;
 use std::time::Duration;
 
-use common::{lab_sampler, screen_vertex, Ground};
+use common::{lab_sampler, screen_grid, Ground};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Mat4;
 use texel_raster::{render, DrawCall, RenderSettings};
-use texel_texture::{Format, Limits, Sampler, Texture};
+use texel_texture::Sampler;
 
 /// The filters this branch's sampler implements. Anisotropic (`anisotropy_clamp = 16`) and EWA are
 /// not measured here: on this branch `Sampler` accepts `anisotropy_clamp` but filters trilinearly
@@ -55,31 +55,7 @@ fn ground(c: &mut Criterion) {
 fn mesh(c: &mut Criterion) {
     let (w, h) = (1280, 720);
     // 224 x 224 cells, two triangles each: 100 352 triangles over the whole frame (~9 px each).
-    let (nx, ny) = (224u32, 224u32);
-    let vertices: Vec<_> = (0..=ny)
-        .flat_map(|b| {
-            (0..=nx).map(move |a| {
-                screen_vertex(
-                    f64::from(a) * f64::from(w) / f64::from(nx),
-                    f64::from(b) * f64::from(h) / f64::from(ny),
-                    w,
-                    h,
-                )
-            })
-        })
-        .collect();
-    let triangles: Vec<[u32; 3]> = (0..ny)
-        .flat_map(|b| {
-            (0..nx).flat_map(move |a| {
-                let k = b * (nx + 1) + a;
-                [[k, k + 1, k + nx + 2], [k, k + nx + 2, k + nx + 1]]
-            })
-        })
-        .collect();
-    let texture = Texture::from_fn(64, 64, Format::Rgba8Srgb, &Limits::default(), |i, j| {
-        [i as f32 / 63.0, j as f32 / 63.0, 0.5, 1.0]
-    })
-    .unwrap();
+    let (vertices, triangles, texture) = screen_grid(w, h, 224, 224);
     let sampler = lab_sampler(4);
     let draw = DrawCall {
         vertices: &vertices,

@@ -10,10 +10,9 @@ mod common;
 
 use std::time::Instant;
 
-use common::{lab_sampler, screen_vertex, Ground};
+use common::{lab_sampler, screen_grid, Ground};
 use glam::Mat4;
 use texel_raster::{render, render_reference, DrawCall, RenderSettings};
-use texel_texture::{Format, Limits, Texture};
 
 /// (min, median) in milliseconds of `runs` calls of `f`.
 fn time(runs: usize, mut f: impl FnMut()) -> (f64, f64) {
@@ -61,31 +60,7 @@ fn main() {
         println!("| ground 1280x720, {name} | {} | {} |", cells[0], cells[1]);
     }
     // 100k-triangle mesh, 64x64 texture.
-    let (nx, ny) = (224u32, 224u32);
-    let vertices: Vec<_> = (0..=ny)
-        .flat_map(|b| {
-            (0..=nx).map(move |a| {
-                screen_vertex(
-                    f64::from(a) * f64::from(w) / f64::from(nx),
-                    f64::from(b) * f64::from(h) / f64::from(ny),
-                    w,
-                    h,
-                )
-            })
-        })
-        .collect();
-    let triangles: Vec<[u32; 3]> = (0..ny)
-        .flat_map(|b| {
-            (0..nx).flat_map(move |a| {
-                let k = b * (nx + 1) + a;
-                [[k, k + 1, k + nx + 2], [k, k + nx + 2, k + nx + 1]]
-            })
-        })
-        .collect();
-    let texture = Texture::from_fn(64, 64, Format::Rgba8Srgb, &Limits::default(), |i, j| {
-        [i as f32 / 63.0, j as f32 / 63.0, 0.5, 1.0]
-    })
-    .unwrap();
+    let (vertices, triangles, texture) = screen_grid(w, h, 224, 224);
     let sampler = lab_sampler(4);
     let draw = DrawCall {
         vertices: &vertices,

@@ -3,7 +3,7 @@
 
 use glam::{DMat4, DVec2, DVec4, Mat4, Vec2, Vec3};
 use texel_raster::{camera, DrawCall, Vertex};
-use texel_texture::{AddressMode, ColorSpace, Limits, Sampler, SamplerDescriptor, Texture};
+use texel_texture::{AddressMode, ColorSpace, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
 /// The ground scene's camera.
 pub const EYE: Vec3 = Vec3::new(0.0, 1.0, 0.0);
@@ -148,4 +148,35 @@ pub fn white() -> (Texture, Sampler) {
         .unwrap(),
         Sampler::new(SamplerDescriptor::default()).unwrap(),
     )
+}
+
+/// The benchmarks' mesh: an `nx x ny` grid of cells over a `w x h` frame, two triangles per cell
+/// (224 x 224 cells give 100 352 triangles of about 9 pixels each at 1280 x 720), and a 64 x 64
+/// gradient texture to map on it with an identity `clip_from_world`.
+pub fn screen_grid(w: u32, h: u32, nx: u32, ny: u32) -> (Vec<Vertex>, Vec<[u32; 3]>, Texture) {
+    let vertices = (0..=ny)
+        .flat_map(|b| {
+            (0..=nx).map(move |a| {
+                screen_vertex(
+                    f64::from(a) * f64::from(w) / f64::from(nx),
+                    f64::from(b) * f64::from(h) / f64::from(ny),
+                    w,
+                    h,
+                )
+            })
+        })
+        .collect();
+    let triangles = (0..ny)
+        .flat_map(|b| {
+            (0..nx).flat_map(move |a| {
+                let k = b * (nx + 1) + a;
+                [[k, k + 1, k + nx + 2], [k, k + nx + 2, k + nx + 1]]
+            })
+        })
+        .collect();
+    let texture = Texture::from_fn(64, 64, Format::Rgba8Srgb, &Limits::default(), |i, j| {
+        [i as f32 / 63.0, j as f32 / 63.0, 0.5, 1.0]
+    })
+    .expect("64x64 texture");
+    (vertices, triangles, texture)
 }
