@@ -78,7 +78,7 @@ use std::sync::OnceLock;
 
 use glam::{DVec2, Vec2, Vec4};
 
-use crate::address::Address;
+use crate::address::{Address, AddressMode};
 use crate::bilinear::{bilinear, texel_or_border};
 use crate::fetch::{Fetch, Pyramid};
 use crate::footprint::{lod_from_rho, Footprint};
@@ -370,8 +370,16 @@ fn ewa_at<P: Pyramid>(p: &P, addr: &Address, e: &Ellipse, k: usize, u: f32, v: f
     while k < last && e.in_level(scale(k), false).area() > MAX_ELLIPSE_AREA {
         k += 1;
     }
-    let q = e.in_level(scale(k), true);
     let level = p.level(k);
+    // A 1x1 level maps every texel index to its one texel (all modes but ClampToBorder): the
+    // normalised average is that texel, however large the ellipse.
+    if level.size() == (1, 1)
+        && addr.u != AddressMode::ClampToBorder
+        && addr.v != AddressMode::ClampToBorder
+    {
+        return level.texel(0, 0);
+    }
+    let q = e.in_level(scale(k), true);
     ewa_level(&level, addr, &q, u, v).unwrap_or_else(|| bilinear(&level, addr, u, v))
 }
 
@@ -411,6 +419,58 @@ pub(crate) fn ewa<P: Pyramid>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An ellipse far larger than the texture ends at the 1x1 level, which is read once (it used
+    /// to be revisited up to the 4096-texel area cap), and equals that level's texel.
+    #[test]
+    fn huge_ellipse_reads_the_last_level_once() {
+        let tex = crate::Texture::from_fn(
+            16,
+            8,
+            crate::Format::Rgba32Float,
+            &crate::Limits::default(),
+            |i, j| [i as f32 / 16.0, j as f32 / 8.0, 0.5, 1.0],
+        )
+        .unwrap();
+        let mean = tex.texel(tex.levels().len() - 1, 0, 0).unwrap();
+        for mode in [
+            AddressMode::Repeat,
+            AddressMode::ClampToEdge,
+            AddressMode::MirrorRepeat,
+        ] {
+            let s = crate::Sampler::new(
+                SamplerDescriptor::minification(FilterMode::Ewa).with_address_mode(mode),
+            )
+            .unwrap();
+            let fp = Footprint {
+                u: 0.3,
+                v: 0.6,
+                dudx: 900.0,
+                dudy: 5.0,
+                dvdx: -3.0,
+                dvdy: 700.0,
+            };
+            let (c, reads) = s.sample_counted(&tex, &fp);
+            assert_eq!(reads, 1, "{mode:?}");
+            assert_eq!(c, mean);
+        }
+        // ClampToBorder still weighs the (transparent) border against the texture.
+        let s = crate::Sampler::new(
+            SamplerDescriptor::minification(FilterMode::Ewa)
+                .with_address_mode(AddressMode::ClampToBorder),
+        )
+        .unwrap();
+        let fp = Footprint {
+            u: 0.3,
+            v: 0.6,
+            dudx: 900.0,
+            dudy: 5.0,
+            dvdx: -3.0,
+            dvdy: 700.0,
+        };
+        let c = s.sample(&tex, &fp);
+        assert!(c[3] > 0.0 && c[3] < 1.0, "{c:?}");
+    }
 
     #[test]
     fn integer_floor_and_ceil_match_libm() {
