@@ -147,34 +147,15 @@ impl Ripmap {
     }
 }
 
-/// Bytes needed if the ripmap is added to `texture` now: `Err(bytes)` when over the limit.
+/// `Err(bytes)` if adding the ripmap (and its build scratch) to `texture` would exceed its limits.
 fn check(texture: &Texture) -> Result<(), u64> {
     let (w, h) = (texture.width(), texture.height());
-    let level0 = u64::from(w) * u64::from(h);
-    let others = match texture.sat.get() {
-        Some(Ok(t)) => t.bytes(),
-        _ => 0,
-    };
-    let bytes = Ripmap::bytes_for(w, h, texture.format())
-        .and_then(|b| b.checked_add(texture.pyramid_bytes()))
-        .and_then(|b| b.checked_add(others))
-        .and_then(|b| b.checked_add(level0.checked_mul(SCRATCH_BYTES_PER_TEXEL)?))
-        .unwrap_or(u64::MAX);
-    if bytes > texture.limits().max_bytes {
-        Err(bytes)
-    } else {
-        Ok(())
-    }
+    let scratch = (u64::from(w) * u64::from(h)).saturating_mul(SCRATCH_BYTES_PER_TEXEL);
+    texture.structure_budget(Ripmap::bytes_for(w, h, texture.format()), scratch)
 }
 
 fn over_limit(texture: &Texture, bytes: u64) -> TextureError {
-    TextureError::StructureOverMemoryLimit {
-        structure: "ripmap",
-        width: texture.width(),
-        height: texture.height(),
-        bytes,
-        max: texture.limits().max_bytes,
-    }
+    texture.over_budget("ripmap", bytes)
 }
 
 /// Reduce a `w x h` image by 2 along x (exact box taps); rows in parallel.

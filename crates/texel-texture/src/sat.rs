@@ -310,30 +310,14 @@ impl SummedAreaTable {
 
 /// `Err(bytes)` if adding the table to `texture` would exceed its limits.
 fn check(texture: &Texture) -> Result<(), u64> {
-    let (w, h) = (texture.width(), texture.height());
-    let others = match texture.ripmap.get() {
-        Some(Ok(r)) => r.bytes(),
-        _ => 0,
-    };
-    let bytes = SummedAreaTable::bytes_for(w, h)
-        .and_then(|b| b.checked_add(texture.pyramid_bytes()))
-        .and_then(|b| b.checked_add(others))
-        .unwrap_or(u64::MAX);
-    if bytes > texture.limits().max_bytes {
-        Err(bytes)
-    } else {
-        Ok(())
-    }
+    texture.structure_budget(
+        SummedAreaTable::bytes_for(texture.width(), texture.height()),
+        0,
+    )
 }
 
 fn over_limit(texture: &Texture, bytes: u64) -> TextureError {
-    TextureError::StructureOverMemoryLimit {
-        structure: "summed-area table",
-        width: texture.width(),
-        height: texture.height(),
-        bytes,
-        max: texture.limits().max_bytes,
-    }
+    texture.over_budget("summed-area table", bytes)
 }
 
 fn build_from<F: Fetch + Sync>(level0: &F) -> SummedAreaTable {

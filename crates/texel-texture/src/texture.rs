@@ -374,6 +374,47 @@ impl Texture {
             .unwrap_or(u64::MAX)
     }
 
+    /// Whether a structure of `bytes` (plus `scratch` bytes while it is built) still fits this
+    /// texture's [`Limits::max_bytes`] next to the pyramid and the structures already built:
+    /// `Err(total)` with the total it would need. `None` (an overflowing size) never fits.
+    pub(crate) fn structure_budget(&self, bytes: Option<u64>, scratch: u64) -> Result<(), u64> {
+        let built = |b: Option<u64>| b.unwrap_or(0);
+        let ripmap = built(
+            self.ripmap
+                .get()
+                .and_then(|r| r.as_ref().ok())
+                .map(|r| r.bytes()),
+        );
+        let sat = built(
+            self.sat
+                .get()
+                .and_then(|t| t.as_ref().ok())
+                .map(|t| t.bytes()),
+        );
+        let total = bytes
+            .and_then(|b| b.checked_add(self.pyramid_bytes()))
+            .and_then(|b| b.checked_add(ripmap))
+            .and_then(|b| b.checked_add(sat))
+            .and_then(|b| b.checked_add(scratch))
+            .unwrap_or(u64::MAX);
+        if total > self.limits.max_bytes {
+            Err(total)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// The error for a `structure` that needs `bytes` in all (from [`Texture::structure_budget`]).
+    pub(crate) fn over_budget(&self, structure: &'static str, bytes: u64) -> TextureError {
+        TextureError::StructureOverMemoryLimit {
+            structure,
+            width: self.width(),
+            height: self.height(),
+            bytes,
+            max: self.limits.max_bytes,
+        }
+    }
+
     /// The storage format.
     pub fn format(&self) -> Format {
         self.format
