@@ -129,19 +129,8 @@ impl Ripmap {
         let info = &self.infos[a * self.ny + b];
         let idx = info.offset + j as usize * w as usize + i as usize;
         Some(match &self.storage {
-            Storage::U8(v) => {
-                // Decode as the pyramid does.
-                let t = v[idx];
-                let srgb = crate::color::srgb_table();
-                let lin = crate::color::unorm8_table();
-                let table = if self.srgb { srgb } else { lin };
-                [
-                    table[t[0] as usize],
-                    table[t[1] as usize],
-                    table[t[2] as usize],
-                    lin[t[3] as usize],
-                ]
-            }
+            // Decode as the pyramid does.
+            Storage::U8(v) => crate::texture::decode_rgba8(v[idx], self.srgb),
             Storage::F32(v) => v[idx],
         })
     }

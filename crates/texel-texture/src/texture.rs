@@ -449,24 +449,9 @@ impl Texture {
         }
         let idx = info.offset + j as usize * info.width as usize + i as usize;
         Some(match &self.storage {
-            Storage::U8(v) => self.u8_table_decode(v[idx]),
+            Storage::U8(v) => decode_rgba8(v[idx], self.format == Format::Rgba8Srgb),
             Storage::F32(v) => v[idx],
         })
-    }
-
-    fn u8_table_decode(&self, t: [u8; 4]) -> [f32; 4] {
-        let table = if self.format == Format::Rgba8Srgb {
-            srgb_table()
-        } else {
-            unorm8_table()
-        };
-        let a = unorm8_table();
-        [
-            table[t[0] as usize],
-            table[t[1] as usize],
-            table[t[2] as usize],
-            a[t[3] as usize],
-        ]
     }
 
     /// Mean of every texel of `level` in linear RGBA (`f64` accumulation).
@@ -488,6 +473,19 @@ impl Texture {
     pub(crate) fn storage(&self) -> &Storage {
         &self.storage
     }
+}
+
+/// One 8-bit texel to linear RGBA through the decode tables: RGB sRGB-decoded when `srgb`, else
+/// `b / 255`; alpha always `b / 255`.
+pub(crate) fn decode_rgba8(t: [u8; 4], srgb: bool) -> [f32; 4] {
+    let lin = unorm8_table();
+    let table = if srgb { srgb_table() } else { lin };
+    [
+        table[t[0] as usize],
+        table[t[1] as usize],
+        table[t[2] as usize],
+        lin[t[3] as usize],
+    ]
 }
 
 fn check_len(width: u32, height: u32, got: usize) -> Result<(), TextureError> {
