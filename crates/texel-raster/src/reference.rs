@@ -127,7 +127,9 @@ fn reference_frame(
 ) -> Result<Frame, RasterError> {
     let (width, height) = (settings.width, settings.height);
     let setups = setup_draws(settings, draws)?;
-    let bins = bin(&setups, width, height);
+    // Sub-samples reach the whole pixel: bin by the sample box, so a triangle that ends just short
+    // of a tile's first pixel centre, or covers no centre at all, still reaches its samples.
+    let bins = bin(&setups, width, height, |t| Some(t.sample_bbox));
     let pixels = width as usize * height as usize;
     let mut frame = Frame {
         width,
@@ -223,12 +225,11 @@ fn reference_row(
     let x1 = x0 + w as u32 - 1;
     for &id in bin {
         let t = &ctx.setups[id as usize];
-        let [bi0, bj0, bi1, bj1] = t.bbox;
-        // The bbox holds pixel centres; samples reach half a pixel further.
-        if j + 1 < bj0 || j > bj1 + 1 {
+        let [bi0, bj0, bi1, bj1] = t.sample_bbox;
+        if j < bj0 || j > bj1 {
             continue;
         }
-        let (i_lo, i_hi) = (bi0.saturating_sub(1).max(x0), (bi1 + 1).min(x1));
+        let (i_lo, i_hi) = (bi0.max(x0), bi1.min(x1));
         if i_lo > i_hi {
             continue;
         }

@@ -131,8 +131,13 @@ pub struct TriangleSetup {
     pub indices: [u32; 3],
     /// The three edge functions.
     pub edges: [Edge; 3],
-    /// Pixels that may be covered, inclusive, clamped to the frame: `[i_min, j_min, i_max, j_max]`.
-    pub bbox: [u32; 4],
+    /// Pixels whose centres may be covered, inclusive, clamped to the frame:
+    /// `[i_min, j_min, i_max, j_max]`; `None` for a triangle that covers no pixel centre (a sliver
+    /// or a triangle smaller than a pixel), which only the reference renderer's sub-samples see.
+    pub bbox: Option<[u32; 4]>,
+    /// Pixels any part of which the triangle may cover (its fixed-point bounding box, one sub-pixel
+    /// unit wider), clamped to the frame: where the reference renderer's sub-samples can hit it.
+    pub sample_bbox: [u32; 4],
     /// `1 / w_clip` (sum of [`TriangleSetup::q`]).
     pub r: Plane,
     /// `lambda_k / w_clip` of the original triangle.
@@ -148,7 +153,9 @@ impl TriangleSetup {
     /// of all three edges, with the top-left rule).
     #[inline]
     pub fn covers(&self, i: u32, j: u32) -> bool {
-        let [i0, j0, i1, j1] = self.bbox;
+        let Some([i0, j0, i1, j1]) = self.bbox else {
+            return false;
+        };
         (i0..=i1).contains(&i) && (j0..=j1).contains(&j) && {
             let (x, y) = (pixel_center_fixed(i), pixel_center_fixed(j));
             self.edges.iter().all(|e| e.at(x, y) >= 0)
@@ -258,9 +265,10 @@ pub fn setup_triangle(
             ids.swap(1, 2);
         }
         let [f0, f1, f2] = ids.map(|i| fixed[i]);
-        let Some(bbox) = pixel_bbox([f0, f1, f2], settings.width, settings.height) else {
+        let Some(sample_bbox) = touched_bbox([f0, f1, f2], settings.width, settings.height) else {
             continue;
         };
+        let bbox = pixel_bbox([f0, f1, f2], settings.width, settings.height);
         let pos = ids.map(|i| screen[i]);
         let lam = ids.map(|i| verts[i].lambda);
         let affine = std::array::from_fn(|c| {
@@ -276,6 +284,7 @@ pub fn setup_triangle(
             indices,
             edges: [Edge::new(f1, f2), Edge::new(f2, f0), Edge::new(f0, f1)],
             bbox,
+            sample_bbox,
             r,
             q,
             z,
@@ -347,6 +356,21 @@ fn pixel_bbox(v: [[i64; 2]; 3], width: u32, height: u32) -> Option<[u32; 4]> {
         let hi = v.iter().map(|p| p[axis]).max()?;
         let first = (lo - half + SUBPIXEL - 1).div_euclid(SUBPIXEL).max(0);
         let last = (hi - half).div_euclid(SUBPIXEL).min(i64::from(n) - 1);
+        (first <= last).then_some((first as u32, last as u32))
+    };
+    let (i0, i1) = range(0, width)?;
+    let (j0, j1) = range(1, height)?;
+    Some([i0, j0, i1, j1])
+}
+
+/// Pixels any part of which lies within the fixed-point bounding box (widened by one sub-pixel unit,
+/// so a sample rounded onto a pixel's far edge still finds the triangle), clamped to the frame.
+fn touched_bbox(v: [[i64; 2]; 3], width: u32, height: u32) -> Option<[u32; 4]> {
+    let range = |axis: usize, n: u32| -> Option<(u32, u32)> {
+        let lo = v.iter().map(|p| p[axis]).min()?;
+        let hi = v.iter().map(|p| p[axis]).max()?;
+        let first = (lo - 1).div_euclid(SUBPIXEL).max(0);
+        let last = hi.div_euclid(SUBPIXEL).min(i64::from(n) - 1);
         (first <= last).then_some((first as u32, last as u32))
     };
     let (i0, i1) = range(0, width)?;

@@ -56,12 +56,20 @@ pub(crate) fn tile_counts(width: u32, height: u32) -> (u32, u32) {
     (width.div_ceil(TILE), height.div_ceil(TILE))
 }
 
-/// For each tile (row-major), the indices of the setups whose bounding box overlaps it, in order.
-pub(crate) fn bin(setups: &[TriangleSetup], width: u32, height: u32) -> Vec<Vec<u32>> {
+/// For each tile (row-major), the indices of the setups whose box (`bbox` of the setup: the
+/// pixel-centre box for the rasterizer, the sample box for the reference) overlaps it, in order.
+pub(crate) fn bin(
+    setups: &[TriangleSetup],
+    width: u32,
+    height: u32,
+    bbox: impl Fn(&TriangleSetup) -> Option<[u32; 4]>,
+) -> Vec<Vec<u32>> {
     let (tx, ty) = tile_counts(width, height);
     let mut bins = vec![Vec::new(); (tx * ty) as usize];
     for (s, t) in setups.iter().enumerate() {
-        let [i0, j0, i1, j1] = t.bbox;
+        let Some([i0, j0, i1, j1]) = bbox(t) else {
+            continue;
+        };
         for by in j0 / TILE..=j1 / TILE {
             for bx in i0 / TILE..=i1 / TILE {
                 bins[(by * tx + bx) as usize].push(s as u32);
@@ -127,7 +135,7 @@ pub(crate) fn render_frame(
 ) -> Result<Frame, RasterError> {
     let (width, height) = (settings.width, settings.height);
     let setups = setup_draws(settings, draws)?;
-    let bins = bin(&setups, width, height);
+    let bins = bin(&setups, width, height, |t| t.bbox);
     let n = width as usize * height as usize;
     let counting = settings.counts_texels();
     let capture = settings.capture_footprints;
@@ -184,7 +192,9 @@ pub(crate) fn render_frame(
 fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[u32]) {
     for &s in bin {
         let t = &ctx.setups[s as usize];
-        let [bi0, bj0, bi1, bj1] = t.bbox;
+        let Some([bi0, bj0, bi1, bj1]) = t.bbox else {
+            continue;
+        };
         let (i_lo, i_hi) = (bi0.max(tile.x0), bi1.min(tile.x0 + tile.w - 1));
         let (j_lo, j_hi) = (bj0.max(tile.y0), bj1.min(tile.y0 + tile.h - 1));
         if i_lo > i_hi || j_lo > j_hi {

@@ -4,7 +4,7 @@ mod common;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use common::{lab_sampler, Ground};
+use common::{lab_sampler, screen_vertex, white, Ground};
 use texel_raster::{render, render_reference, render_reference_strata, Frame, RenderSettings};
 use texel_texture::{Format, Limits, Texture};
 
@@ -133,4 +133,59 @@ fn reference_agrees_with_the_rasterizer_where_the_texture_is_magnified() {
         .iter()
         .zip(&reference.coverage)
         .all(|(&r, &f)| !r || f));
+}
+
+/// Two triangles meeting on a vertical edge at x = 64.3, just past the first tile's last pixel
+/// centre: every sub-sample of every pixel hits one of them, so the reference of a white texture is
+/// exactly white everywhere (before the sample box, column 64's left samples saw the background).
+/// A triangle smaller than a pixel, covering no pixel centre, still shows as partial coverage.
+#[test]
+fn reference_covers_tile_seams_and_subpixel_triangles() {
+    let (w, h) = (128u32, 72u32);
+    let (tex, sampler) = white();
+    let v = |x: f64, y: f64| screen_vertex(x, y, w, h);
+    // The outer edges lie beyond the frame, so only the seam is an edge inside it.
+    let vertices = vec![
+        v(-2.0, -2.0),
+        v(64.3, -2.0),
+        v(64.3, 74.0),
+        v(-2.0, 74.0),
+        v(130.0, -2.0),
+        v(130.0, 74.0),
+    ];
+    let triangles = [[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 2]];
+    let draw = texel_raster::DrawCall {
+        vertices: &vertices,
+        triangles: &triangles,
+        texture: &tex,
+        sampler: &sampler,
+        clip_from_world: glam::Mat4::IDENTITY,
+    };
+    let s = RenderSettings::new(w, h);
+    let f = render_reference(&s, &[draw], 4, 7, None).unwrap();
+    assert_eq!(f.covered_pixels(), (w * h) as usize);
+    for (k, c) in f.color.iter().enumerate() {
+        assert_eq!(*c, [1.0; 4], "pixel ({}, {})", k as u32 % w, k as u32 / w);
+    }
+
+    // A 0.4 x 0.4 pixel triangle inside pixel (10, 10), away from its centre (10.5, 10.5).
+    let tiny = vec![v(10.05, 10.05), v(10.45, 10.05), v(10.05, 10.45)];
+    let draw = texel_raster::DrawCall {
+        vertices: &tiny,
+        triangles: &[[0, 1, 2]],
+        texture: &tex,
+        sampler: &sampler,
+        clip_from_world: glam::Mat4::IDENTITY,
+    };
+    assert_eq!(render(&s, &[draw]).unwrap().covered_pixels(), 0);
+    let f = render_reference(&s, &[draw], 8, 7, None).unwrap();
+    let k = (10 * w + 10) as usize;
+    assert!(f.coverage[k]);
+    // Background black, triangle white: the pixel's grey is the covered fraction (area 0.08).
+    assert!(
+        f.color[k][0] > 0.02 && f.color[k][0] < 0.2,
+        "{:?}",
+        f.color[k]
+    );
+    assert_eq!(f.covered_pixels(), 1);
 }

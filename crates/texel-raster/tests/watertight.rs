@@ -21,7 +21,9 @@ fn coverage_counts(vertices: &[Vertex], triangles: &[[u32; 3]], w: u32, h: u32) 
     let setups = setup_draws(&settings, &[draw]).unwrap();
     let mut counts = vec![0u32; (w * h) as usize];
     for t in &setups {
-        let [i0, j0, i1, j1] = t.bbox;
+        let Some([i0, j0, i1, j1]) = t.bbox else {
+            continue;
+        };
         for j in j0..=j1 {
             for i in i0..=i1 {
                 counts[(j * w + i) as usize] += u32::from(t.covers(i, j));
