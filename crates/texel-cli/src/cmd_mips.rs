@@ -27,10 +27,12 @@ pub fn run(args: &MipsArgs) -> Result<()> {
             .join(format!("level-{k:02}-{}x{}.png", l.width, l.height));
         write_png(&path, l.width, l.height, &pixels, args.color)?;
     }
-    // The classic layout: level 0 on the left, levels 1.. stacked top to bottom to its right.
+    // The classic layout: level 0 on the left, levels 1.. stacked top to bottom to its right. For
+    // wide textures the stack (whose last levels are 1 row each) can be taller than level 0.
     let (w0, h0) = (levels[0].width, levels[0].height);
     let right = levels.get(1).map_or(0, |l| l.width);
-    let (cw, ch) = (w0 + right, h0);
+    let stack: u32 = levels.iter().skip(1).map(|l| l.height).sum();
+    let (cw, ch) = (w0 + right, h0.max(stack));
     let mut chain = vec![[0.0f32; 4]; cw as usize * ch as usize];
     let mut y0 = 0u32;
     for (k, l) in levels.iter().enumerate() {

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use glam::DVec2;
-use texel_texture::warp::warp_perspective;
+use texel_texture::warp::{warp_perspective, WarpError};
 use texel_texture::{AddressMode, ColorSpace, Limits, Sampler, Texture};
 
 use crate::cli::{ColorArg, WarpArgs};
@@ -27,6 +27,12 @@ pub fn run(args: &WarpArgs) -> Result<()> {
         .descriptor(AddressMode::ClampToBorder, AddressMode::ClampToBorder)?;
     desc.border_color = texel_texture::BorderColor::TransparentBlack;
     let sampler = Sampler::new(desc)?;
-    let pixels = warp_perspective(&tex, &sampler, corners, w, h).context("invalid --corners")?;
+    let pixels = warp_perspective(&tex, &sampler, corners, w, h).map_err(|e| {
+        let what = match e {
+            WarpError::InvalidSize { .. } => "invalid --size",
+            _ => "invalid --corners",
+        };
+        anyhow::Error::new(e).context(what)
+    })?;
     write_png(&args.output, w, h, &pixels, args.color)
 }

@@ -1509,6 +1509,52 @@ fn error_bad_size() {
     );
 }
 
+/// A wide texture's stacked levels 1.. (ending in 1-row levels) are taller than level 0: the chain
+/// image grows to hold them (64 x 8: 4 + 2 + 1 + 1 + 1 + 1 = 10 rows).
+#[test]
+fn mips_of_a_wide_texture() {
+    let d = Dir::new("mips-wide");
+    let input = d.join("wide.png");
+    Image8::from_fn(64, 8, |x, y| [(x * 4) as u8, (y * 30) as u8, 128, 255])
+        .unwrap()
+        .write_png(&input)
+        .unwrap();
+    let out = d.join("mips");
+    ok(&[
+        "mips",
+        &input.to_string_lossy(),
+        "--out",
+        &out.to_string_lossy(),
+    ]);
+    assert_eq!(load(out.join("chain.png")).size(), (64 + 32, 10));
+}
+
+/// A warp larger than the pixel cap is refused before anything is allocated.
+#[test]
+fn error_warp_too_large() {
+    let d = Dir::new("err-warp-size");
+    let src = d.join("src.png");
+    Image8::filled(8, 8, [9, 9, 9, 255])
+        .unwrap()
+        .write_png(&src)
+        .unwrap();
+    fails(
+        &[
+            "warp",
+            &src.to_string_lossy(),
+            "--corners",
+            "0,0,8,0,8,8,0,8",
+            "--size",
+            "16384x16384",
+            "-o",
+            &d.arg("x.png"),
+        ],
+        1,
+        &["invalid --size", "16384x16384"],
+    );
+    assert!(!d.join("x.png").exists());
+}
+
 #[test]
 fn error_bad_corners() {
     let d = Dir::new("err-corners");

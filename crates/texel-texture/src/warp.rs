@@ -54,6 +54,16 @@ pub enum WarpError {
         /// y coordinate.
         y: f64,
     },
+    /// The output would have more than [`MAX_WARP_PIXELS`] pixels (or a zero side).
+    #[error("warp output {width}x{height} must have 1 to {max} pixels")]
+    InvalidSize {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+        /// The limit in pixels.
+        max: u64,
+    },
     /// The corners are not a convex quadrilateral in the stated order (collinear, self-intersecting
     /// or concave), so the mapping would fold or pass through infinity.
     #[error("warp corners do not form a convex quadrilateral in order top-left, top-right, bottom-right, bottom-left")]
@@ -121,6 +131,10 @@ impl SquareToQuad {
     }
 }
 
+/// Largest output of [`warp_perspective`] in pixels (2^26, as the rasterizer's frames: the linear
+/// result then takes at most 1 GiB).
+pub const MAX_WARP_PIXELS: u64 = 1 << 26;
+
 /// Warp `source` into a `width x height` image whose corners (top-left, top-right, bottom-right,
 /// bottom-left) show the source pixel positions `corners` (pixels of level 0, `(0, 0)` the top-left
 /// corner of the source). Returns linear RGBA, row-major, top row first; pixels mapping outside the
@@ -128,7 +142,8 @@ impl SquareToQuad {
 /// transparent).
 ///
 /// # Errors
-/// As [`SquareToQuad::new`].
+/// As [`SquareToQuad::new`], and [`WarpError::InvalidSize`] for an empty output or one over
+/// [`MAX_WARP_PIXELS`] (checked before allocating).
 pub fn warp_perspective(
     source: &Texture,
     sampler: &Sampler,
@@ -137,6 +152,14 @@ pub fn warp_perspective(
     height: u32,
 ) -> Result<Vec<[f32; 4]>, WarpError> {
     use rayon::prelude::*;
+    let pixels = u64::from(width) * u64::from(height);
+    if pixels == 0 || pixels > MAX_WARP_PIXELS {
+        return Err(WarpError::InvalidSize {
+            width,
+            height,
+            max: MAX_WARP_PIXELS,
+        });
+    }
     let map = SquareToQuad::new(corners)?;
     let (sw, sh) = (f64::from(source.width()), f64::from(source.height()));
     let (w, h) = (f64::from(width), f64::from(height));
@@ -217,6 +240,25 @@ mod tests {
         assert_eq!((m.g, m.h), (0.0, 0.0));
         let (p, _, _) = m.map_with_derivatives(0.5, 0.5);
         assert!((p - DVec2::new(2.5, 2.0)).length() < 1e-12);
+    }
+
+    #[test]
+    fn absurd_sizes_are_errors_before_allocating() {
+        let tex = Texture::from_fn(
+            2,
+            2,
+            crate::Format::Rgba8Unorm,
+            &crate::Limits::default(),
+            |_, _| [1.0; 4],
+        )
+        .unwrap();
+        let s = Sampler::new(crate::SamplerDescriptor::default()).unwrap();
+        for (w, h) in [(0, 5), (u32::MAX, u32::MAX), (16384, 16384)] {
+            assert!(matches!(
+                warp_perspective(&tex, &s, quad(), w, h),
+                Err(WarpError::InvalidSize { .. })
+            ));
+        }
     }
 
     #[test]

@@ -186,20 +186,49 @@ fn anisotropic_probe_counts_follow_the_ext_rule() {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
 
+    /// The raw weights are the table's: each lies in `(0, LUT[0]]`, and a texel centre at the
+    /// ellipse's centre gets the largest one, `LUT[0] = 1 - e^-2`. (That EWA divides by their sum
+    /// is what `constant_texture_is_constant_under_every_filter` checks.)
     #[test]
-    fn ewa_weights_sum_to_one(
+    fn ewa_weights_come_from_the_table_and_are_normalised(
         px in prop::array::uniform2(-50.0f32..50.0), py in prop::array::uniform2(-50.0f32..50.0),
         x in -100.0f32..100.0, y in -100.0f32..100.0, scale in 0.01f64..1.0,
     ) {
+        let lut = texel_texture::ewa::weight_lut();
         let e = Ellipse::from_axes(Vec2::from(px), Vec2::from(py), 16.0).unwrap();
         let q = e.in_level(DVec2::splat(scale), true);
         let mut weights = Vec::new();
-        q.for_each_weight(x, y, |_, _, w| weights.push(f64::from(w)));
+        q.for_each_weight(x, y, |_, _, w| weights.push(w));
         prop_assert!(!weights.is_empty());
-        prop_assert!(weights.iter().all(|&w| w > 0.0));
-        let total: f64 = weights.iter().sum();
-        let normalised: f64 = weights.iter().map(|w| w / total).sum();
-        prop_assert!((normalised - 1.0).abs() < 1e-9);
+        prop_assert!(weights.iter().all(|&w| w > 0.0 && w <= lut[0]));
+        prop_assert!(weights.iter().all(|w| lut.contains(w)));
+        // The quadratic form at the centre is 0, so any texel centre within r^2 < 1/128 of it gets
+        // LUT[0]; the ellipse always covers at least the unit circle (Q = D S D + I).
+        let (fx, fy) = (x - x.floor() - 0.5, y - y.floor() - 0.5);
+        if fx * fx + fy * fy < 1e-4 {
+            prop_assert!(weights.contains(&lut[0]));
+        }
+    }
+}
+
+/// At a texel centre the centre texel gets `LUT[0]`, the largest weight, for any ellipse.
+#[test]
+fn ewa_centre_texel_gets_the_peak_weight() {
+    let lut = texel_texture::ewa::weight_lut();
+    for (px, py) in [
+        ((3.0, 0.0), (0.0, 1.0)),
+        ((5.0, 5.0), (-0.5, 0.5)),
+        ((0.2, 0.0), (0.0, 0.2)),
+    ] {
+        let e = Ellipse::from_axes(Vec2::from(px), Vec2::from(py), 16.0).unwrap();
+        let q = e.in_level(DVec2::ONE, true);
+        let mut centre = None;
+        q.for_each_weight(10.5, 20.5, |i, j, w| {
+            if (i, j) == (10, 20) {
+                centre = Some(w);
+            }
+        });
+        assert_eq!(centre, Some(lut[0]), "{px:?} {py:?}");
     }
 }
 
