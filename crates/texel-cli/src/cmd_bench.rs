@@ -9,7 +9,7 @@ use std::io::Write;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use texel_raster::render;
+use texel_raster::{render, DrawCall, RasterError, RenderSettings};
 
 use crate::cli::BenchArgs;
 use crate::filters::parse_list;
@@ -26,6 +26,28 @@ pub struct Timing {
     pub min_ms: f64,
     /// Slowest timed frame.
     pub max_ms: f64,
+}
+
+/// Render `warmup` untimed frames, then `frames` timed ones; their times in milliseconds. A frame is
+/// one `texel_raster::render` call (no I/O, no encoding).
+pub fn time_frames(
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+    warmup: u32,
+    frames: u32,
+) -> Result<Vec<f64>, RasterError> {
+    for _ in 0..warmup {
+        std::hint::black_box(render(settings, draws)?);
+    }
+    (0..frames)
+        .map(|_| {
+            let t0 = Instant::now();
+            let frame = render(settings, draws)?;
+            let ms = t0.elapsed().as_secs_f64() * 1e3;
+            std::hint::black_box(&frame);
+            Ok(ms)
+        })
+        .collect()
 }
 
 /// Median of a non-empty list.
@@ -50,16 +72,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             scene.prepare(&samplers)?;
             let draws = scene.draws(&samplers);
             let settings = scene.settings();
-            let mut times = Vec::with_capacity(args.frames as usize);
-            for k in 0..args.warmup + args.frames {
-                let t0 = Instant::now();
-                let frame = render(&settings, &draws)?;
-                let ms = t0.elapsed().as_secs_f64() * 1e3;
-                std::hint::black_box(&frame);
-                if k >= args.warmup {
-                    times.push(ms);
-                }
-            }
+            let mut times = time_frames(&settings, &draws, args.warmup, args.frames)?;
             let (min_ms, max_ms) = times
                 .iter()
                 .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));

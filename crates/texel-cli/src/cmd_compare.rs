@@ -6,7 +6,6 @@
 //! decision), so anyone can recompute it from the PNG files.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use texel_quality::{
@@ -16,7 +15,7 @@ use texel_quality::{
 use texel_raster::{render, Frame};
 
 use crate::cli::{ColorArg, CompareArgs};
-use crate::cmd_bench::median;
+use crate::cmd_bench::{median, time_frames};
 use crate::cmd_reference::reference_frame;
 use crate::filters::{parse_list, FilterName};
 use crate::output::encoding;
@@ -24,7 +23,7 @@ use crate::prepare::Prepared;
 use crate::progress;
 
 /// Timed frames per filter in a comparison.
-pub const TIMED_FRAMES: usize = 3;
+pub const TIMED_FRAMES: u32 = 3;
 
 /// Error (8-bit units) at the top of the heat maps' colour ramp.
 pub const HEAT_MAP_MAX: f32 = 64.0;
@@ -133,16 +132,7 @@ pub fn compare(
         let bytes = scene.prepare(&samplers)?;
         let draws = scene.draws(&samplers);
         let settings = scene.settings();
-        render(&settings, &draws)?; // warm-up
-        let mut times: Vec<f64> = (0..TIMED_FRAMES)
-            .map(|_| {
-                let t0 = Instant::now();
-                render(&settings, &draws).map(|f| {
-                    std::hint::black_box(&f);
-                    t0.elapsed().as_secs_f64() * 1e3
-                })
-            })
-            .collect::<Result<_, _>>()?;
+        let mut times = time_frames(&settings, &draws, 1, TIMED_FRAMES)?;
         let mut counting = settings;
         counting.count_texels = true;
         let frame = render(&counting, &draws)?;
