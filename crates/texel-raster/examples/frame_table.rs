@@ -28,6 +28,23 @@ fn time(runs: usize, mut f: impl FnMut()) -> (f64, f64) {
     (t[0], t[runs / 2])
 }
 
+/// `(min, median)` of rendering `draw` at `w x h` on 1 thread, then on 2.
+fn per_thread_count(runs: usize, w: u32, h: u32, draw: DrawCall) -> Vec<(f64, f64)> {
+    [1, 2]
+        .iter()
+        .map(|&threads| {
+            let s = RenderSettings {
+                threads: Some(threads),
+                ..RenderSettings::new(w, h)
+            };
+            let (min, med) = time(runs, || {
+                render(&s, &[draw]).unwrap();
+            });
+            (min, med)
+        })
+        .collect()
+}
+
 fn main() {
     let runs: usize = std::env::args()
         .nth(1)
@@ -44,18 +61,9 @@ fn main() {
     ] {
         let sampler = lab_sampler(mode);
         let draw = scene.draw(&sampler);
-        let cells: Vec<String> = [1, 2]
+        let cells: Vec<String> = per_thread_count(runs, w, h, draw)
             .iter()
-            .map(|&threads| {
-                let s = RenderSettings {
-                    threads: Some(threads),
-                    ..RenderSettings::new(w, h)
-                };
-                let (min, med) = time(runs, || {
-                    render(&s, &[draw]).unwrap();
-                });
-                format!("{min:.1} / {med:.1}")
-            })
+            .map(|(min, med)| format!("{min:.1} / {med:.1}"))
             .collect();
         println!("| ground 1280x720, {name} | {} | {} |", cells[0], cells[1]);
     }
@@ -69,16 +77,9 @@ fn main() {
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
     };
-    let cells: Vec<String> = [1, 2]
+    let cells: Vec<String> = per_thread_count(runs, w, h, draw)
         .iter()
-        .map(|&threads| {
-            let s = RenderSettings {
-                threads: Some(threads),
-                ..RenderSettings::new(w, h)
-            };
-            let (min, med) = time(runs, || {
-                render(&s, &[draw]).unwrap();
-            });
+        .map(|(min, med)| {
             let mtri = triangles.len() as f64 / (min * 1e-3) / 1e6;
             format!("{min:.1} / {med:.1} ({mtri:.2} M tri/s)")
         })
