@@ -141,7 +141,7 @@ pub fn compare(
         let (mean, max) = texel_stats(&frame);
         row.texels_per_pixel_mean = Some(mean);
         row.texels_per_pixel_max = Some(max);
-        row.ms_per_frame = Some(median(&mut times));
+        row.ms_per_frame = Some(median(&mut times.draw_ms));
         row.texture_bytes = Some(bytes);
         rows.push(row);
         pb.inc(1);

@@ -1084,6 +1084,7 @@ fn bench_json_has_the_llvmpipe_shape() {
     assert_eq!(
         keys,
         [
+            "clear_ms",
             "frames",
             "height",
             "median_ms",
@@ -1099,15 +1100,17 @@ fn bench_json_has_the_llvmpipe_shape() {
         (Some(64), Some(36))
     );
     assert_eq!(v["frames"], 3);
-    let medians = v["median_ms"].as_object().unwrap();
-    let mut filters: Vec<&str> = medians.keys().map(String::as_str).collect();
-    filters.sort_unstable();
-    assert_eq!(filters, ["ewa", "nearest", "trilinear"]);
-    for (f, ms) in medians {
-        assert!(
-            ms.as_f64().is_some_and(|ms| ms.is_finite() && ms >= 0.0),
-            "{f}: {ms}"
-        );
+    for key in ["median_ms", "clear_ms"] {
+        let medians = v[key].as_object().unwrap();
+        let mut filters: Vec<&str> = medians.keys().map(String::as_str).collect();
+        filters.sort_unstable();
+        assert_eq!(filters, ["ewa", "nearest", "trilinear"], "{key}");
+        for (f, ms) in medians {
+            assert!(
+                ms.as_f64().is_some_and(|ms| ms.is_finite() && ms >= 0.0),
+                "{key} {f}: {ms}"
+            );
+        }
     }
     // Without --json: a table with one line per filter.
     let run = ok(&[

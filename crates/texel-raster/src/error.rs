@@ -43,6 +43,14 @@ pub enum RasterError {
         /// Number of vertices in the draw.
         vertex_count: usize,
     },
+    /// [`crate::draw_into`] was given a frame not reset for its settings (size or side channels).
+    #[error("frame is {}x{} or lacks side channels; the settings want {}x{}: reset the frame first", frame[0], frame[1], settings[0], settings[1])]
+    FrameMismatch {
+        /// The frame's width and height.
+        frame: [u32; 2],
+        /// The settings' width and height.
+        settings: [u32; 2],
+    },
     /// `threads` is `Some(0)`.
     #[error("thread count must be at least 1, got {0}")]
     InvalidThreadCount(usize),

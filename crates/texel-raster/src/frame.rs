@@ -1,7 +1,29 @@
 //! The rendered frame and its 8-bit encodings.
 
+use rayon::prelude::*;
 use texel_texture::color::{linear_to_srgb8, unorm8};
 use texel_texture::Footprint;
+
+use crate::settings::RenderSettings;
+
+/// Elements per parallel chunk when clearing a buffer (large enough that rayon's overhead is noise).
+const CLEAR_CHUNK: usize = 1 << 15;
+
+/// Set every element of `buf` to `value`, in parallel on the current rayon pool.
+fn fill<T: Copy + Send + Sync>(buf: &mut [T], value: T) {
+    buf.par_chunks_mut(CLEAR_CHUNK).for_each(|c| c.fill(value));
+}
+
+/// Resize `buf` to `n` elements of `value` (`n = 0` frees nothing but empties it), reusing its
+/// allocation when it is large enough.
+fn reset_buffer<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, value: T) {
+    if buf.len() == n {
+        fill(buf, value);
+    } else {
+        buf.clear();
+        buf.resize(n, value);
+    }
+}
 
 /// A rendered image with its per-pixel side channels. Every buffer is row-major, row 0 at the top,
 /// `width * height` long unless stated otherwise.
@@ -27,6 +49,54 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// A cleared frame for `settings` (see [`Frame::reset`]). The size is not validated here:
+    /// [`crate::render`] and [`crate::render_into`] validate the settings before allocating.
+    pub fn new(settings: &RenderSettings) -> Frame {
+        let mut frame = Frame {
+            width: 0,
+            height: 0,
+            color: Vec::new(),
+            texels_read: Vec::new(),
+            coverage: Vec::new(),
+            depth: Vec::new(),
+            footprints: Vec::new(),
+        };
+        frame.reset(settings);
+        frame
+    }
+
+    /// Clear the frame for a render with `settings`, reusing its buffers when the size is unchanged:
+    /// colour to the background, depth to `+inf`, coverage to `false`; the texel counts
+    /// (when [`RenderSettings::counts_texels`]) and footprints (when
+    /// [`RenderSettings::capture_footprints`]) to zero, and emptied otherwise. Runs on the current
+    /// rayon pool. This is the "clear" of a GPU frame: [`crate::draw_into`] then draws on top.
+    pub fn reset(&mut self, settings: &RenderSettings) {
+        let n = settings.width as usize * settings.height as usize;
+        self.width = settings.width;
+        self.height = settings.height;
+        reset_buffer(&mut self.color, n, settings.background);
+        reset_buffer(&mut self.depth, n, f32::INFINITY);
+        reset_buffer(&mut self.coverage, n, false);
+        let counted = if settings.counts_texels() { n } else { 0 };
+        reset_buffer(&mut self.texels_read, counted, 0);
+        let captured = if settings.capture_footprints { n } else { 0 };
+        reset_buffer(&mut self.footprints, captured, Footprint::default());
+    }
+
+    /// Whether the frame's buffers have the size and side channels a render with `settings` writes
+    /// (what [`Frame::reset`] gives).
+    pub fn matches(&self, settings: &RenderSettings) -> bool {
+        let n = settings.width as usize * settings.height as usize;
+        let side = |on: bool| if on { n } else { 0 };
+        self.width == settings.width
+            && self.height == settings.height
+            && self.color.len() == n
+            && self.depth.len() == n
+            && self.coverage.len() == n
+            && self.texels_read.len() == side(settings.counts_texels())
+            && self.footprints.len() == side(settings.capture_footprints)
+    }
+
     /// Index of pixel `(i, j)` in the buffers. No bounds check beyond the buffers' own.
     pub fn index(&self, i: u32, j: u32) -> usize {
         j as usize * self.width as usize + i as usize

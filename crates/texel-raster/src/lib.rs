@@ -73,7 +73,57 @@ pub use settings::{
 pub fn render(settings: &RenderSettings, draws: &[DrawCall]) -> Result<Frame, RasterError> {
     settings.validate()?;
     setup::validate_draws(draws)?;
-    with_threads(settings.threads, || tile::render_frame(settings, draws))
+    with_threads(settings.threads, || {
+        let mut frame = Frame::new(settings);
+        tile::draw_frame(settings, draws, &mut frame)?;
+        Ok(frame)
+    })
+}
+
+/// [`render`] into an existing frame, reusing its buffers: the frame is cleared
+/// ([`Frame::reset`]) and drawn. The result is bit for bit what [`render`] returns. For repeated
+/// renders of one size this saves the allocation (and page faults) of a new frame.
+///
+/// # Errors
+/// As [`render`]; on error the frame is left unchanged.
+pub fn render_into(
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+    frame: &mut Frame,
+) -> Result<(), RasterError> {
+    settings.validate()?;
+    setup::validate_draws(draws)?;
+    with_threads(settings.threads, || {
+        frame.reset(settings);
+        tile::draw_frame(settings, draws, frame)
+    })
+}
+
+/// Draw on top of `frame` without clearing it, as a GPU draw call into a bound render target:
+/// fragments are depth-tested against the frame's depth and overwrite its colour. Use
+/// [`Frame::reset`] (the clear) first for a fresh image; `reset` then `draw_into` equals
+/// [`render_into`] bit for bit. This is what `texel bench` times, as the llvmpipe comparison
+/// script times the draw after an untimed clear.
+///
+/// # Errors
+/// As [`render`], and [`RasterError::FrameMismatch`] when the frame was not reset for these
+/// settings (size or side channels differ, see [`Frame::matches`]). On error nothing is drawn.
+pub fn draw_into(
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+    frame: &mut Frame,
+) -> Result<(), RasterError> {
+    settings.validate()?;
+    setup::validate_draws(draws)?;
+    if !frame.matches(settings) {
+        return Err(RasterError::FrameMismatch {
+            frame: [frame.width, frame.height],
+            settings: [settings.width, settings.height],
+        });
+    }
+    with_threads(settings.threads, || {
+        tile::draw_frame(settings, draws, frame)
+    })
 }
 
 /// Run `f` on rayon's global pool (`None`) or on a local pool of `n` threads.

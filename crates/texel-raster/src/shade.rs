@@ -50,21 +50,25 @@ fn inv_period(mode: AddressMode) -> f64 {
 }
 
 /// `x - p * floor(x / p)` for a period `p > 0`; `x` unchanged for `p = 0`, non-finite `x` or
-/// `|x / p| >= 2^52` (where f64 has no fraction left to keep). The floor is done by integer
-/// conversion: without SSE4.1 `f64::floor` is a libm call, measured at 5% of a nearest-filtered
-/// ground frame.
+/// `|x / p| >= 2^51` (where f64 has at most one fraction bit left to keep).
+///
+/// Branch-free so that [`crate::tile`]'s span loops vectorise: the floor is `t` rounded to the
+/// nearest integer by adding and subtracting `1.5 * 2^52` (exact for `|t| < 2^51`, where the sum
+/// lies in `[2^52, 2^53)` and has no fraction bits), minus one where that rounded up. Without
+/// SSE4.1, `f64::floor` is a libm call (measured at 5% of a nearest-filtered ground frame), and the
+/// earlier integer-conversion floor (`t as i64`) has no packed form before AVX-512.
 ///
 /// `inv_p` is `1 / p` (0 for `p = 0`): the periods are 1 and 2, whose reciprocals are exact, so
 /// `x * inv_p` equals `x / p` bit for bit without a division (a `divsd` per coordinate was on
 /// every pixel's critical path).
 #[inline(always)]
 fn reduce(x: f64, p: f64, inv_p: f64) -> f64 {
+    const ROUND: f64 = 6_755_399_441_055_744.0; // 1.5 * 2^52
+    const LIMIT: f64 = 2_251_799_813_685_248.0; // 2^51
     let t = x * inv_p;
-    if p > 0.0 && t.abs() < 4_503_599_627_370_496.0 {
-        let mut q = t as i64 as f64;
-        if q > t {
-            q -= 1.0;
-        }
+    let r = (t + ROUND) - ROUND;
+    let q = if r > t { r - 1.0 } else { r };
+    if p > 0.0 && t.abs() < LIMIT {
         x - p * q
     } else {
         x
@@ -163,6 +167,20 @@ mod tests {
         assert_eq!(reduce(3.5, 0.0, 0.0), 3.5);
         assert_eq!(reduce(-2.0, 1.0, 1.0), 0.0);
         assert_eq!(reduce(1e300, 1.0, 1.0), 1e300);
+        assert_eq!(reduce(-0.0, 1.0, 1.0), 0.0);
+        assert_eq!(reduce(-1e-300, 1.0, 1.0), 1.0);
+        assert_eq!(reduce(2.5, 2.0, 0.5), 0.5);
+        assert_eq!(reduce(-3.0, 2.0, 0.5), 1.0);
+        // The rounding floor against the library floor, near and far from the origin.
+        for k in -20_000..20_000 {
+            let x = k as f64 * 0.377_777_7 + (k as f64).powi(3) * 1e-3;
+            for (p, ip) in [(1.0, 1.0), (2.0, 0.5)] {
+                assert_eq!(reduce(x, p, ip), x - p * (x / p).floor(), "{x} mod {p}");
+            }
+        }
+        let big = 2f64.powi(51) - 0.5;
+        assert_eq!(reduce(big, 1.0, 1.0), 0.5);
+        assert_eq!(reduce(2f64.powi(51), 1.0, 1.0), 2f64.powi(51));
         assert!(reduce(f64::NAN, 1.0, 1.0).is_nan());
         assert_eq!(inv_period(AddressMode::MirrorRepeat), 0.5);
         assert_eq!(inv_period(AddressMode::ClampToEdge), 0.0);

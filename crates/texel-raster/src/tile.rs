@@ -42,7 +42,7 @@ use texel_texture::Footprint;
 use crate::draw::DrawCall;
 use crate::frame::Frame;
 use crate::interp::quad_differences;
-use crate::settings::{Derivatives, RenderSettings, View};
+use crate::settings::{Derivatives, Perspective, RenderSettings, View};
 use crate::setup::{pixel_center_fixed, setup_draws, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
 use crate::views;
@@ -128,30 +128,18 @@ struct Fragment {
     z: f32,
 }
 
-/// Render a frame on the current rayon pool (validation is the caller's).
-pub(crate) fn render_frame(
+/// Draw into `frame` (already the right size, see [`Frame::matches`]) on the current rayon pool;
+/// validation is the caller's.
+pub(crate) fn draw_frame(
     settings: &RenderSettings,
     draws: &[DrawCall],
-) -> Result<Frame, RasterError> {
+    frame: &mut Frame,
+) -> Result<(), RasterError> {
     let (width, height) = (settings.width, settings.height);
     let setups = setup_draws(settings, draws)?;
     let bins = bin(&setups, width, height, |t| t.bbox);
-    let n = width as usize * height as usize;
     let counting = settings.counts_texels();
     let capture = settings.capture_footprints;
-    let mut frame = Frame {
-        width,
-        height,
-        color: vec![settings.background; n],
-        texels_read: if counting { vec![0; n] } else { Vec::new() },
-        coverage: vec![false; n],
-        depth: vec![f32::INFINITY; n],
-        footprints: if capture {
-            vec![Footprint::default(); n]
-        } else {
-            Vec::new()
-        },
-    };
     let ctx = Context {
         settings,
         setups: &setups,
@@ -186,10 +174,12 @@ pub(crate) fn render_frame(
         .zip(bins.par_iter())
         .with_max_len(1)
         .for_each(|(tile, bin)| raster_tile(&ctx, tile, bin));
-    Ok(frame)
+    Ok(())
 }
 
 fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[u32]) {
+    let batched = ctx.settings.view == View::Color && !ctx.counting;
+    let mut span = if batched { Some(Span::new()) } else { None };
     for &s in bin {
         let t = &ctx.setups[s as usize];
         let Some([bi0, bj0, bi1, bj1]) = t.bbox else {
@@ -201,9 +191,10 @@ fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[u32]) {
             continue;
         }
         let range = [i_lo, j_lo, i_hi, j_hi];
-        match ctx.settings.derivatives {
-            Derivatives::Analytic => raster_pixels(ctx, tile, t, range),
-            Derivatives::Quad => raster_quads(ctx, tile, t, range),
+        match (ctx.settings.derivatives, span.as_deref_mut()) {
+            (Derivatives::Analytic, Some(span)) => raster_pixels_batched(ctx, tile, t, range, span),
+            (Derivatives::Analytic, None) => raster_pixels(ctx, tile, t, range),
+            (Derivatives::Quad, _) => raster_quads(ctx, tile, t, range),
         }
     }
 }
@@ -216,9 +207,6 @@ fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range:
     let step = t.edges.map(|e| e.a * SUBPIXEL);
     let x_start = pixel_center_fixed(i_lo);
     let perspective = ctx.settings.perspective;
-    if ctx.settings.view == View::Color && !ctx.counting {
-        return raster_pixels_batched(ctx, tile, t, range);
-    }
     for j in j_lo..=j_hi {
         let y_fixed = pixel_center_fixed(j);
         let mut e = t.edges.map(|e| e.at(x_start, y_fixed));
@@ -249,21 +237,135 @@ fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range:
     }
 }
 
-/// A fragment of a row span waiting for its texture sample.
-#[derive(Clone, Copy, Default)]
-struct Pending {
-    li: usize,
-    z: f32,
-    lambda: DVec3,
+/// Pixels in a row span of a tile.
+const SPAN: usize = TILE as usize;
+
+/// Structure-of-arrays scratch for one row span of one triangle, reused across the spans and
+/// triangles of a tile (no allocation or clearing per triangle). Each stage below is a short loop
+/// over `0..n` with no branches and no calls, which the compiler vectorises.
+struct Span {
+    /// Covered, depth-passing fragments in the span.
+    n: usize,
+    /// Their column within the tile.
+    li: [u32; SPAN],
+    /// Their depth.
+    z: [f32; SPAN],
+    /// Their pixel-centre `x`.
+    x: [f64; SPAN],
+    /// `1 / r` (perspective) or 1 (affine).
+    inv_r: [f64; SPAN],
+    /// Barycentrics.
+    l: [[f64; SPAN]; 3],
+    /// Their x and y derivatives (only when the footprint needs them).
+    ldx: [[f64; SPAN]; 3],
+    ldy: [[f64; SPAN]; 3],
+    /// The sampler's input and output.
+    fps: [Footprint; SPAN],
+    texs: [[f32; 4]; SPAN],
+}
+
+impl Span {
+    fn new() -> Box<Span> {
+        Box::new(Span {
+            n: 0,
+            li: [0; SPAN],
+            z: [0.0; SPAN],
+            x: [0.0; SPAN],
+            inv_r: [0.0; SPAN],
+            l: [[0.0; SPAN]; 3],
+            ldx: [[0.0; SPAN]; 3],
+            ldy: [[0.0; SPAN]; 3],
+            fps: [Footprint::default(); SPAN],
+            texs: [[0.0; 4]; SPAN],
+        })
+    }
+
+    /// Barycentrics of the span's fragments at row centre `y`, with the derivatives when asked:
+    /// the operations of [`TriangleSetup::barycentrics`] (and `lambda_at`) in the same order, so
+    /// the same bits.
+    #[inline(always)]
+    fn barycentrics(&mut self, t: &TriangleSetup, y: f64, perspective: Perspective, deriv: bool) {
+        let n = self.n;
+        let xs = &self.x[..n];
+        match perspective {
+            Perspective::Correct => {
+                let r = t.r;
+                for (inv, &x) in self.inv_r[..n].iter_mut().zip(xs) {
+                    *inv = 1.0 / r.at(x, y);
+                }
+                for (q, l) in t.q.iter().zip(&mut self.l) {
+                    for ((l, &x), &inv) in l[..n].iter_mut().zip(xs).zip(&self.inv_r[..n]) {
+                        *l = q.at(x, y) * inv;
+                    }
+                }
+                if deriv {
+                    for k in 0..3 {
+                        let q = t.q[k];
+                        let it = self.l[k][..n].iter().zip(&self.inv_r[..n]);
+                        let out = self.ldx[k][..n].iter_mut().zip(&mut self.ldy[k][..n]);
+                        for ((dx, dy), (&l, &inv)) in out.zip(it) {
+                            *dx = (q.dx - l * r.dx) * inv;
+                            *dy = (q.dy - l * r.dy) * inv;
+                        }
+                    }
+                }
+            }
+            Perspective::Affine => {
+                for (a, l) in t.affine.iter().zip(&mut self.l) {
+                    for (l, &x) in l[..n].iter_mut().zip(xs) {
+                        *l = a.at(x, y);
+                    }
+                }
+                if deriv {
+                    for k in 0..3 {
+                        self.ldx[k][..n].fill(t.affine[k].dx);
+                        self.ldy[k][..n].fill(t.affine[k].dy);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The footprints of the span's fragments from their barycentrics: `uv` and (when `deriv`)
+    /// its derivatives as [`crate::interp::Barycentrics::interpolate2`] and `derivatives2` compute
+    /// them, reduced by [`DrawContext::footprint`].
+    #[inline(always)]
+    fn footprints(&mut self, dc: &DrawContext, uvs: [DVec2; 3], deriv: bool) {
+        let n = self.n;
+        let [l0, l1, l2] = &self.l;
+        let [x0, x1, x2] = &self.ldx;
+        let [y0, y1, y2] = &self.ldy;
+        let dot = |a: [DVec2; 3], l: [f64; 3]| a[0] * l[0] + a[1] * l[1] + a[2] * l[2];
+        for k in 0..n {
+            let uv = dot(uvs, [l0[k], l1[k], l2[k]]);
+            let (dx, dy) = if deriv {
+                (
+                    dot(uvs, [x0[k], x1[k], x2[k]]),
+                    dot(uvs, [y0[k], y1[k], y2[k]]),
+                )
+            } else {
+                (DVec2::ZERO, DVec2::ZERO)
+            };
+            self.fps[k] = dc.footprint(uv, dx, dy);
+        }
+    }
 }
 
 /// [`raster_pixels`] for the colour view without texel counting: each row span (at most one tile
-/// wide) is covered, depth-tested and interpolated first, then sampled with one
-/// [`texel_texture::Sampler::sample_batch`] call, then shaded and written. The pixels of a span are
-/// distinct, so deferring their writes changes nothing: the image is bit for bit the per-pixel
-/// path's. What it buys: the sampler's lod chains of the span pipeline together, and the
-/// per-call dispatch (format, tables) happens once per span.
-fn raster_pixels_batched(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: [u32; 4]) {
+/// wide) is covered and depth-tested first, then interpolated stage by stage over all its fragments
+/// ([`Span`]), sampled with one [`texel_texture::Sampler::sample_batch`] call, then shaded and
+/// written. The pixels of a span are distinct, so deferring their writes changes nothing, and each
+/// stage performs the per-pixel path's operations in the same order: the image is bit for bit the
+/// per-pixel path's (`tests/threads.rs`). What it buys: the interpolation stages vectorise, the
+/// sampler's lod chains of the span pipeline together, and per-call dispatch (format, tables)
+/// happens once per span.
+fn raster_pixels_batched(
+    ctx: &Context,
+    tile: &mut TileTarget,
+    t: &TriangleSetup,
+    range: [u32; 4],
+    span: &mut Span,
+) {
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];
     let uvs = dc.uvs(t);
@@ -271,11 +373,8 @@ fn raster_pixels_batched(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup
     let step = t.edges.map(|e| e.a * SUBPIXEL);
     let x_start = pixel_center_fixed(i_lo);
     let perspective = ctx.settings.perspective;
-    let mut pending = [Pending::default(); TILE as usize];
-    let mut fps = [Footprint::default(); TILE as usize];
-    let mut texs = [[0.0f32; 4]; TILE as usize];
     // Nearest or bilinear without mipmaps ignore the derivatives: skip them unless captured.
-    let derivatives = ctx.capture || dc.sampler.uses_derivatives();
+    let deriv = ctx.capture || dc.sampler.uses_derivatives();
     for j in j_lo..=j_hi {
         let y_fixed = pixel_center_fixed(j);
         let mut e = t.edges.map(|e| e.at(x_start, y_fixed));
@@ -286,22 +385,12 @@ fn raster_pixels_batched(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup
         for i in i_lo..=i_hi {
             if (e[0] | e[1] | e[2]) >= 0 {
                 let x = f64::from(i) + 0.5;
-                let li = (i - tile.x0) as usize;
+                let li = i - tile.x0;
                 let z = t.depth_at(x, y) as f32;
-                if z < depth_row[li] {
-                    let lambda = if derivatives {
-                        let b = t.barycentrics(x, y, perspective);
-                        let (duv_dx, duv_dy) = b.derivatives2(uvs);
-                        fps[n] = dc.footprint(b.interpolate2(uvs), duv_dx, duv_dy);
-                        b.lambda
-                    } else {
-                        // Same operations as `barycentrics`' lambda, so the same bits.
-                        let lambda = t.lambda_at(x, y, perspective);
-                        let uv = uvs[0] * lambda.x + uvs[1] * lambda.y + uvs[2] * lambda.z;
-                        fps[n] = dc.footprint(uv, DVec2::ZERO, DVec2::ZERO);
-                        lambda
-                    };
-                    pending[n] = Pending { li, z, lambda };
+                if z < depth_row[li as usize] {
+                    span.li[n] = li;
+                    span.z[n] = z;
+                    span.x[n] = x;
                     n += 1;
                 }
             }
@@ -312,15 +401,23 @@ fn raster_pixels_batched(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup
         if n == 0 {
             continue;
         }
+        span.n = n;
+        span.barycentrics(t, y, perspective, deriv);
+        span.footprints(dc, uvs, deriv);
         dc.sampler
-            .sample_batch(dc.texture, &fps[..n], &mut texs[..n]);
-        for ((p, tex), fp) in pending[..n].iter().zip(&texs[..n]).zip(&fps[..n]) {
-            let li = p.li;
-            tile.color[lj][li] = shade(dc, verts, p.lambda, *tex, ctx.light.as_ref());
-            tile.depth[lj][li] = p.z;
-            tile.coverage[lj][li] = true;
-            if ctx.capture {
-                tile.footprints[lj][li] = *fp;
+            .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
+        let (color, depth) = (&mut tile.color[lj], &mut tile.depth[lj]);
+        let coverage = &mut tile.coverage[lj];
+        for k in 0..n {
+            let li = span.li[k] as usize;
+            let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
+            color[li] = shade(dc, verts, lambda, span.texs[k], ctx.light.as_ref());
+            depth[li] = span.z[k];
+            coverage[li] = true;
+        }
+        if ctx.capture {
+            for k in 0..n {
+                tile.footprints[lj][span.li[k] as usize] = span.fps[k];
             }
         }
     }

@@ -98,3 +98,51 @@ fn reference_is_identical_for_any_thread_count_and_deterministic() {
     assert_eq!(a, run(1, 7));
     assert_ne!(a, run(2, 8), "a different seed jitters differently");
 }
+
+/// `render_into` reuses a frame and gives `render`'s frame bit for bit, across size and side-channel
+/// changes; `draw_into` refuses a frame not reset for its settings and draws on top of one that is.
+#[test]
+fn reused_frames_equal_fresh_ones() {
+    use texel_raster::{draw_into, render_into, Frame, RasterError};
+    let sampler = lab_sampler(4);
+    let mut frame = Frame::new(&RenderSettings::new(8, 8));
+    for (w, h, capture, view) in [
+        (300, 170, false, View::Color),
+        (300, 170, true, View::Fetches),
+        (64, 65, false, View::Color),
+        (300, 170, false, View::Color),
+    ] {
+        let scene = Ground::new(w, h);
+        let settings = RenderSettings {
+            view,
+            capture_footprints: capture,
+            threads: Some(2),
+            ..RenderSettings::new(w, h)
+        };
+        let fresh = render(&settings, &[scene.draw(&sampler)]).unwrap();
+        render_into(&settings, &[scene.draw(&sampler)], &mut frame).unwrap();
+        assert!(frame.matches(&settings));
+        assert!(fresh.covered_pixels() > 0);
+        assert_eq!(frame, fresh, "{w}x{h} {view:?}");
+        // A second draw of the same triangles on top changes nothing: equal depths keep the first.
+        draw_into(&settings, &[scene.draw(&sampler)], &mut frame).unwrap();
+        assert_eq!(frame, fresh, "{w}x{h} {view:?} drawn twice");
+        // Reset then draw is render_into.
+        frame.reset(&settings);
+        assert_eq!(frame.covered_pixels(), 0);
+        draw_into(&settings, &[scene.draw(&sampler)], &mut frame).unwrap();
+        assert_eq!(frame, fresh);
+    }
+    // A frame of another size, or without the side channel the settings write, is refused untouched.
+    let scene = Ground::new(300, 170);
+    let before = frame.clone();
+    let counting = RenderSettings {
+        count_texels: true,
+        ..RenderSettings::new(300, 170)
+    };
+    for settings in [RenderSettings::new(299, 170), counting] {
+        let err = draw_into(&settings, &[scene.draw(&sampler)], &mut frame).unwrap_err();
+        assert!(matches!(err, RasterError::FrameMismatch { .. }), "{err}");
+        assert_eq!(frame, before);
+    }
+}
