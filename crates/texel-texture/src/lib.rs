@@ -32,6 +32,7 @@
 
 pub mod address;
 pub mod aniso;
+mod batch;
 pub mod bicubic;
 mod bilinear;
 pub mod color;

@@ -75,6 +75,7 @@ use glam::Vec4;
 
 use crate::address::{Address, AddressMode, BorderColor};
 use crate::aniso::anisotropic;
+use crate::batch::{self, Kernel, Levels, Within};
 use crate::bicubic::Cubic;
 use crate::error::TextureError;
 use crate::ewa::ewa;
@@ -86,7 +87,7 @@ use crate::sat::summed_area;
 use crate::texture::Texture;
 
 /// Footprints [`Sampler::sample_batch`] prepares (lods) at once before filtering them.
-const BATCH_CHUNK: usize = 64;
+const BATCH_CHUNK: usize = batch::CHUNK;
 
 /// Largest |u| or |v| honoured (2^24): coordinates beyond are clamped to it.
 pub const UV_LIMIT: f32 = 16_777_216.0;
@@ -268,6 +269,8 @@ pub struct Sampler {
     /// The result does not depend on the lod (no mipmapping and `mag_filter == min_filter`), so
     /// the per-sample lod computation is skipped.
     lod_free: bool,
+    /// The staged kernel of [`Sampler::sample_batch`] for the core filters (see [`crate::batch`]).
+    kernel: Option<Kernel>,
     pub(crate) addr: Address,
 }
 
@@ -327,10 +330,29 @@ impl Sampler {
         let lod_free = technique == Technique::Mip
             && desc.mipmap_filter == MipmapFilterMode::None
             && desc.mag_filter == desc.min_filter;
+        let within = match desc.min_filter {
+            FilterMode::Nearest => Some(Within::Nearest),
+            FilterMode::Linear => Some(Within::Linear),
+            _ => None,
+        };
+        let kernel = match within {
+            Some(within) if technique == Technique::Mip && desc.mag_filter == desc.min_filter => {
+                Some(Kernel {
+                    within,
+                    levels: match desc.mipmap_filter {
+                        MipmapFilterMode::None => Levels::Base,
+                        MipmapFilterMode::Nearest => Levels::Nearest,
+                        MipmapFilterMode::Linear => Levels::Linear,
+                    },
+                })
+            }
+            _ => None,
+        };
         Ok(Sampler {
             desc,
             technique,
             lod_free,
+            kernel,
             addr: Address {
                 u: desc.address_mode_u,
                 v: desc.address_mode_v,
@@ -399,6 +421,11 @@ impl Sampler {
             let (w, h) = p.level(0).size();
             // Two stages per chunk (see `prepare`): all lods first, then all filters.
             let mut pre = [(0.0f32, 0.0f32, 0.0f32); BATCH_CHUNK];
+            if let Some(kernel) = self.kernel {
+                return batch::run(&p, &self.addr, kernel, footprints, out, |f| {
+                    self.prepare(w, h, f)
+                });
+            }
             for (fps, outs) in footprints
                 .chunks(BATCH_CHUNK)
                 .zip(out.chunks_mut(BATCH_CHUNK))

@@ -183,15 +183,31 @@ proptest! {
         }
     }
 
-    /// `sample_batch` equals `sample` one by one (lengths beyond the 64-footprint chunk included).
+    /// `sample_batch` equals `sample` one by one, bit for bit (lengths beyond the 64-footprint
+    /// chunk included): the staged kernels of the core filters (`batch.rs`) and the generic path,
+    /// for every filter, mipmap mode and address mode, on 8-bit sRGB, 8-bit linear and float
+    /// textures of odd sizes (a 1-texel-wide one included).
     #[test]
-    fn batch_equals_single(fps in proptest::collection::vec(footprint_strategy(), 1..150)) {
-        let tex = noise_texture(64, 32, Format::Rgba8Srgb);
-        let s = sampler(FilterMode::Linear, FilterMode::Cubic(Cubic::MITCHELL), MipmapFilterMode::Linear, AddressMode::MirrorRepeat);
+    fn batch_equals_single(
+        fps in proptest::collection::vec(footprint_strategy(), 1..150),
+        (w, h) in prop_oneof![Just((64u32, 32u32)), Just((37, 5)), Just((1, 9)), Just((3, 3))],
+    ) {
+        let textures = [
+            noise_texture(w, h, Format::Rgba8Srgb),
+            noise_texture(w, h, Format::Rgba8Unorm),
+            noise_texture(w, h, Format::Rgba32Float),
+        ];
+        let mut samplers = every_sampler(BorderColor::OpaqueWhite);
+        samplers.push(sampler(FilterMode::Linear, FilterMode::Cubic(Cubic::MITCHELL), MipmapFilterMode::Linear, AddressMode::MirrorRepeat));
+        samplers.push(sampler(FilterMode::Nearest, FilterMode::Linear, MipmapFilterMode::Linear, AddressMode::Repeat));
         let mut out = vec![[0.0; 4]; fps.len()];
-        s.sample_batch(&tex, &fps, &mut out);
-        for (f, o) in fps.iter().zip(&out) {
-            prop_assert_eq!(s.sample(&tex, f), *o);
+        for tex in &textures {
+            for s in &samplers {
+                s.sample_batch(tex, &fps, &mut out);
+                for (f, o) in fps.iter().zip(&out) {
+                    prop_assert_eq!(s.sample(tex, f).map(f32::to_bits), o.map(f32::to_bits), "{:?} {:?}", s.descriptor(), f);
+                }
+            }
         }
     }
 }

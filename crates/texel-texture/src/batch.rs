@@ -1,0 +1,230 @@
+//! Specialised kernels behind [`crate::Sampler::sample_batch`] for the four core filters: nearest
+//! or bilinear inside a level, with no mipmapping (level 0), the nearest level, or trilinear.
+//!
+//! The per-sample path ([`crate::Sampler::sample`]) walks one sample through lod, level choice,
+//! a run-time dispatch on the filter, coordinate set-up, range checks, texel loads and blends. Here a
+//! chunk of samples goes through the same steps in stages, each a short loop over the chunk:
+//!
+//! 1. levels: each sample's level (and, for trilinear, its second level and weight);
+//! 2. coordinates: per level pass, `x = u * W` (`- 1/2` for bilinear), the integer texel index by
+//!    a clamp and a truncating conversion, the fractions, and whether every texel the sample reads
+//!    lies inside the level. Branch-free, with no calls: the compiler vectorises it;
+//! 3. texels: loads, decodes and blends for the samples inside the level; the few near an edge
+//!    go through the general filter ([`crate::nearest`], [`crate::bilinear`]) with address wrapping.
+//!
+//! Every stage performs the per-sample path's floating-point operations in the same order, so the
+//! results are bit for bit those of [`crate::Sampler::sample`] (`tests/core.rs`, `batch_equals_single`,
+//! over every filter, mipmap mode, address mode and texel format).
+//!
+//! Why the index is exact: the per-sample path's `floor_index(x)` is `floor(x)` as an `i64`. Here
+//! `x` is first clamped to `[-1, W]`; inside that range truncation toward zero, minus one where it
+//! rounded up, is the floor, and the floor of the clamped value lies in `[0, W)` exactly when the
+//! floor of `x` does. For samples inside the level the clamp is the identity, so the fractions
+//! `x - floor(x)` are the per-sample path's.
+
+use glam::Vec4;
+
+use crate::address::Address;
+use crate::bilinear::bilinear;
+use crate::fetch::{Fetch, Pyramid};
+use crate::footprint::Footprint;
+use crate::mip::mip_nearest_level;
+use crate::nearest::nearest;
+
+/// Samples per stage (the sampler's chunk).
+pub(crate) const CHUNK: usize = 64;
+
+/// The filter inside a level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Within {
+    /// One texel.
+    Nearest,
+    /// Bilinear, 2x2 texels.
+    Linear,
+}
+
+/// How levels are chosen from the lod.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Levels {
+    /// Level 0 whatever the lod (no mipmapping, `mag_filter == min_filter`).
+    Base,
+    /// The Vulkan nearest level ([`mip_nearest_level`]); level 0 for `lod <= 0`.
+    Nearest,
+    /// Trilinear between `floor(d)` and `floor(d) + 1`, `d = clamp(lod, 0, last)`.
+    Linear,
+}
+
+/// A kernel: the filter inside a level and the level rule. Valid when `mag_filter == min_filter`
+/// (then the magnification branch, `lod <= 0`, is the level rule at level 0 with weight 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Kernel {
+    pub within: Within,
+    pub levels: Levels,
+}
+
+/// Level sizes as the coordinate stage reads them, indexed by the `u8` level (no bounds checks).
+struct Dims {
+    /// `W` and `H` as `f32` (scales) and as clamp bounds.
+    w: [f32; 256],
+    h: [f32; 256],
+}
+
+/// Per-sample scratch of one level pass.
+struct Pass {
+    level: [u8; CHUNK],
+    /// Top-left texel index (nearest: the texel).
+    i: [i32; CHUNK],
+    j: [i32; CHUNK],
+    /// Bilinear fractions.
+    a: [f32; CHUNK],
+    b: [f32; CHUNK],
+    /// Every texel read lies inside the level.
+    inside: [bool; CHUNK],
+}
+
+impl Pass {
+    fn new() -> Self {
+        Pass {
+            level: [0; CHUNK],
+            i: [0; CHUNK],
+            j: [0; CHUNK],
+            a: [0.0; CHUNK],
+            b: [0.0; CHUNK],
+            inside: [false; CHUNK],
+        }
+    }
+
+    /// Stage 2 for the first `n` samples at their `level`s.
+    #[inline(always)]
+    fn coordinates(&mut self, within: Within, dims: &Dims, us: &[f32], vs: &[f32]) {
+        let n = us.len();
+        let half = match within {
+            Within::Nearest => 0.0,
+            Within::Linear => 0.5,
+        };
+        // Bilinear reads texel i0 + 1 too: i0 must be below W - 1.
+        let reach = match within {
+            Within::Nearest => 0.0,
+            Within::Linear => 1.0,
+        };
+        for k in 0..n {
+            let l = self.level[k];
+            let (w, h) = (dims.w[l as usize], dims.h[l as usize]);
+            let x = us[k] * w - half;
+            let y = vs[k] * h - half;
+            let (i, fi) = clamped_floor(x, w);
+            let (j, fj) = clamped_floor(y, h);
+            self.i[k] = i;
+            self.j[k] = j;
+            self.a[k] = x - fi;
+            self.b[k] = y - fj;
+            self.inside[k] = fi >= 0.0 && fi < w - reach && fj >= 0.0 && fj < h - reach;
+        }
+    }
+}
+
+/// `floor(x)` for `x` clamped to `[-1, hi]`, as an integer and as an `f32`; `hi >= 1`, `x` finite.
+#[inline(always)]
+fn clamped_floor(x: f32, hi: f32) -> (i32, f32) {
+    let c = x.max(-1.0).min(hi);
+    let t = c as i32;
+    let t = t - i32::from(t as f32 > c);
+    (t, t as f32)
+}
+
+/// Filter `footprints` with `kernel` into `out` (same length); `prepare` is the sampler's first
+/// stage, giving each footprint's finite `(u, v)` and its lod.
+pub(crate) fn run<P: Pyramid>(
+    p: &P,
+    addr: &Address,
+    kernel: Kernel,
+    footprints: &[Footprint],
+    out: &mut [[f32; 4]],
+    prepare: impl Fn(&Footprint) -> (f32, f32, f32),
+) {
+    // A 2^31-texel side has 32 levels: the u8 level index cannot overflow.
+    let levels = p.level_count().min(256);
+    let mut dims = Dims {
+        w: [0.0; 256],
+        h: [0.0; 256],
+    };
+    for l in 0..levels {
+        let (w, h) = p.level(l).size();
+        (dims.w[l], dims.h[l]) = (w as f32, h as f32);
+    }
+    let mut first = Pass::new();
+    let mut second = Pass::new();
+    let mut delta = [0.0f32; CHUNK];
+    let (mut us, mut vs, mut lods) = ([0.0f32; CHUNK], [0.0f32; CHUNK], [0.0f32; CHUNK]);
+    let last = levels - 1;
+    for (fps, out) in footprints.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+        let n = fps.len();
+        for (k, f) in fps.iter().enumerate() {
+            (us[k], vs[k], lods[k]) = prepare(f);
+        }
+        let (us, vs, lods) = (&us[..n], &vs[..n], &lods[..n]);
+        // Stage 1: levels (u8: at most 32 levels for a 2^31 side; textures are far smaller).
+        match kernel.levels {
+            Levels::Base => first.level[..n].fill(0),
+            Levels::Nearest => {
+                for (l, &lod) in first.level[..n].iter_mut().zip(lods) {
+                    *l = mip_nearest_level(lod, last) as u8;
+                }
+            }
+            Levels::Linear => {
+                for k in 0..n {
+                    // As `mip::trilinear`: truncation is the floor for d >= 0; NaN gives level 0
+                    // and a NaN weight, which reads level 0 only.
+                    let d = lods[k].clamp(0.0, last as f32);
+                    let l = d as usize;
+                    first.level[k] = l as u8;
+                    second.level[k] = (l + 1).min(last) as u8;
+                    delta[k] = d - l as f32;
+                }
+            }
+        }
+        // Stages 2 and 3.
+        first.coordinates(kernel.within, &dims, us, vs);
+        let trilinear = kernel.levels == Levels::Linear;
+        if trilinear {
+            second.coordinates(kernel.within, &dims, us, vs);
+        }
+        for k in 0..n {
+            let a = texels(p, addr, kernel.within, &first, k, us[k], vs[k]);
+            let c = if trilinear && delta[k] > 0.0 && (first.level[k] as usize) < last {
+                let b = texels(p, addr, kernel.within, &second, k, us[k], vs[k]);
+                a + (b - a) * delta[k]
+            } else {
+                a
+            };
+            out[k] = c.to_array();
+        }
+    }
+}
+
+/// Stage 3 for sample `k` of a pass: the filtered value in its level.
+#[inline(always)]
+fn texels<P: Pyramid>(
+    p: &P,
+    addr: &Address,
+    within: Within,
+    pass: &Pass,
+    k: usize,
+    u: f32,
+    v: f32,
+) -> Vec4 {
+    let level = p.level(pass.level[k] as usize);
+    let inside = pass.inside[k];
+    match within {
+        Within::Nearest if inside => level.texel(pass.i[k] as u32, pass.j[k] as u32),
+        Within::Nearest => nearest(&level, addr, u, v),
+        Within::Linear if inside => {
+            let [t00, t10, t01, t11] = level.quad(pass.i[k] as u32, pass.j[k] as u32);
+            let (a, b) = (pass.a[k], pass.b[k]);
+            let top = t00 + (t10 - t00) * a;
+            let bottom = t01 + (t11 - t01) * a;
+            top + (bottom - top) * b
+        }
+        Within::Linear => bilinear(&level, addr, u, v),
+    }
+}
