@@ -47,9 +47,10 @@
 use glam::Vec4;
 
 use crate::address::Address;
+use crate::batch;
 use crate::fetch::{Fetch, Pyramid};
 use crate::footprint::{lod_from_rho, Footprint};
-use crate::mip::{trilinear, LevelFilter, Linear};
+use crate::mip::{trilinear, Linear};
 use crate::sampler::SamplerDescriptor;
 
 /// Relative tolerance applied to `|Pmax| / |Pmin|` before rounding up (see the module docs).
@@ -114,25 +115,91 @@ pub(crate) fn anisotropic<P: Pyramid>(
     let dl = lod.clamp(0.0, last as f32);
     let k = dl as usize;
     let delta = dl - k as f32;
-    let fine = p.level(k);
-    let coarse = (delta > 0.0 && k < last).then(|| p.level(k + 1));
-    let mut sum = Vec4::ZERO;
+    let coarse = delta > 0.0 && k < last;
+    // The probes' coordinates, then their staged trilinear sum (`batch::probe_sum`, the same
+    // arithmetic as `mip::trilinear` with `Linear` per probe). `n <= 64` (`anisotropy_clamp`).
+    let mut pu = [0.0f32; batch::CHUNK];
+    let mut pv = [0.0f32; batch::CHUNK];
+    let n = (n as usize).min(batch::CHUNK);
     for i in 0..n {
         let t = (i as f32 + 0.5) * inv - 0.5;
-        let pu = finite(u + t * axes.major_uv.x);
-        let pv = finite(v + t * axes.major_uv.y);
-        let a = Linear.apply(&fine, addr, pu, pv);
-        sum += match &coarse {
-            Some(c) => a + (Linear.apply(c, addr, pu, pv) - a) * delta,
-            None => a,
-        };
+        pu[i] = finite(u + t * axes.major_uv.x);
+        pv[i] = finite(v + t * axes.major_uv.y);
     }
-    sum * inv
+    batch::probe_sum(p, addr, k, coarse, delta, &pu[..n], &pv[..n]) * inv
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fetch::pyramid_of;
+    use crate::mip::LevelFilter;
+    use crate::texture::{Format, Limits, Texture};
+
+    /// The staged probes (`batch::probe_sum`) equal the plain probe loop bit for bit: each probe a
+    /// `Linear` trilinear sample in the shared levels, summed in order.
+    #[test]
+    fn staged_probes_equal_the_probe_loop() {
+        let tex = Texture::from_fn(61, 34, Format::Rgba8Srgb, &Limits::default(), |i, j| {
+            let x = (i * 7 + j * 13) % 256;
+            [
+                x as f32 / 255.0,
+                (i % 5) as f32 / 4.0,
+                (j % 3) as f32 / 2.0,
+                1.0,
+            ]
+        })
+        .unwrap();
+        let crate::fetch::AnyPyramid::U8(p) = pyramid_of(&tex) else {
+            unreachable!()
+        };
+        let d = SamplerDescriptor::anisotropic(16);
+        let addr = crate::address::Address {
+            u: crate::address::AddressMode::Repeat,
+            v: crate::address::AddressMode::MirrorRepeat,
+            border: Vec4::ZERO,
+        };
+        let mut checked = 0;
+        for s in 0..4000u32 {
+            let f = |k: u32| ((s.wrapping_mul(2_654_435_761) >> k) % 1000) as f32 / 1000.0;
+            let fp = Footprint {
+                u: 3.0 * f(0) - 1.0,
+                v: 3.0 * f(3) - 1.0,
+                dudx: 0.3 * (f(5) - 0.5),
+                dudy: 0.02 * (f(7) - 0.5),
+                dvdx: 0.01 * (f(9) - 0.5),
+                dvdy: 0.2 * f(11) * (f(13) - 0.5),
+            };
+            let axes = fp.axes(61, 34);
+            let major = axes.major.length();
+            let n = probe_count(major, axes.minor.length(), 16);
+            if n == 1 {
+                continue;
+            }
+            let lod = lod_from_rho(major / n as f32, 0.0, 0.0, 32.0);
+            let last = p.level_count() - 1;
+            let dl = lod.clamp(0.0, last as f32);
+            let k = dl as usize;
+            let delta = dl - k as f32;
+            let inv = 1.0 / n as f32;
+            let mut sum = Vec4::ZERO;
+            for i in 0..n {
+                let t = (i as f32 + 0.5) * inv - 0.5;
+                let (pu, pv) = (fp.u + t * axes.major_uv.x, fp.v + t * axes.major_uv.y);
+                let a = Linear.apply(&p.level(k), &addr, pu, pv);
+                sum += if delta > 0.0 && k < last {
+                    a + (Linear.apply(&p.level(k + 1), &addr, pu, pv) - a) * delta
+                } else {
+                    a
+                };
+            }
+            let want = (sum * inv).to_array().map(f32::to_bits);
+            let got = anisotropic(&p, &addr, &d, &fp, fp.u, fp.v, 1.0, 16);
+            assert_eq!(got.to_array().map(f32::to_bits), want, "{fp:?}");
+            checked += 1;
+        }
+        assert!(checked > 1000, "{checked}");
+    }
 
     #[test]
     fn probe_count_table() {

@@ -94,9 +94,15 @@ impl Pass {
         }
     }
 
-    /// Stage 2 for the first `n` samples at their `level`s.
+    /// Stage 2 for the first `n` samples at their `level`s, whose sizes `size(level)` gives.
     #[inline(always)]
-    fn coordinates(&mut self, within: Within, dims: &Dims, us: &[f32], vs: &[f32]) {
+    fn coordinates(
+        &mut self,
+        within: Within,
+        size: impl Fn(u8) -> (f32, f32),
+        us: &[f32],
+        vs: &[f32],
+    ) {
         let n = us.len();
         let half = match within {
             Within::Nearest => 0.0,
@@ -108,8 +114,7 @@ impl Pass {
             Within::Linear => 1.0,
         };
         for k in 0..n {
-            let l = self.level[k];
-            let (w, h) = (dims.w[l as usize], dims.h[l as usize]);
+            let (w, h) = size(self.level[k]);
             let x = us[k] * w - half;
             let y = vs[k] * h - half;
             let (i, fi) = clamped_floor(x, w);
@@ -184,10 +189,11 @@ pub(crate) fn run<P: Pyramid>(
             }
         }
         // Stages 2 and 3.
-        first.coordinates(kernel.within, &dims, us, vs);
+        let size = |l: u8| (dims.w[l as usize], dims.h[l as usize]);
+        first.coordinates(kernel.within, size, us, vs);
         let trilinear = kernel.levels == Levels::Linear;
         if trilinear {
-            second.coordinates(kernel.within, &dims, us, vs);
+            second.coordinates(kernel.within, size, us, vs);
         }
         for k in 0..n {
             let a = texels(p, addr, kernel.within, &first, k, us[k], vs[k]);
@@ -227,4 +233,45 @@ fn texels<P: Pyramid>(
         }
         Within::Linear => bilinear(&level, addr, u, v),
     }
+}
+
+/// The sum over anisotropic probes at `(us[i], vs[i])` (at most [`CHUNK`]) of a trilinear
+/// sample between levels `k` and `k + 1` with weight `delta`, the coarser level read only when
+/// `coarse` (the probes of [`crate::aniso`], staged as above: bit for bit the probe loop's sum).
+pub(crate) fn probe_sum<P: Pyramid>(
+    p: &P,
+    addr: &Address,
+    k: usize,
+    coarse: bool,
+    delta: f32,
+    us: &[f32],
+    vs: &[f32],
+) -> Vec4 {
+    let n = us.len().min(CHUNK);
+    let (us, vs) = (&us[..n], &vs[..n]);
+    let mut sum = Vec4::ZERO;
+    let mut fine = Pass::new();
+    let mut next = Pass::new();
+    let size_of = |l: usize| {
+        let (w, h) = p.level(l).size();
+        (w as f32, h as f32)
+    };
+    // The pass stores levels as u8; a level beyond 255 cannot exist (2^255 texels).
+    fine.level[..n].fill(k as u8);
+    let fine_size = size_of(k);
+    fine.coordinates(Within::Linear, |_| fine_size, us, vs);
+    if coarse {
+        next.level[..n].fill(k as u8 + 1);
+        let next_size = size_of(k + 1);
+        next.coordinates(Within::Linear, |_| next_size, us, vs);
+    }
+    for i in 0..n {
+        let a = texels(p, addr, Within::Linear, &fine, i, us[i], vs[i]);
+        sum += if coarse {
+            a + (texels(p, addr, Within::Linear, &next, i, us[i], vs[i]) - a) * delta
+        } else {
+            a
+        };
+    }
+    sum
 }
