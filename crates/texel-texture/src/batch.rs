@@ -196,9 +196,11 @@ pub(crate) fn run<P: Pyramid>(
             second.coordinates(kernel.within, size, us, vs);
         }
         for k in 0..n {
-            let a = texels(p, addr, kernel.within, &first, k, us[k], vs[k]);
+            let level = p.level(first.level[k] as usize);
+            let a = texels(&level, addr, kernel.within, &first, k, us[k], vs[k]);
             let c = if trilinear && delta[k] > 0.0 && (first.level[k] as usize) < last {
-                let b = texels(p, addr, kernel.within, &second, k, us[k], vs[k]);
+                let level = p.level(second.level[k] as usize);
+                let b = texels(&level, addr, kernel.within, &second, k, us[k], vs[k]);
                 a + (b - a) * delta[k]
             } else {
                 a
@@ -208,10 +210,10 @@ pub(crate) fn run<P: Pyramid>(
     }
 }
 
-/// Stage 3 for sample `k` of a pass: the filtered value in its level.
+/// Stage 3 for sample `k` of a pass, in its level `level`: the filtered value.
 #[inline(always)]
-fn texels<P: Pyramid>(
-    p: &P,
+fn texels<F: Fetch>(
+    level: &F,
     addr: &Address,
     within: Within,
     pass: &Pass,
@@ -219,11 +221,10 @@ fn texels<P: Pyramid>(
     u: f32,
     v: f32,
 ) -> Vec4 {
-    let level = p.level(pass.level[k] as usize);
     let inside = pass.inside[k];
     match within {
         Within::Nearest if inside => level.texel(pass.i[k] as u32, pass.j[k] as u32),
-        Within::Nearest => nearest(&level, addr, u, v),
+        Within::Nearest => nearest(level, addr, u, v),
         Within::Linear if inside => {
             let [t00, t10, t01, t11] = level.quad(pass.i[k] as u32, pass.j[k] as u32);
             let (a, b) = (pass.a[k], pass.b[k]);
@@ -231,7 +232,7 @@ fn texels<P: Pyramid>(
             let bottom = t01 + (t11 - t01) * a;
             top + (bottom - top) * b
         }
-        Within::Linear => bilinear(&level, addr, u, v),
+        Within::Linear => bilinear(level, addr, u, v),
     }
 }
 
@@ -252,23 +253,23 @@ pub(crate) fn probe_sum<P: Pyramid>(
     let mut sum = Vec4::ZERO;
     let mut fine = Pass::new();
     let mut next = Pass::new();
-    let size_of = |l: usize| {
-        let (w, h) = p.level(l).size();
+    // Every probe reads the same one or two levels: their views are made once.
+    let fine_level = p.level(k);
+    let next_level = p.level(if coarse { k + 1 } else { k });
+    let size_of = |level: &P::Level<'_>| {
+        let (w, h) = level.size();
         (w as f32, h as f32)
     };
-    // The pass stores levels as u8; a level beyond 255 cannot exist (2^255 texels).
-    fine.level[..n].fill(k as u8);
-    let fine_size = size_of(k);
+    let fine_size = size_of(&fine_level);
     fine.coordinates(Within::Linear, |_| fine_size, us, vs);
     if coarse {
-        next.level[..n].fill(k as u8 + 1);
-        let next_size = size_of(k + 1);
+        let next_size = size_of(&next_level);
         next.coordinates(Within::Linear, |_| next_size, us, vs);
     }
     for i in 0..n {
-        let a = texels(p, addr, Within::Linear, &fine, i, us[i], vs[i]);
+        let a = texels(&fine_level, addr, Within::Linear, &fine, i, us[i], vs[i]);
         sum += if coarse {
-            a + (texels(p, addr, Within::Linear, &next, i, us[i], vs[i]) - a) * delta
+            a + (texels(&next_level, addr, Within::Linear, &next, i, us[i], vs[i]) - a) * delta
         } else {
             a
         };

@@ -279,11 +279,14 @@ impl LevelEllipse {
             while done < cols {
                 let len = (cols - done).min(RUN as u32) as usize;
                 for w in &mut buf[..len] {
-                    *w = if r2 < 1.0 {
-                        lut[((r2 * LUT_SIZE as f64) as usize).min(LUT_SIZE - 1)]
-                    } else {
-                        0.0
-                    };
+                    // `r2 < 1` bounds the index above; the conversion goes through i32 (one
+                    // `cvttsd2si`; an f64-to-u64 conversion needs a range fix-up on x86-64),
+                    // and the rare rounding-negative `r2` clamps to entry 0 as before.
+                    // Branch-free: the load always happens (at a clamped index); the select
+                    // keeps it inside the ellipse.
+                    let x =
+                        lut[((r2 * LUT_SIZE as f64) as i32).clamp(0, LUT_SIZE as i32 - 1) as usize];
+                    *w = if r2 < 1.0 { x } else { 0.0 };
                     r2 += step;
                     step += step2;
                 }
