@@ -34,6 +34,10 @@ use crate::nearest::nearest;
 /// Samples per stage (the sampler's chunk).
 pub(crate) const CHUNK: usize = 64;
 
+/// Level views kept per call: a power of two above the 23 levels of a `MAX_SIDE` texture, so that
+/// `% LEVELS` is a mask.
+const LEVELS: usize = 32;
+
 /// The filter inside a level.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Within {
@@ -128,13 +132,30 @@ impl Pass {
     }
 }
 
-/// `floor(x)` for `x` clamped to `[-1, hi]`, as an integer and as an `f32`; `hi >= 1`, `x` finite.
+/// Largest level-0 side the kernels accept (2^22): [`clamped_floor`] is exact below it. Larger
+/// textures take the generic path.
+pub(crate) const MAX_SIDE: u32 = 1 << 22;
+
+/// `1.5 * 2^23`: added to an `f32` of magnitude below `2^22`, the sum lies in `[2^23, 2^24)`, where
+/// the spacing is 1, so it is rounded to an integer, which its low mantissa bits hold.
+const ROUND: f32 = 12_582_912.0;
+
+/// `floor(x)` for `x` clamped to `[-1, hi]`, as an integer and as an `f32`; `1 <= hi < 2^22`, `x`
+/// finite. Rounds by adding and subtracting [`ROUND`] and reads the integer from the sum's bits:
+/// no float-to-integer conversion, whose saturating semantics (NaN to 0, out of range to the
+/// limits) cost about 20 instructions per sample on SSE2 (callgrind).
 #[inline(always)]
 fn clamped_floor(x: f32, hi: f32) -> (i32, f32) {
     let c = x.max(-1.0).min(hi);
-    let t = c as i32;
-    let t = t - i32::from(t as f32 > c);
-    (t, t as f32)
+    let sum = c + ROUND;
+    let rounded = sum - ROUND;
+    // Integer value of the rounded sum: its bits minus those of ROUND.
+    let r = sum.to_bits() as i32 - ROUND.to_bits() as i32;
+    let down = rounded > c;
+    (
+        r - i32::from(down),
+        if down { rounded - 1.0 } else { rounded },
+    )
 }
 
 /// Filter `footprints` with `kernel` into `out` (same length); `prepare` is the sampler's first
@@ -147,14 +168,17 @@ pub(crate) fn run<P: Pyramid>(
     out: &mut [[f32; 4]],
     prepare: impl Fn(&Footprint) -> (f32, f32, f32),
 ) {
-    // A 2^31-texel side has 32 levels: the u8 level index cannot overflow.
-    let levels = p.level_count().min(256);
+    // Level 0 is below 2^22 per side (`MAX_SIDE`), so there are at most 23 levels.
+    let levels = p.level_count().min(LEVELS);
     let mut dims = Dims {
         w: [0.0; 256],
         h: [0.0; 256],
     };
-    for l in 0..levels {
-        let (w, h) = p.level(l).size();
+    let base = p.level(0);
+    let mut views = [base; LEVELS];
+    for (l, view) in views.iter_mut().enumerate().take(levels) {
+        *view = p.level(l);
+        let (w, h) = view.size();
         (dims.w[l], dims.h[l]) = (w as f32, h as f32);
     }
     let mut first = Pass::new();
@@ -177,14 +201,15 @@ pub(crate) fn run<P: Pyramid>(
                 }
             }
             Levels::Linear => {
+                let top = last as f32;
                 for k in 0..n {
-                    // As `mip::trilinear`: truncation is the floor for d >= 0; NaN gives level 0
-                    // and a NaN weight, which reads level 0 only.
-                    let d = lods[k].clamp(0.0, last as f32);
-                    let l = d as usize;
+                    // As `mip::trilinear`: `d = clamp(lod, 0, last)`, level `floor(d)`, weight
+                    // `d - floor(d)`; NaN gives level 0 and a NaN weight, which reads level 0 only.
+                    let d = lods[k].clamp(0.0, top);
+                    let (l, fl) = clamped_floor(if d.is_nan() { 0.0 } else { d }, top);
                     first.level[k] = l as u8;
-                    second.level[k] = (l + 1).min(last) as u8;
-                    delta[k] = d - l as f32;
+                    second.level[k] = (l as u8 + 1).min(last as u8);
+                    delta[k] = d - fl;
                 }
             }
         }
@@ -196,11 +221,11 @@ pub(crate) fn run<P: Pyramid>(
             second.coordinates(kernel.within, size, us, vs);
         }
         for k in 0..n {
-            let level = p.level(first.level[k] as usize);
-            let a = texels(&level, addr, kernel.within, &first, k, us[k], vs[k]);
+            let level = &views[first.level[k] as usize % LEVELS];
+            let a = texels(level, addr, kernel.within, &first, k, us[k], vs[k]);
             let c = if trilinear && delta[k] > 0.0 && (first.level[k] as usize) < last {
-                let level = p.level(second.level[k] as usize);
-                let b = texels(&level, addr, kernel.within, &second, k, us[k], vs[k]);
+                let level = &views[second.level[k] as usize % LEVELS];
+                let b = texels(level, addr, kernel.within, &second, k, us[k], vs[k]);
                 a + (b - a) * delta[k]
             } else {
                 a
@@ -275,4 +300,41 @@ pub(crate) fn probe_sum<P: Pyramid>(
         };
     }
     sum
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rounding floor equals `f32::floor` of the clamped value everywhere it is used: level
+    /// sides up to `MAX_SIDE`, fractions, negatives clamped to -1, values beyond `hi`.
+    #[test]
+    fn clamped_floor_is_the_floor() {
+        let his = [1.0f32, 2.0, 3.0, 37.0, 1024.0, 16_384.0, MAX_SIDE as f32];
+        let mut xs = vec![
+            -1e30f32,
+            -2.5,
+            -1.0,
+            -0.999_999_9,
+            -1e-30,
+            -0.0,
+            0.0,
+            1e-30,
+            0.5,
+        ];
+        for k in 0..20_000 {
+            xs.push(k as f32 * 0.173_205_08 - 3.0);
+        }
+        for e in [1.0f32, 2.0, 16_384.0, MAX_SIDE as f32] {
+            xs.extend([e - 0.5, e - 1e-3 * e.max(1.0).sqrt(), e, e + 0.25, e * 2.0]);
+        }
+        for &hi in &his {
+            for &x in &xs {
+                let c = x.max(-1.0).min(hi);
+                let (i, f) = clamped_floor(x, hi);
+                assert_eq!(f, c.floor(), "x {x} hi {hi}");
+                assert_eq!(i as f32, c.floor(), "x {x} hi {hi}");
+            }
+        }
+    }
 }

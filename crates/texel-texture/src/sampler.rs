@@ -70,6 +70,39 @@
 //! and its eight texel decodes alone are about 90 instructions (per texel four byte loads, four
 //! table loads and three shuffles), so reaching them needs 8-lane SIMD
 //! (gathered or pre-decoded texels), which this scalar code does not have yet.
+//!
+//! ### Second pass: staged kernels
+//!
+//! [`Sampler::sample_batch`] now runs the core filters through [`crate::batch`] (levels, then
+//! branch-free coordinates for the whole chunk, then texels), and anisotropic probes through the same
+//! stages; results bit-identical to [`Sampler::sample`] (tested). Together with the rasterizer's
+//! staged spans and reused frames (`texel-raster/src/tile.rs`), ground scene 1280 x 720, 2 threads,
+//! `texel bench ../shared/scenes/ground.toml --color raw --frames 20 --threads 2`, ms per frame, one
+//! session, each column a build of its own: "fresh frame" is the previous pass (each timed render
+//! allocates its frame), "reused" times only the draw into a reused frame after an untimed clear
+//! (0.25-0.45 ms; what `texel bench` times now, as the llvmpipe script does), "staged" adds the
+//! staged spans and kernels:
+//!
+//! | filter | fresh frame | reused | staged |
+//! |---|---|---|---|
+//! | nearest | 5.22-5.29 | 4.77 | 3.6-4.0 |
+//! | bilinear | 6.20-6.39 | 5.85 | 4.4-4.8 |
+//! | mip-nearest | 10.47-10.86 | 10.47 | 7.0-7.5 |
+//! | trilinear | 12.94-14.05 | 12.72 | 8.9-9.5 |
+//! | aniso16 | - | 52.9 | 45.7-49 |
+//!
+//! One thread, `cargo bench -p texel-texture --bench sampler -- --warm-up-time 1
+//! --measurement-time 2`, M samples/s, the previous pass's README table -> this pass: nearest
+//! 138-144 -> 183-192, bilinear 86-91 -> 127-128, mip-nearest 38.5-62.5 -> 68.5-69.2, trilinear
+//! 28.1-60.9 -> 47.4-61.5 (3x minified, two levels: 28.1 -> 47.4). Compiling everything for AVX2 (`RUSTFLAGS="-C target-cpu=x86-64-v3"`) gave another
+//! 8-12% on frames; not adopted (see ARCHITECTURE.md).
+//!
+//! Where the time goes now (`perf record`, trilinear ground frame, one thread): `batch::run` 65%
+//! (texel loads, the four table loads per texel that decode it, and the `Vec4` blends: 8 texels per
+//! two-level sample), the rasterizer 25%. Bilinear at 127 M/s is about 20 cycles per sample; 300 M/s
+//! would be 8.7, which leaves no room for the 16 table loads and 12 inserts that decode its four
+//! texels one at a time: the next step is decoding and blending 8 samples per instruction (SoA
+//! texels, 8-bit arithmetic or gathers), which this code does not do yet.
 
 use glam::Vec4;
 
@@ -421,7 +454,8 @@ impl Sampler {
             let (w, h) = p.level(0).size();
             // Two stages per chunk (see `prepare`): all lods first, then all filters.
             let mut pre = [(0.0f32, 0.0f32, 0.0f32); BATCH_CHUNK];
-            if let Some(kernel) = self.kernel {
+            let small = w <= batch::MAX_SIDE && h <= batch::MAX_SIDE;
+            if let Some(kernel) = self.kernel.filter(|_| small) {
                 return batch::run(&p, &self.addr, kernel, footprints, out, |f| {
                     self.prepare(w, h, f)
                 });
