@@ -108,7 +108,7 @@ use glam::Vec4;
 
 use crate::address::{Address, AddressMode, BorderColor};
 use crate::aniso::anisotropic;
-use crate::batch::{self, Kernel, Levels, Within};
+use crate::batch::{self, Kernel, Levels, LodParams, Within};
 use crate::bicubic::Cubic;
 use crate::error::TextureError;
 use crate::ewa::ewa;
@@ -124,6 +124,18 @@ const BATCH_CHUNK: usize = batch::CHUNK;
 
 /// Largest |u| or |v| honoured (2^24): coordinates beyond are clamped to it.
 pub const UV_LIMIT: f32 = 16_777_216.0;
+
+/// A sample coordinate made usable: NaN and infinities sample at 0; beyond `+-2^24`
+/// ([`UV_LIMIT`]) an `f32` has no fractional bits left, so clamping there changes nothing a caller
+/// could rely on and keeps `u * W` finite for every level.
+#[inline(always)]
+pub(crate) fn finite_uv(x: f32) -> f32 {
+    if x.is_finite() {
+        x.clamp(-UV_LIMIT, UV_LIMIT)
+    } else {
+        0.0
+    }
+}
 
 /// Filter used within one mip level (WebGPU `GPUFilterMode`, plus cubic).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -452,23 +464,30 @@ impl Sampler {
         );
         with_pyramid!(texture, |p| {
             let (w, h) = p.level(0).size();
-            // Two stages per chunk (see `prepare`): all lods first, then all filters.
-            let mut pre = [(0.0f32, 0.0f32, 0.0f32); BATCH_CHUNK];
+            let d = &self.desc;
+            let lod = (!self.lod_free).then_some(LodParams {
+                width: w,
+                height: h,
+                bias: d.lod_bias,
+                min: d.lod_min_clamp,
+                max: d.lod_max_clamp,
+            });
             let small = w <= batch::MAX_SIDE && h <= batch::MAX_SIDE;
             if let Some(kernel) = self.kernel.filter(|_| small) {
-                return batch::run(&p, &self.addr, kernel, footprints, out, |f| {
-                    self.prepare(w, h, f)
-                });
+                return batch::run(&p, &self.addr, kernel, lod, footprints, out);
             }
+            // Two stages per chunk: all lods first (`batch::prepare`, `prepare`'s arithmetic
+            // vectorised), then all filters.
+            let mut us = [0.0f32; BATCH_CHUNK];
+            let mut vs = [0.0f32; BATCH_CHUNK];
+            let mut lods = [0.0f32; BATCH_CHUNK];
             for (fps, outs) in footprints
                 .chunks(BATCH_CHUNK)
                 .zip(out.chunks_mut(BATCH_CHUNK))
             {
-                for (q, f) in pre.iter_mut().zip(fps) {
-                    *q = self.prepare(w, h, f);
-                }
-                for ((o, f), &(u, v, lod)) in outs.iter_mut().zip(fps).zip(&pre) {
-                    *o = self.filter(&p, f, u, v, lod).to_array();
+                batch::prepare(fps, lod, &mut us, &mut vs, &mut lods);
+                for (k, (o, f)) in outs.iter_mut().zip(fps).enumerate() {
+                    *o = self.filter(&p, f, us[k], vs[k], lods[k]).to_array();
                 }
             }
         })
@@ -489,15 +508,6 @@ impl Sampler {
     /// clamp) that pipelines across footprints there instead of stalling each sample.
     #[inline(always)]
     fn prepare(&self, w: u32, h: u32, fp: &Footprint) -> (f32, f32, f32) {
-        // NaN/inf sample at 0; beyond +-2^24 an f32 has no fractional bits left, so clamping there
-        // changes nothing a caller could rely on and keeps `u * W` finite for every level.
-        let finite = |x: f32| {
-            if x.is_finite() {
-                x.clamp(-UV_LIMIT, UV_LIMIT)
-            } else {
-                0.0
-            }
-        };
         let d = &self.desc;
         let lod = if self.lod_free {
             // Both branches of `filter` read level 0 with the same filter: any lod gives the
@@ -511,7 +521,7 @@ impl Sampler {
                 d.lod_max_clamp,
             )
         };
-        (finite(fp.u), finite(fp.v), lod)
+        (finite_uv(fp.u), finite_uv(fp.v), lod)
     }
 
     /// Second stage of a sample: the filter at finite `(u, v)` and `lod` (from [`Sampler::prepare`]).
