@@ -62,7 +62,13 @@
 //! 557 ms -> 487 ms per frame (trilinear 42 ms in both runs). Images change by at most 1 in 8 bits
 //! (`r^2` now in `f64`). The LUT index goes through an `i32` conversion (an `f64` to `u64`
 //! conversion needs a range fix-up on x86-64) with a branch-free select: 2 threads, 231 -> 212 ms per
-//! frame, bit-identical. Measured and dropped: two interleaved accumulators for the texel sum (no
+//! frame, bit-identical. The scan follows the ellipse's wider side (columns for a tall ellipse,
+//! [`LevelEllipse::for_each_run`]): the ground's footprints near the horizon are long in v, so rows
+//! were many and one to four texels long, each paying a square root, a floor, a ceil and its
+//! differences' set-up. 2 threads, alternating runs: 205-209 -> 168 ms per frame; the image's
+//! scores are unchanged to 0.01 dB (PSNR 25.06 dB all, 22.58 band, SSIM 0.9300 against a 64-spp
+//! reference; texels per pixel 77.1 mean, 311 max), the sums' order changes for tall ellipses
+//! only. Measured and dropped: two interleaved accumulators for the texel sum (no
 //! change: the sum is not the latency bound). `perf` on the ground frame: the weight loop about 20%,
 //! the per-row set-up (square root, floor and ceil of the row's column range) about 25%.
 //!
@@ -205,6 +211,29 @@ pub struct LevelEllipse {
     pub det: f64,
 }
 
+/// A run of consecutive texels handed over by [`LevelEllipse::for_each_run`]: texel `k` of the run
+/// is `(i0 + k, j0)` along a row, or `(i0, j0 + k)` along a column (`vertical`). Unwrapped indices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Run {
+    /// Column of the first texel.
+    pub i0: i64,
+    /// Row of the first texel.
+    pub j0: i64,
+    /// Whether the run goes down a column (else along a row).
+    pub vertical: bool,
+}
+
+impl Run {
+    /// Unwrapped indices `(i, j)` of texel `k` of the run.
+    pub fn texel(&self, k: usize) -> (i64, i64) {
+        if self.vertical {
+            (self.i0, self.j0.saturating_add(k as i64))
+        } else {
+            (self.i0.saturating_add(k as i64), self.j0)
+        }
+    }
+}
+
 impl LevelEllipse {
     /// Area in texels of the level: `pi sqrt(det Q)`.
     pub fn area(&self) -> f64 {
@@ -215,24 +244,61 @@ impl LevelEllipse {
     /// the ellipse centred at continuous texel position `(x, y)`, with its unnormalised LUT weight.
     /// Visits at most [`MAX_VISITS`] texels and rows together; returns how many it visited.
     pub fn for_each_weight(&self, x: f32, y: f32, mut f: impl FnMut(i64, i64, f32)) -> u32 {
-        self.for_each_run(x, y, |i0, j, weights| {
+        self.for_each_run(x, y, |run, weights| {
             for (k, &w) in weights.iter().enumerate() {
                 if w > 0.0 {
-                    f(i0.saturating_add(k as i64), j, w);
+                    let (i, j) = run.texel(k);
+                    f(i, j, w);
                 }
             }
         })
     }
 
-    /// As [`LevelEllipse::for_each_weight`], a run of consecutive texels at a time: `f(i0, j, w)`
-    /// covers texels `i0 .. i0 + w.len()` of row `j` (unwrapped), with weight 0 for the rare centre
-    /// that rounding puts just outside the ellipse. Runs are at most [`RUN`] texels long.
+    /// As [`LevelEllipse::for_each_weight`], a [`Run`] of consecutive texels at a time, along a row
+    /// or (for an ellipse taller than wide) along a column, with weight 0 for the rare centre that
+    /// rounding puts just outside the ellipse. Runs are at most [`RUN`] texels long.
     ///
-    /// Along a row, `r^2` is a quadratic in the column offset and is updated by forward differences
+    /// Along a run, `r^2` is a quadratic in the offset and is updated by forward differences
     /// (two additions per texel) instead of being re-evaluated.
-    pub fn for_each_run(&self, x: f32, y: f32, mut f: impl FnMut(i64, i64, &[f32])) -> u32 {
+    ///
+    /// The scan follows the ellipse's wider side: rows when it is at least as wide as tall
+    /// (`q00 >= q11`), else columns. Each row or column costs a square root, a floor and a ceil
+    /// and the set-up of its differences; a tall, thin ellipse (the ground plane's footprints
+    /// near the horizon stretch along v) has many rows of one to four texels but few long
+    /// columns. Ground scene, 1280 x 720, 2 threads: see the module docs.
+    pub fn for_each_run(&self, x: f32, y: f32, mut f: impl FnMut(Run, &[f32])) -> u32 {
+        if self.q00 >= self.q11 {
+            self.scan(x, y, self.q00, self.q11, |a0, b, w| {
+                f(
+                    Run {
+                        i0: a0,
+                        j0: b,
+                        vertical: false,
+                    },
+                    w,
+                )
+            })
+        } else {
+            // Transposed: x and y swap roles, and so do q00 and q11.
+            self.scan(y, x, self.q11, self.q00, |a0, b, w| {
+                f(
+                    Run {
+                        i0: b,
+                        j0: a0,
+                        vertical: true,
+                    },
+                    w,
+                )
+            })
+        }
+    }
+
+    /// The row scan of [`LevelEllipse::for_each_run`] in axes `(a, b)`: lines of constant `b`,
+    /// runs along `a`; `qaa` and `qbb` are `Q`'s diagonal entries for `a` and `b`. `f(a0, b, w)`.
+    #[inline(always)]
+    fn scan(&self, x: f32, y: f32, q00: f64, q11: f64, mut f: impl FnMut(i64, i64, &[f32])) -> u32 {
         let lut = weight_lut();
-        let (q00, q01, q11, det) = (self.q00, self.q01, self.q11, self.det);
+        let (q01, det) = (self.q01, self.det);
         if !(det > 0.0 && q11 > 0.0 && q00 > 0.0 && det.is_finite()) {
             return 0;
         }
@@ -343,20 +409,39 @@ fn ewa_level<F: Fetch>(
     let (x, y) = (u * w as f32, v * h as f32);
     let mut sum = Vec4::ZERO;
     let mut wsum = 0.0f32;
-    q.for_each_run(x, y, |i0, j, weights| {
-        let jw = addr.v.wrap(j, h);
-        let inside = i0 >= 0 && i0.saturating_add(weights.len() as i64) <= i64::from(w);
-        match jw {
-            Some(jw) if inside => {
+    q.for_each_run(x, y, |run, weights| {
+        let len = weights.len() as i64;
+        // The run's fixed index wrapped once; the run inside the level along its own axis.
+        let (fixed, inside) = if run.vertical {
+            let j0 = run.j0;
+            (
+                addr.u.wrap(run.i0, w),
+                j0 >= 0 && j0.saturating_add(len) <= i64::from(h),
+            )
+        } else {
+            let i0 = run.i0;
+            (
+                addr.v.wrap(run.j0, h),
+                i0 >= 0 && i0.saturating_add(len) <= i64::from(w),
+            )
+        };
+        match fixed {
+            Some(fixed) if inside => {
                 for (k, &wt) in weights.iter().enumerate() {
-                    sum += level.texel(i0 as u32 + k as u32, jw) * wt;
+                    let t = if run.vertical {
+                        level.texel(fixed, run.j0 as u32 + k as u32)
+                    } else {
+                        level.texel(run.i0 as u32 + k as u32, fixed)
+                    };
+                    sum += t * wt;
                     wsum += wt;
                 }
             }
             _ => {
                 for (k, &wt) in weights.iter().enumerate() {
-                    let i = addr.u.wrap(i0.saturating_add(k as i64), w);
-                    sum += texel_or_border(level, addr, i, jw) * wt;
+                    let (i, j) = run.texel(k);
+                    let t = texel_or_border(level, addr, addr.u.wrap(i, w), addr.v.wrap(j, h));
+                    sum += t * wt;
                     wsum += wt;
                 }
             }
@@ -560,7 +645,10 @@ mod tests {
                     }
                 }
             }
-            let got: Vec<(i64, i64)> = got.iter().map(|g| (g.0, g.1)).collect();
+            // The scan runs along rows or columns (the ellipse's wider side): compare as sets.
+            let mut got: Vec<(i64, i64)> = got.iter().map(|g| (g.0, g.1)).collect();
+            got.sort_unstable();
+            brute.sort_unstable();
             assert_eq!(got, brute);
         }
     }
