@@ -327,43 +327,49 @@ fn texels<F: Fetch, const N: usize>(
     }
 }
 
-/// The sum over anisotropic probes at `(us[i], vs[i])` (at most [`CHUNK`]) of a trilinear
-/// sample between levels `k` and `k + 1` with weight `delta`, the coarser level read only when
-/// `coarse` (the probes of [`crate::aniso`], staged as above: bit for bit the probe loop's sum).
+/// Scratch for [`probe_sum`]: the probes' coordinates and their two level passes, made once per
+/// [`crate::Sampler::sample_batch`] call and reused by every sample (zeroing about 1.7 KB per sample
+/// was measurable: see [`crate::aniso`]). Entries beyond a sample's probe count are stale and never
+/// read.
+pub(crate) struct Probes {
+    /// Probe coordinates, written by the caller for the first `n` probes.
+    pub u: [f32; CHUNK],
+    /// As `u`.
+    pub v: [f32; CHUNK],
+    fine: Pass<CHUNK>,
+    next: Pass<CHUNK>,
+}
+
+impl Probes {
+    /// Zeroed scratch.
+    pub(crate) fn new() -> Self {
+        Probes {
+            u: [0.0; CHUNK],
+            v: [0.0; CHUNK],
+            fine: Pass::new(),
+            next: Pass::new(),
+        }
+    }
+}
+
+/// The sum over the first `n` anisotropic probes at `(s.u[i], s.v[i])` (`n` at most [`CHUNK`]) of
+/// a trilinear sample between levels `k` and `k + 1` with weight `delta`, the coarser level read
+/// only when `coarse` (the probes of [`crate::aniso`], staged as above: bit for bit the probe
+/// loop's sum).
+#[inline]
 pub(crate) fn probe_sum<P: Pyramid>(
     p: &P,
     addr: &Address,
     k: usize,
     coarse: bool,
     delta: f32,
-    us: &[f32],
-    vs: &[f32],
+    n: usize,
+    s: &mut Probes,
 ) -> Vec4 {
-    // Scratch sized to the probes: up to 16 (the usual clamp) without clearing 64 entries twice
-    // per sample (`memset` was 3% of an aniso16 frame's instructions).
-    if us.len() <= 16 {
-        probes::<P, 16>(p, addr, k, coarse, delta, us, vs)
-    } else {
-        probes::<P, CHUNK>(p, addr, k, coarse, delta, us, vs)
-    }
-}
-
-/// [`probe_sum`] with scratch for `N` probes.
-#[inline(always)]
-fn probes<P: Pyramid, const N: usize>(
-    p: &P,
-    addr: &Address,
-    k: usize,
-    coarse: bool,
-    delta: f32,
-    us: &[f32],
-    vs: &[f32],
-) -> Vec4 {
-    let n = us.len().min(N);
-    let (us, vs) = (&us[..n], &vs[..n]);
+    let n = n.min(CHUNK);
+    let (us, vs) = (&s.u[..n], &s.v[..n]);
+    let (fine, next) = (&mut s.fine, &mut s.next);
     let mut sum = Vec4::ZERO;
-    let mut fine = Pass::<N>::new();
-    let mut next = Pass::<N>::new();
     // Every probe reads the same one or two levels: their views are made once.
     let fine_level = p.level(k);
     let next_level = p.level(if coarse { k + 1 } else { k });
@@ -378,9 +384,9 @@ fn probes<P: Pyramid, const N: usize>(
         next.coordinates(Within::Linear, |_| next_size, us, vs);
     }
     for i in 0..n {
-        let a = texels(&fine_level, addr, Within::Linear, &fine, i, us[i], vs[i]);
+        let a = texels(&fine_level, addr, Within::Linear, fine, i, us[i], vs[i]);
         sum += if coarse {
-            a + (texels(&next_level, addr, Within::Linear, &next, i, us[i], vs[i]) - a) * delta
+            a + (texels(&next_level, addr, Within::Linear, next, i, us[i], vs[i]) - a) * delta
         } else {
             a
         };

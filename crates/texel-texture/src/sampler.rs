@@ -107,8 +107,8 @@
 use glam::Vec4;
 
 use crate::address::{Address, AddressMode, BorderColor};
-use crate::aniso::anisotropic;
-use crate::batch::{self, Kernel, Levels, LodParams, Within};
+use crate::aniso::{anisotropic, anisotropic_in};
+use crate::batch::{self, Kernel, Levels, LodParams, Probes, Within};
 use crate::bicubic::Cubic;
 use crate::error::TextureError;
 use crate::ewa::ewa;
@@ -481,13 +481,23 @@ impl Sampler {
             let mut us = [0.0f32; BATCH_CHUNK];
             let mut vs = [0.0f32; BATCH_CHUNK];
             let mut lods = [0.0f32; BATCH_CHUNK];
+            // The anisotropic probes' scratch, made once for the whole batch.
+            let mut probes = matches!(self.technique, Technique::Anisotropic(_)).then(Probes::new);
             for (fps, outs) in footprints
                 .chunks(BATCH_CHUNK)
                 .zip(out.chunks_mut(BATCH_CHUNK))
             {
                 batch::prepare(fps, lod, &mut us, &mut vs, &mut lods);
                 for (k, (o, f)) in outs.iter_mut().zip(fps).enumerate() {
-                    *o = self.filter(&p, f, us[k], vs[k], lods[k]).to_array();
+                    let (u, v, l) = (us[k], vs[k], lods[k]);
+                    *o = match (self.technique, probes.as_mut()) {
+                        // As `filter`: magnification first.
+                        (Technique::Anisotropic(max), Some(s)) if l > 0.0 => {
+                            anisotropic_in(&p, &self.addr, d, f, u, v, l, max, s)
+                        }
+                        _ => self.filter(&p, f, u, v, l),
+                    }
+                    .to_array();
                 }
             }
         })
