@@ -6,21 +6,29 @@
 //! Access is coherent: a 64 x 64 block of "pixels" walks the texture like a rasterizer's tile would,
 //! so the numbers are throughput with warm caches, not random-access latency.
 //! Run: `cargo bench -p texel-texture --bench sampler`.
+//!
+//! The `bound/*` group measures what the 8-bit path's design allows (issue 6): the same samplers on a
+//! float copy of the texture (no decode), and the texel loads, table decodes and blends of the 1:1
+//! bilinear walk alone, with every coordinate computed beforehand (nothing a sampler could skip).
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use glam::Vec4;
+use texel_texture::color::{srgb_table, unorm8_table};
 use texel_texture::{
     AddressMode, Cubic, FilterMode, Footprint, Format, Limits, MipmapFilterMode, Sampler,
     SamplerDescriptor, Texture,
 };
 
+/// The benchmark texture's texel `(i, j)` in linear RGBA.
+fn pattern(i: u32, j: u32) -> [f32; 4] {
+    let c = (((i / 8) + (j / 8)) % 2) as f32;
+    [c, 0.5 * c, i as f32 / 1024.0, 1.0]
+}
+
 fn texture() -> Texture {
-    Texture::from_fn(1024, 1024, Format::Rgba8Srgb, &Limits::default(), |i, j| {
-        let c = (((i / 8) + (j / 8)) % 2) as f32;
-        [c, 0.5 * c, i as f32 / 1024.0, 1.0]
-    })
-    .unwrap()
+    Texture::from_fn(1024, 1024, Format::Rgba8Srgb, &Limits::default(), pattern).unwrap()
 }
 
 fn footprints(texels_per_pixel: f32) -> Vec<Footprint> {
@@ -104,5 +112,78 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// Lower bounds for the 8-bit path (see the module docs).
+fn bound(c: &mut Criterion) {
+    let f32_tex =
+        Texture::from_fn(1024, 1024, Format::Rgba32Float, &Limits::default(), pattern).unwrap();
+    let mut group = c.benchmark_group("bound");
+    for (label, scale, name) in [
+        ("f32-texture-1to1", 1.0f32, "bilinear"),
+        ("f32-texture-minified3x", 3.0, "trilinear"),
+    ] {
+        let fps = footprints(scale);
+        let mut out = vec![[0.0f32; 4]; fps.len()];
+        let (_, desc) = filters().into_iter().find(|f| f.0 == name).unwrap();
+        let s = Sampler::new(desc).unwrap();
+        group.throughput(Throughput::Elements(fps.len() as u64));
+        group.bench_function(format!("{label}/{name}"), |b| {
+            b.iter(|| {
+                s.sample_batch(&f32_tex, black_box(&fps), &mut out);
+                black_box(&out);
+            })
+        });
+    }
+    // The 1:1 bilinear walk's texels as the 8-bit path stores them (sRGB bytes), its top-left
+    // indices and fractions computed beforehand: per sample two 2-texel row reads, 16 table loads
+    // and three blends, as `batch`'s texel stage does for a sample inside the level.
+    let w = 1024usize;
+    let texels: Vec<[u8; 4]> = (0..w * w)
+        .map(|k| {
+            let t = pattern((k % w) as u32, (k / w) as u32);
+            [0, 1, 2, 3].map(|c| {
+                let x = if c < 3 {
+                    texel_texture::color::linear_to_srgb(t[c])
+                } else {
+                    t[c]
+                };
+                texel_texture::color::unorm8(x)
+            })
+        })
+        .collect();
+    let quads: Vec<(usize, f32, f32)> = footprints(1.0)
+        .iter()
+        .map(|f| {
+            let (x, y) = (f.u * 1024.0 - 0.5, f.v * 1024.0 - 0.5);
+            let (i, j) = (x.floor(), y.floor());
+            (j as usize * w + i as usize, x - i, y - j)
+        })
+        .collect();
+    let (table, alpha) = (srgb_table(), unorm8_table());
+    let decode = |t: [u8; 4]| {
+        Vec4::new(
+            table[t[0] as usize],
+            table[t[1] as usize],
+            table[t[2] as usize],
+            alpha[t[3] as usize],
+        )
+    };
+    let mut out = vec![[0.0f32; 4]; quads.len()];
+    group.throughput(Throughput::Elements(quads.len() as u64));
+    group.bench_function("decode-and-blend-only/bilinear", |b| {
+        b.iter(|| {
+            for (o, &(k, a, bb)) in out.iter_mut().zip(black_box(&quads)) {
+                let (r0, r1) = (&texels[k..k + 2], &texels[k + w..k + w + 2]);
+                let (t00, t10, t01, t11) =
+                    (decode(r0[0]), decode(r0[1]), decode(r1[0]), decode(r1[1]));
+                let top = t00 + (t10 - t00) * a;
+                let bottom = t01 + (t11 - t01) * a;
+                *o = (top + (bottom - top) * bb).to_array();
+            }
+            black_box(&out);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bound);
 criterion_main!(benches);
