@@ -27,7 +27,7 @@ use glam::Vec4;
 use crate::address::Address;
 use crate::bilinear::bilinear;
 use crate::fetch::{Fetch, Pyramid};
-use crate::footprint::{lod_from_rho_squared, rho_squared, Footprint};
+use crate::footprint::{lod_from_rho_squared, log2_normal, rho_squared, Footprint};
 use crate::mip::mip_nearest_level;
 use crate::nearest::nearest;
 use crate::sampler::finite_uv;
@@ -201,16 +201,7 @@ pub(crate) fn prepare(
         let finite = a.is_finite() & b.is_finite();
         let rho2 = a.max(b);
         // `fast_log2` for normal positive input.
-        let bits = rho2.to_bits();
-        let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-        let big = m > std::f32::consts::SQRT_2;
-        let e = ((bits >> 23) as i32 - 127) + i32::from(big);
-        let m = if big { m * 0.5 } else { m };
-        let s = (m - 1.0) / (m + 1.0);
-        let s2 = s * s;
-        let series =
-            1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 * (1.0 / 9.0))));
-        let log2 = e as f32 + (2.0 * std::f32::consts::LOG2_E) * s * series;
+        let log2 = log2_normal(rho2);
         // `lod_from_rho_squared`: non-finite rho^2 gives lod_max.
         let l = (0.5 * log2 + q.bias).clamp(q.min, q.max);
         *lod = if finite { l } else { q.max };

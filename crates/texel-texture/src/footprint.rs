@@ -129,14 +129,15 @@ impl Footprint {
 }
 
 /// `lod = log2(rho) + bias` clamped to `[lod_min, lod_max]`, with non-finite `rho` giving `lod_max`
-/// (the coarsest allowed level) and `rho = 0` giving `lod_min`.
+/// (the coarsest allowed level) and `rho = 0` giving `lod_min`. `log2` is [`fast_log2`], as for
+/// the isotropic lod ([`lod_from_rho_squared`]).
 #[inline]
 pub fn lod_from_rho(rho: f32, bias: f32, lod_min: f32, lod_max: f32) -> f32 {
     if rho.is_nan() || rho == f32::INFINITY {
         return lod_max;
     }
     // log2(0) = -inf clamps to lod_min.
-    (rho.log2() + bias).clamp(lod_min, lod_max)
+    (fast_log2(rho) + bias).clamp(lod_min, lod_max)
 }
 
 /// `rho^2 = max(|Px|^2, |Py|^2)` in texels of a `width x height` level 0 (no square root);
@@ -180,13 +181,19 @@ pub fn fast_log2(x: f32) -> f32 {
     if !(f32::MIN_POSITIVE..f32::INFINITY).contains(&x) {
         return x.log2();
     }
+    log2_normal(x)
+}
+
+/// [`fast_log2`] for normal, finite, positive `x` only, branch-free (selects, no calls), so that a
+/// loop over many inputs vectorises; other inputs give meaningless results, which the batch
+/// stages recompute with [`fast_log2`].
+#[inline(always)]
+pub(crate) fn log2_normal(x: f32) -> f32 {
     let bits = x.to_bits();
-    let mut e = ((bits >> 23) as i32) - 127;
-    let mut m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    if m > std::f32::consts::SQRT_2 {
-        m *= 0.5;
-        e += 1;
-    }
+    let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+    let big = m > std::f32::consts::SQRT_2;
+    let e = (((bits >> 23) & 0xff) as i32 - 127) + i32::from(big);
+    let m = if big { m * 0.5 } else { m };
     let s = (m - 1.0) / (m + 1.0);
     let s2 = s * s;
     let series = 1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 * (1.0 / 9.0))));

@@ -107,7 +107,7 @@
 use glam::Vec4;
 
 use crate::address::{Address, AddressMode, BorderColor};
-use crate::aniso::{anisotropic, anisotropic_in};
+use crate::aniso::{anisotropic, filter_planned, plan_chunk, Plan};
 use crate::batch::{self, Kernel, Levels, LodParams, Probes, Within};
 use crate::bicubic::Cubic;
 use crate::error::TextureError;
@@ -481,23 +481,37 @@ impl Sampler {
             let mut us = [0.0f32; BATCH_CHUNK];
             let mut vs = [0.0f32; BATCH_CHUNK];
             let mut lods = [0.0f32; BATCH_CHUNK];
-            // The anisotropic probes' scratch, made once for the whole batch.
-            let mut probes = matches!(self.technique, Technique::Anisotropic(_)).then(Probes::new);
+            if let Technique::Anisotropic(max) = self.technique {
+                // A third stage between the two: every sample's probe plan (axes, probe count,
+                // probe lod), vectorised as the lods are; the probes' scratch is made once.
+                let mut plans = [Plan::default(); BATCH_CHUNK];
+                let mut scratch = Probes::new();
+                for (fps, outs) in footprints
+                    .chunks(BATCH_CHUNK)
+                    .zip(out.chunks_mut(BATCH_CHUNK))
+                {
+                    batch::prepare(fps, lod, &mut us, &mut vs, &mut lods);
+                    plan_chunk(fps, w as f32, h as f32, d, max, &mut plans);
+                    for (k, (o, f)) in outs.iter_mut().zip(fps).enumerate() {
+                        let (u, v, l) = (us[k], vs[k], lods[k]);
+                        // As `filter`: magnification first.
+                        *o = if l > 0.0 {
+                            filter_planned(&p, &self.addr, &plans[k], u, v, l, &mut scratch)
+                        } else {
+                            self.filter(&p, f, u, v, l)
+                        }
+                        .to_array();
+                    }
+                }
+                return;
+            }
             for (fps, outs) in footprints
                 .chunks(BATCH_CHUNK)
                 .zip(out.chunks_mut(BATCH_CHUNK))
             {
                 batch::prepare(fps, lod, &mut us, &mut vs, &mut lods);
                 for (k, (o, f)) in outs.iter_mut().zip(fps).enumerate() {
-                    let (u, v, l) = (us[k], vs[k], lods[k]);
-                    *o = match (self.technique, probes.as_mut()) {
-                        // As `filter`: magnification first.
-                        (Technique::Anisotropic(max), Some(s)) if l > 0.0 => {
-                            anisotropic_in(&p, &self.addr, d, f, u, v, l, max, s)
-                        }
-                        _ => self.filter(&p, f, u, v, l),
-                    }
-                    .to_array();
+                    *o = self.filter(&p, f, us[k], vs[k], lods[k]).to_array();
                 }
             }
         })
