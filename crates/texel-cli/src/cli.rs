@@ -196,7 +196,7 @@ pub struct BenchArgs {
     /// Timed frames per filter (the median is reported).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=10000))]
     pub frames: u32,
-    /// Untimed warm-up frames per filter.
+    /// Untimed warm-up frames per filter (at least 0.2 s of them unless 0).
     #[arg(long, default_value_t = 2)]
     pub warmup: u32,
     /// Worker threads (default: all cores).

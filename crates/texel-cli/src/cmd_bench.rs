@@ -6,10 +6,11 @@
 //! ([`Frame::reset`], a fill of the reused buffers) is not timed, as `llvmpipe_bench.py` clears its
 //! framebuffer and calls `glFinish` before starting the clock; its cost is reported separately
 //! (`clear ms`). No file I/O, no PNG encoding. The median of `--frames` timed frames after
-//! `--warmup` untimed ones, on a pool of `--threads` workers built once.
+//! `--warmup` untimed ones (lasting at least [`MIN_WARMUP`] unless `--warmup 0`), on a pool of
+//! `--threads` workers built once.
 
 use std::io::Write;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
@@ -41,12 +42,22 @@ pub struct FrameTimes {
     pub clear_ms: Vec<f64>,
 }
 
-/// Draw `warmup` untimed frames, then `frames` timed ones into one reused frame, clearing it
-/// before each; the clear and draw times in milliseconds.
+/// Shortest warm-up when any is asked for: fast frames (a few ms) ran measurably slower while the
+/// first filter's two warm-up frames were all the machine had run (nearest on one thread: 11.9 ms
+/// first in the list, 7.4 ms after another filter), so warm-up lasts at least this long.
+pub const MIN_WARMUP: Duration = Duration::from_millis(200);
+
+/// Most warm-up frames [`MIN_WARMUP`] can add (a bound for very fast frames).
+const MAX_WARMUP_FRAMES: u32 = 10_000;
+
+/// Draw untimed frames (at least `warmup`, and while `warmup > 0` until `min_warmup` has passed),
+/// then `frames` timed ones into one reused frame, clearing it before each; the timed frames'
+/// clear and draw times in milliseconds.
 pub fn time_frames(
     settings: &RenderSettings,
     draws: &[DrawCall],
     warmup: u32,
+    min_warmup: Duration,
     frames: u32,
 ) -> Result<FrameTimes, RasterError> {
     let mut frame = Frame::new(settings);
@@ -54,17 +65,23 @@ pub fn time_frames(
         draw_ms: Vec::new(),
         clear_ms: Vec::new(),
     };
-    for k in 0..warmup + frames {
+    let start = Instant::now();
+    let mut k = 0u32;
+    while k < warmup || (warmup > 0 && k < MAX_WARMUP_FRAMES && start.elapsed() < min_warmup) {
+        frame.reset(settings);
+        draw_into(settings, draws, &mut frame)?;
+        std::hint::black_box(&frame);
+        k += 1;
+    }
+    for _ in 0..frames {
         let t0 = Instant::now();
         frame.reset(settings);
         let t1 = Instant::now();
         draw_into(settings, draws, &mut frame)?;
         let t2 = Instant::now();
         std::hint::black_box(&frame);
-        if k >= warmup {
-            times.clear_ms.push((t1 - t0).as_secs_f64() * 1e3);
-            times.draw_ms.push((t2 - t1).as_secs_f64() * 1e3);
-        }
+        times.clear_ms.push((t1 - t0).as_secs_f64() * 1e3);
+        times.draw_ms.push((t2 - t1).as_secs_f64() * 1e3);
     }
     Ok(times)
 }
@@ -91,7 +108,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             scene.prepare(&samplers)?;
             let draws = scene.draws(&samplers);
             let settings = scene.settings();
-            let mut times = time_frames(&settings, &draws, args.warmup, args.frames)?;
+            let mut times = time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;
             let (min_ms, max_ms) = times
                 .draw_ms
                 .iter()

@@ -6,6 +6,7 @@
 //! decision), so anyone can recompute it from the PNG files.
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 use texel_quality::{
@@ -132,7 +133,7 @@ pub fn compare(
         let bytes = scene.prepare(&samplers)?;
         let draws = scene.draws(&samplers);
         let settings = scene.settings();
-        let mut times = time_frames(&settings, &draws, 1, TIMED_FRAMES)?;
+        let mut times = time_frames(&settings, &draws, 1, Duration::ZERO, TIMED_FRAMES)?;
         let mut counting = settings;
         counting.count_texels = true;
         let frame = render(&counting, &draws)?;
