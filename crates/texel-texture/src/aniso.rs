@@ -45,13 +45,13 @@
 //! 66.5 to 54.2 ms (trilinear 13.7 ms: aniso16 costs 3.95x trilinear), with identical images.
 //!
 //! The probes' scratch (coordinates and two level passes, about 2.8 KB) is made once per
-//! `sample_batch` call ([`crate::batch::Probes`]) instead of zeroed per sample: ground scene,
+//! `sample_batch` call (`batch::Probes`) instead of zeroed per sample: ground scene,
 //! 1280 x 720, one thread, `texel bench --color raw --filters trilinear,aniso16 --threads 1`, three
 //! alternating runs, 74.4-75.0 -> 72.8-74.4 ms per frame (trilinear 14.3-15.1 in both); callgrind
 //! at 640 x 360: 627.8 -> 619.4 M instructions for the whole run; images bit-identical.
 //!
 //! Staged plans: in `sample_batch` each sample's set-up (axes, their lengths, the probe count, the
-//! probe lod) runs for a chunk of 64 footprints in one branch-free loop ([`plan_chunk`]) before any
+//! probe lod) runs for a chunk of 64 footprints in one branch-free loop (`plan_chunk`) before any
 //! probe is read, as the isotropic lods do (`batch::prepare`). That needs a `log2` without a call:
 //! the probe lod now uses [`crate::footprint::fast_log2`] (within 1.2 units in the last place;
 //! libm's `log2f` before), for the single-sample path too. Ground scene, 1280 x 720, one thread,

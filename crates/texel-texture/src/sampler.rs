@@ -73,7 +73,7 @@
 //!
 //! ### Second pass: staged kernels
 //!
-//! [`Sampler::sample_batch`] now runs the core filters through [`crate::batch`] (levels, then
+//! [`Sampler::sample_batch`] now runs the core filters through `batch` (`batch.rs`) (levels, then
 //! branch-free coordinates for the whole chunk, then texels), and anisotropic probes through the same
 //! stages; results bit-identical to [`Sampler::sample`] (tested). Together with the rasterizer's
 //! staged spans and reused frames (`texel-raster/src/tile.rs`), ground scene 1280 x 720, 2 threads,
