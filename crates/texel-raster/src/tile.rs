@@ -43,6 +43,14 @@
 //! Ground scene 1280 x 720, 2 threads, draw into a reused frame, same session: nearest 4.77 ->
 //! 3.71-3.86 ms, bilinear 5.85 -> 4.71-4.82, mip-nearest 10.47 -> 8.83-8.88, trilinear 12.72 ->
 //! 10.94-11.11 (before the sampler's staged kernels, which `texel-texture/src/sampler.rs` records).
+//!
+//! Batches of several rows (third pass): a batch now gathers a triangle's fragments over as many
+//! rows as fit in [`Span`] (64), each fragment carrying its row, so a small triangle is sampled in
+//! one `sample_batch` call instead of one per row; with the sampler's 16-sample scratch for short
+//! calls. `cargo run --release -p texel-raster --example frame_table -- 7`, 100 352-triangle mesh
+//! (about 9 pixels per triangle), min ms, two alternating runs: one thread 121-124 -> 88-90, two
+//! threads 68-72 -> 57-59 (the ground plane's rows are already full spans: unchanged). Images
+//! bit-identical (`tests/threads.rs`, now also on grids of small triangles, head-on and tilted).
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -257,10 +265,13 @@ struct Span {
     n: usize,
     /// Their column within the tile.
     li: [u32; SPAN],
+    /// Their row within the tile.
+    lj: [u32; SPAN],
     /// Their depth.
     z: [f32; SPAN],
-    /// Their pixel-centre `x`.
+    /// Their pixel-centre `x` and `y`.
     x: [f64; SPAN],
+    y: [f64; SPAN],
     /// `1 / r` (perspective) or 1 (affine).
     inv_r: [f64; SPAN],
     /// Barycentrics.
@@ -278,8 +289,10 @@ impl Span {
         Box::new(Span {
             n: 0,
             li: [0; SPAN],
+            lj: [0; SPAN],
             z: [0.0; SPAN],
             x: [0.0; SPAN],
+            y: [0.0; SPAN],
             inv_r: [0.0; SPAN],
             l: [[0.0; SPAN]; 3],
             ldx: [[0.0; SPAN]; 3],
@@ -289,21 +302,22 @@ impl Span {
         })
     }
 
-    /// Barycentrics of the span's fragments at row centre `y`, with the derivatives when asked:
-    /// the operations of [`TriangleSetup::barycentrics`] (and `lambda_at`) in the same order, so
-    /// the same bits.
+    /// Barycentrics of the span's fragments at their pixel centres, with the derivatives when
+    /// asked: the operations of [`TriangleSetup::barycentrics`] (and `lambda_at`) in the same
+    /// order, so the same bits.
     #[inline(always)]
-    fn barycentrics(&mut self, t: &TriangleSetup, y: f64, perspective: Perspective, deriv: bool) {
+    fn barycentrics(&mut self, t: &TriangleSetup, perspective: Perspective, deriv: bool) {
         let n = self.n;
-        let xs = &self.x[..n];
+        let xys = self.x[..n].iter().zip(&self.y[..n]);
         match perspective {
             Perspective::Correct => {
                 let r = t.r;
-                for (inv, &x) in self.inv_r[..n].iter_mut().zip(xs) {
+                for (inv, (&x, &y)) in self.inv_r[..n].iter_mut().zip(xys.clone()) {
                     *inv = 1.0 / r.at(x, y);
                 }
                 for (q, l) in t.q.iter().zip(&mut self.l) {
-                    for ((l, &x), &inv) in l[..n].iter_mut().zip(xs).zip(&self.inv_r[..n]) {
+                    let it = xys.clone().zip(&self.inv_r[..n]);
+                    for (l, ((&x, &y), &inv)) in l[..n].iter_mut().zip(it) {
                         *l = q.at(x, y) * inv;
                     }
                 }
@@ -321,7 +335,7 @@ impl Span {
             }
             Perspective::Affine => {
                 for (a, l) in t.affine.iter().zip(&mut self.l) {
-                    for (l, &x) in l[..n].iter_mut().zip(xs) {
+                    for (l, (&x, &y)) in l[..n].iter_mut().zip(xys.clone()) {
                         *l = a.at(x, y);
                     }
                 }
@@ -360,14 +374,16 @@ impl Span {
     }
 }
 
-/// [`raster_pixels`] for the colour view without texel counting: each row span (at most one tile
-/// wide) is covered and depth-tested first, then interpolated stage by stage over all its fragments
-/// ([`Span`]), sampled with one [`texel_texture::Sampler::sample_batch`] call, then shaded and
-/// written. The pixels of a span are distinct, so deferring their writes changes nothing, and each
-/// stage performs the per-pixel path's operations in the same order: the image is bit for bit the
-/// per-pixel path's (`tests/threads.rs`). What it buys: the interpolation stages vectorise, the
-/// sampler's lod chains of the span pipeline together, and per-call dispatch (format, tables)
-/// happens once per span.
+/// [`raster_pixels`] for the colour view without texel counting: the triangle's covered,
+/// depth-passing fragments in the tile are gathered row by row into a [`Span`] (up to [`SPAN`] of
+/// them, several rows of a small triangle at once), then interpolated stage by stage over all of
+/// them, sampled with one [`texel_texture::Sampler::sample_batch`] call, then shaded and written.
+/// The fragments of one triangle are distinct pixels, so deferring their writes changes nothing,
+/// and each stage performs the per-pixel path's operations in the same order: the image is bit for
+/// bit the per-pixel path's (`tests/threads.rs`). What it buys: the interpolation stages
+/// vectorise, the sampler's lod chains pipeline together, and per-call set-up (format, tables,
+/// scratch) happens once per batch. Gathering several rows matters for small triangles: a mesh of
+/// 100 352 triangles of about nine pixels each made three calls of three samples per triangle.
 fn raster_pixels_batched(
     ctx: &Context,
     tile: &mut TileTarget,
@@ -377,20 +393,21 @@ fn raster_pixels_batched(
 ) {
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];
-    let uvs = dc.uvs(t);
-    let verts = dc.vertices(t);
     let step = t.edges.map(|e| e.a * SUBPIXEL);
     let x_start = pixel_center_fixed(i_lo);
-    let perspective = ctx.settings.perspective;
-    // Nearest or bilinear without mipmaps ignore the derivatives: skip them unless captured.
-    let deriv = ctx.capture || dc.sampler.uses_derivatives();
+    // A row adds at most this many fragments.
+    let width = (i_hi - i_lo + 1) as usize;
+    span.n = 0;
     for j in j_lo..=j_hi {
+        if span.n + width > SPAN {
+            flush_span(ctx, tile, t, dc, span);
+        }
         let y_fixed = pixel_center_fixed(j);
         let mut e = t.edges.map(|e| e.at(x_start, y_fixed));
         let y = f64::from(j) + 0.5;
-        let lj = (j - tile.y0) as usize;
-        let depth_row = &tile.depth[lj];
-        let mut n = 0;
+        let lj = j - tile.y0;
+        let depth_row = &tile.depth[lj as usize];
+        let mut n = span.n;
         for i in i_lo..=i_hi {
             if (e[0] | e[1] | e[2]) >= 0 {
                 let x = f64::from(i) + 0.5;
@@ -398,8 +415,10 @@ fn raster_pixels_batched(
                 let z = t.depth_at(x, y) as f32;
                 if z < depth_row[li as usize] {
                     span.li[n] = li;
+                    span.lj[n] = lj;
                     span.z[n] = z;
                     span.x[n] = x;
+                    span.y[n] = y;
                     n += 1;
                 }
             }
@@ -407,29 +426,44 @@ fn raster_pixels_batched(
             e[1] += step[1];
             e[2] += step[2];
         }
-        if n == 0 {
-            continue;
-        }
         span.n = n;
-        span.barycentrics(t, y, perspective, deriv);
-        span.footprints(dc, uvs, deriv);
-        dc.sampler
-            .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
-        let (color, depth) = (&mut tile.color[lj], &mut tile.depth[lj]);
-        let coverage = &mut tile.coverage[lj];
+    }
+    flush_span(ctx, tile, t, dc, span);
+}
+
+/// Interpolate, sample, shade and write the `span.n` gathered fragments of triangle `t`, then empty
+/// the span.
+fn flush_span(
+    ctx: &Context,
+    tile: &mut TileTarget,
+    t: &TriangleSetup,
+    dc: &DrawContext,
+    span: &mut Span,
+) {
+    let n = span.n;
+    if n == 0 {
+        return;
+    }
+    // Nearest or bilinear without mipmaps ignore the derivatives: skip them unless captured.
+    let deriv = ctx.capture || dc.sampler.uses_derivatives();
+    span.barycentrics(t, ctx.settings.perspective, deriv);
+    span.footprints(dc, dc.uvs(t), deriv);
+    dc.sampler
+        .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
+    let verts = dc.vertices(t);
+    for k in 0..n {
+        let (li, lj) = (span.li[k] as usize, span.lj[k] as usize);
+        let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
+        tile.color[lj][li] = shade(dc, verts, lambda, span.texs[k], ctx.light.as_ref());
+        tile.depth[lj][li] = span.z[k];
+        tile.coverage[lj][li] = true;
+    }
+    if ctx.capture {
         for k in 0..n {
-            let li = span.li[k] as usize;
-            let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
-            color[li] = shade(dc, verts, lambda, span.texs[k], ctx.light.as_ref());
-            depth[li] = span.z[k];
-            coverage[li] = true;
-        }
-        if ctx.capture {
-            for k in 0..n {
-                tile.footprints[lj][span.li[k] as usize] = span.fps[k];
-            }
+            tile.footprints[span.lj[k] as usize][span.li[k] as usize] = span.fps[k];
         }
     }
+    span.n = 0;
 }
 
 /// Quad derivatives: walk aligned 2x2 quads; a quad with any covered pixel interpolates all four.

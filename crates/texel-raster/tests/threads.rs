@@ -2,8 +2,9 @@
 
 mod common;
 
-use common::{lab_sampler, Ground};
-use texel_raster::{render, render_reference, Derivatives, RenderSettings, View};
+use common::{lab_sampler, screen_grid, Ground};
+use glam::{Mat4, Vec3};
+use texel_raster::{render, render_reference, Derivatives, DrawCall, RenderSettings, View};
 
 #[test]
 fn one_and_two_threads_give_identical_frames() {
@@ -45,25 +46,19 @@ fn one_and_two_threads_give_identical_frames() {
     }
 }
 
-/// The colour view samples a row span at a time (`sample_batch`) unless texels are counted, which
-/// takes the per-pixel path: both give the same image, bit for bit, for every lab filter, with and
-/// without captured footprints.
-#[test]
-fn batched_and_per_pixel_sampling_give_identical_frames() {
-    let (w, h) = (300, 170);
-    let scene = Ground::new(w, h);
-    // Without captured footprints, nearest and bilinear (lab modes 1 and 2) also skip derivatives.
-    for (mode, capture_footprints) in (1..=8).flat_map(|m| [(m, true), (m, false)]) {
-        let sampler = lab_sampler(mode);
+/// Render `draw` with batched sampling (the colour view) and with the per-pixel path (texel
+/// counting) and require the same frame, bit for bit, with and without captured footprints.
+fn assert_batched_equals_per_pixel(w: u32, h: u32, draw: DrawCall, label: &str) {
+    for capture_footprints in [true, false] {
         let settings = |count_texels| RenderSettings {
             count_texels,
             threads: Some(2),
             capture_footprints,
             ..RenderSettings::new(w, h)
         };
-        let batched = render(&settings(false), &[scene.draw(&sampler)]).unwrap();
-        let single = render(&settings(true), &[scene.draw(&sampler)]).unwrap();
-        assert!(batched.covered_pixels() > 0);
+        let batched = render(&settings(false), &[draw]).unwrap();
+        let single = render(&settings(true), &[draw]).unwrap();
+        assert!(batched.covered_pixels() > 0, "{label}");
         let bits = |f: &texel_raster::Frame| {
             f.color
                 .iter()
@@ -73,11 +68,51 @@ fn batched_and_per_pixel_sampling_give_identical_frames() {
         assert_eq!(
             bits(&batched),
             bits(&single),
-            "lab mode {mode} {capture_footprints}"
+            "{label} {capture_footprints}"
         );
-        assert_eq!(batched.depth, single.depth);
-        assert_eq!(batched.coverage, single.coverage);
-        assert_eq!(batched.footprints, single.footprints);
+        assert_eq!(batched.depth, single.depth, "{label}");
+        assert_eq!(batched.coverage, single.coverage, "{label}");
+        assert_eq!(batched.footprints, single.footprints, "{label}");
+    }
+}
+
+/// The colour view samples a triangle's fragments in batches (`sample_batch`) unless texels are
+/// counted, which takes the per-pixel path: both give the same image, bit for bit, for every lab
+/// filter. Without captured footprints, nearest and bilinear (lab modes 1 and 2) also skip
+/// derivatives.
+#[test]
+fn batched_and_per_pixel_sampling_give_identical_frames() {
+    let (w, h) = (300, 170);
+    let scene = Ground::new(w, h);
+    for mode in 1..=8 {
+        let sampler = lab_sampler(mode);
+        let label = format!("ground, lab mode {mode}");
+        assert_batched_equals_per_pixel(w, h, scene.draw(&sampler), &label);
+    }
+}
+
+/// As above for meshes of small triangles, whose batches gather several rows (a triangle of a few
+/// pixels per row): a 60 x 40 grid of 5 x 4-pixel cells seen head-on, and the same grid tilted in
+/// perspective so that its triangles shrink to fractions of a pixel towards the far edge.
+#[test]
+fn batched_small_triangles_equal_per_pixel() {
+    let (w, h) = (300, 170);
+    let (vertices, triangles, texture) = screen_grid(w, h, 60, 40);
+    let tilt = Mat4::perspective_rh_gl(1.0, w as f32 / h as f32, 0.1, 10.0)
+        * Mat4::look_at_rh(Vec3::new(0.0, -1.6, 0.6), Vec3::new(0.0, 0.4, 0.0), Vec3::Z);
+    for (name, clip_from_world) in [("head-on", Mat4::IDENTITY), ("tilted", tilt)] {
+        for mode in 1..=8 {
+            let sampler = lab_sampler(mode);
+            let draw = DrawCall {
+                vertices: &vertices,
+                triangles: &triangles,
+                texture: &texture,
+                sampler: &sampler,
+                clip_from_world,
+            };
+            let label = format!("{name} grid, lab mode {mode}");
+            assert_batched_equals_per_pixel(w, h, draw, &label);
+        }
     }
 }
 
