@@ -129,7 +129,13 @@ fn reference_frame(
     let setups = setup_draws(settings, draws)?;
     // Sub-samples reach the whole pixel: bin by the sample box, so a triangle that ends just short
     // of a tile's first pixel centre, or covers no centre at all, still reaches its samples.
-    let bins = bin(&setups, width, height, |t| Some(t.sample_bbox));
+    let bins = bin(
+        &setups,
+        width,
+        height,
+        |t| Some(t.sample_bbox),
+        |s, _| s as u32,
+    );
     let pixels = width as usize * height as usize;
     let mut frame = Frame {
         width,

@@ -18,6 +18,11 @@
 //! and about 30% to rasterisation and interpolation. A 100k-triangle mesh over the whole frame
 //! renders at about 1.2 M triangles/s (frame included) and does not yet scale to 2 threads: setup
 //! output is concatenated and binned serially (`memmove` and page faults were 9% of its profile).
+//! Later (third pass): the setups are binned in the chunks they are computed in
+//! ([`crate::setup`]'s `setup_chunks`; the bins hold references), without concatenating 33 MB of
+//! setups into a buffer that glibc maps and faults in afresh every frame (kernel page-fault work
+//! was 15 % of the mesh frame, `memmove` 4 %): drawing into a reused frame, min of 30, one thread
+//! 82-84 -> 52-54 ms, two threads 50-52 -> 27.5 ms (3.6 M triangles/s); images bit-identical.
 //!
 //! Row-span batching (issue 6): in the colour view without texel counting, each row span of a
 //! triangle inside a tile is covered, depth-tested and interpolated into a stack buffer first,
@@ -60,7 +65,7 @@ use crate::draw::DrawCall;
 use crate::frame::Frame;
 use crate::interp::quad_differences;
 use crate::settings::{Derivatives, Perspective, RenderSettings, View};
-use crate::setup::{pixel_center_fixed, setup_draws, TriangleSetup, SUBPIXEL};
+use crate::setup::{pixel_center_fixed, setup_chunks, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
 use crate::views;
 use crate::RasterError;
@@ -75,21 +80,23 @@ pub(crate) fn tile_counts(width: u32, height: u32) -> (u32, u32) {
 
 /// For each tile (row-major), the indices of the setups whose box (`bbox` of the setup: the
 /// pixel-centre box for the rasterizer, the sample box for the reference) overlaps it, in order.
-pub(crate) fn bin(
-    setups: &[TriangleSetup],
+pub(crate) fn bin<'s, T: Copy>(
+    setups: impl IntoIterator<Item = &'s TriangleSetup>,
     width: u32,
     height: u32,
     bbox: impl Fn(&TriangleSetup) -> Option<[u32; 4]>,
-) -> Vec<Vec<u32>> {
+    item: impl Fn(usize, &'s TriangleSetup) -> T,
+) -> Vec<Vec<T>> {
     let (tx, ty) = tile_counts(width, height);
     let mut bins = vec![Vec::new(); (tx * ty) as usize];
-    for (s, t) in setups.iter().enumerate() {
+    for (s, t) in setups.into_iter().enumerate() {
         let Some([i0, j0, i1, j1]) = bbox(t) else {
             continue;
         };
+        let it = item(s, t);
         for by in j0 / TILE..=j1 / TILE {
             for bx in i0 / TILE..=i1 / TILE {
-                bins[(by * tx + bx) as usize].push(s as u32);
+                bins[(by * tx + bx) as usize].push(it);
             }
         }
     }
@@ -129,7 +136,6 @@ struct TileTarget<'f> {
 /// Everything shared by the tiles of one frame.
 struct Context<'a> {
     settings: &'a RenderSettings,
-    setups: &'a [TriangleSetup],
     draws: Vec<DrawContext<'a>>,
     light: Option<Lighting>,
     counting: bool,
@@ -153,13 +159,12 @@ pub(crate) fn draw_frame(
     frame: &mut Frame,
 ) -> Result<(), RasterError> {
     let (width, height) = (settings.width, settings.height);
-    let setups = setup_draws(settings, draws)?;
-    let bins = bin(&setups, width, height, |t| t.bbox);
+    let setups = setup_chunks(settings, draws)?;
+    let bins = bin(setups.iter().flatten(), width, height, |t| t.bbox, |_, t| t);
     let counting = settings.counts_texels();
     let capture = settings.capture_footprints;
     let ctx = Context {
         settings,
-        setups: &setups,
         draws: draws.iter().map(DrawContext::new).collect(),
         light: settings.light.as_ref().map(Lighting::new),
         counting,
@@ -194,11 +199,10 @@ pub(crate) fn draw_frame(
     Ok(())
 }
 
-fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[u32]) {
+fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
     let batched = ctx.settings.view == View::Color && !ctx.counting;
     let mut span = if batched { Some(Span::new()) } else { None };
-    for &s in bin {
-        let t = &ctx.setups[s as usize];
+    for &t in bin {
         let Some([bi0, bj0, bi1, bj1]) = t.bbox else {
             continue;
         };
