@@ -42,7 +42,7 @@
 //!
 //! Staged spans (issue 6, second pass): the batched path now covers and depth-tests a span first,
 //! then computes barycentrics, their derivatives and the footprints stage by stage over the span's
-//! fragments in structure-of-arrays scratch ([`Span`], one per tile, reused), each stage a
+//! fragments in structure-of-arrays scratch (`Span`, one per tile, reused), each stage a
 //! branch-free loop the compiler vectorises, with the per-pixel path's operations in the same order
 //! (images bit-identical, `tests/threads.rs`). Frames are reused (`render_into`, `draw_into`).
 //! Ground scene 1280 x 720, 2 threads, draw into a reused frame, same session: nearest 4.77 ->
@@ -50,7 +50,7 @@
 //! 10.94-11.11 (before the sampler's staged kernels, which `texel-texture/src/sampler.rs` records).
 //!
 //! Batches of several rows (third pass): a batch now gathers a triangle's fragments over as many
-//! rows as fit in [`Span`] (64), each fragment carrying its row, so a small triangle is sampled in
+//! rows as fit in a `Span` (64), each fragment carrying its row, so a small triangle is sampled in
 //! one `sample_batch` call instead of one per row; with the sampler's 16-sample scratch for short
 //! calls. `cargo run --release -p texel-raster --example frame_table -- 7`, 100 352-triangle mesh
 //! (about 9 pixels per triangle), min ms, two alternating runs: one thread 121-124 -> 88-90, two
