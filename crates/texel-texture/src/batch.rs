@@ -237,15 +237,17 @@ pub(crate) fn run<P: Pyramid>(
     out: &mut [[f32; 4]],
 ) {
     if footprints.len() <= 16 {
-        run_in::<P, 16>(p, addr, kernel, lod, footprints, out);
+        run_in::<P, 16, 1>(p, addr, kernel, lod, footprints, out);
     } else {
-        run_in::<P, CHUNK>(p, addr, kernel, lod, footprints, out);
+        run_in::<P, CHUNK, LEVELS>(p, addr, kernel, lod, footprints, out);
     }
 }
 
-/// [`run`] in chunks of `N` samples.
+/// [`run`] in chunks of `N` samples, with `V` level views made up front (`V = LEVELS`), or (`V = 1`)
+/// each sample's view made when it is read, which is cheaper for a handful of samples than making
+/// 32 views.
 #[inline(always)]
-fn run_in<P: Pyramid, const N: usize>(
+fn run_in<P: Pyramid, const N: usize, const V: usize>(
     p: &P,
     addr: &Address,
     kernel: Kernel,
@@ -260,12 +262,22 @@ fn run_in<P: Pyramid, const N: usize>(
         h: [0.0; LEVELS],
     };
     let base = p.level(0);
-    let mut views = [base; LEVELS];
-    for (l, view) in views.iter_mut().enumerate().take(levels) {
-        *view = p.level(l);
+    let mut views = [base; V];
+    for l in 0..levels {
+        let view = p.level(l);
         let (w, h) = view.size();
         (dims.w[l], dims.h[l]) = (w as f32, h as f32);
+        if V == LEVELS {
+            views[l % V] = view;
+        }
     }
+    let view = |l: u8| {
+        if V == LEVELS {
+            views[l as usize % V]
+        } else {
+            p.level(l as usize)
+        }
+    };
     let mut first = Pass::<N>::new();
     let mut second = Pass::<N>::new();
     let mut delta = [0.0f32; N];
@@ -307,10 +319,10 @@ fn run_in<P: Pyramid, const N: usize>(
             second.coordinates(kernel.within, size, us, vs);
         }
         for k in 0..n {
-            let level = &views[first.level[k] as usize % LEVELS];
+            let level = &view(first.level[k]);
             let a = texels(level, addr, kernel.within, &first, k, us[k], vs[k]);
             let c = if trilinear && delta[k] > 0.0 && (first.level[k] as usize) < last {
-                let level = &views[second.level[k] as usize % LEVELS];
+                let level = &view(second.level[k]);
                 let b = texels(level, addr, kernel.within, &second, k, us[k], vs[k]);
                 a + (b - a) * delta[k]
             } else {
