@@ -455,12 +455,24 @@ fn flush_span(
     dc.sampler
         .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
     let verts = dc.vertices(t);
-    for k in 0..n {
-        let (li, lj) = (span.li[k] as usize, span.lj[k] as usize);
-        let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
-        tile.color[lj][li] = shade(dc, verts, lambda, span.texs[k], ctx.light.as_ref());
-        tile.depth[lj][li] = span.z[k];
-        tile.coverage[lj][li] = true;
+    // Fragments arrive row by row: look each row's buffers up once per run of equal rows.
+    let mut k = 0;
+    while k < n {
+        let lj = span.lj[k];
+        let row = (
+            &mut *tile.color[lj as usize],
+            &mut *tile.depth[lj as usize],
+            &mut *tile.coverage[lj as usize],
+        );
+        let (color, depth, coverage) = row;
+        while k < n && span.lj[k] == lj {
+            let li = span.li[k] as usize;
+            let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
+            color[li] = shade(dc, verts, lambda, span.texs[k], ctx.light.as_ref());
+            depth[li] = span.z[k];
+            coverage[li] = true;
+            k += 1;
+        }
     }
     if ctx.capture {
         for k in 0..n {
