@@ -110,7 +110,7 @@ pub(crate) fn anisotropic<P: Pyramid>(
     max: u32,
 ) -> Vec4 {
     let (w, h) = p.level(0).size();
-    let (plan, _) = plan(fp, w as f32, h as f32, d, max, fast_log2);
+    let (plan, _) = plan(fp, w, h, d, max, fast_log2);
     filter_planned(p, addr, &plan, u, v, lod_iso, &mut Probes::new())
 }
 
@@ -130,55 +130,32 @@ pub(crate) struct Plan {
 /// The [`Plan`] of footprint `fp` on a `w x h` level 0 (`max` clamped to `1..=64`), with `log2`
 /// either [`fast_log2`] or its branch-free normal-input path [`log2_normal`]; also whether `rho =
 /// |Pmax| / N` is zero or subnormal, where the latter is wrong and the plan must be made again
-/// with [`fast_log2`]. Branch-free (selects only), so that [`plan_chunk`]'s loop vectorises; the
-/// same arithmetic as [`Footprint::axes`], [`probe_count`] and [`lod_from_rho`] (clamping by
-/// `max`/`min`, which equals `clamp` for the non-NaN values reaching it).
+/// with [`fast_log2`]. [`Footprint::axes`], [`probe_count`] and [`lod_from_rho`]'s arithmetic
+/// (clamping by `max`/`min`, which equals `clamp` for the non-NaN values reaching it), inlined so
+/// that [`plan_chunk`]'s loop over a chunk pipelines.
 #[inline(always)]
 pub(crate) fn plan(
     fp: &Footprint,
-    w: f32,
-    h: f32,
+    w: u32,
+    h: u32,
     d: &SamplerDescriptor,
     max: u32,
     log2: impl Fn(f32) -> f32,
 ) -> (Plan, bool) {
-    let inf = f32::INFINITY;
-    // `Footprint::axes`: non-finite axes become infinite, the longer one is the major axis.
-    let (xx, xy) = (fp.dudx * w, fp.dvdx * h);
-    let (yx, yy) = (fp.dudy * w, fp.dvdy * h);
-    let (xx, xy) = if xx.is_finite() & xy.is_finite() {
-        (xx, xy)
+    let axes = fp.axes(w, h);
+    let (major, minor) = (axes.major.length(), axes.minor.length());
+    let (au, av) = (axes.major_uv.x, axes.major_uv.y);
+    let n = if major.is_finite() && axes.major_uv.is_finite() {
+        probe_count(major, minor, max.clamp(1, 64))
     } else {
-        (inf, inf)
+        1
     };
-    let (yx, yy) = if yx.is_finite() & yy.is_finite() {
-        (yx, yy)
-    } else {
-        (inf, inf)
-    };
-    let (lx, ly) = (xx * xx + xy * xy, yx * yx + yy * yy);
-    let x_major = lx >= ly;
-    let (major2, minor2) = if x_major { (lx, ly) } else { (ly, lx) };
-    let (au, av) = if x_major {
-        (fp.dudx, fp.dvdx)
-    } else {
-        (fp.dudy, fp.dvdy)
-    };
-    let (major, minor) = (major2.sqrt(), minor2.sqrt());
-    // `probe_count`, with the ceiling through `i32` (the ratio is clamped to `max <= 64` first).
-    let maxn = max.clamp(1, 64) as i32;
-    let ratio = major / minor;
-    let r = (ratio * (1.0 - RATIO_TOLERANCE)).min(maxn as f32);
-    let t = r as i32;
-    let n = (t + i32::from((t as f32) < r)).max(1).min(maxn);
-    let usable = major.is_finite() & au.is_finite() & av.is_finite() & !ratio.is_nan();
-    let n = if usable { n } else { 1 } as u32;
     // `lod_from_rho(|Pmax| / N)`.
     let rho = major / n as f32;
     let l = (log2(rho) + d.lod_bias)
         .max(d.lod_min_clamp)
         .min(d.lod_max_clamp);
-    let lod = if rho.is_nan() | (rho == inf) {
+    let lod = if rho.is_nan() | (rho == f32::INFINITY) {
         d.lod_max_clamp
     } else {
         l
@@ -192,8 +169,8 @@ pub(crate) fn plan(
 /// [`fast_log2`], so every plan equals [`plan`] with [`fast_log2`] (what [`anisotropic`] uses).
 pub(crate) fn plan_chunk(
     fps: &[Footprint],
-    w: f32,
-    h: f32,
+    w: u32,
+    h: u32,
     d: &SamplerDescriptor,
     max: u32,
     out: &mut [Plan; batch::CHUNK],

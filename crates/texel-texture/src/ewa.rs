@@ -251,11 +251,16 @@ pub struct Run {
 impl Run {
     /// Unwrapped indices `(i, j)` of texel `k` of the run.
     pub fn texel(&self, k: usize) -> (i64, i64) {
-        if self.vertical {
-            (self.i0, self.j0.saturating_add(k as i64))
-        } else {
-            (self.i0.saturating_add(k as i64), self.j0)
-        }
+        step(self.i0, self.j0, self.vertical, k)
+    }
+}
+
+/// Texel `k` from `(i0, j0)` along a row, or down a column when `vertical` (unwrapped, saturating).
+fn step(i0: i64, j0: i64, vertical: bool, k: usize) -> (i64, i64) {
+    if vertical {
+        (i0, j0.saturating_add(k as i64))
+    } else {
+        (i0.saturating_add(k as i64), j0)
     }
 }
 
@@ -288,8 +293,8 @@ impl LevelEllipse {
         self.for_each_line(x, y, |line| {
             let mut weights = line.weights();
             let mut done = 0u32;
-            while done < line.len {
-                let len = (line.len - done).min(RUN as u32) as usize;
+            while done < line.texels() {
+                let len = (line.texels() - done).min(RUN as u32) as usize;
                 for (w, x) in buf[..len].iter_mut().zip(&mut weights) {
                     *w = x;
                 }
@@ -320,7 +325,6 @@ impl LevelEllipse {
                     i0: a0,
                     j0: b,
                     vertical: false,
-                    len: weights.left,
                     weights,
                 })
             })
@@ -331,7 +335,6 @@ impl LevelEllipse {
                     i0: b,
                     j0: a0,
                     vertical: true,
-                    len: weights.left,
                     weights,
                 })
             })
@@ -420,22 +423,21 @@ pub struct Line {
     pub j0: i64,
     /// Whether the line goes down a column (else along a row).
     pub vertical: bool,
-    /// Texels on the line (at least 1).
-    pub len: u32,
     weights: Weights,
 }
 
 impl Line {
     /// Unwrapped indices `(i, j)` of texel `k` of the line.
     pub fn texel(&self, k: usize) -> (i64, i64) {
-        if self.vertical {
-            (self.i0, self.j0.saturating_add(k as i64))
-        } else {
-            (self.i0.saturating_add(k as i64), self.j0)
-        }
+        step(self.i0, self.j0, self.vertical, k)
     }
 
-    /// The unnormalised LUT weights of the line's `len` texels, in order (0 for the rare centre
+    /// Texels on the line (at least 1).
+    pub fn texels(&self) -> u32 {
+        self.weights.left
+    }
+
+    /// The unnormalised LUT weights of the line's texels, in order (0 for the rare centre
     /// that rounding puts just outside the ellipse).
     pub fn weights(&self) -> Weights {
         self.weights.clone()
@@ -522,7 +524,7 @@ fn ewa_level<F: Fetch>(
     let mut sum = Vec4::ZERO;
     let mut wsum = 0.0f32;
     q.for_each_line(x, y, |line| {
-        let len = i64::from(line.len);
+        let len = i64::from(line.texels());
         // The line's fixed index wrapped once; the line inside the level along its own axis.
         let (fixed, inside) = if line.vertical {
             let j0 = line.j0;

@@ -503,7 +503,7 @@ impl Sampler {
                     .zip(out.chunks_mut(BATCH_CHUNK))
                 {
                     batch::prepare(fps, lod, &mut us, &mut vs, &mut lods);
-                    plan_chunk(fps, w as f32, h as f32, d, max, &mut plans);
+                    plan_chunk(fps, w, h, d, max, &mut plans);
                     for (k, (o, f)) in outs.iter_mut().zip(fps).enumerate() {
                         let (u, v, l) = (us[k], vs[k], lods[k]);
                         // As `filter`: magnification first.
