@@ -51,7 +51,7 @@
 //! at 640 x 360: 627.8 -> 619.4 M instructions for the whole run; images bit-identical.
 //!
 //! Staged plans: in `sample_batch` each sample's set-up (axes, their lengths, the probe count, the
-//! probe lod) runs for a chunk of 64 footprints in one branch-free loop (`plan_chunk`) before any
+//! probe lod) runs for a chunk of 64 footprints in one loop (`plan_chunk`) before any
 //! probe is read, as the isotropic lods do (`batch::prepare`). That needs a `log2` without a call:
 //! the probe lod now uses [`crate::footprint::fast_log2`] (within 1.2 units in the last place;
 //! libm's `log2f` before), for the single-sample path too. Ground scene, 1280 x 720, one thread,
