@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use crate::budget::ByteSize;
 use crate::filters::FilterName;
 
 /// texel: texture mapping and texture filtering on the CPU, measured.
@@ -13,6 +14,15 @@ pub struct Cli {
     /// The command to run.
     #[command(subcommand)]
     pub command: Command,
+    /// Most memory the command may hold at once, e.g. 512M or 4G (K, M, G, T: powers of 1024;
+    /// at least 1M). Work that would need more is refused before it starts, with the figures.
+    /// Default: half of this machine's memory.
+    #[arg(long, global = true, value_name = "SIZE")]
+    pub max_memory: Option<ByteSize>,
+    /// Replace NaN and infinite texels of float images (EXR) with 0 and +-65504, with a warning,
+    /// instead of refusing the image.
+    #[arg(long, global = true)]
+    pub sanitize: bool,
 }
 
 /// The commands.
@@ -128,10 +138,10 @@ pub struct RenderArgs {
     /// What each pixel shows.
     #[arg(long, value_enum, default_value_t)]
     pub view: ViewArg,
-    /// Worker threads (default: all cores).
+    /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
-    /// Output PNG.
+    /// Output PNG (`-` writes it to standard output).
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -141,10 +151,11 @@ pub struct RenderArgs {
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Samples per pixel, stratified n x m with n*m = spp as square as possible (256 = 16x16, 512 = 16x32).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Samples per pixel, 1 to 4096, stratified n x m with n*m = spp as square as possible and each
+    /// side at most 64 (256 = 16x16, 512 = 16x32).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub spp: u32,
-    /// Output PNG.
+    /// Output PNG (`-` writes it to standard output).
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -157,13 +168,15 @@ pub struct CompareArgs {
     /// Filters to compare: comma-separated names, or all.
     #[arg(long, default_value = "all")]
     pub filters: String,
-    /// Reference samples per pixel, stratified n x m (256 = 16x16, 512 = 16x32).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Reference samples per pixel, 1 to 4096, stratified n x m with each side at most 64
+    /// (256 = 16x16, 512 = 16x32).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub spp: u32,
-    /// An image rendered elsewhere to score against the same reference: LABEL=PATH (repeatable).
+    /// An image rendered elsewhere to score against the same reference: LABEL=PATH (repeatable;
+    /// labels must differ from each other and from the filters compared).
     #[arg(long, value_name = "LABEL=IMAGE")]
     pub extra: Vec<String>,
-    /// Output directory (created if missing).
+    /// Output directory: created, or replaced as a whole if texel wrote it before.
     #[arg(long)]
     pub out: PathBuf,
 }
@@ -171,14 +184,15 @@ pub struct CompareArgs {
 /// `texel demo`.
 #[derive(Debug, Args)]
 pub struct DemoArgs {
-    /// Output directory (created if missing).
+    /// Output directory: created, or replaced as a whole if texel wrote it before.
     #[arg(long, default_value = "texel-demo")]
     pub out: PathBuf,
     /// Image size of every scene (default: each scene's own, e.g. 1280x720 for the ground plane).
     #[arg(long)]
     pub size: Option<Size>,
-    /// Reference samples per pixel, stratified n x m (256 = 16x16, 512 = 16x32).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Reference samples per pixel, 1 to 4096, stratified n x m with each side at most 64
+    /// (256 = 16x16, 512 = 16x32).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub spp: u32,
 }
 
@@ -193,13 +207,13 @@ pub struct BenchArgs {
         default_value = "nearest,bilinear,mip-nearest,trilinear,aniso16,ewa"
     )]
     pub filters: String,
-    /// Timed frames per filter (the median is reported).
+    /// Timed frames per filter, 1 to 10000 (the median is reported).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=10000))]
     pub frames: u32,
-    /// Untimed warm-up frames per filter (at least 0.2 s of them unless 0).
-    #[arg(long, default_value_t = 2)]
+    /// Untimed warm-up frames per filter, 0 to 10000 (at least 0.2 s of them unless 0).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=10000))]
     pub warmup: u32,
-    /// Worker threads (default: all cores).
+    /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// Print JSON in the shape of ../shared/peers/llvmpipe_bench.py.
@@ -225,6 +239,9 @@ pub struct Size {
     /// Height in pixels.
     pub height: u32,
 }
+
+/// Most reference samples per pixel: 64 x 64, the rasterizer's largest stratification.
+pub const MAX_SPP: i64 = 4096;
 
 /// Largest output side accepted (pixels).
 pub const MAX_SIDE: u32 = 16384;
@@ -301,7 +318,7 @@ pub struct WarpArgs {
     /// Colour handling.
     #[arg(long, value_enum, default_value_t)]
     pub color: ColorArg,
-    /// Output PNG.
+    /// Output PNG (`-` writes it to standard output).
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -314,7 +331,7 @@ pub struct MipsArgs {
     /// Colour handling: srgb averages in linear light, raw averages the bytes.
     #[arg(long, value_enum, default_value_t)]
     pub color: ColorArg,
-    /// Output directory (created if missing).
+    /// Output directory: created, or replaced as a whole if texel wrote it before.
     #[arg(long)]
     pub out: PathBuf,
 }

@@ -10,17 +10,18 @@ use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 use texel_quality::{
-    crop_enlarge, default_band_rows, heat_map, horizon_crop_rect, FilterRow, Image8, Mask, Report,
-    Scores,
+    crop_enlarge, default_band_rows, heat_map, horizon_crop_rect, publish_dir, FilterRow, Image8,
+    Mask, Report, Scores,
 };
 use texel_raster::{render, Frame};
 
+use crate::budget::FRAME_BYTES_PER_PIXEL;
 use crate::cli::{ColorArg, CompareArgs};
 use crate::cmd_bench::{median, time_frames};
 use crate::cmd_reference::reference_frame;
 use crate::filters::{parse_list, FilterName};
 use crate::output::encoding;
-use crate::prepare::Prepared;
+use crate::prepare::{Input, Prepared};
 use crate::progress;
 
 /// Timed frames per filter in a comparison.
@@ -88,8 +89,42 @@ impl Scoring<'_> {
     }
 }
 
-/// Compare `filters` on a prepared scene against a `spp` reference, write everything into `dir` and
-/// return the report. `label` names the scene in the report.
+/// What a comparison holds per pixel besides the prepared scene's one frame: the reference frame
+/// ([`FRAME_BYTES_PER_PIXEL`]), the coverage mask (1), the reference and current 8-bit images
+/// (8), the heat map (4) and the encoder's copies (8), rounded up.
+pub const COMPARE_BYTES_PER_PIXEL: u64 = FRAME_BYTES_PER_PIXEL + 32;
+
+/// Check `--extra` entries against each other and the filters: every label names one row and one
+/// file, so two labels that are equal, or whose file names would be equal, or a label equal to a
+/// compared filter's name, are refused.
+pub fn check_extras(extras: &[(String, PathBuf)], filters: &[FilterName]) -> Result<()> {
+    for (i, (label, _)) in extras.iter().enumerate() {
+        if let Some(f) = filters.iter().find(|f| f.name() == label) {
+            bail!(
+                "--extra label {label:?} is also the name of a compared filter ({}): give the extra image another label",
+                f.name()
+            );
+        }
+        for (other, _) in &extras[..i] {
+            if other == label {
+                bail!(
+                    "--extra label {label:?} is given twice: each extra image needs its own label"
+                );
+            }
+            if slug(other) == slug(label) {
+                bail!(
+                    "--extra labels {other:?} and {label:?} would both be written as extra-{}.png: make them differ in letters, digits, - or _",
+                    slug(label)
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Compare `filters` on a prepared scene against a `spp` reference, write everything into `dir`
+/// (which must exist: the caller publishes it, see [`texel_quality::publish_dir`]) and return the
+/// report. `label` names the scene in the report.
 pub fn compare(
     scene: &Prepared,
     label: &str,
@@ -98,7 +133,6 @@ pub fn compare(
     extras: &[(String, PathBuf)],
     dir: &Path,
 ) -> Result<Report> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let enc = encoding(scene.color);
     let reference = reference_frame(scene, spp)?;
     let (w, h) = (reference.width, reference.height);
@@ -151,7 +185,7 @@ pub fn compare(
 
     for (label, path) in extras {
         let image = Image8::load(path)
-            .with_context(|| format!("cannot load --extra image {}", path.display()))?;
+            .with_context(|| format!("cannot load --extra image {label}={}", path.display()))?;
         if image.size() != (w, h) {
             bail!(
                 "--extra image {} is {}x{} but the comparison is {w}x{h} (pass --size to match)",
@@ -202,22 +236,23 @@ fn texel_stats(frame: &Frame) -> (f64, u64) {
 }
 
 /// Run `texel compare`.
-pub fn run(args: &CompareArgs) -> Result<()> {
+pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     let filters = parse_list(&args.filters)?;
     let extras = args
         .extra
         .iter()
         .map(|e| parse_extra(e))
         .collect::<Result<Vec<_>>>()?;
-    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
-    let report = compare(
-        &scene,
-        &args.scene.scene,
-        &filters,
-        args.spp,
-        &extras,
-        &args.out,
+    check_extras(&extras, &filters)?;
+    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    input.budget.take(
+        "the comparison's reference and images",
+        u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
     )?;
+    let report = publish_dir(&args.out, |dir| {
+        compare(&scene, &args.scene.scene, &filters, args.spp, &extras, dir)
+    })
+    .with_context(|| format!("cannot write the report to {}", args.out.display()))?;
     print!("{}", report.to_markdown());
     eprintln!("report: {}", args.out.join("index.html").display());
     Ok(())
@@ -241,5 +276,22 @@ mod tests {
         assert!(parse_extra("=x.png").is_err());
         assert!(parse_extra("x=").is_err());
         assert_eq!(slug("llvm pipe/1"), "llvm_pipe_1");
+    }
+
+    #[test]
+    fn extras_distinct() {
+        let e = |l: &str| (l.to_string(), PathBuf::from("x.png"));
+        let f = [FilterName::Trilinear];
+        assert!(check_extras(&[e("gpu"), e("llvmpipe")], &f).is_ok());
+        let msg = check_extras(&[e("gpu"), e("gpu")], &f)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("given twice"), "{msg}");
+        let msg = check_extras(&[e("a b"), e("a_b")], &f)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("extra-a_b.png"), "{msg}");
+        let msg = check_extras(&[e("trilinear")], &f).unwrap_err().to_string();
+        assert!(msg.contains("compared filter"), "{msg}");
     }
 }

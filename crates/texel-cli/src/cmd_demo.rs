@@ -8,36 +8,45 @@ use std::fmt::Write as _;
 
 use anyhow::{Context, Result};
 use texel_quality::html::escape;
-use texel_quality::{write_atomic, Report};
+use texel_quality::{publish_dir, write_atomic, Report};
 
+use crate::budget::Budget;
 use crate::cli::{ColorArg, DemoArgs};
-use crate::cmd_compare::compare;
+use crate::cmd_compare::{compare, COMPARE_BYTES_PER_PIXEL};
 use crate::filters::FilterName;
-use crate::prepare::Prepared;
+use crate::prepare::{Input, Prepared};
 
-/// Run `texel demo`.
-pub fn run(args: &DemoArgs) -> Result<()> {
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
+/// Run `texel demo`: every scene's report is written into one staging directory, published as a
+/// whole at `--out` when all are done.
+pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let started = std::time::Instant::now();
-    let mut reports: Vec<(String, Report)> = Vec::new();
-    for name in texel_scene::builtin_names() {
-        let label = format!("builtin:{name}");
-        eprintln!("texel demo: {label} ...");
-        let scene = Prepared::load(&label, ColorArg::Srgb, args.size)?;
-        let report = compare(
-            &scene,
-            &label,
-            &FilterName::ALL,
-            args.spp,
-            &[],
-            &args.out.join(name),
-        )?;
-        reports.push((name.to_string(), report));
-    }
-    let html = index_html(&reports, started.elapsed().as_secs_f64());
+    let reports = publish_dir(&args.out, |dir| -> Result<Vec<(String, Report)>> {
+        let mut reports: Vec<(String, Report)> = Vec::new();
+        for name in texel_scene::builtin_names() {
+            let label = format!("builtin:{name}");
+            eprintln!("texel demo: {label} ...");
+            // Scenes are rendered one after another: each gets the whole memory account.
+            let mut scene_input = Input {
+                budget: Budget::new(input.budget.limit_arg()),
+                sanitize: input.sanitize,
+            };
+            let scene = Prepared::load(&label, ColorArg::Srgb, args.size, &mut scene_input)?;
+            scene_input.budget.take(
+                "the comparison's reference and images",
+                u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
+            )?;
+            let sub = dir.join(name);
+            std::fs::create_dir(&sub)
+                .with_context(|| format!("cannot create {}", sub.display()))?;
+            let report = compare(&scene, &label, &FilterName::ALL, args.spp, &[], &sub)?;
+            reports.push((name.to_string(), report));
+        }
+        let html = index_html(&reports, started.elapsed().as_secs_f64());
+        write_atomic(&dir.join("index.html"), html.as_bytes())?;
+        Ok(reports)
+    })
+    .with_context(|| format!("cannot write the demo to {}", args.out.display()))?;
     let index = args.out.join("index.html");
-    write_atomic(&index, html.as_bytes())?;
     println!(
         "texel demo: {} scenes in {:.0} s",
         reports.len(),

@@ -6,7 +6,7 @@ use texel_raster::render_reference_strata;
 use crate::cli::ReferenceArgs;
 use crate::filters::FilterName;
 use crate::output::write_png;
-use crate::prepare::Prepared;
+use crate::prepare::{Input, Prepared};
 use crate::progress;
 
 /// Seed of the reference's jitter: fixed, so references are reproducible.
@@ -43,8 +43,8 @@ pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame
 }
 
 /// Run `texel reference`.
-pub fn run(args: &ReferenceArgs) -> Result<()> {
-    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size)?;
+pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
+    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size, input)?;
     let frame = reference_frame(&scene, args.spp)?;
     write_png(
         &args.output,

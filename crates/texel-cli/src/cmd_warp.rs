@@ -1,27 +1,63 @@
 //! `texel warp`: a perspective warp of an image through a homography, filtered with the exact
 //! per-pixel footprint.
+//!
+//! The output size (`--size`, else the source's) is checked from the image header before the
+//! pixels are decoded, so a size error names its cause at once.
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use glam::DVec2;
-use texel_texture::warp::{warp_perspective, WarpError};
-use texel_texture::{AddressMode, ColorSpace, Limits, Sampler, Texture};
+use texel_texture::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
+use texel_texture::{AddressMode, ColorSpace, Limits, LoadOptions, Sampler, Texture};
 
+use crate::budget::FRAME_BYTES_PER_PIXEL;
 use crate::cli::{ColorArg, WarpArgs};
 use crate::output::write_png;
+use crate::prepare::Input;
 
 /// Run `texel warp`.
-pub fn run(args: &WarpArgs) -> Result<()> {
+pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
     let color = match args.color {
         ColorArg::Srgb => ColorSpace::Srgb,
         ColorArg::Raw => ColorSpace::Linear,
     };
-    let tex = Texture::load(&args.input, color, &Limits::default())
-        .with_context(|| format!("cannot load image {}", args.input.display()))?;
+    let cannot = || format!("cannot load image {}", args.input.display());
+    let bytes = texel_texture::input::read_regular(&args.input, input.budget.remaining())
+        .with_context(cannot)?;
+    let (sw, sh, _) = Texture::header(&bytes).with_context(cannot)?;
+    let (w, h) = match args.size {
+        Some(s) => (s.width, s.height),
+        None => {
+            if u64::from(sw) * u64::from(sh) > MAX_WARP_PIXELS {
+                bail!(
+                    "the source is {sw}x{sh} and no --size was given, so the output would be {sw}x{sh}, over {MAX_WARP_PIXELS} pixels: pass a smaller --size"
+                );
+            }
+            (sw, sh)
+        }
+    };
+    input.budget.take(
+        &format!("the {w}x{h} output"),
+        u64::from(w) * u64::from(h) * FRAME_BYTES_PER_PIXEL,
+    )?;
+    input.budget.take("the image file", bytes.len() as u64)?;
+    let options = LoadOptions {
+        replace_non_finite: input.sanitize,
+        ..LoadOptions::new(
+            color,
+            Limits {
+                max_bytes: input.budget.remaining(),
+                ..Limits::default()
+            },
+        )
+    };
+    let loaded = Texture::decode_with(&bytes, &options)
+        .map_err(|e| input.explain(e.into()))
+        .with_context(cannot)?;
+    drop(bytes);
+    input.warn_replaced(&args.input.display().to_string(), loaded.replaced);
+    let tex = loaded.texture;
     let c = &args.corners.0;
     let corners = [0, 2, 4, 6].map(|k| DVec2::new(c[k], c[k + 1]));
-    let (w, h) = args
-        .size
-        .map_or((tex.width(), tex.height()), |s| (s.width, s.height));
     let mut desc = args
         .filter
         .descriptor(AddressMode::ClampToBorder, AddressMode::ClampToBorder)?;

@@ -4,6 +4,7 @@
 //! The binary is thin (as ripgrep's `crates/core/main.rs`): argument parsing with clap derive, one
 //! function per command, anyhow with context at the top. The work lives in the texel libraries.
 
+mod budget;
 mod cli;
 mod cmd_bench;
 mod cmd_compare;
@@ -24,16 +25,27 @@ use clap::Parser;
 
 use cli::{Cli, Command};
 
+/// Exit status after SIGINT, SIGTERM or SIGHUP (128 + SIGINT, as shells report an interrupt).
+const INTERRUPTED: i32 = 130;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // An interrupted run deletes its unpublished temporary files and staging directories.
+    if let Err(e) = ctrlc::set_handler(|| texel_quality::remove_pending_and_exit(INTERRUPTED)) {
+        eprintln!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files");
+    }
+    let mut input = prepare::Input {
+        budget: budget::Budget::new(cli.max_memory),
+        sanitize: cli.sanitize,
+    };
     let result = match cli.command {
-        Command::Render(args) => cmd_render::run(&args),
-        Command::Reference(args) => cmd_reference::run(&args),
-        Command::Bench(args) => cmd_bench::run(&args),
-        Command::Compare(args) => cmd_compare::run(&args),
-        Command::Demo(args) => cmd_demo::run(&args),
-        Command::Warp(args) => cmd_warp::run(&args),
-        Command::Mips(args) => cmd_mips::run(&args),
+        Command::Render(args) => cmd_render::run(&args, &mut input),
+        Command::Reference(args) => cmd_reference::run(&args, &mut input),
+        Command::Bench(args) => cmd_bench::run(&args, &mut input),
+        Command::Compare(args) => cmd_compare::run(&args, &mut input),
+        Command::Demo(args) => cmd_demo::run(&args, &mut input),
+        Command::Warp(args) => cmd_warp::run(&args, &mut input),
+        Command::Mips(args) => cmd_mips::run(&args, &mut input),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,6 +1,7 @@
 //! Writing images: linear RGBA frames encoded to 8-bit PNG, written atomically (through
 //! texel-quality's `Image8` and `write_atomic`, so images and reports share one encoder).
 
+use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -16,7 +17,9 @@ pub fn encoding(color: ColorArg) -> Encoding {
     }
 }
 
-/// Encode and atomically write a linear RGBA frame as PNG (temporary file, then rename).
+/// Encode a linear RGBA frame as PNG and publish it at `path` ([`texel_quality::write_atomic`]:
+/// atomically over a regular file or a new path, through to a device or FIFO), or stream it to
+/// standard output when `path` is `-`.
 pub fn write_png(
     path: &Path,
     width: u32,
@@ -24,7 +27,21 @@ pub fn write_png(
     pixels: &[[f32; 4]],
     color: ColorArg,
 ) -> Result<()> {
-    Image8::from_linear(width, height, pixels, encoding(color))
-        .and_then(|img| img.write_png(path))
+    let image = Image8::from_linear(width, height, pixels, encoding(color))?;
+    write_image(path, &image)
+}
+
+/// Publish an 8-bit image as PNG at `path`, or on standard output for `-`.
+pub fn write_image(path: &Path, image: &Image8) -> Result<()> {
+    if path.as_os_str() == "-" {
+        let png = image.to_png()?;
+        let mut out = std::io::stdout().lock();
+        return out
+            .write_all(&png)
+            .and_then(|()| out.flush())
+            .context("cannot write the PNG to standard output");
+    }
+    image
+        .write_png(path)
         .with_context(|| format!("cannot write {}", path.display()))
 }

@@ -5,12 +5,62 @@ use std::collections::BTreeMap;
 
 use anyhow::{Context, Result};
 use texel_raster::{DrawCall, RenderSettings, Vertex};
-use texel_scene::Scene;
+use texel_scene::{Scene, SceneLimits};
 use texel_texture::color::srgb_to_linear;
-use texel_texture::{ColorSpace, Limits, Sampler, Texture};
+use texel_texture::{ColorSpace, Limits, Sampler, Texture, TextureError};
 
+use crate::budget::{Budget, FRAME_BYTES_PER_PIXEL};
 use crate::cli::{ColorArg, Size};
 use crate::filters::FilterName;
+
+/// What a scene keeps per vertex, at most: the scene's position, uv, normal and colour (48 bytes)
+/// and the rasterizer's [`Vertex`].
+const VERTEX_BYTES: u64 = 48 + std::mem::size_of::<Vertex>() as u64;
+
+/// What a scene keeps per triangle: its indices (12 bytes) and an allowance of 244 bytes for the
+/// rasterizer's per-frame triangle set-up and bins.
+const TRIANGLE_BYTES: u64 = 256;
+
+/// How a command reads its inputs: the memory account and the non-finite-texel policy.
+pub struct Input {
+    /// The `--max-memory` account.
+    pub budget: Budget,
+    /// `--sanitize`: replace NaN/Inf texels instead of refusing them.
+    pub sanitize: bool,
+}
+
+impl Input {
+    /// Print a warning when `--sanitize` replaced values of texture `name`.
+    pub fn warn_replaced(&self, name: &str, replaced: u64) {
+        if replaced > 0 {
+            eprintln!(
+                "texel: warning: texture {name:?}: replaced {replaced} NaN or infinite channel values (NaN -> 0, +-inf -> +-{})",
+                texel_texture::NON_FINITE_CLAMP
+            );
+        }
+    }
+
+    /// Add to a texture's memory-limit error which flag sets the limit.
+    pub fn explain(&self, e: anyhow::Error) -> anyhow::Error {
+        let over = e.chain().any(|c| {
+            matches!(
+                c.downcast_ref::<TextureError>(),
+                Some(
+                    TextureError::OverMemoryLimit { .. }
+                        | TextureError::StructureOverMemoryLimit { .. }
+                )
+            )
+        });
+        if over {
+            e.context(format!(
+                "the memory limit is what remains of {} after the other inputs",
+                self.budget.describe()
+            ))
+        } else {
+            e
+        }
+    }
+}
 
 /// A loaded scene, ready to render with any filter.
 pub struct Prepared {
@@ -29,18 +79,54 @@ pub struct Prepared {
 }
 
 impl Prepared {
-    /// Load `scene` (a path or `builtin:NAME`) and its textures.
-    pub fn load(scene: &str, color: ColorArg, size: Option<Size>) -> Result<Self> {
-        let scene = Scene::load(scene).with_context(|| format!("cannot load scene {scene}"))?;
+    /// Load `scene` (a path or `builtin:NAME`) and its textures, accounting for the meshes, every
+    /// texture and one frame of the output size in `input.budget` before each is allocated.
+    pub fn load(
+        scene: &str,
+        color: ColorArg,
+        size: Option<Size>,
+        input: &mut Input,
+    ) -> Result<Self> {
+        let scene = Scene::load_with(scene, &SceneLimits::default())
+            .with_context(|| format!("cannot load scene {scene}"))?;
         let override_space = match color {
             ColorArg::Srgb => None,
             ColorArg::Raw => Some(ColorSpace::Linear),
         };
-        let textures = scene.load_textures(override_space, &Limits::default())?;
-        let vertices = scene.meshes.iter().map(texel_vertices).collect();
         let (width, height) = size.map_or((scene.output.width, scene.output.height), |s| {
             (s.width, s.height)
         });
+        let (verts, tris) = scene.meshes.iter().fold((0u64, 0u64), |(v, t), m| {
+            (v + m.positions.len() as u64, t + m.triangles.len() as u64)
+        });
+        input
+            .budget
+            .take("the meshes", verts * VERTEX_BYTES + tris * TRIANGLE_BYTES)?;
+        input.budget.take(
+            &format!("a {width}x{height} frame"),
+            u64::from(width) * u64::from(height) * FRAME_BYTES_PER_PIXEL,
+        )?;
+        let mut textures = BTreeMap::new();
+        for m in &scene.meshes {
+            if textures.contains_key(&m.texture) {
+                continue;
+            }
+            let spec = &scene.textures[&m.texture];
+            let limits = Limits {
+                max_bytes: input.budget.remaining(),
+                ..Limits::default()
+            };
+            let loaded = spec
+                .load_with(&m.texture, override_space, &limits, input.sanitize)
+                .map_err(|e| input.explain(e.into()))?;
+            input.warn_replaced(&m.texture, loaded.replaced);
+            input.budget.take(
+                &format!("texture {:?}", m.texture),
+                loaded.texture.pyramid_bytes(),
+            )?;
+            textures.insert(m.texture.clone(), loaded.texture);
+        }
+        let vertices = scene.meshes.iter().map(texel_vertices).collect();
         Ok(Prepared {
             scene,
             textures,

@@ -1,209 +1,10 @@
-//! Integration tests of the `texel` binary: every command on small sizes, every error case of
-//! issue 5 (exit code, the key part of the one-line message, no panic), atomic outputs, the shipped
-//! ground scene, OBJ and glTF files written here, the compare report against the images it wrote,
-//! and the filter ranking on the ground plane.
-//!
-//! One test binary with small helpers, in the style of ripgrep's `tests/util.rs`: [`texel`] runs the
-//! binary, [`ok`] and [`fails`] check its exit, [`Dir`] is a scratch directory per test.
-
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+//! Every command on small sizes, every usage error (exit code, the key part of the one-line
+//! message, no panic), atomic outputs, the shipped ground scene, OBJ and glTF files written here,
+//! the compare report against the images it wrote, and the filter ranking on the ground plane.
 
 use texel_quality::{psnr, psnr_band, ssim, Image8, Mask, Report, OUTSIDE};
 
-// ---------------------------------------------------------------------------------------------
-// Helpers
-// ---------------------------------------------------------------------------------------------
-
-/// Every filter name, in the CLI's order.
-const FILTERS: [&str; 12] = [
-    "nearest",
-    "bilinear",
-    "bicubic",
-    "mip-nearest",
-    "trilinear",
-    "aniso2",
-    "aniso4",
-    "aniso8",
-    "aniso16",
-    "ewa",
-    "ripmap",
-    "sat",
-];
-
-/// The built-in scenes the demo covers.
-const BUILTINS: [&str; 6] = [
-    "ground",
-    "ground-rotated",
-    "zoneplate",
-    "cube",
-    "sphere",
-    "triangle",
-];
-
-/// Run `texel` with `args`.
-fn texel<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texel"))
-        .args(args)
-        .output()
-        .expect("cannot start the texel binary")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn stdout(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// Run `texel` and require success without a panic; returns the output.
-fn ok<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
-    let out = texel(args);
-    let err = stderr(&out);
-    assert!(
-        out.status.success(),
-        "texel {:?} failed ({:?}): {err}",
-        args.iter()
-            .map(|a| a.as_ref().to_string_lossy().into_owned())
-            .collect::<Vec<_>>(),
-        out.status.code()
-    );
-    assert!(!err.contains("panicked"), "{err}");
-    out
-}
-
-/// Run `texel`, require exit code `code` (1: texel's own errors, 2: clap's usage errors), no panic,
-/// and every one of `needles` in stderr. Texel's own errors must be exactly one line
-/// `texel: error: ...`. Returns stderr.
-fn fails<S: AsRef<std::ffi::OsStr>>(args: &[S], code: i32, needles: &[&str]) -> String {
-    let out = texel(args);
-    let err = stderr(&out);
-    assert_eq!(out.status.code(), Some(code), "stderr: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    if code == 1 {
-        assert_eq!(err.lines().count(), 1, "one error line expected: {err}");
-        assert!(err.starts_with("texel: error: "), "{err}");
-    }
-    for n in needles {
-        assert!(err.contains(n), "stderr lacks {n:?}: {err}");
-    }
-    err
-}
-
-/// A scratch directory under the system temp dir, unique per test (and process); removed when the
-/// test passes, kept for inspection when it fails.
-struct Dir(PathBuf);
-
-impl Dir {
-    fn new(name: &str) -> Dir {
-        let d = std::env::temp_dir().join(format!("texel-cli-test-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        Dir(d)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-
-    fn join(&self, p: &str) -> PathBuf {
-        self.0.join(p)
-    }
-
-    /// `join` as a `String`, for argument lists.
-    fn arg(&self, p: &str) -> String {
-        self.join(p).to_string_lossy().into_owned()
-    }
-
-    fn write(&self, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
-        let p = self.join(name);
-        std::fs::write(&p, bytes).unwrap();
-        p
-    }
-}
-
-impl Drop for Dir {
-    fn drop(&mut self) {
-        if !std::thread::panicking() {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
-
-fn load(path: impl AsRef<Path>) -> Image8 {
-    let path = path.as_ref();
-    Image8::load(path).unwrap_or_else(|e| panic!("cannot load {}: {e}", path.display()))
-}
-
-fn file_bytes(path: impl AsRef<Path>) -> Vec<u8> {
-    let path = path.as_ref();
-    std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
-}
-
-/// Every file under `dir` (recursively) whose name looks like a temporary of an atomic write:
-/// `.NAME.tmpPID` (texel-cli) or `.NAME.PID.N.tmp` (texel-quality).
-fn temp_files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            out.extend(temp_files(&p));
-        }
-        let name = p.file_name().unwrap().to_string_lossy().into_owned();
-        if name.starts_with('.') && name.contains(".tmp") {
-            out.push(p);
-        }
-    }
-    out
-}
-
-/// The shipped ground scene (identical to `../shared/scenes/ground.toml`).
-fn ground_toml() -> String {
-    concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../texel-scene/tests/data/ground.toml"
-    )
-    .to_string()
-}
-
-/// Output, camera and a small checker texture `t` of a scene looking at the z = 0 plane from z = 3;
-/// append `[[meshes]]`. Background blue.
-const HEAD: &str = r#"[output]
-width = 64
-height = 48
-background = [0, 0, 255, 255]
-
-[camera]
-eye = [0.0, 0.0, 3.0]
-target = [0.0, 0.0, 0.0]
-fovy_deg = 45.0
-near = 0.1
-far = 10.0
-
-[textures.t]
-procedural = "checker"
-size = 64
-checks = 4
-"#;
-
-/// A valid inline triangle using texture `t`.
-const TRIANGLE: &str = r#"
-[[meshes]]
-texture = "t"
-positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]]
-uvs = [[0.0, 1.0], [1.0, 1.0], [0.5, 0.0]]
-triangles = [[0, 1, 2]]
-"#;
-
-/// The unit quad `[-1, 1]^2` at z = 0 with uv (0, 0) at its top-left, as inline TOML.
-const QUAD: &str = r#"
-[[meshes]]
-texture = "t"
-positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]]
-uvs = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]
-triangles = [[0, 1, 2], [0, 2, 3]]
-"#;
+use crate::util::*;
 
 // ---------------------------------------------------------------------------------------------
 // Help
@@ -413,13 +214,13 @@ fn shipped_ground_scene_renders_like_the_builtin() {
 // ---------------------------------------------------------------------------------------------
 
 /// The quad as OBJ: the same vertices in the same order; OBJ's v axis points up, so vt = 1 - v.
-const QUAD_OBJ: &str = "# unit quad\n\
+pub(crate) const QUAD_OBJ: &str = "# unit quad\n\
 v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
 vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
 f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
 
 /// The quad's glTF buffer: 4 positions (48 bytes), 4 uvs (32), 6 u16 indices (12).
-fn quad_buffer() -> Vec<u8> {
+pub(crate) fn quad_buffer() -> Vec<u8> {
     let mut b = Vec::new();
     for v in [
         -1.0f32, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0,
@@ -435,7 +236,7 @@ fn quad_buffer() -> Vec<u8> {
     b
 }
 
-fn quad_gltf(uri: &str) -> String {
+pub(crate) fn quad_gltf(uri: &str) -> String {
     format!(
         r#"{{
   "asset": {{"version": "2.0"}},
@@ -459,7 +260,7 @@ fn quad_gltf(uri: &str) -> String {
 }
 
 /// Standard base64 with padding (RFC 4648), for a glTF data URI.
-fn base64(bytes: &[u8]) -> String {
+pub(crate) fn base64(bytes: &[u8]) -> String {
     const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut s = String::new();
     for c in bytes.chunks(3) {
@@ -970,6 +771,7 @@ fn mips_writes_every_level_and_the_chain() {
         .map(|(k, (w, h))| format!("level-{k:02}-{w}x{h}.png"))
         .collect();
     expected.push("chain.png".to_string());
+    expected.push(texel_quality::OUTPUT_MARKER.to_string());
     expected.sort();
     assert_eq!(files, expected);
     for (k, &(w, h)) in sizes.iter().enumerate() {
@@ -1014,7 +816,7 @@ fn mips_writes_every_level_and_the_chain() {
             (w, h)
         );
     }
-    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 6);
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 7); // five levels, chain.png and the output marker
     let last = load(out.join("level-04-1x1.png")).pixel(0, 0).unwrap();
     for c in 0..3 {
         let mean = odd.pixels().iter().map(|p| f64::from(p[c])).sum::<f64>() / 240.0;
@@ -1362,7 +1164,7 @@ fn error_unwritable_output_path() {
     fails(
         &["mips", &src.to_string_lossy(), "--out", &under_file],
         1,
-        &["cannot create", &under_file],
+        &["Not a directory", &under_file],
     );
     fails(
         &[
@@ -1377,7 +1179,7 @@ fn error_unwritable_output_path() {
             &under_file,
         ],
         1,
-        &["cannot create", &under_file],
+        &["Not a directory", &under_file],
     );
     fails(
         &[
@@ -1390,7 +1192,7 @@ fn error_unwritable_output_path() {
             &under_file,
         ],
         1,
-        &["cannot create", &under_file],
+        &["Not a directory", &under_file],
     );
 }
 
@@ -1668,8 +1470,8 @@ fn failed_writes_leave_no_temporary_files() {
         "keep"
     );
 
-    // compare, with report.json a directory: the images are written, the report fails.
-    std::fs::create_dir_all(d.join("cmp/report.json/sub")).unwrap();
+    // compare failing after its filters' images were written (the --extra image is missing): the
+    // report directory is never published, and its staging directory is gone.
     fails(
         &[
             "compare",
@@ -1679,19 +1481,15 @@ fn failed_writes_leave_no_temporary_files() {
             "1",
             "--filters",
             "nearest",
+            "--extra",
+            &format!("gpu={}", d.arg("missing.png")),
             "--out",
             &d.arg("cmp"),
         ],
         1,
-        &["report.json"],
+        &["missing.png"],
     );
-    // mips, with one level's file name taken by a directory.
-    std::fs::create_dir_all(d.join("mips/level-01-4x4.png/sub")).unwrap();
-    fails(
-        &["mips", &src.to_string_lossy(), "--out", &d.arg("mips")],
-        1,
-        &["level-01-4x4.png"],
-    );
+    assert!(!d.join("cmp").exists());
     let left = temp_files(d.path());
     assert!(left.is_empty(), "temporary files left behind: {left:?}");
     // And a successful run leaves none either.

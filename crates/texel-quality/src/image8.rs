@@ -23,6 +23,21 @@ pub enum Encoding {
     Linear,
 }
 
+impl Encoding {
+    /// One linear RGBA value as 8-bit display values (values outside `[0, 1]` clamp; NaN is 0).
+    pub fn encode(self, c: [f32; 4]) -> [u8; 4] {
+        match self {
+            Encoding::Srgb => [
+                linear_to_srgb8(c[0]),
+                linear_to_srgb8(c[1]),
+                linear_to_srgb8(c[2]),
+                unorm8(c[3]),
+            ],
+            Encoding::Linear => [unorm8(c[0]), unorm8(c[1]), unorm8(c[2]), unorm8(c[3])],
+        }
+    }
+}
+
 /// A row-major 8-bit RGBA image; row 0 is the top. Sides are `1..=MAX_SIDE`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Image8 {
@@ -121,18 +136,7 @@ impl Image8 {
                 got: pixels.len(),
             });
         }
-        let px = pixels
-            .iter()
-            .map(|c| match encoding {
-                Encoding::Srgb => [
-                    linear_to_srgb8(c[0]),
-                    linear_to_srgb8(c[1]),
-                    linear_to_srgb8(c[2]),
-                    unorm8(c[3]),
-                ],
-                Encoding::Linear => [unorm8(c[0]), unorm8(c[1]), unorm8(c[2]), unorm8(c[3])],
-            })
-            .collect();
+        let px = pixels.iter().map(|&c| encoding.encode(c)).collect();
         Self::new(width, height, px)
     }
 
@@ -167,23 +171,22 @@ impl Image8 {
     /// crate (`round(v / 257)`); grey and RGB gain opaque alpha.
     ///
     /// # Errors
-    /// [`QualityError::Io`] / [`QualityError::Image`] carrying the path; the size errors.
+    /// [`QualityError::Io`] / [`QualityError::Image`] carrying the path (a FIFO or device is an
+    /// `Io` error: only regular files are read); the size errors.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, QualityError> {
         let path = path.as_ref();
         let img_err = |source| QualityError::Image {
             path: path.to_path_buf(),
             source,
         };
-        let mut reader = image::ImageReader::open(path)
-            .map_err(|source| QualityError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?
+        let io_err = |source| QualityError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = texel_texture::input::open_regular(path).map_err(io_err)?;
+        let mut reader = image::ImageReader::new(std::io::BufReader::new(file))
             .with_guessed_format()
-            .map_err(|source| QualityError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
+            .map_err(io_err)?;
         let mut limits = image::Limits::default();
         limits.max_image_width = Some(MAX_SIDE);
         limits.max_image_height = Some(MAX_SIDE);

@@ -7,7 +7,8 @@
 //! - [`horizon_band`]: the strip just below the horizon, where minification is extreme.
 //! - [`heat_map`], [`legend_svg`], [`crop_enlarge`], [`horizon_crop_rect`]: pictures of the error.
 //! - [`Report`] / [`FilterRow`]: JSON, Markdown and a self-contained `index.html` with a chart.
-//! - [`write_atomic`] / [`write_png_atomic`]: no truncated output after an interruption.
+//! - [`write_atomic`] / [`write_png_atomic`] / [`publish_dir`]: no truncated output after an
+//!   interruption, and only regular files (or new paths) ever replaced.
 //!
 //! Decision: quality is measured on the 8-bit display values (sRGB-encoded, or linear bytes under
 //! `--color raw`), i.e. exactly what is written to the PNG files and what a person sees, so that
@@ -50,7 +51,9 @@ pub mod ssim;
 /// The largest image side, in pixels, any function here accepts (16384, the common GPU limit).
 pub const MAX_SIDE: u32 = 16384;
 
-pub use atomic::{write_atomic, write_png_atomic};
+pub use atomic::{
+    publish_dir, remove_pending_and_exit, write_atomic, write_png_atomic, OUTPUT_MARKER,
+};
 pub use band::{default_band_rows, horizon_band};
 pub use crop::{crop_enlarge, horizon_crop_rect, Rect};
 pub use error::QualityError;

@@ -136,10 +136,12 @@ pub enum SceneError {
         source: TextureError,
     },
     /// An OBJ file could not be parsed.
-    #[error("{path}: cannot load OBJ: {source}")]
+    #[error("{path}: cannot load OBJ: {}{source}", at.as_ref().map(|a| format!("{a}: ")).unwrap_or_default())]
     Obj {
         /// The OBJ file.
         path: PathBuf,
+        /// Where parsing failed: `line N ("text")`, when it could be found.
+        at: Option<String>,
         /// The parser's error.
         source: tobj::LoadError,
     },
@@ -160,4 +162,10 @@ pub enum SceneError {
         /// What is wrong.
         reason: String,
     },
+    /// The scene is larger than its [`crate::SceneLimits`] allow.
+    #[error("{0}")]
+    TooLarge(String),
+    /// The scene draws nothing: no meshes, or a mesh without triangles.
+    #[error("{0}")]
+    Empty(String),
 }

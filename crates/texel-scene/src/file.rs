@@ -36,6 +36,7 @@ use texel_texture::{AddressMode, ColorSpace};
 
 use crate::camera::Camera;
 use crate::error::SceneError;
+use crate::limits::SceneLimits;
 use crate::model::{Mesh, Output, Scene, TextureSource, TextureSpec};
 use crate::procedural::Procedural;
 
@@ -259,7 +260,12 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
     Ok(TextureSpec { source, color })
 }
 
-fn meshes(index: usize, m: RawMesh, base: &Path) -> Result<Vec<Mesh>, SceneError> {
+fn meshes(
+    index: usize,
+    m: RawMesh,
+    base: &Path,
+    limits: &SceneLimits,
+) -> Result<Vec<Mesh>, SceneError> {
     let src = |reason| SceneError::MeshSource {
         mesh: index,
         reason,
@@ -298,10 +304,14 @@ fn meshes(index: usize, m: RawMesh, base: &Path) -> Result<Vec<Mesh>, SceneError
             ));
         }
         if let Some(obj) = m.obj {
-            vec![crate::obj::load_obj(&base.join(obj), &m.texture)?]
+            vec![crate::obj::load_obj_with(
+                &base.join(obj),
+                &m.texture,
+                limits,
+            )?]
         } else {
             let path = base.join(m.gltf.expect("one source"));
-            crate::gltf_import::load_gltf(&path, &m.texture)?
+            crate::gltf_import::load_gltf_with(&path, &m.texture, limits)?
         }
     };
     for mesh in &mut out {
@@ -321,8 +331,22 @@ impl Scene {
     /// ([`Scene::validate`]).
     ///
     /// # Errors
-    /// [`SceneError::Toml`] with line and column; mesh file errors; validation errors.
+    /// As [`Scene::from_toml_str_with`].
     pub fn from_toml_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        Self::from_toml_str_with(text, path, &SceneLimits::default())
+    }
+
+    /// As [`Scene::from_toml_str`], with mesh files read within `limits`, and the whole scene's
+    /// triangles and vertices within them.
+    ///
+    /// # Errors
+    /// [`SceneError::Toml`] with line and column; mesh file errors; [`SceneError::TooLarge`];
+    /// validation errors.
+    pub fn from_toml_str_with(
+        text: &str,
+        path: &Path,
+        limits: &SceneLimits,
+    ) -> Result<Scene, SceneError> {
         let raw: RawScene = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map_or((0, 0), |s| line_column(text, s.start));
             SceneError::Toml {
@@ -340,7 +364,15 @@ impl Scene {
             .collect::<Result<_, _>>()?;
         let mut all = Vec::new();
         for (i, m) in raw.meshes.into_iter().enumerate() {
-            all.extend(meshes(i, m, &base)?);
+            all.extend(meshes(i, m, &base, limits)?);
+        }
+        let tris: u64 = all.iter().map(|m| m.triangles.len() as u64).sum();
+        let verts: u64 = all.iter().map(|m| m.positions.len() as u64).sum();
+        if tris > limits.max_triangles || verts > limits.max_vertices {
+            return Err(SceneError::TooLarge(format!(
+                "the scene has {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",
+                limits.max_triangles, limits.max_vertices
+            )));
         }
         let scene = Scene {
             output: Output {
@@ -366,14 +398,37 @@ impl Scene {
     /// Read and parse a scene file ([`Scene::from_toml_str`]).
     ///
     /// # Errors
-    /// [`SceneError::Io`] with the path, and those of [`Scene::from_toml_str`].
+    /// As [`Scene::from_path_with`].
     pub fn from_path(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        Self::from_path_with(path, &SceneLimits::default())
+    }
+
+    /// Read a scene file (a regular file of at most [`SceneLimits::max_scene_bytes`], UTF-8) and
+    /// parse it ([`Scene::from_toml_str_with`]).
+    ///
+    /// # Errors
+    /// [`SceneError::Io`] with the path (missing, not a regular file, too large, not UTF-8), and
+    /// those of [`Scene::from_toml_str_with`].
+    pub fn from_path_with(
+        path: impl AsRef<Path>,
+        limits: &SceneLimits,
+    ) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        let io = |source| SceneError::Io {
             path: path.to_path_buf(),
             source,
+        };
+        let bytes = texel_texture::input::read_regular(path, limits.max_scene_bytes).map_err(io)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            io(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "is not UTF-8 text (byte {} is invalid)",
+                    e.utf8_error().valid_up_to()
+                ),
+            ))
         })?;
-        Self::from_toml_str(&text, path)
+        Self::from_toml_str_with(&text, path, limits)
     }
 
     /// A scene from a command-line argument: `builtin:NAME` ([`crate::builtin_names`]) or a path
@@ -382,9 +437,17 @@ impl Scene {
     /// # Errors
     /// [`SceneError::UnknownBuiltin`], and those of [`Scene::from_path`].
     pub fn load(arg: &str) -> Result<Scene, SceneError> {
+        Self::load_with(arg, &SceneLimits::default())
+    }
+
+    /// As [`Scene::load`], with files read within `limits`.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownBuiltin`], and those of [`Scene::from_path_with`].
+    pub fn load_with(arg: &str, limits: &SceneLimits) -> Result<Scene, SceneError> {
         match arg.strip_prefix("builtin:") {
             Some(name) => crate::builtin::builtin(name),
-            None => Self::from_path(arg),
+            None => Self::from_path_with(arg, limits),
         }
     }
 }

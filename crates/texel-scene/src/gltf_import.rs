@@ -11,10 +11,19 @@
 //! The base colour texture's sampler gives the address modes (`wrapS`/`wrapT`: `REPEAT` ->
 //! Repeat, `MIRRORED_REPEAT` -> MirrorRepeat, `CLAMP_TO_EDGE` -> ClampToEdge; glTF's default is
 //! Repeat) and the filters ([`MeshFilters`]). Images are not loaded: the scene file names the
-//! texture. Buffers are loaded with `gltf::import_buffers` (data URIs, files beside the glTF, the
-//! GLB binary chunk); accessors outside their buffers read as missing and are reported.
+//! texture.
+//!
+//! Hostile files are refused before they cost anything ([`SceneLimits`]): the node hierarchy must
+//! be disjoint trees as glTF 2.0 requires (a node with two parents, a cycle, or a scene root that
+//! is another node's child would instantiate shared subtrees exponentially often); the instances'
+//! triangles and vertices are counted from accessor counts before any is read; buffers are read
+//! here, not by `gltf::import_buffers`: at most `byteLength` bytes each, from the GLB binary chunk,
+//! a base64 `data:` URI or a regular file beside the glTF (absolute paths and `file:` URIs are
+//! allowed, other schemes are not), and their `byteLength`s together within the file bound.
+//! Accessors outside their buffers read as missing and are reported.
 
-use std::path::Path;
+use std::io::Read;
+use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
@@ -22,6 +31,7 @@ use gltf::texture::{MagFilter, MinFilter, WrappingMode};
 use texel_texture::{AddressMode, FilterMode, MipmapFilterMode};
 
 use crate::error::SceneError;
+use crate::limits::SceneLimits;
 use crate::model::{Mesh, MeshFilters};
 
 fn wrap(m: WrappingMode) -> AddressMode {
@@ -54,13 +64,13 @@ pub fn filters(mag: Option<MagFilter>, min: Option<MinFilter>) -> MeshFilters {
     }
 }
 
-/// Deepest node nesting followed (guards against cyclic hierarchies in malformed files).
+/// Deepest node nesting followed (the recursion's stack depth).
 const MAX_DEPTH: usize = 256;
 
 struct Ctx<'a> {
     path: &'a Path,
     texture: &'a str,
-    buffers: &'a [gltf::buffer::Data],
+    buffers: &'a [Vec<u8>],
     out: Vec<Mesh>,
 }
 
@@ -75,7 +85,7 @@ impl Ctx<'_> {
     fn node(&mut self, node: gltf::Node, parent: Mat4, depth: usize) -> Result<(), SceneError> {
         if depth > MAX_DEPTH {
             return Err(self.bad(format!(
-                "node hierarchy deeper than {MAX_DEPTH} (a cycle?) at node {}",
+                "node hierarchy deeper than {MAX_DEPTH} at node {}",
                 node.index()
             )));
         }
@@ -94,7 +104,7 @@ impl Ctx<'_> {
         for (pi, prim) in mesh.primitives().enumerate() {
             let what = format!("mesh {} primitive {pi}", mesh.index());
             let buffers = self.buffers;
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
             let positions: Vec<Vec3> = reader
                 .read_positions()
                 .ok_or_else(|| self.bad(format!("{what}: no readable POSITION")))?
@@ -176,46 +186,274 @@ impl Ctx<'_> {
     }
 }
 
+/// Triangles a primitive of `mode` makes from `n` indices (glTF 2.0 spec 3.7.2.1).
+fn triangle_count(mode: Mode, n: u64) -> Option<u64> {
+    match mode {
+        Mode::Triangles => Some(n / 3),
+        Mode::TriangleStrip | Mode::TriangleFan => Some(n.saturating_sub(2)),
+        _ => None,
+    }
+}
+
+/// Check that the nodes form disjoint trees: every node has at most one parent, no node is its
+/// own ancestor, and a scene's root nodes are nobody's children.
+fn check_hierarchy(document: &gltf::Document) -> Result<(), String> {
+    let n = document.nodes().len();
+    let mut parent: Vec<Option<usize>> = vec![None; n];
+    for node in document.nodes() {
+        for child in node.children() {
+            let c = child.index();
+            if let Some(p) = parent[c] {
+                return Err(format!(
+                    "node {c} is a child of both node {p} and node {}: glTF 2.0 node hierarchies must be disjoint trees",
+                    node.index()
+                ));
+            }
+            parent[c] = Some(node.index());
+        }
+    }
+    // With one parent each, a cycle is a chain of parents that comes back to its start.
+    for start in 0..n {
+        let mut at = start;
+        for _ in 0..=n {
+            match parent[at] {
+                Some(p) if p == start => {
+                    return Err(format!("node {start} is its own ancestor (a cycle)"))
+                }
+                Some(p) => at = p,
+                None => break,
+            }
+        }
+    }
+    for scene in document.scenes() {
+        for root in scene.nodes() {
+            if let Some(p) = parent[root.index()] {
+                return Err(format!(
+                    "node {} is a root of scene {} but also a child of node {p}",
+                    root.index(),
+                    scene.index()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The triangles and vertices of `mesh`'s primitives, from accessor counts (nothing is read).
+fn mesh_counts(mesh: &gltf::Mesh) -> (u64, u64) {
+    let (mut tris, mut verts) = (0u64, 0u64);
+    for prim in mesh.primitives() {
+        let v = prim
+            .get(&gltf::Semantic::Positions)
+            .map_or(0, |a| a.count() as u64);
+        let i = prim.indices().map_or(v, |a| a.count() as u64);
+        tris = tris.saturating_add(triangle_count(prim.mode(), i).unwrap_or(0));
+        verts = verts.saturating_add(v);
+    }
+    (tris, verts)
+}
+
+/// Read buffer `buffer`: exactly its `byteLength` bytes (padded to a multiple of 4, as the gltf
+/// crate's readers expect).
+fn read_buffer(
+    buffer: &gltf::Buffer,
+    base: Option<&Path>,
+    blob: Option<&[u8]>,
+) -> Result<Vec<u8>, String> {
+    let len = buffer.length();
+    let i = buffer.index();
+    let mut data = match buffer.source() {
+        gltf::buffer::Source::Bin => {
+            let blob = blob.ok_or(format!(
+                "buffer {i} refers to a GLB binary chunk the file does not have"
+            ))?;
+            blob.get(..len)
+                .ok_or(format!(
+                    "buffer {i}: byteLength {len} but the GLB binary chunk has {} bytes",
+                    blob.len()
+                ))?
+                .to_vec()
+        }
+        gltf::buffer::Source::Uri(uri) => {
+            if let Some(rest) = uri.strip_prefix("data:") {
+                let b64 = rest
+                    .split_once(";base64,")
+                    .map(|(_, d)| d)
+                    .ok_or(format!("buffer {i}: a data URI that is not base64"))?;
+                if b64.len() / 4 > len / 3 + 1 {
+                    return Err(format!(
+                        "buffer {i}: the data URI holds {} base64 characters, more than byteLength {len} needs",
+                        b64.len()
+                    ));
+                }
+                use base64::Engine;
+                base64::engine::general_purpose::STANDARD
+                    .decode(b64.trim_end())
+                    .map_err(|e| format!("buffer {i}: invalid base64 data URI: {e}"))?
+            } else {
+                let path = buffer_path(uri, base).map_err(|e| format!("buffer {i}: {e}"))?;
+                let file = texel_texture::input::open_regular(&path)
+                    .map_err(|e| format!("buffer {i}: {}: {e}", path.display()))?;
+                let mut data = Vec::new();
+                file.take(len as u64)
+                    .read_to_end(&mut data)
+                    .map_err(|e| format!("buffer {i}: {}: {e}", path.display()))?;
+                data
+            }
+        }
+    };
+    if data.len() < len {
+        return Err(format!(
+            "buffer {i}: byteLength {len} but its data has only {} bytes",
+            data.len()
+        ));
+    }
+    data.truncate(len);
+    data.resize(len.next_multiple_of(4), 0);
+    Ok(data)
+}
+
+/// The file a buffer URI names: a relative reference (percent-decoded) against `base`, an absolute
+/// path, or a `file:` URI.
+fn buffer_path(uri: &str, base: Option<&Path>) -> Result<PathBuf, String> {
+    let decoded = urlencoding::decode(uri)
+        .map_err(|_| format!("URI {uri:?} is not valid UTF-8 after percent-decoding"))?;
+    let path = if let Some(rest) = decoded
+        .strip_prefix("file://")
+        .or(decoded.strip_prefix("file:"))
+    {
+        PathBuf::from(rest)
+    } else if decoded.contains(':') && !Path::new(&*decoded).is_absolute() {
+        return Err(format!(
+            "URI {uri:?} has a scheme texel does not read (only data:, file: and paths)"
+        ));
+    } else {
+        PathBuf::from(&*decoded)
+    };
+    if path.is_absolute() {
+        return Ok(path);
+    }
+    base.map(|b| b.join(&path)).ok_or_else(|| {
+        format!("URI {uri:?} names an external file, but the glTF was given as bytes")
+    })
+}
+
+/// Load every triangle primitive of `path` (module docs) as meshes using texture `texture`,
+/// within the default [`SceneLimits`].
+///
+/// # Errors
+/// As [`load_gltf_with`].
+pub fn load_gltf(path: &Path, texture: &str) -> Result<Vec<Mesh>, SceneError> {
+    load_gltf_with(path, texture, &SceneLimits::default())
+}
+
 /// Load every triangle primitive of `path` (module docs) as meshes using texture `texture`.
 ///
 /// # Errors
-/// [`SceneError::Io`] (unreadable file), [`SceneError::Gltf`] (malformed glTF/GLB, missing or short
-/// buffer), [`SceneError::MeshFile`] (no positions or uvs, non-triangle primitives, no meshes).
-pub fn load_gltf(path: &Path, texture: &str) -> Result<Vec<Mesh>, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let gerr = |source| SceneError::Gltf {
-        path: path.to_path_buf(),
-        source,
-    };
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(gerr)?;
+/// [`SceneError::Io`] (unreadable file, not a regular file, over
+/// [`SceneLimits::max_mesh_file_bytes`]), [`SceneError::Gltf`] (malformed glTF/GLB),
+/// [`SceneError::MeshFile`] (invalid hierarchy, over the limits, missing or short buffer, no
+/// positions or uvs, non-triangle primitives, no triangles).
+pub fn load_gltf_with(
+    path: &Path,
+    texture: &str,
+    limits: &SceneLimits,
+) -> Result<Vec<Mesh>, SceneError> {
+    let bytes =
+        texel_texture::input::read_regular(path, limits.max_mesh_file_bytes).map_err(|source| {
+            SceneError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(gerr)?;
+    load_gltf_slice(&bytes, Some(base), path, texture, limits)
+}
+
+/// As [`load_gltf_with`], from the bytes of a `.gltf` or `.glb` file. External buffer files are
+/// read relative to `base`; with `base = None` only embedded buffers are allowed. `path` names the
+/// file in errors.
+///
+/// # Errors
+/// As [`load_gltf_with`].
+pub fn load_gltf_slice(
+    bytes: &[u8],
+    base: Option<&Path>,
+    path: &Path,
+    texture: &str,
+    limits: &SceneLimits,
+) -> Result<Vec<Mesh>, SceneError> {
+    let bad = |reason: String| SceneError::MeshFile {
+        path: path.to_path_buf(),
+        reason: format!("cannot load glTF: {reason}"),
+    };
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice(bytes).map_err(|source| SceneError::Gltf {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    check_hierarchy(&document).map_err(bad)?;
+    let roots: Vec<gltf::Node> = match document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    {
+        Some(scene) => scene.nodes().collect(),
+        None => Vec::new(),
+    };
+    // Count what the scene instantiates before reading any buffer.
+    let (mut tris, mut verts) = (0u64, 0u64);
+    if roots.is_empty() && document.scenes().len() == 0 {
+        for mesh in document.meshes() {
+            let (t, v) = mesh_counts(&mesh);
+            tris = tris.saturating_add(t);
+            verts = verts.saturating_add(v);
+        }
+    } else {
+        let mut stack = roots.clone();
+        while let Some(node) = stack.pop() {
+            if let Some(mesh) = node.mesh() {
+                let (t, v) = mesh_counts(&mesh);
+                tris = tris.saturating_add(t);
+                verts = verts.saturating_add(v);
+            }
+            stack.extend(node.children());
+        }
+    }
+    if tris > limits.max_triangles || verts > limits.max_vertices {
+        return Err(bad(format!(
+            "the scene instantiates {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",
+            limits.max_triangles, limits.max_vertices
+        )));
+    }
+    let total: u64 = document.buffers().map(|b| b.length() as u64).sum();
+    if total > limits.max_mesh_file_bytes {
+        return Err(bad(format!(
+            "its buffers declare {total} bytes, over the limit of {} bytes",
+            limits.max_mesh_file_bytes
+        )));
+    }
+    let buffers = document
+        .buffers()
+        .map(|b| read_buffer(&b, base, blob.as_deref()))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(bad)?;
     let mut ctx = Ctx {
         path,
         texture,
         buffers: &buffers,
         out: Vec::new(),
     };
-    match document
-        .default_scene()
-        .or_else(|| document.scenes().next())
-    {
-        Some(scene) => {
-            for node in scene.nodes() {
-                ctx.node(node, Mat4::IDENTITY, 0)?;
-            }
+    if document.scenes().len() == 0 {
+        for mesh in document.meshes() {
+            ctx.mesh(&mesh, Mat4::IDENTITY)?;
         }
-        None => {
-            for mesh in document.meshes() {
-                ctx.mesh(&mesh, Mat4::IDENTITY)?;
-            }
+    } else {
+        for node in roots {
+            ctx.node(node, Mat4::IDENTITY, 0)?;
         }
     }
-    if ctx.out.is_empty() {
-        return Err(ctx.bad("no mesh primitives in the file's scene".into()));
+    if ctx.out.iter().all(|m| m.triangles.is_empty()) {
+        return Err(bad("no triangles in the file's scene".into()));
     }
     Ok(ctx.out)
 }

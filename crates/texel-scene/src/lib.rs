@@ -35,6 +35,7 @@ mod camera;
 mod error;
 pub mod file;
 mod gltf_import;
+mod limits;
 mod model;
 mod obj;
 mod procedural;
@@ -46,7 +47,8 @@ pub use builtin::{
 };
 pub use camera::Camera;
 pub use error::SceneError;
-pub use gltf_import::load_gltf;
+pub use gltf_import::{load_gltf, load_gltf_slice, load_gltf_with};
+pub use limits::SceneLimits;
 pub use model::{Mesh, MeshFilters, Output, Scene, TextureSource, TextureSpec, MAX_OUTPUT_SIDE};
-pub use obj::load_obj;
+pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::Procedural;

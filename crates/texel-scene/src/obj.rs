@@ -12,40 +12,141 @@ use glam::{Vec2, Vec3, Vec4};
 use texel_texture::AddressMode;
 
 use crate::error::SceneError;
+use crate::limits::SceneLimits;
 use crate::model::Mesh;
 
 fn chunks<const N: usize>(v: &[f32]) -> impl Iterator<Item = [f32; N]> + '_ {
     v.chunks_exact(N).map(|c| std::array::from_fn(|k| c[k]))
 }
 
-/// Load `path` as one [`Mesh`] using texture `texture` (address modes Repeat, no glTF filters).
+/// Load `path` as one [`Mesh`] using texture `texture` (address modes Repeat, no glTF filters),
+/// within the default [`SceneLimits`].
 ///
 /// # Errors
-/// [`SceneError::Io`] (unreadable), [`SceneError::Obj`] (parse error),
-/// [`SceneError::MeshFile`] (no texture coordinates, indices over `u32`).
+/// As [`load_obj_with`].
 pub fn load_obj(path: &Path, texture: &str) -> Result<Mesh, SceneError> {
-    let file = std::fs::File::open(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    load_obj_with(path, texture, &SceneLimits::default())
+}
+
+/// Load `path` as one [`Mesh`] using texture `texture`: a regular file of at most
+/// [`SceneLimits::max_mesh_file_bytes`], parsed by [`load_obj_bytes`].
+///
+/// # Errors
+/// [`SceneError::Io`] (unreadable, not a regular file, too large) and those of
+/// [`load_obj_bytes`].
+pub fn load_obj_with(path: &Path, texture: &str, limits: &SceneLimits) -> Result<Mesh, SceneError> {
+    let bytes =
+        texel_texture::input::read_regular(path, limits.max_mesh_file_bytes).map_err(|source| {
+            SceneError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
+    load_obj_bytes(&bytes, path, texture, limits)
+}
+
+/// Faces and vertices an OBJ text declares, counted from its `f` and `v` lines before parsing
+/// (a polygon of n corners is n - 2 triangles).
+fn declared_counts(text: &[u8]) -> (u64, u64) {
+    let (mut tris, mut verts) = (0u64, 0u64);
+    for line in text.split(|&b| b == b'\n') {
+        let mut tokens = line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|t| !t.is_empty());
+        match tokens.next() {
+            Some(b"f") => tris += (tokens.count() as u64).saturating_sub(2),
+            Some(b"v") => verts += 1,
+            _ => {}
+        }
+    }
+    (tris, verts)
+}
+
+fn parse(text: &[u8]) -> tobj::LoadResult {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
-        ..Default::default()
+        // Triangulated, points and lines would become degenerate triangles (a, a, a) and (a, b, b).
+        ignore_points: true,
+        ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj_buf(&mut BufReader::new(file), &opts, |_| {
+    tobj::load_obj_buf(&mut BufReader::new(text), &opts, |_| {
         Err(tobj::LoadError::GenericFailure)
     })
-    .map_err(|source| SceneError::Obj {
-        path: path.to_path_buf(),
-        source,
-    })?;
+}
+
+/// The 1-based line at which parsing `text` first fails: tobj stops at the first bad line, so a
+/// prefix of the file fails exactly when it contains that line (binary search over prefixes).
+/// The line's text is `None` when it is not UTF-8 (binary data).
+fn failing_line(text: &[u8]) -> Option<(usize, Option<String>)> {
+    let ends: Vec<usize> = text
+        .iter()
+        .enumerate()
+        .filter(|(_, &b)| b == b'\n')
+        .map(|(i, _)| i + 1)
+        .chain(std::iter::once(text.len()))
+        .collect();
+    let (mut lo, mut hi) = (0usize, ends.len() - 1);
+    if parse(&text[..ends[hi]]).is_ok() {
+        return None;
+    }
+    // Invariant: the prefix of lines 0..=hi fails; lines 0..lo (exclusive of lo) parse.
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if parse(&text[..ends[mid]]).is_err() {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    let start = if hi == 0 { 0 } else { ends[hi - 1] };
+    let line = std::str::from_utf8(&text[start..ends[hi]]).ok().map(|l| {
+        let l = l.trim_end();
+        if l.chars().count() > 60 {
+            l.chars().take(60).collect::<String>() + "..."
+        } else {
+            l.to_string()
+        }
+    });
+    Some((hi + 1, line))
+}
+
+/// Parse OBJ text as one [`Mesh`] (module docs). `path` names the file in errors.
+///
+/// # Errors
+/// [`SceneError::Obj`]: a parse error, with the line number and the line; [`SceneError::MeshFile`]:
+/// over the limits (counted before parsing), no texture coordinates, no triangles, indices over
+/// `u32`.
+pub fn load_obj_bytes(
+    bytes: &[u8],
+    path: &Path,
+    texture: &str,
+    limits: &SceneLimits,
+) -> Result<Mesh, SceneError> {
     let bad = |reason: String| SceneError::MeshFile {
         path: path.to_path_buf(),
         reason,
     };
+    let (tris, verts) = declared_counts(bytes);
+    if tris > limits.max_triangles || verts > limits.max_vertices {
+        return Err(bad(format!(
+            "it declares {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",
+            limits.max_triangles, limits.max_vertices
+        )));
+    }
+    let (models, _materials) = parse(bytes).map_err(|source| SceneError::Obj {
+        path: path.to_path_buf(),
+        at: failing_line(bytes).map(|(line, text)| match text {
+            Some(t) => format!("line {line} ({t:?})"),
+            None => format!("line {line} (not UTF-8 text: is this an OBJ file?)"),
+        }),
+        source,
+    })?;
+    let no_triangles = || {
+        bad("no triangles: an OBJ file needs f lines with 3 or more corners (points and lines are not drawn)".into())
+    };
     if models.is_empty() {
-        return Err(bad("the OBJ file has no faces".into()));
+        return Err(no_triangles());
     }
     let mut mesh = Mesh {
         positions: Vec::new(),
@@ -94,6 +195,9 @@ pub fn load_obj(path: &Path, texture: &str) -> Result<Mesh, SceneError> {
                 .chunks_exact(3)
                 .map(|t| [base + t[0], base + t[1], base + t[2]]),
         );
+    }
+    if mesh.triangles.is_empty() {
+        return Err(no_triangles());
     }
     Ok(mesh)
 }

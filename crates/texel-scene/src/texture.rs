@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 
-use texel_texture::{ColorSpace, Limits, Texture};
+use texel_texture::{ColorSpace, Limits, LoadOptions, Loaded, Texture};
 
 use crate::error::SceneError;
 use crate::model::{Scene, TextureSource, TextureSpec};
@@ -25,23 +25,46 @@ impl TextureSpec {
         color_override: Option<ColorSpace>,
         limits: &Limits,
     ) -> Result<Texture, SceneError> {
+        self.load_with(name, color_override, limits, false)
+            .map(|l| l.texture)
+    }
+
+    /// As [`TextureSpec::load`]; with `replace_non_finite`, NaN and infinite float texels are
+    /// replaced ([`texel_texture::replace_non_finite`]) rather than refused, and counted.
+    ///
+    /// # Errors
+    /// As [`TextureSpec::load`].
+    pub fn load_with(
+        &self,
+        name: &str,
+        color_override: Option<ColorSpace>,
+        limits: &Limits,
+        replace_non_finite: bool,
+    ) -> Result<Loaded, SceneError> {
         let color = self.color_space(color_override);
         match &self.source {
             TextureSource::File(path) => {
-                Texture::load(path, color, limits).map_err(|source| SceneError::Texture {
+                let options = LoadOptions {
+                    replace_non_finite,
+                    ..LoadOptions::new(color, *limits)
+                };
+                Texture::load_with(path, &options).map_err(|source| SceneError::Texture {
                     name: name.to_string(),
                     path: Some(path.clone()),
                     source,
                 })
             }
-            TextureSource::Procedural(p) => {
-                p.generate(color, limits)
-                    .map_err(|source| SceneError::Texture {
-                        name: name.to_string(),
-                        path: None,
-                        source,
-                    })
-            }
+            TextureSource::Procedural(p) => p
+                .generate(color, limits)
+                .map(|texture| Loaded {
+                    texture,
+                    replaced: 0,
+                })
+                .map_err(|source| SceneError::Texture {
+                    name: name.to_string(),
+                    path: None,
+                    source,
+                }),
         }
     }
 }

@@ -37,13 +37,13 @@ impl Scene {
     /// output sides in `1..=MAX_OUTPUT_SIDE`; camera values finite, `0 < near < far`,
     /// `0 < fovy_deg < 180`, `eye != target`, `up` not parallel to the view direction; per mesh
     /// `uvs`/`normals`/`colors` as long as `positions`, every index in range, every value finite,
-    /// its texture defined.
+    /// its texture defined; at least one mesh, each with at least one triangle.
     ///
     /// # Errors
     /// The first problem found, as [`SceneError::OutputSize`], [`SceneError::NonFinite`],
     /// [`SceneError::CameraNearFar`], [`SceneError::CameraFov`], [`SceneError::CameraDegenerate`],
     /// [`SceneError::MeshLength`], [`SceneError::IndexOutOfRange`] or
-    /// [`SceneError::UnknownTexture`].
+    /// [`SceneError::UnknownTexture`] or [`SceneError::Empty`].
     pub fn validate(&self) -> Result<(), SceneError> {
         let o = &self.output;
         if !(1..=MAX_OUTPUT_SIDE).contains(&o.width) || !(1..=MAX_OUTPUT_SIDE).contains(&o.height) {
@@ -88,7 +88,17 @@ impl Scene {
                 up: c.up.to_array(),
             });
         }
+        if self.meshes.is_empty() {
+            return Err(SceneError::Empty(
+                "the scene has no meshes: there is nothing to render".into(),
+            ));
+        }
         for (mi, m) in self.meshes.iter().enumerate() {
+            if m.triangles.is_empty() {
+                return Err(SceneError::Empty(format!(
+                    "meshes[{mi}] has no triangles: there is nothing to render"
+                )));
+            }
             let n = m.positions.len();
             let len = |attribute: &'static str, got: usize| {
                 if got == n {

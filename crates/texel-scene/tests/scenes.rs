@@ -423,7 +423,9 @@ fn obj_mesh() {
     fs::write(d.join("bad.obj"), "v 0 0 0\nvt 0 0\nf 1/1 9/1 3/1\n").unwrap();
     let e = texel_scene::load_obj(&d.join("bad.obj"), "t").unwrap_err();
     assert!(
-        matches!(e, SceneError::Obj { .. }) && e.to_string().contains("bad.obj"),
+        matches!(e, SceneError::Obj { .. })
+            && e.to_string().contains("bad.obj")
+            && e.to_string().contains("line 3 (\"f 1/1 9/1 3/1\")"),
         "{e}"
     );
     let e = texel_scene::load_obj(&d.join("none.obj"), "t").unwrap_err();
@@ -549,11 +551,17 @@ fn gltf_with_external_buffer_and_glb() {
     fs::write(d.join("cut.glb"), &glb[..40]).unwrap();
     fs::write(d.join("junk.gltf"), "{ not json").unwrap();
     fs::write(d.join("nobuf.gltf"), triangle_json(Some("gone.bin"))).unwrap();
-    for f in ["cut.glb", "junk.gltf", "nobuf.gltf"] {
+    for f in ["cut.glb", "junk.gltf"] {
         let e = texel_scene::load_gltf(&d.join(f), "t").unwrap_err();
         assert!(matches!(e, SceneError::Gltf { .. }), "{f}: {e}");
         assert!(e.to_string().contains(f), "{e}");
     }
+    let e = texel_scene::load_gltf(&d.join("nobuf.gltf"), "t").unwrap_err();
+    assert!(matches!(e, SceneError::MeshFile { .. }), "{e}");
+    assert!(
+        e.to_string().contains("nobuf.gltf") && e.to_string().contains("gone.bin"),
+        "{e}"
+    );
     // A mesh without TEXCOORD_0.
     let no_uv = triangle_json(Some("tri.bin")).replace(", \"TEXCOORD_0\": 1", "");
     fs::write(d.join("nouv.gltf"), no_uv).unwrap();

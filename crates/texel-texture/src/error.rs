@@ -27,7 +27,7 @@ pub enum TextureError {
         max: u32,
     },
     /// The bytes the texture and its structures would take exceed [`crate::Limits::max_bytes`].
-    #[error("texture {width}x{height} would need {bytes} bytes with its mip pyramid, over the limit of {max} bytes")]
+    #[error("texture {width}x{height} would need {bytes} bytes to load with its mip pyramid ({} MiB), over the limit of {max} bytes ({} MiB)", bytes >> 20, max >> 20)]
     OverMemoryLimit {
         /// Requested width in texels.
         width: u32,
@@ -110,6 +110,21 @@ pub enum TextureError {
         /// The limit in bytes.
         max: u64,
     },
+    /// A float texel (level 0, pixel `x, y` of the image, row 0 at the top) is NaN or infinite.
+    #[error("texel ({x}, {y}) channel {channel} is {value}: textures must be finite (pass --sanitize to replace NaN with 0 and infinities with +-65504)")]
+    NonFiniteTexel {
+        /// Column of the texel.
+        x: u32,
+        /// Row of the texel (0 is the top).
+        y: u32,
+        /// `"R"`, `"G"`, `"B"` or `"A"`.
+        channel: &'static str,
+        /// The value found.
+        value: f32,
+    },
+    /// The image file ends before its data does.
+    #[error("truncated image: {0}")]
+    Truncated(String),
     /// A lab mode outside 1..=8.
     #[error("unknown lab mode {0}: valid modes are 1 (nearest) to 8 (anisotropic 16x)")]
     UnknownLabMode(u8),

@@ -40,6 +40,7 @@ mod error;
 pub mod ewa;
 mod fetch;
 pub mod footprint;
+pub mod input;
 pub mod mip;
 mod nearest;
 pub mod pyramid;
@@ -58,4 +59,7 @@ pub use sampler::{
     FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,
 };
 pub use sat::SummedAreaTable;
-pub use texture::{ColorSpace, Format, LevelInfo, Limits, Texture};
+pub use texture::{
+    replace_non_finite, ColorSpace, Format, LevelInfo, Limits, LoadOptions, Loaded, Texture,
+    NON_FINITE_CLAMP,
+};

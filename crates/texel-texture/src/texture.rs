@@ -73,6 +73,57 @@ impl Default for Limits {
 }
 
 impl Limits {
+    /// The bytes [`Texture::decode`] holds at once, at most, for an encoded file of `file_bytes`
+    /// whose header says `width x height` pixels of `color`: the file, the decoded image, two
+    /// copies of its texels (conversion and the texture's own), and the pyramid's coarser levels
+    /// with their `f32` build scratch. An upper bound, not a measurement of one run.
+    pub fn load_bytes(file_bytes: u64, width: u32, height: u32, color: image::ColorType) -> u64 {
+        let px = u64::from(width) * u64::from(height);
+        let texel = match color {
+            image::ColorType::L8
+            | image::ColorType::La8
+            | image::ColorType::Rgb8
+            | image::ColorType::Rgba8 => 4,
+            _ => 16,
+        };
+        let below = pyramid::pyramid_texels(width, height) - px;
+        file_bytes
+            .saturating_add(px.saturating_mul(u64::from(color.bytes_per_pixel())))
+            .saturating_add(px.saturating_mul(2 * texel))
+            .saturating_add(below.saturating_mul(texel + 16))
+    }
+
+    /// Check an image file's header against these limits before decoding it: the sides
+    /// ([`Limits::check`]'s rules) and [`Limits::load_bytes`] against [`Limits::max_bytes`].
+    ///
+    /// # Errors
+    /// [`TextureError::EmptySize`], [`TextureError::TooLarge`] or
+    /// [`TextureError::OverMemoryLimit`] with the figures.
+    pub fn check_load(
+        &self,
+        file_bytes: u64,
+        width: u32,
+        height: u32,
+        color: image::ColorType,
+    ) -> Result<(), TextureError> {
+        use image::ColorType as C;
+        let format = match color {
+            C::L8 | C::La8 | C::Rgb8 | C::Rgba8 => Format::Rgba8Unorm,
+            _ => Format::Rgba32Float,
+        };
+        self.check(width, height, format)?;
+        let bytes = Self::load_bytes(file_bytes, width, height, color);
+        if bytes > self.max_bytes {
+            return Err(TextureError::OverMemoryLimit {
+                width,
+                height,
+                bytes,
+                max: self.max_bytes,
+            });
+        }
+        Ok(())
+    }
+
     /// Check a `width x height` texture of `format` against these limits.
     ///
     /// # Errors
@@ -104,6 +155,84 @@ impl Limits {
         }
         Ok(())
     }
+}
+
+/// How [`Texture::load_with`] and [`Texture::decode_with`] read an image file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Colour space of 8- and 16-bit images (float images are linear).
+    pub color: ColorSpace,
+    /// Size and memory limits.
+    pub limits: Limits,
+    /// Replace NaN and infinite float texels ([`replace_non_finite`]) instead of refusing the
+    /// image; [`Loaded::replaced`] says how many values were replaced.
+    pub replace_non_finite: bool,
+}
+
+impl LoadOptions {
+    /// `color` and `limits`, refusing non-finite texels.
+    pub fn new(color: ColorSpace, limits: Limits) -> Self {
+        LoadOptions {
+            color,
+            limits,
+            replace_non_finite: false,
+        }
+    }
+}
+
+/// A texture read from a file, and how many non-finite channel values were replaced.
+#[derive(Debug)]
+pub struct Loaded {
+    /// The texture.
+    pub texture: Texture,
+    /// Channel values replaced by [`replace_non_finite`] (0 unless asked for).
+    pub replaced: u64,
+}
+
+/// The largest finite half-float (`65504`), what an infinite texel becomes: OpenEXR stores half
+/// floats, so this is the brightest value such a file can hold.
+pub const NON_FINITE_CLAMP: f32 = 65504.0;
+
+/// Replace every NaN channel value with 0 and every infinity with `±`[`NON_FINITE_CLAMP`];
+/// returns how many values changed.
+pub fn replace_non_finite(texels: &mut [[f32; 4]]) -> u64 {
+    let mut n = 0;
+    for c in texels.iter_mut().flatten() {
+        if !c.is_finite() {
+            *c = if c.is_nan() {
+                0.0
+            } else {
+                NON_FINITE_CLAMP.copysign(*c)
+            };
+            n += 1;
+        }
+    }
+    n
+}
+
+/// A JPEG whose header claims `width x height` must end in its EOI marker after its last scan, and
+/// hold at least one bit per 8x8 block of its full-resolution component: every block's DC
+/// difference is a Huffman code of at least one bit (ITU T.81, F.1.2.1; arithmetic coding, which
+/// could go below, is not decoded by texel's decoder anyway). The decoder itself fills what is
+/// missing with grey.
+fn check_jpeg_complete(bytes: &[u8], width: u32, height: u32) -> Result<(), TextureError> {
+    let last_sos = bytes.windows(2).rposition(|w| w == [0xFF, 0xDA]);
+    let eoi_after = last_sos.is_some_and(|s| bytes[s..].windows(2).any(|w| w == [0xFF, 0xD9]));
+    if !eoi_after {
+        return Err(TextureError::Truncated(format!(
+            "the JPEG ({} bytes) has no end-of-image marker after its last scan",
+            bytes.len()
+        )));
+    }
+    let blocks = u64::from(width.div_ceil(8)) * u64::from(height.div_ceil(8));
+    let need = blocks.div_ceil(8);
+    if (bytes.len() as u64) < need {
+        return Err(TextureError::Truncated(format!(
+            "a {width}x{height} JPEG has {blocks} blocks and needs at least {need} bytes of coded data, but the file has {}",
+            bytes.len()
+        )));
+    }
+    Ok(())
 }
 
 /// Where one mip level lives in the texture's storage.
@@ -195,10 +324,12 @@ impl Texture {
 
     /// A texture from row-major linear `f32` RGBA texels, building its pyramid.
     ///
-    /// Non-finite texel values are accepted and propagate through filtering.
+    /// Every value must be finite: one NaN would spread through every coarser level (and an
+    /// infinity makes its averages NaN). [`replace_non_finite`] cleans data that has them.
     ///
     /// # Errors
-    /// Size or memory limits ([`Limits::check`]) and [`TextureError::DataLength`].
+    /// Size or memory limits ([`Limits::check`]), [`TextureError::DataLength`] and
+    /// [`TextureError::NonFiniteTexel`] naming the first non-finite value in row-major order.
     pub fn from_rgba32f(
         width: u32,
         height: u32,
@@ -207,6 +338,15 @@ impl Texture {
     ) -> Result<Self, TextureError> {
         limits.check(width, height, Format::Rgba32Float)?;
         check_len(width, height, texels.len())?;
+        if let Some(k) = texels.iter().position(|t| !t.iter().all(|c| c.is_finite())) {
+            let channel = texels[k].iter().position(|c| !c.is_finite()).unwrap_or(0);
+            return Err(TextureError::NonFiniteTexel {
+                x: (k % width as usize) as u32,
+                y: (k / width as usize) as u32,
+                channel: ["R", "G", "B", "A"][channel],
+                value: texels[k][channel],
+            });
+        }
         let level0 = F32Level {
             width,
             height,
@@ -263,52 +403,95 @@ impl Texture {
 
     /// Decode an image file (PNG, JPEG, OpenEXR; format guessed from the content) into a texture.
     ///
-    /// `color` applies to 8- and 16-bit images; float images (EXR) are always linear.
-    /// Dimension and allocation limits are enforced by the decoder and again by [`Limits::check`].
+    /// `color` applies to 8- and 16-bit images; float images (EXR) are always linear. The file
+    /// must be a regular file (a FIFO or device is refused before it is opened, see
+    /// [`crate::input`]); everything else is as [`Texture::decode`] says.
     ///
     /// # Errors
-    /// [`TextureError::Io`], [`TextureError::Decode`] (corrupt, truncated, over the decoder's
-    /// limits), [`TextureError::UnsupportedFormat`] and the size errors.
+    /// [`TextureError::Io`], and those of [`Texture::decode`].
     pub fn load(
         path: impl AsRef<Path>,
         color: ColorSpace,
         limits: &Limits,
     ) -> Result<Self, TextureError> {
-        let reader = image::ImageReader::open(path)?.with_guessed_format()?;
-        Self::decode_reader(reader, color, limits)
+        Self::load_with(path, &LoadOptions::new(color, *limits)).map(|l| l.texture)
     }
 
-    /// As [`Texture::load`], from bytes in memory.
+    /// As [`Texture::load`], with the non-finite-texel policy of `options`.
     ///
     /// # Errors
     /// As [`Texture::load`].
-    pub fn decode(bytes: &[u8], color: ColorSpace, limits: &Limits) -> Result<Self, TextureError> {
-        let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format()?;
-        Self::decode_reader(reader, color, limits)
+    pub fn load_with(
+        path: impl AsRef<Path>,
+        options: &LoadOptions,
+    ) -> Result<Loaded, TextureError> {
+        let bytes = crate::input::read_regular(path.as_ref(), options.limits.max_bytes)?;
+        Self::decode_with(&bytes, options)
     }
 
-    fn decode_reader<R: std::io::BufRead + std::io::Seek>(
-        mut reader: image::ImageReader<R>,
-        color: ColorSpace,
-        limits: &Limits,
-    ) -> Result<Self, TextureError> {
+    /// As [`Texture::load`], from the bytes of an image file in memory.
+    ///
+    /// Before any pixel is decoded: the header's size is checked against `limits`
+    /// ([`Limits::check_load`] counts the encoded bytes, the decoded image, its conversion to
+    /// texels and the pyramid with its build scratch, all held at once); a JPEG must end in its
+    /// end-of-image marker and be large enough to hold one coded bit per 8x8 block (a truncated
+    /// file is an error, not an image filled with grey). After decoding, a float texel that is NaN
+    /// or infinite is an error naming it ([`LoadOptions::replace_non_finite`] replaces them).
+    ///
+    /// # Errors
+    /// [`TextureError::Decode`] (corrupt, unsupported), [`TextureError::Truncated`],
+    /// [`TextureError::NonFiniteTexel`], [`TextureError::UnsupportedFormat`] and the size errors.
+    pub fn decode(bytes: &[u8], color: ColorSpace, limits: &Limits) -> Result<Self, TextureError> {
+        Self::decode_with(bytes, &LoadOptions::new(color, *limits)).map(|l| l.texture)
+    }
+
+    /// The size and pixel type an image file's header declares, without decoding its pixels.
+    ///
+    /// # Errors
+    /// [`TextureError::Decode`] for an unknown format or a corrupt header.
+    pub fn header(bytes: &[u8]) -> Result<(u32, u32, image::ColorType), TextureError> {
+        let decoder = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()?
+            .into_decoder()?;
+        let (w, h) = image::ImageDecoder::dimensions(&decoder);
+        Ok((w, h, image::ImageDecoder::color_type(&decoder)))
+    }
+
+    /// As [`Texture::decode`], with the non-finite-texel policy of `options`.
+    ///
+    /// # Errors
+    /// As [`Texture::decode`].
+    pub fn decode_with(bytes: &[u8], options: &LoadOptions) -> Result<Loaded, TextureError> {
+        let (color, limits) = (options.color, &options.limits);
+        let mut reader =
+            image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format()?;
+        let format = reader.format();
         let mut l = image::Limits::default();
         l.max_image_width = Some(limits.max_dimension);
         l.max_image_height = Some(limits.max_dimension);
         l.max_alloc = Some(limits.max_bytes);
         reader.limits(l);
-        let img = reader.decode()?;
-        let (width, height) = (img.width(), img.height());
+        let decoder = reader.into_decoder()?;
+        let (width, height) = image::ImageDecoder::dimensions(&decoder);
+        let decoded_color = image::ImageDecoder::color_type(&decoder);
+        limits.check_load(bytes.len() as u64, width, height, decoded_color)?;
+        if format == Some(image::ImageFormat::Jpeg) {
+            check_jpeg_complete(bytes, width, height)?;
+        }
+        let img = image::DynamicImage::from_decoder(decoder)?;
         use image::ColorType as C;
         match img.color() {
             C::L8 | C::La8 | C::Rgb8 | C::Rgba8 => {
                 let texels = img.into_rgba8().pixels().map(|p| p.0).collect();
-                Self::from_rgba8(width, height, texels, color, limits)
+                Self::from_rgba8(width, height, texels, color, limits).map(|texture| Loaded {
+                    texture,
+                    replaced: 0,
+                })
             }
             C::L16 | C::La16 | C::Rgb16 | C::Rgba16 | C::Rgb32F | C::Rgba32F => {
                 let encoded =
                     !matches!(img.color(), C::Rgb32F | C::Rgba32F) && color == ColorSpace::Srgb;
-                let texels = img
+                let mut texels: Vec<[f32; 4]> = img
                     .into_rgba32f()
                     .pixels()
                     .map(|p| {
@@ -320,7 +503,13 @@ impl Texture {
                         }
                     })
                     .collect();
+                let replaced = if options.replace_non_finite {
+                    replace_non_finite(&mut texels)
+                } else {
+                    0
+                };
                 Self::from_rgba32f(width, height, texels, limits)
+                    .map(|texture| Loaded { texture, replaced })
             }
             other => Err(TextureError::UnsupportedFormat(other)),
         }

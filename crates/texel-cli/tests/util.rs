@@ -1,0 +1,201 @@
+//! Helpers shared by the integration tests, in the style of ripgrep's `tests/util.rs`: [`texel`]
+//! runs the binary, [`ok`] and [`fails`] check its exit, [`Dir`] is a scratch directory per test.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use texel_quality::Image8;
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------------------------
+
+/// Every filter name, in the CLI's order.
+pub(crate) const FILTERS: [&str; 12] = [
+    "nearest",
+    "bilinear",
+    "bicubic",
+    "mip-nearest",
+    "trilinear",
+    "aniso2",
+    "aniso4",
+    "aniso8",
+    "aniso16",
+    "ewa",
+    "ripmap",
+    "sat",
+];
+
+/// The built-in scenes the demo covers.
+pub(crate) const BUILTINS: [&str; 6] = [
+    "ground",
+    "ground-rotated",
+    "zoneplate",
+    "cube",
+    "sphere",
+    "triangle",
+];
+
+/// Run `texel` with `args`.
+pub(crate) fn texel<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_texel"))
+        .args(args)
+        .output()
+        .expect("cannot start the texel binary")
+}
+
+pub(crate) fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+pub(crate) fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Run `texel` and require success without a panic; returns the output.
+pub(crate) fn ok<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    let out = texel(args);
+    let err = stderr(&out);
+    assert!(
+        out.status.success(),
+        "texel {:?} failed ({:?}): {err}",
+        args.iter()
+            .map(|a| a.as_ref().to_string_lossy().into_owned())
+            .collect::<Vec<_>>(),
+        out.status.code()
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    out
+}
+
+/// Run `texel`, require exit code `code` (1: texel's own errors, 2: clap's usage errors), no panic,
+/// and every one of `needles` in stderr. Texel's own errors must be exactly one line
+/// `texel: error: ...`. Returns stderr.
+pub(crate) fn fails<S: AsRef<std::ffi::OsStr>>(args: &[S], code: i32, needles: &[&str]) -> String {
+    let out = texel(args);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(code), "stderr: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    if code == 1 {
+        assert_eq!(err.lines().count(), 1, "one error line expected: {err}");
+        assert!(err.starts_with("texel: error: "), "{err}");
+    }
+    for n in needles {
+        assert!(err.contains(n), "stderr lacks {n:?}: {err}");
+    }
+    err
+}
+
+/// A scratch directory under the system temp dir, unique per test (and process); removed when the
+/// test passes, kept for inspection when it fails.
+pub(crate) struct Dir(pub(crate) PathBuf);
+
+impl Dir {
+    pub(crate) fn new(name: &str) -> Dir {
+        let d = std::env::temp_dir().join(format!("texel-cli-test-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        Dir(d)
+    }
+
+    pub(crate) fn path(&self) -> &Path {
+        &self.0
+    }
+
+    pub(crate) fn join(&self, p: &str) -> PathBuf {
+        self.0.join(p)
+    }
+
+    /// `join` as a `String`, for argument lists.
+    pub(crate) fn arg(&self, p: &str) -> String {
+        self.join(p).to_string_lossy().into_owned()
+    }
+
+    pub(crate) fn write(&self, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+        let p = self.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    }
+}
+
+impl Drop for Dir {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+pub(crate) fn load(path: impl AsRef<Path>) -> Image8 {
+    let path = path.as_ref();
+    Image8::load(path).unwrap_or_else(|e| panic!("cannot load {}: {e}", path.display()))
+}
+
+pub(crate) fn file_bytes(path: impl AsRef<Path>) -> Vec<u8> {
+    let path = path.as_ref();
+    std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+}
+
+/// Every file under `dir` (recursively) whose name looks like a temporary of an atomic write:
+/// `.NAME.tmpPID` (texel-cli) or `.NAME.PID.N.tmp` (texel-quality).
+pub(crate) fn temp_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(temp_files(&p));
+        }
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if name.starts_with('.') && name.contains(".tmp") {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// The shipped ground scene (identical to `../shared/scenes/ground.toml`).
+pub(crate) fn ground_toml() -> String {
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../texel-scene/tests/data/ground.toml"
+    )
+    .to_string()
+}
+
+/// Output, camera and a small checker texture `t` of a scene looking at the z = 0 plane from z = 3;
+/// append `[[meshes]]`. Background blue.
+pub(crate) const HEAD: &str = r#"[output]
+width = 64
+height = 48
+background = [0, 0, 255, 255]
+
+[camera]
+eye = [0.0, 0.0, 3.0]
+target = [0.0, 0.0, 0.0]
+fovy_deg = 45.0
+near = 0.1
+far = 10.0
+
+[textures.t]
+procedural = "checker"
+size = 64
+checks = 4
+"#;
+
+/// A valid inline triangle using texture `t`.
+pub(crate) const TRIANGLE: &str = r#"
+[[meshes]]
+texture = "t"
+positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]]
+uvs = [[0.0, 1.0], [1.0, 1.0], [0.5, 0.0]]
+triangles = [[0, 1, 2]]
+"#;
+
+/// The unit quad `[-1, 1]^2` at z = 0 with uv (0, 0) at its top-left, as inline TOML.
+pub(crate) const QUAD: &str = r#"
+[[meshes]]
+texture = "t"
+positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]]
+uvs = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]
+triangles = [[0, 1, 2], [0, 2, 3]]
+"#;

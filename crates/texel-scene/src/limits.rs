@@ -1,0 +1,30 @@
+//! Bounds on what a scene may make texel read and allocate, checked before the allocation.
+
+/// How much a scene and its mesh files may hold. Checked from file sizes and headers (glTF
+/// accessor counts, OBJ face lines) before anything proportional is allocated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneLimits {
+    /// Largest scene TOML file, in bytes. Default 64 MiB (inline meshes of about a million
+    /// triangles; larger meshes belong in OBJ or glTF files).
+    pub max_scene_bytes: u64,
+    /// Largest OBJ file, glTF/GLB file, and sum of one glTF's buffers (`byteLength`), in bytes.
+    /// Default 512 MiB.
+    pub max_mesh_file_bytes: u64,
+    /// Most triangles in the whole scene (glTF instances counted once per instance).
+    /// Default 2^25 = 33,554,432.
+    pub max_triangles: u64,
+    /// Most vertices in the whole scene (glTF instances counted once per instance).
+    /// Default 2^25.
+    pub max_vertices: u64,
+}
+
+impl Default for SceneLimits {
+    fn default() -> Self {
+        SceneLimits {
+            max_scene_bytes: 64 << 20,
+            max_mesh_file_bytes: 512 << 20,
+            max_triangles: 1 << 25,
+            max_vertices: 1 << 25,
+        }
+    }
+}

@@ -1,0 +1,120 @@
+//! Reading input files safely: only regular files, never more than a stated number of bytes.
+//!
+//! A FIFO, a device or a directory where an input file belongs is an error before anything is
+//! opened (opening a FIFO for reading blocks until a writer appears, and `/dev/zero` never ends);
+//! a file larger than the caller's bound is an error carrying both figures, before it is read.
+//! Every input texel reads (images, scene files, OBJ, glTF and their buffers) goes through here.
+
+use std::fs::File;
+use std::io::{self, Read};
+use std::path::Path;
+
+/// Open `path` for reading if it is a regular file (symbolic links followed).
+///
+/// # Errors
+/// The `stat`/`open` error, or [`io::ErrorKind::InvalidInput`] saying what the path is instead
+/// (a directory, a FIFO, a device, a socket).
+pub fn open_regular(path: &Path) -> io::Result<File> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() {
+            "a directory"
+        } else {
+            special_kind(&meta.file_type())
+        };
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("is {what}, not a regular file: texel reads inputs from regular files only"),
+        ));
+    }
+    let file = File::open(path)?;
+    // The path could have been swapped between the two calls; the open file is what counts.
+    if !file.metadata()?.is_file() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "is not a regular file: texel reads inputs from regular files only",
+        ));
+    }
+    Ok(file)
+}
+
+#[cfg(unix)]
+fn special_kind(ft: &std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if ft.is_fifo() {
+        "a FIFO"
+    } else if ft.is_char_device() {
+        "a character device"
+    } else if ft.is_block_device() {
+        "a block device"
+    } else if ft.is_socket() {
+        "a socket"
+    } else {
+        "not a file"
+    }
+}
+
+#[cfg(not(unix))]
+fn special_kind(_ft: &std::fs::FileType) -> &'static str {
+    "not a file"
+}
+
+/// Read the whole regular file `path`, refusing one larger than `max_bytes` before reading it.
+///
+/// # Errors
+/// As [`open_regular`], read errors, and [`io::ErrorKind::InvalidData`] for a file over
+/// `max_bytes` (with its size and the bound in the message).
+pub fn read_regular(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
+    let file = open_regular(path)?;
+    let len = file.metadata()?.len();
+    if len > max_bytes {
+        return Err(too_large(len, max_bytes));
+    }
+    let mut out = Vec::new();
+    out.try_reserve_exact(len as usize).map_err(|_| {
+        io::Error::new(
+            io::ErrorKind::OutOfMemory,
+            format!("cannot allocate {len} bytes to read it"),
+        )
+    })?;
+    // `take` guards against a file that grows while it is read.
+    file.take(max_bytes + 1).read_to_end(&mut out)?;
+    if out.len() as u64 > max_bytes {
+        return Err(too_large(out.len() as u64, max_bytes));
+    }
+    Ok(out)
+}
+
+fn too_large(len: u64, max: u64) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!("is {len} bytes, over the limit of {max} bytes for this input"),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regular_files_only() {
+        let dir = std::env::temp_dir().join(format!("texel-input-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("a.bin");
+        std::fs::write(&f, b"0123456789").unwrap();
+        assert_eq!(read_regular(&f, 10).unwrap(), b"0123456789");
+        let e = read_regular(&f, 9).unwrap_err();
+        assert!(
+            e.to_string().contains("10 bytes, over the limit of 9"),
+            "{e}"
+        );
+        let e = read_regular(&dir, 100).unwrap_err();
+        assert!(e.to_string().contains("a directory"), "{e}");
+        #[cfg(target_os = "linux")]
+        {
+            let e = read_regular(Path::new("/dev/zero"), 100).unwrap_err();
+            assert!(e.to_string().contains("character device"), "{e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
