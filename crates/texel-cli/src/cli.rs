@@ -113,7 +113,7 @@ pub struct SceneArgs {
     /// Colour handling.
     #[arg(long, value_enum, default_value_t)]
     pub color: ColorArg,
-    /// Output size, overriding the scene's (e.g. 640x360).
+    /// Output size WIDTHxHEIGHT, each side 1 to 16384, overriding the scene's (e.g. 640x360).
     #[arg(long)]
     pub size: Option<Size>,
 }
@@ -309,7 +309,7 @@ pub struct WarpArgs {
     /// bottom-left corners: x0,y0,x1,y1,x2,y2,x3,y3 (pixels; (0,0) is the source's top-left corner).
     #[arg(long, allow_hyphen_values = true)]
     pub corners: Corners,
-    /// Output size; defaults to the source size.
+    /// Output size WIDTHxHEIGHT (each side 1 to 16384, at most 2^26 pixels); defaults to the source size.
     #[arg(long)]
     pub size: Option<Size>,
     /// Texture filter.

@@ -12,9 +12,11 @@
 //! edge see it with opposite directions, so exactly one of them owns its pixels: meshes are watertight
 //! with no double coverage. The rule is folded into the constant term (`E - 1 >= 0` for the others).
 //!
-//! Overflow: the clipper's guard band ([`crate::clip::GUARD`] = 8 NDC units) bounds every coordinate to
-//! `4.5 * MAX_DIMENSION` pixels, i.e. `|X| < 2^25` in fixed point, so the edge coefficients stay below
-//! `2^26` and edge values below `2^53`: far from `i64` overflow whatever the input (1e7, 1e30, ...).
+//! Overflow: the clipper's guard band ([`crate::clip::GUARD`] = 8 NDC units) bounds every coordinate,
+//! and the projection clamps NDC to twice the band (clipping coordinates near 1e33 in `f64` can round
+//! far outside it), so every coordinate is within `8.5 * MAX_DIMENSION` pixels, i.e. `|X| < 2^26` in
+//! fixed point: edge coefficients stay below `2^27` and edge values below `2^55`, far from `i64`
+//! overflow whatever the input (1e7, 1e30, NaN-free extremes found by fuzzing).
 //!
 //! ## Attributes: homogeneous plane equations (Olano & Greer 1997)
 //! With `M` the 3x3 matrix whose columns are the original triangle's clip-space `(x, y, w)`, a point of
@@ -348,7 +350,15 @@ fn homogeneous_planes(
 #[inline]
 fn project(v: &ClipVertex, width: u32, height: u32) -> (f64, f64) {
     let inv_w = 1.0 / v.pos.w;
-    crate::camera::viewport(v.pos.x * inv_w, v.pos.y * inv_w, width, height)
+    // The clipper leaves |NDC| <= GUARD up to rounding; clipping coordinates near 1e33 can round
+    // far past it, so clamp to twice the band (a no-op for every vertex the band already holds).
+    let bound = 2.0 * crate::clip::GUARD;
+    crate::camera::viewport(
+        (v.pos.x * inv_w).clamp(-bound, bound),
+        (v.pos.y * inv_w).clamp(-bound, bound),
+        width,
+        height,
+    )
 }
 
 /// Round a pixel coordinate to fixed point (saturating; the guard band keeps it far from the limits).
@@ -405,6 +415,38 @@ pub fn lambda_from_clip(clip: &[DVec4; 3], x_ndc: f64, y_ndc: f64) -> Option<DVe
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Regression (fuzz target `raster`): a clipped vertex whose rounding left it far outside the
+    /// guard band (x = 1e33 at w = 1e-12) saturated `snap` at `i64::MAX`, and `area2` overflowed.
+    #[test]
+    fn projection_stays_within_twice_the_guard_band() {
+        let (w, h) = (100, 96);
+        for pos in [
+            DVec4::new(1e33, -1e33, 0.0, 1e-12),
+            DVec4::new(-1e300, 1e300, 0.0, 1.0),
+            DVec4::new(7.9, -7.9, 0.0, 1.0),
+        ] {
+            let (x, y) = project(
+                &ClipVertex {
+                    pos,
+                    lambda: DVec3::X,
+                },
+                w,
+                h,
+            );
+            let bound = (2.0 * crate::clip::GUARD + 1.0) * 0.5;
+            assert!(
+                x.abs() <= bound * f64::from(w) && y.abs() <= bound * f64::from(h),
+                "{x} {y}"
+            );
+            let f = [snap(x), snap(y)];
+            assert!(f.iter().all(|c| c.abs() < 1 << 26), "{f:?}");
+            // Inside the band nothing changes.
+            if pos.x.abs() < 8.0 {
+                assert_eq!((x, y), crate::camera::viewport(7.9, -7.9, w, h));
+            }
+        }
+    }
 
     #[test]
     fn top_left_rule_table() {

@@ -294,3 +294,44 @@ fn backface_culling_and_depth() {
         assert!((f.depth[f.index(8, 8)] + 0.5).abs() < 1e-6);
     }
 }
+
+/// Regression (fuzz target `raster`): clipping coordinates near 1e33 in `f64` rounded a vertex far
+/// outside the guard band, its fixed-point position saturated at `i64::MAX` and the edge functions
+/// overflowed. Every set-up edge must stay within the bound `setup.rs` documents.
+#[test]
+fn extreme_coordinates_keep_fixed_point_edges_bounded() {
+    let positions = [
+        [3853934000000000.0f32, -2.7368e-11, -1.1266637e-23],
+        [-28172647000000.0, -1.874289e23, 6.7916946e24],
+        [-6.9382367e-9, 6.7871653e24, -6.9382367e-9],
+        [-74267896.0, 1.1728593e35, 393572150000000.0],
+    ];
+    let vertices: Vec<Vertex> = positions
+        .iter()
+        .map(|&p| Vertex::new(Vec3::from(p), Vec2::ZERO))
+        .collect();
+    let clip_from_world = Mat4::perspective_rh_gl(
+        26301677000000.0f32.to_radians(),
+        100.0 / 96.0,
+        33.845303,
+        -4.570989e-19,
+    ) * Mat4::look_at_rh(
+        Vec3::new(15628.749, 3.6691683e-22, 4.4329315e-38),
+        Vec3::new(-1.5712015e-28, 2015374100000000.0, -169191700000000.0),
+        Vec3::Y,
+    );
+    let tex = white();
+    let triangles = [[0u32, 1, 2], [1, 0, 3]];
+    let call = draw(&vertices, &triangles, clip_from_world, &tex);
+    let settings = RenderSettings::new(100, 96);
+    let mut out = Vec::new();
+    for (t, tri) in triangles.iter().enumerate() {
+        texel_raster::setup::setup_triangle(&settings, &call, 0, t as u32, *tri, &mut out);
+    }
+    for s in &out {
+        for e in &s.edges {
+            assert!(e.a.abs() < 1 << 27 && e.b.abs() < 1 << 27, "{e:?}");
+        }
+    }
+    render(&settings, &[call]).unwrap();
+}

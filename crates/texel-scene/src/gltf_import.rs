@@ -387,11 +387,32 @@ pub fn load_gltf_slice(
         path: path.to_path_buf(),
         reason: format!("cannot load glTF: {reason}"),
     };
+    let gerr = |source| SceneError::Gltf {
+        path: path.to_path_buf(),
+        source,
+    };
     let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice(bytes).map_err(|source| SceneError::Gltf {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(gerr)?;
+    // gltf-json's validation indexes `accessors` with each primitive's POSITION without a bounds
+    // check (and panics on a dangling one): check those references first.
+    let json = document.into_json();
+    for (mi, mesh) in json.meshes.iter().enumerate() {
+        for (pi, prim) in mesh.primitives.iter().enumerate() {
+            let dangling = prim
+                .attributes
+                .values()
+                .chain(prim.indices.as_ref())
+                .find(|a| a.value() >= json.accessors.len());
+            if let Some(a) = dangling {
+                return Err(bad(format!(
+                    "mesh {mi} primitive {pi} refers to accessor {}, but the file has {}",
+                    a.value(),
+                    json.accessors.len()
+                )));
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(gerr)?;
     check_hierarchy(&document).map_err(bad)?;
     let roots: Vec<gltf::Node> = match document
         .default_scene()

@@ -45,21 +45,67 @@ pub fn load_obj_with(path: &Path, texture: &str, limits: &SceneLimits) -> Result
     load_obj_bytes(&bytes, path, texture, limits)
 }
 
-/// Faces and vertices an OBJ text declares, counted from its `f` and `v` lines before parsing
-/// (a polygon of n corners is n - 2 triangles).
-fn declared_counts(text: &[u8]) -> (u64, u64) {
-    let (mut tris, mut verts) = (0u64, 0u64);
+/// What an OBJ text declares, counted before parsing: triangles (a polygon of n corners is n - 2),
+/// vertices, and the first face index (1-based line) whose magnitude exceeds the number of `v`,
+/// `vt` or `vn` lines in the whole file. Such an index is out of range anyway, and `tobj` would
+/// multiply it (`vt * 2 + 1`) before checking it, which overflows for indices near 2^63.
+struct Declared {
+    triangles: u64,
+    vertices: u64,
+    bad_index: Option<(usize, String)>,
+}
+
+fn tokens(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    line.split(|b| b.is_ascii_whitespace())
+        .filter(|t| !t.is_empty())
+}
+
+fn declared(text: &[u8]) -> Declared {
+    let mut d = Declared {
+        triangles: 0,
+        vertices: 0,
+        bad_index: None,
+    };
+    // Lines of each kind a face index may refer to: v, vt, vn.
+    let mut counts = [0u64; 3];
     for line in text.split(|&b| b == b'\n') {
-        let mut tokens = line
-            .split(|b| b.is_ascii_whitespace())
-            .filter(|t| !t.is_empty());
-        match tokens.next() {
-            Some(b"f") => tris += (tokens.count() as u64).saturating_sub(2),
-            Some(b"v") => verts += 1,
+        match tokens(line).next() {
+            Some(b"v") => counts[0] += 1,
+            Some(b"vt") => counts[1] += 1,
+            Some(b"vn") => counts[2] += 1,
             _ => {}
         }
     }
-    (tris, verts)
+    d.vertices = counts[0];
+    for (n, line) in text.split(|&b| b == b'\n').enumerate() {
+        let mut t = tokens(line);
+        if t.next() != Some(b"f") {
+            continue;
+        }
+        let corners: Vec<&[u8]> = t.collect();
+        d.triangles += (corners.len() as u64).saturating_sub(2);
+        if d.bad_index.is_some() {
+            continue;
+        }
+        let too_big = corners.iter().any(|c| {
+            c.split(|&b| b == b'/').zip(counts).any(|(i, count)| {
+                std::str::from_utf8(i)
+                    .ok()
+                    .and_then(|i| i.parse::<i64>().ok())
+                    .is_some_and(|i| i.unsigned_abs() > count)
+                    || (i.len() > 18 && i.iter().all(|b| b.is_ascii_digit() || *b == b'-'))
+            })
+        });
+        if too_big {
+            let shown = String::from_utf8_lossy(line)
+                .trim_end()
+                .chars()
+                .take(60)
+                .collect();
+            d.bad_index = Some((n + 1, shown));
+        }
+    }
+    d
 }
 
 fn parse(text: &[u8]) -> tobj::LoadResult {
@@ -127,7 +173,18 @@ pub fn load_obj_bytes(
         path: path.to_path_buf(),
         reason,
     };
-    let (tris, verts) = declared_counts(bytes);
+    let Declared {
+        triangles: tris,
+        vertices: verts,
+        bad_index,
+    } = declared(bytes);
+    if let Some((line, text)) = bad_index {
+        return Err(SceneError::Obj {
+            path: path.to_path_buf(),
+            at: Some(format!("line {line} ({text:?})")),
+            source: tobj::LoadError::FaceVertexOutOfBounds,
+        });
+    }
     if tris > limits.max_triangles || verts > limits.max_vertices {
         return Err(bad(format!(
             "it declares {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",

@@ -572,3 +572,23 @@ fn gltf_with_external_buffer_and_glb() {
     );
     fs::remove_dir_all(&d).unwrap();
 }
+
+/// Regressions found by the `obj` and `gltf` fuzz targets: inputs that panicked inside `tobj`
+/// (a relative face index past the first `vt`: `vt * 2 + 1` overflowed) and `gltf-json` (a
+/// POSITION accessor index with no accessors) are errors naming the problem.
+#[test]
+fn fuzz_regressions_are_errors() {
+    use texel_scene::{load_gltf_slice, load_obj_bytes, SceneLimits};
+    let limits = SceneLimits::default();
+    let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf -1/-1 -2/-2 -3/-3\n";
+    let e = load_obj_bytes(obj, Path::new("f.obj"), "t", &limits).unwrap_err();
+    assert!(matches!(e, SceneError::Obj { .. }), "{e}");
+    assert!(e.to_string().contains("line 5"), "{e}");
+    let gltf = br#"{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}}]}]}"#;
+    let e = load_gltf_slice(gltf, None, Path::new("f.gltf"), "t", &limits).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("refers to accessor 0, but the file has 0"),
+        "{e}"
+    );
+}

@@ -20,6 +20,13 @@ use crate::address::{floor_index, Address};
 use crate::bilinear::texel_or_border;
 use crate::fetch::Fetch;
 
+/// Largest `|B|` and `|C|` a sampler accepts. Mitchell and Netravali's family is drawn for B and C
+/// in `[0, 1]` and Keys' cubics need C up to 1; unbounded values overflow `f32` (found by fuzzing:
+/// B = 6e17 gave infinite samples). Within the bound the 4 weights of an axis sum in absolute value
+/// to at most 7/3 (at B = -2, C = ±2; 1.19 for Catmull-Rom), so a 4x4 sample lies within
+/// (7/3)^2 < 5.5 times the largest texel magnitude.
+pub const MAX_CUBIC_PARAMETER: f32 = 2.0;
+
 /// Mitchell-Netravali cubic parameters `(B, C)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cubic {

@@ -80,8 +80,9 @@ pub enum TextureError {
         "anisotropy_clamp = {0} requires mag_filter, min_filter and mipmap_filter to be Linear"
     )]
     AnisotropyNeedsLinear(u16),
-    /// A cubic filter's (B, C) parameters are not finite.
-    #[error("invalid Mitchell-Netravali parameters B = {b}, C = {c}: must be finite")]
+    /// A cubic filter's (B, C) parameters are not finite or outside
+    /// `[-MAX_CUBIC_PARAMETER, MAX_CUBIC_PARAMETER]` ([`crate::bicubic::MAX_CUBIC_PARAMETER`]).
+    #[error("invalid Mitchell-Netravali parameters B = {b}, C = {c}: each must be within [-2, 2]")]
     InvalidCubic {
         /// The B parameter.
         b: f32,

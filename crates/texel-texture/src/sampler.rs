@@ -354,7 +354,8 @@ impl Sampler {
         }
         for f in [desc.mag_filter, desc.min_filter] {
             if let FilterMode::Cubic(c) = f {
-                if !c.b.is_finite() || !c.c.is_finite() {
+                let ok = |x: f32| x.abs() <= crate::bicubic::MAX_CUBIC_PARAMETER;
+                if !ok(c.b) || !ok(c.c) {
                     return Err(TextureError::InvalidCubic { b: c.b, c: c.c });
                 }
             }

@@ -611,6 +611,18 @@ fn invalid_descriptors_are_rejected() {
             }),
             ..Default::default()
         },
+        // Found by the `sampler` fuzz target: finite but huge parameters made samples infinite.
+        SamplerDescriptor {
+            mag_filter: FilterMode::Cubic(Cubic {
+                b: 5.7646075e17,
+                c: -4.519031e33,
+            }),
+            ..Default::default()
+        },
+        SamplerDescriptor {
+            min_filter: FilterMode::Cubic(Cubic { b: 0.0, c: 2.5 }),
+            ..Default::default()
+        },
     ];
     for d in bad {
         assert!(Sampler::new(d).is_err(), "{d:?} should be rejected");
@@ -785,4 +797,32 @@ fn exr_round_trip() {
 /// Native-endian bytes of `f32`s, as image-rs's encoders take them.
 fn bytemuck_f32(v: &[f32]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_ne_bytes()).collect()
+}
+
+/// Within the accepted range (`|B|, |C| <= 2`) a cubic sample stays within (7/3)^2 times the
+/// largest texel magnitude, the bound `bicubic::MAX_CUBIC_PARAMETER` documents; checked at the
+/// range's corners on a checkerboard, the worst case for negative lobes.
+#[test]
+fn cubic_overshoot_is_bounded_at_the_parameter_limits() {
+    let tex = Texture::from_fn(8, 8, Format::Rgba32Float, &Limits::default(), |i, j| {
+        let v = ((i + j) % 2) as f32;
+        [v, v, v, 1.0]
+    })
+    .unwrap();
+    let m = texel_texture::bicubic::MAX_CUBIC_PARAMETER;
+    for (b, c) in [(m, m), (-m, m), (m, -m), (-m, -m), (0.0, 0.5)] {
+        let s = Sampler::new(SamplerDescriptor {
+            mag_filter: FilterMode::Cubic(Cubic { b, c }),
+            ..SamplerDescriptor::default().with_address_mode(AddressMode::Repeat)
+        })
+        .unwrap();
+        for k in 0..64 {
+            let (u, v) = (k as f32 / 64.0 + 0.003, (k * 7 % 64) as f32 / 64.0 + 0.011);
+            let r = s.sample(&tex, &Footprint::point(u, v));
+            assert!(
+                r[0].is_finite() && r[0].abs() <= (7.0f32 / 3.0).powi(2),
+                "{b} {c}: {r:?}"
+            );
+        }
+    }
 }
