@@ -10,5 +10,5 @@ target=$1
 runs=${2:-10000000}
 shift $(( $# >= 2 ? 2 : 1 ))
 mkdir -p "corpus/$target"
-exec cargo +nightly fuzz run -a "$target" "corpus/$target" "seeds/$target" -- \
+RAYON_NUM_THREADS=1 exec cargo +nightly fuzz run -a "$target" "corpus/$target" "seeds/$target" -- \
   -runs="$runs" -max_len=4096 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "$@"

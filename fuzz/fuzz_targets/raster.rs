@@ -67,8 +67,8 @@ fuzz_target!(|input: Input| {
     let vertices: Vec<Vertex> = (0..4)
         .map(|k| Vertex::new(Vec3::from(input.positions[k]), Vec2::from(input.uvs[k])))
         .collect();
-    let mut settings = RenderSettings::new(w, h);
-    settings.threads = Some(1);
+    // One rayon pool for the whole run (scripts/fuzz.sh sets RAYON_NUM_THREADS=1), not one per frame.
+    let settings = RenderSettings::new(w, h);
     let draw = |triangles: &[[u32; 3]]| {
         let call = DrawCall {
             vertices: &vertices,

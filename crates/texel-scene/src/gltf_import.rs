@@ -391,6 +391,21 @@ pub fn load_gltf_slice(
         path: path.to_path_buf(),
         source,
     };
+    // The gltf crate subtracts the 12-byte header from the GLB's declared length unchecked.
+    if let Some(rest) = bytes.strip_prefix(b"glTF") {
+        let declared = rest
+            .get(4..8)
+            .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]));
+        match declared {
+            Some(l) if l >= 12 => {}
+            Some(l) => {
+                return Err(bad(format!(
+                    "the GLB header declares a length of {l} bytes, less than the header's 12"
+                )))
+            }
+            None => return Err(bad("the GLB header is cut short".into())),
+        }
+    }
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(gerr)?;
     // gltf-json's validation indexes `accessors` with each primitive's POSITION without a bounds

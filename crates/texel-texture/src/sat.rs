@@ -152,6 +152,24 @@ fn axis_terms(mode: AddressMode, n: u32, mut x0: f64, mut x1: f64) -> Terms {
             x1 -= shift;
         }
     }
+    // Beyond the edge the clamped extensions are constant along the axis, so a box lying wholly
+    // there has the mean of the same box moved to the edge. Moving it keeps the prefix terms
+    // small: far out (x ~ 1e8, found by fuzzing) their products cancelled to garbage in f64.
+    if mode == AddressMode::MirrorClampToEdge && x1 <= 0.0 {
+        (x0, x1) = (-x1, -x0);
+    }
+    if matches!(
+        mode,
+        AddressMode::ClampToEdge | AddressMode::MirrorClampToEdge
+    ) {
+        if x0 > n {
+            x1 -= x0 - n;
+            x0 = n;
+        } else if x1 < 0.0 {
+            x0 -= x1;
+            x1 = 0.0;
+        }
+    }
     let mut t = Terms {
         items: [(0.0, 0.0); 6],
         len: 0,

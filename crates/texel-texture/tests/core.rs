@@ -826,3 +826,47 @@ fn cubic_overshoot_is_bounded_at_the_parameter_limits() {
         }
     }
 }
+
+/// Regression (fuzz target `sampler`): a summed-area box far beyond a clamped edge (x ~ 2e8,
+/// y ~ -3e9) cancelled its huge prefix terms to a mean of 2048 on a texture in `[0, 1]`. Beyond
+/// the edge the extension is constant, so the mean is the corner texel.
+#[test]
+fn summed_area_far_beyond_clamped_edges_is_the_edge_texel() {
+    use texel_texture::SummedAreaTable;
+    let tex = Texture::from_fn(14, 163, Format::Rgba32Float, &Limits::default(), |i, j| {
+        [
+            (i as f32 * 0.37 + j as f32 * 0.11).fract(),
+            (j as f32 * 0.013).fract(),
+            0.5,
+            1.0,
+        ]
+    })
+    .unwrap();
+    let t = SummedAreaTable::build(&tex).unwrap();
+    let corner = tex.texel(0, 13, 162).unwrap();
+    for mode in [AddressMode::ClampToEdge, AddressMode::MirrorClampToEdge] {
+        let (x, y) = (
+            2.3e8,
+            if mode == AddressMode::ClampToEdge {
+                2.7e9
+            } else {
+                -2.7e9
+            },
+        );
+        let m = t.box_mean(
+            x,
+            y,
+            x + 1.0,
+            y + 1.0,
+            mode,
+            mode,
+            BorderColor::TransparentBlack,
+        );
+        for c in 0..4 {
+            assert!(
+                (m[c] - f64::from(corner[c])).abs() < 1e-9,
+                "{mode:?}: {m:?} vs {corner:?}"
+            );
+        }
+    }
+}
