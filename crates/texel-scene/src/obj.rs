@@ -46,9 +46,10 @@ pub fn load_obj_with(path: &Path, texture: &str, limits: &SceneLimits) -> Result
 }
 
 /// What an OBJ text declares, counted before parsing: triangles (a polygon of n corners is n - 2),
-/// vertices, and the first face index (1-based line) whose magnitude exceeds the number of `v`,
-/// `vt` or `vn` lines in the whole file. Such an index is out of range anyway, and `tobj` would
-/// multiply it (`vt * 2 + 1`) before checking it, which overflows for indices near 2^63.
+/// vertices, and the first face (1-based line, text) with an index out of range: a negative
+/// (relative) index reaching back past the first `v`, `vt` or `vn` line above it, or a positive one
+/// past the file's count (`tobj` accepts forward references). Such a face is an error anyway, and
+/// `tobj` computes `vt * 2 + 1` from the index before checking it, which overflows.
 struct Declared {
     triangles: u64,
     vertices: u64,
@@ -66,45 +67,56 @@ fn declared(text: &[u8]) -> Declared {
         vertices: 0,
         bad_index: None,
     };
-    // Lines of each kind a face index may refer to: v, vt, vn.
-    let mut counts = [0u64; 3];
+    let kind = |line: &[u8]| match tokens(line).next() {
+        Some(b"v") => Some(0),
+        Some(b"vt") => Some(1),
+        Some(b"vn") => Some(2),
+        _ => None,
+    };
+    let mut totals = [0u64; 3];
     for line in text.split(|&b| b == b'\n') {
-        match tokens(line).next() {
+        if let Some(k) = kind(line) {
+            totals[k] += 1;
+        }
+    }
+    // Elements defined so far that a face index may refer to: v, vt, vn.
+    let mut counts = [0u64; 3];
+    for (n, line) in text.split(|&b| b == b'\n').enumerate() {
+        let mut t = tokens(line);
+        match t.next() {
             Some(b"v") => counts[0] += 1,
             Some(b"vt") => counts[1] += 1,
             Some(b"vn") => counts[2] += 1,
+            Some(b"f") => {
+                let corners: Vec<&[u8]> = t.collect();
+                d.triangles += (corners.len() as u64).saturating_sub(2);
+                let out_of_range = |c: &&[u8]| {
+                    c.split(|&b| b == b'/').zip(counts).any(|(i, count)| {
+                        // Unparsable indices are tobj's to report; over-long ones are out of range.
+                        match std::str::from_utf8(i)
+                            .ok()
+                            .and_then(|i| i.parse::<i64>().ok())
+                        {
+                            Some(i) => i.unsigned_abs() > count,
+                            None => {
+                                i.len() > 18 && i.iter().all(|b| b.is_ascii_digit() || *b == b'-')
+                            }
+                        }
+                    })
+                };
+                if d.bad_index.is_none() && corners.iter().any(out_of_range) {
+                    let shown = String::from_utf8_lossy(line)
+                        .trim_end()
+                        .chars()
+                        .take(60)
+                        .collect();
+                    d.bad_index = Some((n + 1, shown));
+                }
+            }
             _ => {}
         }
     }
-    d.vertices = counts[0];
-    for (n, line) in text.split(|&b| b == b'\n').enumerate() {
-        let mut t = tokens(line);
-        if t.next() != Some(b"f") {
-            continue;
-        }
-        let corners: Vec<&[u8]> = t.collect();
-        d.triangles += (corners.len() as u64).saturating_sub(2);
-        if d.bad_index.is_some() {
-            continue;
-        }
-        let too_big = corners.iter().any(|c| {
-            c.split(|&b| b == b'/').zip(counts).any(|(i, count)| {
-                std::str::from_utf8(i)
-                    .ok()
-                    .and_then(|i| i.parse::<i64>().ok())
-                    .is_some_and(|i| i.unsigned_abs() > count)
-                    || (i.len() > 18 && i.iter().all(|b| b.is_ascii_digit() || *b == b'-'))
-            })
-        });
-        if too_big {
-            let shown = String::from_utf8_lossy(line)
-                .trim_end()
-                .chars()
-                .take(60)
-                .collect();
-            d.bad_index = Some((n + 1, shown));
-        }
-    }
+    d.vertices = totals[0];
     d
 }
 

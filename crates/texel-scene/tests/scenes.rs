@@ -584,6 +584,10 @@ fn fuzz_regressions_are_errors() {
     let e = load_obj_bytes(obj, Path::new("f.obj"), "t", &limits).unwrap_err();
     assert!(matches!(e, SceneError::Obj { .. }), "{e}");
     assert!(e.to_string().contains("line 5"), "{e}");
+    // The same relative index with enough vt lines later in the file: still out of range there.
+    let later = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf -1/-1 -2/-2 -3/-3\nvt 1 0\nvt 0 1\n";
+    let e = load_obj_bytes(later, Path::new("f.obj"), "t", &limits).unwrap_err();
+    assert!(e.to_string().contains("line 5"), "{e}");
     let gltf = br#"{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}}]}]}"#;
     let e = load_gltf_slice(gltf, None, Path::new("f.gltf"), "t", &limits).unwrap_err();
     assert!(
