@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::budget::ByteSize;
-use crate::filters::FilterName;
+use crate::filters::{filter_parser, Filter};
 
 /// texel: texture mapping and texture filtering on the CPU, measured.
 #[derive(Debug, Parser)]
@@ -124,8 +124,8 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Texture filter for every mesh (default: a glTF mesh's own sampler filters, else trilinear).
-    #[arg(long, conflicts_with = "lab_mode")]
-    pub filter: Option<FilterName>,
+    #[arg(long, conflicts_with = "lab_mode", value_parser = filter_parser())]
+    pub filter: Option<Filter>,
     /// The lab's numbered filter modes: 1 nearest, 2 bilinear, 3 mip-nearest, 4 trilinear, 5-8 anisotropic 2x-16x.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8))]
     pub lab_mode: Option<u8>,
@@ -221,7 +221,7 @@ pub struct BenchArgs {
     pub json: bool,
 }
 
-/// How 8-bit texture bytes and output bytes are interpreted.
+/// How 8-bit texture bytes and output bytes are interpreted ([`texel::ColorHandling`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum ColorArg {
     /// Textures marked sRGB are decoded to linear light for filtering; output is sRGB-encoded.
@@ -229,6 +229,15 @@ pub enum ColorArg {
     Srgb,
     /// Every texture's bytes are linear; output bytes are linear (as a GPU sampling plain RGBA8).
     Raw,
+}
+
+impl From<ColorArg> for texel::ColorHandling {
+    fn from(c: ColorArg) -> Self {
+        match c {
+            ColorArg::Srgb => texel::ColorHandling::Srgb,
+            ColorArg::Raw => texel::ColorHandling::Raw,
+        }
+    }
 }
 
 /// Output size `WIDTHxHEIGHT`, each side 1 to 16384.
@@ -313,8 +322,8 @@ pub struct WarpArgs {
     #[arg(long)]
     pub size: Option<Size>,
     /// Texture filter.
-    #[arg(long, default_value = "ewa")]
-    pub filter: FilterName,
+    #[arg(long, default_value = "ewa", value_parser = filter_parser())]
+    pub filter: Filter,
     /// Colour handling.
     #[arg(long, value_enum, default_value_t)]
     pub color: ColorArg,

@@ -17,7 +17,7 @@ use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
 use crate::cli::BenchArgs;
 use crate::filters::parse_list;
-use crate::prepare::{Input, Prepared};
+use crate::prepare::{load_scene, Input};
 use crate::threads::{thread_count, with_threads};
 
 /// One filter's timings in milliseconds.
@@ -99,7 +99,7 @@ pub fn median(v: &mut [f64]) -> f64 {
 
 /// Run `texel bench`.
 pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
-    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
     let filters = parse_list(&args.filters)?;
     let timings = with_threads(args.threads, || -> Result<Vec<Timing>> {
         let mut out = Vec::new();

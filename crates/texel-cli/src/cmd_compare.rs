@@ -15,14 +15,15 @@ use texel_quality::{
 };
 use texel_raster::{render, Frame};
 
-use crate::budget::FRAME_BYTES_PER_PIXEL;
-use crate::cli::{ColorArg, CompareArgs};
+use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
 use crate::cmd_reference::reference_frame;
-use crate::filters::{parse_list, FilterName};
+use crate::filters::{parse_list, Filter};
 use crate::output::encoding;
-use crate::prepare::{Input, Prepared};
+use crate::prepare::{load_scene, Input};
 use crate::progress;
+use texel::memory::FRAME_BYTES_PER_PIXEL;
+use texel::PreparedScene;
 
 /// Timed frames per filter in a comparison.
 pub const TIMED_FRAMES: u32 = 3;
@@ -97,7 +98,7 @@ pub const COMPARE_BYTES_PER_PIXEL: u64 = FRAME_BYTES_PER_PIXEL + 32;
 /// Check `--extra` entries against each other and the filters: every label names one row and one
 /// file, so two labels that are equal, or whose file names would be equal, or a label equal to a
 /// compared filter's name, are refused.
-pub fn check_extras(extras: &[(String, PathBuf)], filters: &[FilterName]) -> Result<()> {
+pub fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<()> {
     for (i, (label, _)) in extras.iter().enumerate() {
         if let Some(f) = filters.iter().find(|f| f.name() == label) {
             bail!(
@@ -126,9 +127,9 @@ pub fn check_extras(extras: &[(String, PathBuf)], filters: &[FilterName]) -> Res
 /// (which must exist: the caller publishes it, see [`texel_quality::publish_dir`]) and return the
 /// report. `label` names the scene in the report.
 pub fn compare(
-    scene: &Prepared,
+    scene: &PreparedScene,
     label: &str,
-    filters: &[FilterName],
+    filters: &[Filter],
     spp: u32,
     extras: &[(String, PathBuf)],
     dir: &Path,
@@ -206,8 +207,8 @@ pub fn compare(
         height: h,
         spp,
         color: match scene.color {
-            ColorArg::Srgb => "srgb",
-            ColorArg::Raw => "raw",
+            texel::ColorHandling::Srgb => "srgb",
+            texel::ColorHandling::Raw => "raw",
         }
         .to_string(),
         reference_image: "reference.png".to_string(),
@@ -244,7 +245,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         .map(|e| parse_extra(e))
         .collect::<Result<Vec<_>>>()?;
     check_extras(&extras, &filters)?;
-    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
     input.budget.take(
         "the comparison's reference and images",
         u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
@@ -281,7 +282,7 @@ mod tests {
     #[test]
     fn extras_distinct() {
         let e = |l: &str| (l.to_string(), PathBuf::from("x.png"));
-        let f = [FilterName::Trilinear];
+        let f = [Filter::Trilinear];
         assert!(check_extras(&[e("gpu"), e("llvmpipe")], &f).is_ok());
         let msg = check_extras(&[e("gpu"), e("gpu")], &f)
             .unwrap_err()

@@ -10,11 +10,10 @@ use anyhow::{Context, Result};
 use texel_quality::html::escape;
 use texel_quality::{publish_dir, write_atomic, Report};
 
-use crate::budget::Budget;
 use crate::cli::{ColorArg, DemoArgs};
 use crate::cmd_compare::{compare, COMPARE_BYTES_PER_PIXEL};
-use crate::filters::FilterName;
-use crate::prepare::{Input, Prepared};
+use crate::filters::Filter;
+use crate::prepare::{load_scene, Input};
 
 /// Run `texel demo`: every scene's report is written into one staging directory, published as a
 /// whole at `--out` when all are done.
@@ -27,10 +26,10 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
             eprintln!("texel demo: {label} ...");
             // Scenes are rendered one after another: each gets the whole memory account.
             let mut scene_input = Input {
-                budget: Budget::new(input.budget.limit_arg()),
+                budget: input.budget.clone(),
                 sanitize: input.sanitize,
             };
-            let scene = Prepared::load(&label, ColorArg::Srgb, args.size, &mut scene_input)?;
+            let scene = load_scene(&label, ColorArg::Srgb, args.size, &mut scene_input)?;
             scene_input.budget.take(
                 "the comparison's reference and images",
                 u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
@@ -38,7 +37,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
             let sub = dir.join(name);
             std::fs::create_dir(&sub)
                 .with_context(|| format!("cannot create {}", sub.display()))?;
-            let report = compare(&scene, &label, &FilterName::ALL, args.spp, &[], &sub)?;
+            let report = compare(&scene, &label, &Filter::ALL, args.spp, &[], &sub)?;
             reports.push((name.to_string(), report));
         }
         let html = index_html(&reports, started.elapsed().as_secs_f64());

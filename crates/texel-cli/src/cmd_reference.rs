@@ -4,10 +4,11 @@ use anyhow::Result;
 use texel_raster::render_reference_strata;
 
 use crate::cli::ReferenceArgs;
-use crate::filters::FilterName;
+use crate::filters::Filter;
 use crate::output::write_png;
-use crate::prepare::{Input, Prepared};
+use crate::prepare::{load_scene, Input};
 use crate::progress;
+use texel::PreparedScene;
 
 /// Seed of the reference's jitter: fixed, so references are reproducible.
 pub const SEED: u64 = 0x7e_7e1;
@@ -23,10 +24,10 @@ pub fn strata(spp: u32) -> (u32, u32) {
 }
 
 /// Render the reference of a prepared scene, with a progress bar on a terminal.
-pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame> {
+pub fn reference_frame(scene: &PreparedScene, spp: u32) -> Result<texel_raster::Frame> {
     // The reference samples level 0 bilinearly with each mesh's address modes; the filter only
     // supplies those.
-    let samplers = scene.samplers(FilterName::Bilinear)?;
+    let samplers = scene.samplers(Filter::Bilinear)?;
     let draws = scene.draws(&samplers);
     let settings = scene.settings();
     let (n, m) = strata(spp);
@@ -44,7 +45,7 @@ pub fn reference_frame(scene: &Prepared, spp: u32) -> Result<texel_raster::Frame
 
 /// Run `texel reference`.
 pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
-    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
     let frame = reference_frame(&scene, args.spp)?;
     write_png(
         &args.output,

@@ -4,18 +4,18 @@ use anyhow::Result;
 use texel_raster::{render, Derivatives, Perspective, View};
 
 use crate::cli::{ColorArg, DerivativesArg, PerspectiveArg, RenderArgs, ViewArg};
-use crate::filters::FilterName;
+use crate::filters::Filter;
 use crate::output::write_png;
-use crate::prepare::{Input, Prepared};
+use crate::prepare::{load_scene, Input};
 use crate::threads::with_threads;
 
 /// Run `texel render`.
 pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     let filter = match args.lab_mode {
-        Some(m) => Some(FilterName::from_lab_mode(m)?),
+        Some(m) => Some(Filter::from_lab_mode(m)?),
         None => args.filter,
     };
-    let scene = Prepared::load(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
     let samplers = match filter {
         Some(f) => scene.samplers(f)?,
         None => scene.default_samplers()?,

@@ -9,10 +9,10 @@ use glam::DVec2;
 use texel_texture::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
 use texel_texture::{AddressMode, ColorSpace, Limits, LoadOptions, Sampler, Texture};
 
-use crate::budget::FRAME_BYTES_PER_PIXEL;
 use crate::cli::{ColorArg, WarpArgs};
 use crate::output::write_png;
 use crate::prepare::Input;
+use texel::memory::FRAME_BYTES_PER_PIXEL;
 
 /// Run `texel warp`.
 pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
@@ -60,7 +60,7 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
     let corners = [0, 2, 4, 6].map(|k| DVec2::new(c[k], c[k + 1]));
     let mut desc = args
         .filter
-        .descriptor(AddressMode::ClampToBorder, AddressMode::ClampToBorder)?;
+        .descriptor(AddressMode::ClampToBorder, AddressMode::ClampToBorder);
     desc.border_color = texel_texture::BorderColor::TransparentBlack;
     let sampler = Sampler::new(desc)?;
     let pixels = warp_perspective(&tex, &sampler, corners, w, h).map_err(|e| {

@@ -35,7 +35,7 @@ fn main() -> ExitCode {
         eprintln!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files");
     }
     let mut input = prepare::Input {
-        budget: budget::Budget::new(cli.max_memory),
+        budget: budget::budget(cli.max_memory),
         sanitize: cli.sanitize,
     };
     let result = match cli.command {

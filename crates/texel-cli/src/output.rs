@@ -7,13 +7,15 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use texel_quality::{Encoding, Image8};
 
+use texel::ColorHandling;
+
 use crate::cli::ColorArg;
 
 /// The 8-bit encoding `--color` asks for: sRGB-encoded RGB, or raw `round(255 x)`.
-pub fn encoding(color: ColorArg) -> Encoding {
-    match color {
-        ColorArg::Srgb => Encoding::Srgb,
-        ColorArg::Raw => Encoding::Linear,
+pub fn encoding(color: impl Into<ColorHandling>) -> Encoding {
+    match color.into() {
+        ColorHandling::Srgb => Encoding::Srgb,
+        ColorHandling::Raw => Encoding::Linear,
     }
 }
 

@@ -1,0 +1,46 @@
+//! The one error type of the `texel` crate: the libraries' errors, plus what scene preparation adds.
+
+use thiserror::Error;
+
+/// Everything that can go wrong preparing or rendering a scene.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Loading or validating the scene, its mesh files or its textures.
+    #[error(transparent)]
+    Scene(#[from] texel_scene::SceneError),
+    /// A sampler descriptor, or building a ripmap or summed-area table.
+    #[error(transparent)]
+    Texture(#[from] texel_texture::TextureError),
+    /// Rendering.
+    #[error(transparent)]
+    Raster(#[from] texel_raster::RasterError),
+    /// An allocation the memory budget cannot hold ([`crate::MemoryBudget::take`]).
+    #[error(
+        "{what} needs about {}{}, over {limit}: raise the limit or make the input smaller",
+        crate::memory::mib(*bytes),
+        crate::memory::held(*used, *bytes)
+    )]
+    OverBudget {
+        /// What was to be allocated.
+        what: String,
+        /// Its bytes.
+        bytes: u64,
+        /// Bytes already accounted for.
+        used: u64,
+        /// The limit, as its owner describes it (e.g. `--max-memory 512.0 MiB`).
+        limit: String,
+    },
+    /// A filter name that is not one of [`crate::Filter::NAMES`].
+    #[error("unknown filter {name:?}: valid filters are {}, or all", crate::Filter::NAMES.join(", "))]
+    UnknownFilter {
+        /// The name given.
+        name: String,
+    },
+    /// A filter list with no names.
+    #[error("the filter list is empty: name at least one filter, or all")]
+    EmptyFilterList,
+    /// A lab mode outside `1..=8`.
+    #[error("unknown lab mode {0}: valid modes are 1 (nearest) to 8 (anisotropic 16x)")]
+    UnknownLabMode(u8),
+}

@@ -1,0 +1,206 @@
+//! Every texture filter texel offers, by name, with the lab's numbered modes and the sampler
+//! descriptor each one means. The one list of filter names: the CLI, reports and benches use it.
+
+use texel_texture::{AddressMode, Cubic, FilterMode, MipmapFilterMode, SamplerDescriptor};
+
+use crate::Error;
+
+/// A texture filter, as the command line and the reports name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Filter {
+    /// Nearest texel of level 0 (lab mode 1).
+    Nearest,
+    /// Bilinear in level 0 (lab mode 2).
+    Bilinear,
+    /// Catmull-Rom bicubic in level 0.
+    Bicubic,
+    /// Bilinear in the nearest mip level (lab mode 3).
+    MipNearest,
+    /// Bilinear in the two nearest mip levels, blended (lab mode 4).
+    Trilinear,
+    /// Anisotropic, up to 2 trilinear probes (lab mode 5).
+    Aniso2,
+    /// Anisotropic, up to 4 probes (lab mode 6).
+    Aniso4,
+    /// Anisotropic, up to 8 probes (lab mode 7).
+    Aniso8,
+    /// Anisotropic, up to 16 probes (lab mode 8).
+    Aniso16,
+    /// Elliptical weighted average (Heckbert 1989), eccentricity clamped at 16.
+    Ewa,
+    /// Ripmap: anisotropically reduced images, four neighbours blended.
+    Ripmap,
+    /// Summed-area table: box mean over the footprint's bounding rectangle.
+    Sat,
+}
+
+impl Filter {
+    /// Every filter, cheapest first.
+    pub const ALL: [Filter; 12] = [
+        Filter::Nearest,
+        Filter::Bilinear,
+        Filter::Bicubic,
+        Filter::MipNearest,
+        Filter::Trilinear,
+        Filter::Aniso2,
+        Filter::Aniso4,
+        Filter::Aniso8,
+        Filter::Aniso16,
+        Filter::Ewa,
+        Filter::Ripmap,
+        Filter::Sat,
+    ];
+
+    /// Every filter's name, in the order of [`Filter::ALL`].
+    pub const NAMES: [&'static str; 12] = [
+        "nearest",
+        "bilinear",
+        "bicubic",
+        "mip-nearest",
+        "trilinear",
+        "aniso2",
+        "aniso4",
+        "aniso8",
+        "aniso16",
+        "ewa",
+        "ripmap",
+        "sat",
+    ];
+
+    /// The name (`mip-nearest`).
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
+    /// The lab's numbered modes: 1 nearest, 2 bilinear, 3 mip-nearest, 4 trilinear, 5-8
+    /// anisotropic 2x-16x.
+    ///
+    /// # Errors
+    /// [`Error::UnknownLabMode`] outside `1..=8`.
+    pub fn from_lab_mode(mode: u8) -> Result<Self, Error> {
+        Ok(match mode {
+            1 => Filter::Nearest,
+            2 => Filter::Bilinear,
+            3 => Filter::MipNearest,
+            4 => Filter::Trilinear,
+            5 => Filter::Aniso2,
+            6 => Filter::Aniso4,
+            7 => Filter::Aniso8,
+            8 => Filter::Aniso16,
+            _ => return Err(Error::UnknownLabMode(mode)),
+        })
+    }
+
+    /// The sampler descriptor this filter means, with the given address modes.
+    pub fn descriptor(
+        self,
+        address_mode_u: AddressMode,
+        address_mode_v: AddressMode,
+    ) -> SamplerDescriptor {
+        use FilterMode::{Linear, Nearest};
+        let base = |mag, min, mipmap_filter, anisotropy_clamp| SamplerDescriptor {
+            address_mode_u,
+            address_mode_v,
+            mag_filter: mag,
+            min_filter: min,
+            mipmap_filter,
+            anisotropy_clamp,
+            ..SamplerDescriptor::default()
+        };
+        let cubic = FilterMode::Cubic(Cubic::CATMULL_ROM);
+        let minification = |min| SamplerDescriptor {
+            address_mode_u,
+            address_mode_v,
+            ..SamplerDescriptor::minification(min)
+        };
+        match self {
+            Filter::Nearest => base(Nearest, Nearest, MipmapFilterMode::None, 1),
+            Filter::Bilinear => base(Linear, Linear, MipmapFilterMode::None, 1),
+            Filter::Bicubic => base(cubic, cubic, MipmapFilterMode::None, 1),
+            Filter::MipNearest => base(Linear, Linear, MipmapFilterMode::Nearest, 1),
+            Filter::Trilinear => base(Linear, Linear, MipmapFilterMode::Linear, 1),
+            Filter::Aniso2 => base(Linear, Linear, MipmapFilterMode::Linear, 2),
+            Filter::Aniso4 => base(Linear, Linear, MipmapFilterMode::Linear, 4),
+            Filter::Aniso8 => base(Linear, Linear, MipmapFilterMode::Linear, 8),
+            Filter::Aniso16 => base(Linear, Linear, MipmapFilterMode::Linear, 16),
+            Filter::Ewa => minification(FilterMode::Ewa),
+            Filter::Ripmap => minification(FilterMode::Ripmap),
+            Filter::Sat => minification(FilterMode::SummedArea),
+        }
+    }
+
+    /// Parse a filter list: `all`, or comma-separated names (duplicates dropped, order kept).
+    ///
+    /// # Errors
+    /// [`Error::UnknownFilter`] naming the valid filters, [`Error::EmptyFilterList`].
+    pub fn parse_list(list: &str) -> Result<Vec<Filter>, Error> {
+        if list.trim() == "all" {
+            return Ok(Filter::ALL.to_vec());
+        }
+        let mut out = Vec::new();
+        for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let f = item.parse::<Filter>()?;
+            if !out.contains(&f) {
+                out.push(f);
+            }
+        }
+        if out.is_empty() {
+            return Err(Error::EmptyFilterList);
+        }
+        Ok(out)
+    }
+}
+
+impl std::fmt::Display for Filter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Filter {
+    type Err = Error;
+    /// A filter by name, ASCII case ignored (`Trilinear`, `mip-nearest`).
+    fn from_str(s: &str) -> Result<Self, Error> {
+        Filter::NAMES
+            .iter()
+            .position(|n| n.eq_ignore_ascii_case(s.trim()))
+            .map(|k| Filter::ALL[k])
+            .ok_or_else(|| Error::UnknownFilter {
+                name: s.to_string(),
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_lists_parse() {
+        for (k, f) in Filter::ALL.iter().enumerate() {
+            assert_eq!(f.name(), Filter::NAMES[k]);
+            assert_eq!(f.name().parse::<Filter>().unwrap(), *f);
+        }
+        assert_eq!(
+            Filter::parse_list(" trilinear, EWA,trilinear ").unwrap(),
+            vec![Filter::Trilinear, Filter::Ewa]
+        );
+        assert_eq!(Filter::parse_list("all").unwrap(), Filter::ALL.to_vec());
+        let e = Filter::parse_list("trilinear,bogus")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("\"bogus\"") && e.contains("mip-nearest"), "{e}");
+        assert!(Filter::parse_list(" , ").is_err());
+        for m in 1..=8 {
+            let f = Filter::from_lab_mode(m).unwrap();
+            let d = f.descriptor(AddressMode::Repeat, AddressMode::Repeat);
+            assert_eq!(
+                d,
+                SamplerDescriptor::lab_mode(m)
+                    .unwrap()
+                    .with_address_mode(AddressMode::Repeat)
+            );
+        }
+        assert!(Filter::from_lab_mode(9).is_err());
+    }
+}

@@ -1,0 +1,241 @@
+//! A scene made ready to draw: textures decoded and their pyramids built once, meshes turned into
+//! the rasterizer's vertices, the camera into `clip_from_world`, and one sampler per mesh for a
+//! filter. The CLI, the examples and (later) the GPU path and the viewer all draw through this.
+
+use std::collections::BTreeMap;
+
+use texel_raster::{DrawCall, RenderSettings, Vertex};
+use texel_scene::Scene;
+use texel_texture::color::srgb_to_linear;
+use texel_texture::{ColorSpace, Limits, Sampler, Texture};
+
+use crate::memory::{FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_BYTES};
+use crate::{Error, Filter, MemoryBudget};
+
+/// How 8-bit texture bytes and output bytes are interpreted (the CLI's `--color`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ColorHandling {
+    /// Textures marked sRGB are decoded to linear light for filtering; output is sRGB-encoded.
+    #[default]
+    Srgb,
+    /// Every texture's bytes are linear and output bytes are linear (a GPU sampling plain RGBA8).
+    Raw,
+}
+
+/// How a scene is prepared.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneOptions {
+    /// Output size `(width, height)` in pixels, overriding the scene's.
+    pub size: Option<(u32, u32)>,
+    /// Colour handling.
+    pub color: ColorHandling,
+    /// Replace NaN and infinite float texels ([`texel_texture::replace_non_finite`]) instead of
+    /// refusing the texture; [`PreparedScene::replaced`] reports how many.
+    pub replace_non_finite: bool,
+}
+
+/// A loaded scene, ready to render with any filter.
+#[derive(Debug)]
+pub struct PreparedScene {
+    /// The scene as loaded.
+    pub scene: Scene,
+    /// Every texture the meshes use, by name, with its pyramid.
+    pub textures: BTreeMap<String, Texture>,
+    /// Each mesh's vertices.
+    pub vertices: Vec<Vec<Vertex>>,
+    /// Output width in pixels.
+    pub width: u32,
+    /// Output height in pixels.
+    pub height: u32,
+    /// The colour handling the textures were loaded with.
+    pub color: ColorHandling,
+    /// Per texture, the non-finite channel values replaced (only with
+    /// [`SceneOptions::replace_non_finite`]; textures with none are not listed).
+    pub replaced: Vec<(String, u64)>,
+}
+
+impl PreparedScene {
+    /// Prepare `scene` (already validated, as [`Scene::load`] returns it): charge `budget` for
+    /// the meshes and one frame of the output size, then load every texture the meshes use
+    /// within what is left, charging each one's pyramid.
+    ///
+    /// # Errors
+    /// [`Error::OverBudget`]; [`Error::Scene`] for a texture that cannot be loaded (its own memory
+    /// limit is what the budget has left).
+    pub fn new(
+        scene: Scene,
+        options: &SceneOptions,
+        budget: &mut MemoryBudget,
+    ) -> Result<Self, Error> {
+        let (width, height) = options
+            .size
+            .unwrap_or((scene.output.width, scene.output.height));
+        let (verts, tris) = scene.meshes.iter().fold((0u64, 0u64), |(v, t), m| {
+            (v + m.positions.len() as u64, t + m.triangles.len() as u64)
+        });
+        budget.take("the meshes", verts * VERTEX_BYTES + tris * TRIANGLE_BYTES)?;
+        budget.take(
+            &format!("a {width}x{height} frame"),
+            u64::from(width) * u64::from(height) * FRAME_BYTES_PER_PIXEL,
+        )?;
+        let override_space = match options.color {
+            ColorHandling::Srgb => None,
+            ColorHandling::Raw => Some(ColorSpace::Linear),
+        };
+        let mut textures = BTreeMap::new();
+        let mut replaced = Vec::new();
+        for m in &scene.meshes {
+            if textures.contains_key(&m.texture) {
+                continue;
+            }
+            let spec = scene.textures.get(&m.texture).ok_or_else(|| {
+                texel_scene::SceneError::UnknownTexture {
+                    mesh: 0,
+                    name: m.texture.clone(),
+                    defined: scene
+                        .textures
+                        .keys()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                }
+            })?;
+            let limits = Limits {
+                max_bytes: budget.remaining(),
+                ..Limits::default()
+            };
+            let loaded = spec.load_with(
+                &m.texture,
+                override_space,
+                &limits,
+                options.replace_non_finite,
+            )?;
+            if loaded.replaced > 0 {
+                replaced.push((m.texture.clone(), loaded.replaced));
+            }
+            budget.take(
+                &format!("texture {:?}", m.texture),
+                loaded.texture.pyramid_bytes(),
+            )?;
+            textures.insert(m.texture.clone(), loaded.texture);
+        }
+        let vertices = scene.meshes.iter().map(texel_vertices).collect();
+        Ok(PreparedScene {
+            scene,
+            textures,
+            vertices,
+            width,
+            height,
+            color: options.color,
+            replaced,
+        })
+    }
+
+    /// One sampler per mesh for `filter`, with each mesh's address modes.
+    ///
+    /// # Errors
+    /// [`Error::Texture`] if the descriptor is invalid (it never is for the built-in filters).
+    pub fn samplers(&self, filter: Filter) -> Result<Vec<Sampler>, Error> {
+        self.scene
+            .meshes
+            .iter()
+            .map(|m| {
+                Ok(Sampler::new(
+                    filter.descriptor(m.address_mode_u, m.address_mode_v),
+                )?)
+            })
+            .collect()
+    }
+
+    /// One sampler per mesh when no filter is named: a glTF mesh's own sampler filters
+    /// (`magFilter`/`minFilter`; what the glTF leaves unspecified is linear, as for trilinear),
+    /// and trilinear for every other mesh.
+    ///
+    /// # Errors
+    /// [`Error::Texture`] for an invalid combination from the glTF file.
+    pub fn default_samplers(&self) -> Result<Vec<Sampler>, Error> {
+        self.scene
+            .meshes
+            .iter()
+            .map(|m| {
+                let mut desc = Filter::Trilinear.descriptor(m.address_mode_u, m.address_mode_v);
+                if let Some(f) = &m.filters {
+                    desc.mag_filter = f.mag_filter.unwrap_or(desc.mag_filter);
+                    desc.min_filter = f.min_filter.unwrap_or(desc.min_filter);
+                    desc.mipmap_filter = f.mipmap_filter.unwrap_or(desc.mipmap_filter);
+                }
+                Ok(Sampler::new(desc)?)
+            })
+            .collect()
+    }
+
+    /// Build the acceleration structures `samplers` need (ripmaps, summed-area tables) ahead of
+    /// drawing, and return the bytes of every structure the frame uses (pyramids included),
+    /// counting each texture once.
+    ///
+    /// # Errors
+    /// [`Error::Texture`] when a structure does not fit the texture's memory limit.
+    pub fn prepare(&self, samplers: &[Sampler]) -> Result<u64, Error> {
+        let mut bytes = BTreeMap::new();
+        for (mesh, sampler) in self.scene.meshes.iter().zip(samplers) {
+            let tex = &self.textures[&mesh.texture];
+            tex.prepare(sampler)?;
+            let b = tex.structure_bytes(sampler.descriptor());
+            let e = bytes.entry(mesh.texture.clone()).or_insert(0u64);
+            *e = (*e).max(b);
+        }
+        Ok(bytes.values().sum())
+    }
+
+    /// The draw calls of the whole scene with `samplers` (one per mesh).
+    pub fn draws<'a>(&'a self, samplers: &'a [Sampler]) -> Vec<DrawCall<'a>> {
+        let aspect = self.width as f32 / self.height as f32;
+        let clip_from_world = self.scene.camera.clip_from_world(aspect);
+        self.scene
+            .meshes
+            .iter()
+            .zip(&self.vertices)
+            .zip(samplers)
+            .map(|((mesh, vertices), sampler)| DrawCall {
+                vertices,
+                triangles: &mesh.triangles,
+                texture: &self.textures[&mesh.texture],
+                sampler,
+                clip_from_world,
+            })
+            .collect()
+    }
+
+    /// Render settings for this scene's size and background (the background decoded as the
+    /// colour handling says).
+    pub fn settings(&self) -> RenderSettings {
+        let mut s = RenderSettings::new(self.width, self.height);
+        let bg = self.scene.output.background;
+        let decode = |b: u8| match self.color {
+            ColorHandling::Srgb => srgb_to_linear(f32::from(b) / 255.0),
+            ColorHandling::Raw => f32::from(b) / 255.0,
+        };
+        s.background = [
+            decode(bg[0]),
+            decode(bg[1]),
+            decode(bg[2]),
+            f32::from(bg[3]) / 255.0,
+        ];
+        s
+    }
+}
+
+fn texel_vertices(mesh: &texel_scene::Mesh) -> Vec<Vertex> {
+    (0..mesh.positions.len())
+        .map(|k| {
+            let mut v = Vertex::new(mesh.positions[k], mesh.uvs[k]);
+            if let Some(c) = &mesh.colors {
+                v.color = c[k];
+            }
+            if let Some(n) = &mesh.normals {
+                v.normal = n[k];
+            }
+            v
+        })
+        .collect()
+}
