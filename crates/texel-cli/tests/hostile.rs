@@ -9,7 +9,6 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::cli::{base64, quad_buffer, quad_gltf, QUAD_OBJ};
 use crate::util::*;
 
 /// Run `texel` with `args`, killing it (and failing the test) if it runs over `limit`: a hang is

@@ -1,6 +1,15 @@
 //! The `texel` binary's integration tests, one test binary (as ripgrep's `tests/tests.rs`):
-//! [`util`] holds the shared helpers, each other module one area.
+//! [`util`] holds the shared helpers and fixtures, each other module one command or concern.
 
-mod cli;
+mod compare;
+mod demo_bench;
+mod errors;
+mod help;
 mod hostile;
+mod meshes;
+mod mips;
+mod outputs;
+mod reference;
+mod render;
 mod util;
+mod warp;

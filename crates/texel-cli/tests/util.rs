@@ -199,3 +199,70 @@ positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0
 uvs = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]
 triangles = [[0, 1, 2], [0, 2, 3]]
 "#;
+
+// ---------------------------------------------------------------------------------------------
+// Mesh fixtures: the unit quad as OBJ, glTF buffer and glTF JSON
+// ---------------------------------------------------------------------------------------------
+
+pub(crate) const QUAD_OBJ: &str = "# unit quad\n\
+v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
+vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+
+pub(crate) fn quad_buffer() -> Vec<u8> {
+    let mut b = Vec::new();
+    for v in [
+        -1.0f32, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0,
+    ] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [0.0f32, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0] {
+        b.extend(v.to_le_bytes());
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        b.extend(i.to_le_bytes());
+    }
+    b
+}
+
+pub(crate) fn quad_gltf(uri: &str) -> String {
+    format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0]}}],
+  "nodes": [{{"mesh": 0}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "indices": 2}}]}}],
+  "buffers": [{{"uri": "{uri}", "byteLength": 92}}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 48, "byteLength": 32}},
+    {{"buffer": 0, "byteOffset": 80, "byteLength": 12}}
+  ],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"}},
+    {{"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}}
+  ]
+}}"#
+    )
+}
+
+/// Standard base64 with padding (RFC 4648), for a glTF data URI.
+pub(crate) fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in bytes.chunks(3) {
+        let n = (u32::from(c[0]) << 16)
+            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
+            | u32::from(*c.get(2).unwrap_or(&0));
+        for k in 0..4 {
+            if k <= c.len() {
+                s.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}

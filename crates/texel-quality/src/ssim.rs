@@ -17,9 +17,9 @@
 //!   every image edge; the mean ("MSSIM", eq. 17) is over the mask's pixels in that interior.
 //!   Windows of pixels next to the mask's edge also see uncovered pixels (background in both images).
 //! - No automatic downsampling (the later `ssim.m` adds it for large images; the 2004 paper has none).
-//! - `f64` throughout; the two separable passes run in parallel over rows (rayon). Measured:
-//!   70 ms for a masked 1280x720 SSIM, 0.62 ms for PSNR, on the 2-core VM
-//!   (`cargo bench -p texel-quality --bench metrics -- --quick`), small beside rendering a frame.
+//! - `f64` throughout; the two separable passes run in parallel over rows (rayon). A masked
+//!   1280x720 SSIM costs little beside rendering a frame (`cargo bench -p texel-quality --bench
+//!   metrics -- --quick`; figures in docs/perf-log.md).
 
 use rayon::prelude::*;
 

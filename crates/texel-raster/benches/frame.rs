@@ -1,5 +1,5 @@
-//! Frame-time benchmarks: the ground scene (`shared/scenes/ground.toml`) at 1280 x 720 with each
-//! filter the sampler has, on 1 and 2 threads; triangle throughput on a 100k-triangle mesh.
+//! Frame-time benchmarks: the ground scene (`shared/scenes/ground.toml`) at 1280 x 720 with the
+//! four core filters, on 1 and 2 threads; triangle throughput on a 100k-triangle mesh.
 //!
 //! Run: `CARGO_TARGET_DIR=/work/target-shared cargo bench -p texel-raster --bench frame`.
 
@@ -18,9 +18,10 @@ use glam::Mat4;
 use texel_raster::{render, DrawCall, RenderSettings};
 use texel_texture::Sampler;
 
-/// The filters this branch's sampler implements. Anisotropic (`anisotropy_clamp = 16`) and EWA are
-/// not measured here: on this branch `Sampler` accepts `anisotropy_clamp` but filters trilinearly
-/// (the anisotropic and EWA filters live on another branch); add their rows once merged.
+/// The four core filters this bench times: the lab's modes 1-4 (nearest, bilinear, mip-nearest,
+/// trilinear). The anisotropic filters (modes 5-8) and EWA have no rows here; their frame times
+/// come from `texel bench` (README.md's Benchmarks section) and their per-sample throughput from
+/// `cargo bench -p texel-texture --bench aniso`.
 fn samplers() -> Vec<(&'static str, Sampler)> {
     vec![
         ("nearest", lab_sampler(1)),

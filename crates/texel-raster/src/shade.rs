@@ -55,11 +55,12 @@ fn inv_period(mode: AddressMode) -> f64 {
 /// Branch-free so that [`crate::tile`]'s span loops vectorise: the floor is `t` rounded to the
 /// nearest integer by adding and subtracting `1.5 * 2^52` (exact for `|t| < 2^51`, where the sum
 /// lies in `[2^52, 2^53)` and has no fraction bits), minus one where that rounded up. Without
-/// SSE4.1, `f64::floor` is a libm call (measured at 5% of a nearest-filtered ground frame), and the
-/// earlier integer-conversion floor (`t as i64`) has no packed form before AVX-512.
+/// SSE4.1, `f64::floor` is a libm call (a measurable share of a nearest-filtered ground frame:
+/// docs/perf-log.md), and an integer-conversion floor (`t as i64`) has no packed form before
+/// AVX-512.
 ///
 /// `inv_p` is `1 / p` (0 for `p = 0`): the periods are 1 and 2, whose reciprocals are exact, so
-/// `x * inv_p` equals `x / p` bit for bit without a division (a `divsd` per coordinate was on
+/// `x * inv_p` equals `x / p` bit for bit without a division (a `divsd` per coordinate would sit on
 /// every pixel's critical path).
 #[inline(always)]
 fn reduce(x: f64, p: f64, inv_p: f64) -> f64 {

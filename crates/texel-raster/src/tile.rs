@@ -11,51 +11,30 @@
 //! - Coverage in the analytic mode steps the three integer edge functions incrementally along each
 //!   row (three adds per pixel); the quad mode evaluates 2x2 aligned quads (tiles have even origins,
 //!   so quads never straddle tiles) and interpolates all four pixels of a touched quad.
+//! - Triangle setups run in parallel chunks ([`crate::setup`]'s `setup_chunks`) and are binned in
+//!   the chunks they are computed in (the bins hold references; binning itself is serial), never
+//!   concatenated: a mesh's setups (33 MB for 100k triangles) copied into one buffer above glibc's
+//!   largest `mmap` threshold would be mapped and faulted in afresh for every frame.
 //!
-//! Measurements (2-core VM shared with other builds, `examples/frame_table.rs`, min of 30 runs):
-//! the ground scene at 1280 x 720 takes 18.9 ms with nearest on 1 thread and 10.1 ms on 2; `perf`
-//! attributes about 60% of the nearest frame to the sampler (`sample_pyramid`, `log2f`, `floorf`)
-//! and about 30% to rasterisation and interpolation. A 100k-triangle mesh over the whole frame
-//! renders at about 1.2 M triangles/s (frame included) and does not yet scale to 2 threads: setup
-//! output is concatenated and binned serially (`memmove` and page faults were 9% of its profile).
-//! Later (third pass): the setups are binned in the chunks they are computed in
-//! ([`crate::setup`]'s `setup_chunks`; the bins hold references), without concatenating 33 MB of
-//! setups into a buffer that glibc maps and faults in afresh every frame (kernel page-fault work
-//! was 15 % of the mesh frame, `memmove` 4 %): drawing into a reused frame, min of 30, one thread
-//! 82-84 -> 52-54 ms, two threads 50-52 -> 27.5 ms (3.6 M triangles/s); images bit-identical.
+//! Row-span batching: in the colour view without texel counting, a triangle's covered,
+//! depth-passing fragments in a tile are gathered into structure-of-arrays scratch (`Span`, one
+//! per tile, reused, never cleared per triangle): up to 64 fragments over as many rows as fit,
+//! each fragment carrying its row. The span is then interpolated stage by stage (barycentrics,
+//! their derivatives, the footprints; each stage a branch-free loop the compiler vectorises),
+//! sampled by one `Sampler::sample_batch` call, then shaded and written. Each stage performs the
+//! per-pixel path's operations in the same order, so images are bit for bit the per-pixel path's
+//! (`tests/threads.rs`, also on grids of small triangles, head-on and tilted). Why: the per-pixel
+//! path is latency-bound (one long chain per pixel: `1/w` division, footprint, `log2`, level,
+//! texel loads, blend), so cutting instructions alone does not move the wall time; batching lets
+//! the independent lod computations of a span overlap, and gathering several rows samples a small
+//! triangle in one `sample_batch` call instead of one per row (the sampler runs calls of at most
+//! 16 footprints with 16-sample scratch). The periodic `uv` reduction multiplies by the exact
+//! reciprocal of the period instead of dividing. When the sampler ignores derivatives
+//! (`Sampler::uses_derivatives`: nearest or bilinear without mipmaps) and footprints are not
+//! captured, the span skips them. Frames are reusable (`render_into`, `draw_into`).
 //!
-//! Row-span batching (issue 6): in the colour view without texel counting, each row span of a
-//! triangle inside a tile is covered, depth-tested and interpolated into a stack buffer first,
-//! then sampled by one `Sampler::sample_batch` call, then shaded and written. The per-pixel path
-//! was latency-bound (one long chain per pixel: `1/w` division, footprint, `log2`, level, texel
-//! loads, blend), so cutting instructions alone did not move the wall time; batching lets the
-//! independent lod computations of a span overlap. Ground scene, 1280 x 720, 2 threads,
-//! `texel bench --frames 10` medians before -> after (same run, alternating): nearest 10.7 -> 8.4 ms,
-//! bilinear 13.3 -> 9.5-10.9, mip-nearest 18.1 -> 11.3-11.6, trilinear 21.2-21.7 -> 13.7-13.8;
-//! images bit-identical (`tests/threads.rs` checks batched against per-pixel). The periodic `uv`
-//! reduction multiplies by the exact reciprocal of the period instead of dividing. When the sampler
-//! ignores derivatives (`Sampler::uses_derivatives`: nearest or bilinear without mipmaps) and
-//! footprints are not captured, the span skips them: measured while the VM was loaded by other
-//! builds (so all times about doubled), alternating runs, nearest 12.2-12.5 -> 10.3 ms, bilinear
-//! 14.1-14.5 -> 12.3-12.8 ms; callgrind `render_frame` at 640 x 360 nearest 50.4M -> 45.8M
-//! instructions, bilinear 59.0M -> 54.4M; images bit-identical.
-//!
-//! Staged spans (issue 6, second pass): the batched path now covers and depth-tests a span first,
-//! then computes barycentrics, their derivatives and the footprints stage by stage over the span's
-//! fragments in structure-of-arrays scratch (`Span`, one per tile, reused), each stage a
-//! branch-free loop the compiler vectorises, with the per-pixel path's operations in the same order
-//! (images bit-identical, `tests/threads.rs`). Frames are reused (`render_into`, `draw_into`).
-//! Ground scene 1280 x 720, 2 threads, draw into a reused frame, same session: nearest 4.77 ->
-//! 3.71-3.86 ms, bilinear 5.85 -> 4.71-4.82, mip-nearest 10.47 -> 8.83-8.88, trilinear 12.72 ->
-//! 10.94-11.11 (before the sampler's staged kernels, which `texel-texture/src/sampler.rs` records).
-//!
-//! Batches of several rows (third pass): a batch now gathers a triangle's fragments over as many
-//! rows as fit in a `Span` (64), each fragment carrying its row, so a small triangle is sampled in
-//! one `sample_batch` call instead of one per row; with the sampler's 16-sample scratch for short
-//! calls. `cargo run --release -p texel-raster --example frame_table -- 7`, 100 352-triangle mesh
-//! (about 9 pixels per triangle), min ms, two alternating runs: one thread 121-124 -> 88-90, two
-//! threads 68-72 -> 57-59 (the ground plane's rows are already full spans: unchanged). Images
-//! bit-identical (`tests/threads.rs`, now also on grids of small triangles, head-on and tilted).
+//! Frame times, the mesh's triangle rate and the profiles are in README.md's Benchmarks section;
+//! how each of these decisions moved them is in docs/perf-log.md.
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -386,8 +365,9 @@ impl Span {
 /// and each stage performs the per-pixel path's operations in the same order: the image is bit for
 /// bit the per-pixel path's (`tests/threads.rs`). What it buys: the interpolation stages
 /// vectorise, the sampler's lod chains pipeline together, and per-call set-up (format, tables,
-/// scratch) happens once per batch. Gathering several rows matters for small triangles: a mesh of
-/// 100 352 triangles of about nine pixels each made three calls of three samples per triangle.
+/// scratch) happens once per batch. Gathering several rows matters for small triangles: one call
+/// per row would make three calls of three samples for each triangle of a mesh of 100 352
+/// triangles of about nine pixels each.
 fn raster_pixels_batched(
     ctx: &Context,
     tile: &mut TileTarget,

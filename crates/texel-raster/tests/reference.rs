@@ -137,7 +137,8 @@ fn reference_agrees_with_the_rasterizer_where_the_texture_is_magnified() {
 
 /// Two triangles meeting on a vertical edge at x = 64.3, just past the first tile's last pixel
 /// centre: every sub-sample of every pixel hits one of them, so the reference of a white texture is
-/// exactly white everywhere (before the sample box, column 64's left samples saw the background).
+/// exactly white everywhere (binned by the pixel-centre box instead of the sample box, column 64's
+/// left samples would see the background).
 /// A triangle smaller than a pixel, covering no pixel centre, still shows as partial coverage.
 #[test]
 fn reference_covers_tile_seams_and_subpixel_triangles() {

@@ -7,8 +7,8 @@
 //! so the numbers are throughput with warm caches, not random-access latency.
 //! Run: `cargo bench -p texel-texture --bench sampler`.
 //!
-//! The `bound/*` group measures what the 8-bit path's design allows (issue 6): the same samplers on a
-//! float copy of the texture (no decode), and the texel loads, table decodes and blends of the 1:1
+//! The `bound/*` group measures what the 8-bit path's design allows: the same samplers on a float
+//! copy of the texture (no decode), and the texel loads, table decodes and blends of the 1:1
 //! bilinear walk alone, with every coordinate computed beforehand (nothing a sampler could skip).
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items

@@ -97,9 +97,9 @@ pub(crate) struct Address {
 /// Texel coordinate: from continuous `xy` (float) to an `i64` index, saturating; NaN gives 0.
 ///
 /// Equal to `x.floor() as i64` for every `x`, but computed by truncating conversion and a compare:
-/// on the x86-64 baseline (no SSE4.1 `roundss`) `f32::floor` is a call into libm, measured at 10%
-/// of a trilinear ground frame. For `|x| < 2^63` the result converts back to `x.floor()` exactly
-/// (below 2^24 every integer is an `f32`; above, `x` is itself an integer).
+/// on the x86-64 baseline (no SSE4.1 `roundss`) `f32::floor` is a call into libm, a measurable
+/// share of a trilinear ground frame (docs/perf-log.md). For `|x| < 2^63` the result converts back
+/// to `x.floor()` exactly (below 2^24 every integer is an `f32`; above, `x` is itself an integer).
 #[inline(always)]
 pub(crate) fn floor_index(x: f32) -> i64 {
     let t = x as i64; // truncates toward zero, saturates, NaN -> 0

@@ -29,36 +29,23 @@
 //!   (at most 64), so the loop is bounded. Probe positions that overflow to infinity are sampled
 //!   at 0, as the sampler treats non-finite `uv`.
 //!
-//! Cost: `N` trilinear probes, so at most `8 N` texel reads. Measured (benches/aniso.rs,
-//! 2048x2048 sRGB RGBA8, minor axis 2 texels, random angles, 2-core VM, shared), texels per sample
-//! and samples per second for 16x: ratio 1: 4.7, 10.3 M/s; ratio 4: 18.9, 4.8 M/s; ratio 16: 76,
-//! 1.9 M/s; ratio 64: 64, 2.0 M/s (trilinear: 4 to 4.7 texels, 10.5 to 20 M/s). Quality against a
-//! brute-force Gaussian (RMS error 0.0138 for 16x vs 0.0230 for trilinear) is in [`crate::ewa`].
+//! Cost: `N` trilinear probes, so at most `8 N` texel reads. Throughput and texels read per sample
+//! at anisotropy ratios 1 to 64 are in README.md's Benchmarks section (`benches/aniso.rs`); quality
+//! against a brute-force Gaussian (RMS error 0.0138 for 16x vs 0.0230 for trilinear) is in
+//! [`crate::ewa`].
 //!
-//! The probes call the trilinear filter specialised to bilinear at compile time
-//! ([`crate::mip`]'s `Linear`), not through the run-time `FilterMode` dispatch: ground scene,
-//! 1280 x 720, 2 threads, `texel bench --filters aniso16 --frames 10`, 80 -> 65 ms; images
-//! bit-identical.
-//!
-//! Probes share their two levels: choosing them once per sample instead of once per probe took the
-//! ground frame (1280 x 720, 2 threads, `texel bench --filters trilinear,aniso16 --threads 2`) from
-//! 66.5 to 54.2 ms (trilinear 13.7 ms: aniso16 costs 3.95x trilinear), with identical images.
-//!
-//! The probes' scratch (coordinates and two level passes, about 2.8 KB) is made once per
-//! `sample_batch` call (`batch::Probes`) instead of zeroed per sample: ground scene,
-//! 1280 x 720, one thread, `texel bench --color raw --filters trilinear,aniso16 --threads 1`, three
-//! alternating runs, 74.4-75.0 -> 72.8-74.4 ms per frame (trilinear 14.3-15.1 in both); callgrind
-//! at 640 x 360: 627.8 -> 619.4 M instructions for the whole run; images bit-identical.
-//!
-//! Staged plans: in `sample_batch` each sample's set-up (axes, their lengths, the probe count, the
-//! probe lod) runs for a chunk of 64 footprints in one loop (`plan_chunk`) before any
-//! probe is read, as the isotropic lods do (`batch::prepare`). That needs a `log2` without a call:
-//! the probe lod now uses [`crate::footprint::fast_log2`] (within 1.2 units in the last place;
-//! libm's `log2f` before), for the single-sample path too. Ground scene, 1280 x 720, one thread,
-//! `texel bench --color raw --filters trilinear,aniso16 --threads 1`, three alternating runs:
-//! 74.3-75.1 -> 62.6-65.2 ms per frame (trilinear 14.8-14.9 in both: 16x costs 4.2-4.4x
-//! trilinear); `texel compare` at 640 x 360, 64 spp: the aniso16 and EWA images are bit-identical
-//! to before (0 of 230 400 pixels differ).
+//! Performance design (how each step moved the frame times, and the image comparisons that found
+//! no bit changed by it: docs/perf-log.md):
+//! - The probes call the trilinear filter specialised to bilinear at compile time
+//!   ([`crate::mip`]'s `Linear`), not through the run-time `FilterMode` dispatch.
+//! - Probes share their two levels: they are chosen once per sample, not once per probe.
+//! - The probes' scratch (coordinates and two level passes, about 2.8 KB) is made once per
+//!   `sample_batch` call (`batch::Probes`) instead of zeroed per sample.
+//! - Staged plans: in `sample_batch` each sample's set-up (axes, their lengths, the probe count,
+//!   the probe lod) runs for a chunk of 64 footprints in one loop (`plan_chunk`) before any probe
+//!   is read, as the isotropic lods do (`batch::prepare`). That needs a `log2` without a call: the
+//!   probe lod uses [`crate::footprint::fast_log2`] (within 1.2 units in the last place), for the
+//!   single-sample path too, so both paths agree bit for bit.
 
 use glam::Vec4;
 
@@ -87,9 +74,8 @@ pub fn probe_count(major: f32, minor: f32, max_anisotropy: u32) -> u32 {
         return max_anisotropy.max(1);
     }
     // `ceil(r)` for `0 <= r <= max_anisotropy` (at most 2^32) without libm's `ceilf` (the x86-64
-    // baseline has no rounding instruction; the call was 1.5 % of a 16x frame): truncate, and add
-    // one where truncation went down. `r < 2^24` here in practice, where every step is exact.
-    // Callgrind, 16x frame at 640 x 360: 0.4 % fewer instructions; images bit-identical.
+    // baseline has no rounding instruction, so `ceilf` is a call; docs/perf-log.md): truncate, and
+    // add one where truncation went down. `r < 2^24` here in practice, where every step is exact.
     let t = r as u32;
     let n = if (t as f32) < r { t + 1 } else { t };
     n.clamp(1, max_anisotropy.max(1))

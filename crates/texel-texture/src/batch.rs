@@ -17,8 +17,8 @@
 //! over every filter, mipmap mode, address mode and texel format).
 //!
 //! Short calls (at most 16 footprints) run with 16-sample scratch: zeroing and filling 64-sample
-//! scratch (about 6 KB per call) cost more than sampling a small triangle's few pixels (100k-triangle
-//! mesh at 1280 x 720, one thread: 120.5 -> 108.2 ms per frame; see `texel-raster/src/tile.rs`).
+//! scratch (about 6 KB per call) costs more than sampling a small triangle's few pixels (the
+//! 100k-triangle mesh of `texel-raster`'s benchmarks; figures in docs/perf-log.md).
 //!
 //! Why the index is exact: the per-sample path's `floor_index(x)` is `floor(x)` as an `i64`. Here
 //! `x` is first clamped to `[-1, W]`; inside that range truncation toward zero, minus one where it
@@ -226,8 +226,8 @@ pub(crate) fn prepare(
 /// sampler (no mipmapping, `mag_filter == min_filter`), whose lods are all 0.
 ///
 /// Short calls (at most 16 footprints: a small triangle's fragments) use 16-sample scratch: the
-/// per-call set-up of 64-sample scratch (about 6 KB of stores) cost more than sampling three or four
-/// pixels (see the module docs).
+/// per-call set-up of 64-sample scratch (about 6 KB of stores) costs more than sampling three or
+/// four pixels (see the module docs).
 pub(crate) fn run<P: Pyramid>(
     p: &P,
     addr: &Address,
@@ -360,9 +360,9 @@ fn texels<F: Fetch, const N: usize>(
 }
 
 /// Scratch for [`probe_sum`]: the probes' coordinates and their two level passes, made once per
-/// [`crate::Sampler::sample_batch`] call and reused by every sample (zeroing about 1.7 KB per sample
-/// was measurable: see [`crate::aniso`]). Entries beyond a sample's probe count are stale and never
-/// read.
+/// [`crate::Sampler::sample_batch`] call and reused by every sample (zeroing scratch per sample
+/// costs measurable frame time: docs/perf-log.md). Entries beyond a sample's probe count are stale
+/// and never read.
 pub(crate) struct Probes {
     /// Probe coordinates, written by the caller for the first `n` probes.
     pub u: [f32; CHUNK],

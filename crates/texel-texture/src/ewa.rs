@@ -56,30 +56,21 @@
 //! centroid and effective blur vary with the sub-texel position; a level one finer would cost 4x the
 //! reads.
 //!
-//! Inner loop: texels arrive in runs along a row with `r^2` updated by forward differences; runs
-//! inside the level read texels without address wrapping; `floor`/`ceil` avoid libm calls (16 % of
-//! the frame before). Ground scene, 1280 x 720, one thread, `texel bench --filters ewa --threads 1`:
-//! 557 ms -> 487 ms per frame (trilinear 42 ms in both runs). Images change by at most 1 in 8 bits
-//! (`r^2` now in `f64`). The LUT index goes through an `i32` conversion (an `f64` to `u64`
-//! conversion needs a range fix-up on x86-64) with a branch-free select: 2 threads, 231 -> 212 ms per
-//! frame, bit-identical. The scan follows the ellipse's wider side (columns for a tall ellipse,
-//! [`LevelEllipse::for_each_run`]): the ground's footprints near the horizon are long in v, so rows
-//! were many and one to four texels long, each paying a square root, a floor, a ceil and its
-//! differences' set-up. 2 threads, alternating runs: 205-209 -> 168 ms per frame; the image's
-//! scores are unchanged to 0.01 dB (PSNR 25.06 dB all, 22.58 band, SSIM 0.9300 against a 64-spp
-//! reference; texels per pixel 77.1 mean, 311 max), the sums' order changes for tall ellipses
-//! only. Weights and texels in one loop per line ([`LevelEllipse::for_each_line`], [`Weights`]):
-//! callgrind's branch simulation counted 43 mispredicted branches per pixel (trilinear: 1), two
-//! thirds of them the exits of the weight loop and of the texel loop, whose lengths vary from
-//! line to line; fusing them leaves one exit per line: one thread, 351-353 -> 313-315 ms per frame,
-//! 2 threads 185 -> 165 ms, images bit-identical. Measured and dropped: two interleaved
-//! accumulators for the texel sum (no change: the sum is not the latency bound); `r^2` evaluated
-//! directly at every centre instead of by forward differences (no change); one bounds check per
-//! run instead of per texel (no change); `floor_f64` with selects instead of its branch (7 %
-//! slower). The ellipse's axes without `atan2`, `sin`, `cos` and `hypot` ([`Ellipse::from_axes`]:
-//! the eigenvector in closed form): one thread 318-326 -> 308-315 ms per frame, images
-//! bit-identical on the ground and sphere scenes. `perf` on the ground frame: the weight loop about 20%,
-//! the per-row set-up (square root, floor and ceil of the row's column range) about 25%.
+//! Inner loop: the ellipse is scanned line by line along its wider side (columns for a tall
+//! ellipse, rows otherwise; [`LevelEllipse::for_each_run`]). Footprints near the ground's horizon
+//! are long in v, and scanning them by rows would give many lines one to four texels long, each
+//! paying a square root, a floor, a ceil and its differences' set-up. Along a line `r^2` (in
+//! `f64`) is updated by forward differences, and weights and texels are read in one loop
+//! ([`LevelEllipse::for_each_line`], [`Weights`]), so a line has a single loop exit: separate
+//! weight and texel loops, whose lengths vary from line to line, would each mispredict their exit.
+//! Lines inside the level read texels without address wrapping; `floor`/`ceil` avoid libm calls;
+//! the LUT index goes through an `i32` conversion (an `f64` to `u64` conversion needs a range
+//! fix-up on x86-64) with a branch-free select. The ellipse's axes come from the eigenvector in
+//! closed form ([`Ellipse::from_axes`]: no `atan2`, `sin`, `cos` or `hypot`). Measured and not
+//! adopted (no gain, or slower; docs/perf-log.md): two interleaved accumulators for the texel sum
+//! (the sum is not the latency bound); `r^2` evaluated directly at every centre instead of by
+//! forward differences; one bounds check per run instead of per texel; `floor_f64` with selects
+//! instead of its branch.
 //!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
@@ -89,9 +80,8 @@
 //! and the RMS error against its own brute-force Gaussian rose from 0.0119 to 0.0196, behind aniso16.
 //! Keeping it would need a level one finer (4x the reads); pbrt's falloff stays.
 //!
-//! Cost (benches/aniso.rs, 2048x2048 sRGB RGBA8, minor axis 2 texels, random angles, 2-core VM,
-//! shared): ratio 1: 6.6 texels, 3.7 M samples/s; ratio 4: 19.4, 2.8 M/s; ratio 16: 75, 0.75 M/s;
-//! ratio 64 (clamped to 16): 71, 0.68 M/s.
+//! Cost: throughput and texels read per sample at anisotropy ratios 1 to 64 are in README.md's
+//! Benchmarks section (the anisotropic filters' table, from `benches/aniso.rs`); frame times too.
 
 use std::sync::OnceLock;
 
@@ -317,7 +307,7 @@ impl LevelEllipse {
     /// The scan follows the ellipse's wider side: each line costs a square root, a floor and a ceil
     /// and the set-up of its differences, and a tall, thin ellipse (the ground plane's footprints
     /// near the horizon stretch along v) has many rows of one to four texels but few long
-    /// columns. Ground scene, 1280 x 720, 2 threads: see the module docs.
+    /// columns. Timings: docs/perf-log.md.
     pub fn for_each_line(&self, x: f32, y: f32, mut f: impl FnMut(Line)) -> u32 {
         if self.q00 >= self.q11 {
             self.lines(x, y, self.q00, self.q11, |a0, b, weights| {
@@ -482,9 +472,10 @@ impl Iterator for Weights {
 
 impl ExactSizeIterator for Weights {}
 
-/// `floor` without a libm call (the x86-64 baseline has no rounding instruction, and `floor`/`ceil`
-/// were 16 % of an EWA frame's profile). Exact for `|x| < 2^63`; NaN stays NaN; beyond that range
-/// the result saturates, which the callers' visit bounds absorb.
+/// `floor` without a libm call (the x86-64 baseline has no rounding instruction, so libm's
+/// `floor`/`ceil` are calls, a visible share of an EWA frame's profile: docs/perf-log.md). Exact
+/// for `|x| < 2^63`; NaN stays NaN; beyond that range the result saturates, which the callers'
+/// visit bounds absorb.
 #[inline(always)]
 fn floor_f64(x: f64) -> f64 {
     if x.is_nan() {

@@ -30,11 +30,9 @@
 //!   `f32` build scratch of `40 W H` bytes). Over the limit, sampling falls back to trilinear.
 //! - Reads: up to four bilinear lookups, at most 16 texels.
 //!
-//! Measured (benches/aniso.rs, 2048x2048 sRGB RGBA8, 2-core VM, shared): 50.3 MB (the pyramid:
-//! 22.4 MB), built in 537 ms (the pyramid: 97 ms). The build is dominated by sRGB-encoding
-//! 12.6 M texels (three `powf` each), ten times the pyramid's. Sampling: 16 texels per sample at
-//! every ratio (four bilinear lookups), 3.7 M samples/s at ratio 1 (four large images: cache
-//! misses), 6.1 M/s at ratio 4, 6.0 at 16, 5.0 at 64.
+//! The build of a 2048x2048 sRGB ripmap is dominated by sRGB-encoding its 12.6 M texels (three
+//! `powf` each), ten times the pyramid's. Memory, build time, throughput and texels read per sample
+//! (2048x2048, `benches/aniso.rs`) are in README.md's Benchmarks section.
 
 use glam::Vec4;
 use rayon::prelude::*;

@@ -24,97 +24,38 @@
 //! - `mipmap_filter` is ignored: each technique chooses its own levels (EWA lerps two pyramid
 //!   levels, the ripmap blends four images, the summed-area table reads level 0 only);
 //! - `anisotropy_clamp` is EWA's eccentricity clamp; its WebGPU default of 1 ("not requested")
-//!   means the issue's default of 16 for EWA ([`EWA_DEFAULT_ANISOTROPY`]). Ripmap and summed-area
-//!   table ignore it (their box has no eccentricity limit);
+//!   means 16 for EWA ([`EWA_DEFAULT_ANISOTROPY`]). Ripmap and summed-area table ignore it
+//!   (their box has no eccentricity limit);
 //! - the ripmap and the summed-area table are built on first use, or by [`Texture::prepare`]; if
 //!   one would exceed the texture's [`crate::Limits`], sampling falls back to trilinear.
 //!
-//! ## Performance (issue 6)
+//! ## Performance design
 //!
 //! The per-sample path: integer floor/ceil instead of libm `floorf`/`ceilf` (not inlined on the
 //! x86-64 baseline); bilinear and nearest read inside the level without address wrapping
 //! ([`crate::address`] only at the edges); the lod is `0.5 * log2(rho^2)` with
 //! [`crate::footprint::fast_log2`] (no square root, no libm call; exact on integer lods); the lod
-//! is skipped when it cannot matter (no mipmapping and `mag_filter == min_filter`);
-//! [`Sampler::sample_batch`] computes the lods of 64 footprints before filtering any (the
-//! per-pixel path was latency-bound: instruction cuts alone did not move the wall time, batching
-//! did); anisotropic probes use a trilinear specialised to bilinear at compile time.
-//! Every rendered image is bit-identical to before (ground scene, all six CLI filters).
+//! is skipped when it cannot matter (no mipmapping and `mag_filter == min_filter`); anisotropic
+//! probes use a trilinear specialised to bilinear at compile time. The ground scene's images are
+//! bit-identical with and without these shortcuts (docs/perf-log.md).
 //!
-//! Ground scene 1280 x 720, 2 threads, `texel bench ../shared/scenes/ground.toml --frames 10
-//! --threads 2`, 2-core VM shared with other builds; median of three alternating runs of the
-//! old and new binaries, ms per frame:
+//! [`Sampler::sample_batch`] computes the lods of 64 footprints before filtering any: the
+//! per-pixel path is latency-bound (one long dependency chain per sample), so cutting instructions
+//! alone does not move the wall time, while a batch lets the independent lod computations overlap.
+//! It then runs the core filters through `batch` (`batch.rs`) in stages (levels, then branch-free
+//! coordinates for the whole chunk, then texels), and anisotropic probes through the same stages,
+//! whose set-up is planned per chunk too ([`crate::aniso`]); results are bit-identical to
+//! [`Sampler::sample`] (tested).
 //!
-//! | filter | before | after |
-//! |---|---|---|
-//! | nearest | 10.96 | 6.15 |
-//! | bilinear | 13.17 | 7.09 |
-//! | mip-nearest | 18.32 | 11.68 |
-//! | trilinear | 21.32 | 14.07 |
-//! | aniso16 | 80.2 | 66.2 (4.7x trilinear) |
-//! | ewa | 289 | 280 (not optimised here) |
-//!
-//! `cargo bench -p texel-texture --bench sampler -- --warm-up-time 1 --measurement-time 2`,
-//! one thread, 1024^2 sRGB RGBA8, coherent, M samples/s before -> after (same session):
-//! 1:1 (magnified path) nearest 84 -> 153, bilinear 44 -> 97, trilinear 44 -> 65; 3x minified
-//! (two levels) bilinear 41 -> 94, mip-nearest 19.5 -> 42, trilinear 18.6 -> 29; 4x (integer lod,
-//! one level) mip-nearest 19.5 -> 42, trilinear 30.5 -> 45.
-//!
-//! Where the time goes (callgrind, ground scene at 640 x 360, one thread, 120 960 covered pixels,
-//! instructions in `render_frame`): trilinear 1125 per covered pixel before, 859 after, of which
-//! the sampler 603 (the two bilinear lookups 456: 8 texel decodes at one load plus four table
-//! loads each, coordinate set-up, range checks, lerps; lod and batch loop 147) and rasterisation,
-//! interpolation (`f64`) and shading 256; nearest 671 before, 378 after. The issue's targets
-//! (bilinear 300 M/s, trilinear 150 M/s on one core) mean about 9 and 17 cycles per sample at
-//! 2.6 GHz: the scalar trilinear path measured here costs about 90 cycles per sample (29 M/s)
-//! and its eight texel decodes alone are about 90 instructions (per texel four byte loads, four
-//! table loads and three shuffles), so reaching them needs 8-lane SIMD
-//! (gathered or pre-decoded texels), which this scalar code does not have yet.
-//!
-//! ### Second pass: staged kernels
-//!
-//! [`Sampler::sample_batch`] now runs the core filters through `batch` (`batch.rs`) (levels, then
-//! branch-free coordinates for the whole chunk, then texels), and anisotropic probes through the same
-//! stages; results bit-identical to [`Sampler::sample`] (tested). Together with the rasterizer's
-//! staged spans and reused frames (`texel-raster/src/tile.rs`), ground scene 1280 x 720, 2 threads,
-//! `texel bench ../shared/scenes/ground.toml --color raw --frames 20 --threads 2`, ms per frame, one
-//! session, each column a build of its own: "fresh frame" is the previous pass (each timed render
-//! allocates its frame), "reused" times only the draw into a reused frame after an untimed clear
-//! (0.25-0.45 ms; what `texel bench` times now, as the llvmpipe script does), "staged" adds the
-//! staged spans and kernels:
-//!
-//! | filter | fresh frame | reused | staged |
-//! |---|---|---|---|
-//! | nearest | 5.22-5.29 | 4.77 | 3.6-4.0 |
-//! | bilinear | 6.20-6.39 | 5.85 | 4.4-4.8 |
-//! | mip-nearest | 10.47-10.86 | 10.47 | 7.0-7.5 |
-//! | trilinear | 12.94-14.05 | 12.72 | 8.9-9.5 |
-//! | aniso16 | - | 52.9 | 45.7-49 |
-//!
-//! One thread, `cargo bench -p texel-texture --bench sampler -- --warm-up-time 1
-//! --measurement-time 2`, M samples/s, the previous pass's README table -> this pass: nearest
-//! 138-144 -> 183-192, bilinear 86-91 -> 127-128, mip-nearest 38.5-62.5 -> 68.5-69.2, trilinear
-//! 28.1-60.9 -> 47.4-61.5 (3x minified, two levels: 28.1 -> 47.4). Compiling everything for AVX2 (`RUSTFLAGS="-C target-cpu=x86-64-v3"`) gave another
-//! 8-12% on frames; not adopted (see ARCHITECTURE.md).
-//!
-//! Where the time goes now (`perf record`, trilinear ground frame, one thread): `batch::run` 65%
-//! (texel loads, the four table loads per texel that decode it, and the `Vec4` blends: 8 texels per
-//! two-level sample), the rasterizer 25%. Bilinear at 127 M/s is about 20 cycles per sample; 300 M/s
-//! would be 8.7, which leaves no room for the 16 table loads and 12 inserts that decode its four
-//! texels one at a time: the next step is decoding and blending 8 samples per instruction (SoA
-//! texels, 8-bit arithmetic or gathers), which this code does not do yet.
-//!
-//! ### Third pass: bounds
-//!
-//! `mip_nearest_level` converts through `i32` (1:1 mip-nearest 93-95 -> 105-108 M samples/s);
-//! the anisotropic set-up is staged per chunk ([`crate::aniso`]). The sampler bench's `bound/*`
-//! group measures what the design allows (one thread, same session as the README's table): the
-//! loads, sRGB table decodes and blends of the 1:1 bilinear walk alone, every index and fraction
-//! precomputed, run at 289.7 M samples/s, against 158.7 for the full bilinear sampler and the
-//! issue's 300; a float copy of the texture (no decode) gives 269.4 (bilinear) and 101.0
-//! (trilinear, two levels; 8-bit: 66.7, issue: 150). The table decode alone runs at about the
-//! bilinear target (290 here, 265-320 in `experiments/avx2_gather`, where AVX2 gathers reach only
-//! 195), leaving nothing for coordinates, lods and edges.
+//! What bounds the 8-bit path: over half of a trilinear frame is the sampler's kernel (texel
+//! loads, the four table loads that decode each sRGB texel, the `Vec4` blends). The sampler
+//! bench's `bound/*` group times the loads, table decodes and blends of the 1:1 bilinear walk
+//! alone, every index and fraction precomputed, and the same samplers on a float copy of the
+//! texture (no decode): the table decode alone runs at about the one-core bilinear throughput
+//! target, leaving nothing for coordinates, lods and edges, and AVX2 gathers
+//! (`experiments/avx2_gather`) decode slower than the scalar table loop. Compiling everything for
+//! AVX2 is not adopted (see ARCHITECTURE.md). The figures and profiles are in README.md's
+//! Benchmarks section; how each change moved them is in docs/perf-log.md.
 
 use glam::Vec4;
 
@@ -570,10 +511,10 @@ impl Sampler {
             return (&d.mag_filter).apply(&p.level(0), addr, u, v);
         }
         match self.technique {
-            // Measured: specialising these calls at compile time (`Linear` instead of
-            // `&FilterMode`) cut their instructions but made mip-nearest and trilinear ground
-            // frames 10-25% slower (code layout), so they keep the run-time dispatch; the
-            // anisotropic probes do use `Linear` (18% faster).
+            // Specialising these calls at compile time (`Linear` instead of `&FilterMode`) cuts
+            // their instructions but makes mip-nearest and trilinear ground frames slower (code
+            // layout; docs/perf-log.md), so they keep the run-time dispatch; the anisotropic
+            // probes, where specialising pays, do use `Linear`.
             Technique::Mip => match d.mipmap_filter {
                 MipmapFilterMode::None => (&d.min_filter).apply(&p.level(0), addr, u, v),
                 MipmapFilterMode::Nearest => mip_nearest(p, &d.min_filter, addr, u, v, lod),

@@ -1,4 +1,4 @@
-//! The anisotropic filters (issue 3): hardware-style N x, EWA, ripmap, summed-area table.
+//! The anisotropic filters: hardware-style N x, EWA, ripmap, summed-area table.
 //!
 //! Run `cargo test --release -p texel-texture --test aniso -- --nocapture` to see the measured
 //! numbers that the module docs of `ewa.rs` record.
@@ -33,7 +33,7 @@ fn noise_texture(w: u32, h: u32, format: Format, seed: u64) -> Texture {
     .unwrap()
 }
 
-/// Every minification technique of issue 3, plus trilinear as the baseline.
+/// Every anisotropic minification technique, plus trilinear as the baseline.
 fn technique(name: &str) -> SamplerDescriptor {
     match name {
         "trilinear" => SamplerDescriptor::lab_mode(4).unwrap(),

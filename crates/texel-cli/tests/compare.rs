@@ -1,0 +1,194 @@
+//! `texel compare`: the report agrees with the images it wrote; the filter ranking on the ground plane.
+
+use texel_quality::{psnr, psnr_band, ssim, Image8, Mask, Report, OUTSIDE};
+
+use crate::util::*;
+
+/// The coverage mask as the report used it, read back from a heat map: [`OUTSIDE`] marks the
+/// uncovered pixels and viridis never reaches it.
+fn coverage_from_heat_map(heat: &Image8) -> Mask {
+    let bits = heat.pixels().iter().map(|p| *p != OUTSIDE).collect();
+    Mask::new(heat.width(), heat.height(), bits).unwrap()
+}
+
+fn close(a: f64, b: f64) -> bool {
+    a == b || (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
+}
+
+#[test]
+fn compare_report_is_consistent_with_its_images() {
+    let d = Dir::new("compare");
+    // An image rendered elsewhere: texel's own bilinear image at the same size.
+    let extra = d.arg("elsewhere.png");
+    ok(&[
+        "render", "--size", "96x54", "--filter", "bilinear", "-o", &extra,
+    ]);
+    let out = d.join("report");
+    let out_s = out.to_string_lossy().into_owned();
+    let run = ok(&[
+        "compare",
+        "builtin:ground",
+        "--size",
+        "96x54",
+        "--spp",
+        "16",
+        "--filters",
+        "nearest,bilinear,trilinear,ewa",
+        "--extra",
+        &format!("gpu={extra}"),
+        "--out",
+        &out_s,
+    ]);
+    // The Markdown table goes to stdout, the report's place to stderr.
+    assert!(stdout(&run).contains("| trilinear |"), "{}", stdout(&run));
+    assert!(stderr(&run).contains("index.html"));
+
+    let report =
+        Report::from_json(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!((report.width, report.height, report.spp), (96, 54, 16));
+    assert_eq!(report.color, "srgb");
+    let names: Vec<&str> = report.rows.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(names, ["nearest", "bilinear", "trilinear", "ewa", "gpu"]);
+    let reference = load(out.join(&report.reference_image));
+    assert_eq!(reference.size(), (96, 54));
+
+    let mut coverage: Option<Mask> = None;
+    for row in &report.rows {
+        let image = load(out.join(&row.image));
+        let heat = load(out.join(row.heat_map.as_ref().expect("every row has a heat map")));
+        let mask = coverage_from_heat_map(&heat);
+        // Every heat map shows the same coverage, part of the image (the plane below the horizon).
+        match &coverage {
+            None => {
+                assert!(
+                    mask.count() > 0 && mask.count() < 96 * 54,
+                    "coverage {} pixels",
+                    mask.count()
+                );
+                assert!(mask.get(48, 53) && !mask.get(48, 0));
+                coverage = Some(mask.clone());
+            }
+            Some(c) => assert_eq!(&mask, c, "{}: another coverage", row.name),
+        }
+        // The scores are exactly those of the images written.
+        let p = psnr(&reference, &image, Some(&mask)).unwrap();
+        assert!(
+            close(row.psnr_all, p),
+            "{}: psnr_all {} but the images give {p}",
+            row.name,
+            row.psnr_all
+        );
+        let b = psnr_band(&reference, &image, &mask, report.band_rows).unwrap();
+        assert!(
+            close(row.psnr_band, b),
+            "{}: psnr_band {} but the images give {b}",
+            row.name,
+            row.psnr_band
+        );
+        let s = ssim(&reference, &image, Some(&mask)).unwrap();
+        assert!(
+            close(row.ssim, s),
+            "{}: ssim {} but the images give {s}",
+            row.name,
+            row.ssim
+        );
+        assert!(
+            row.psnr_all.is_finite() && row.psnr_all > 5.0,
+            "{}: {}",
+            row.name,
+            row.psnr_all
+        );
+        if let Some(crop) = &row.horizon_crop {
+            assert!(out.join(crop).is_file());
+        }
+        if row.extra {
+            assert!(
+                row.ms_per_frame.is_none()
+                    && row.texels_per_pixel_mean.is_none()
+                    && row.texture_bytes.is_none()
+            );
+        } else {
+            assert!(row.ms_per_frame.is_some_and(|ms| ms > 0.0), "{}", row.name);
+            assert!(row.texture_bytes.is_some_and(|b| b > 0), "{}", row.name);
+            let (mean, max) = (
+                row.texels_per_pixel_mean.unwrap(),
+                row.texels_per_pixel_max.unwrap(),
+            );
+            assert!(
+                mean >= 1.0 && mean <= max as f64,
+                "{}: mean {mean} max {max}",
+                row.name
+            );
+        }
+    }
+    // Nearest reads one texel per pixel, bilinear four (the 2x2 quad).
+    assert_eq!(report.rows[0].texels_per_pixel_mean, Some(1.0));
+    assert_eq!(report.rows[0].texels_per_pixel_max, Some(1));
+    assert_eq!(report.rows[1].texels_per_pixel_max, Some(4));
+    // The extra image is copied unchanged and, being texel's bilinear image, scores as bilinear.
+    let gpu = &report.rows[4];
+    assert!(gpu.extra);
+    assert_eq!(load(out.join(&gpu.image)), load(&extra));
+    assert_eq!(load(&extra), load(out.join(&report.rows[1].image)));
+    assert_eq!(
+        (gpu.psnr_all, gpu.psnr_band, gpu.ssim),
+        (
+            report.rows[1].psnr_all,
+            report.rows[1].psnr_band,
+            report.rows[1].ssim
+        )
+    );
+
+    // report.md has the same table; index.html shows every image.
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    for row in &report.rows {
+        assert!(
+            md.contains(&format!("{:.2}", row.psnr_all)),
+            "report.md lacks {}'s PSNR",
+            row.name
+        );
+        assert!(html.contains(&row.image), "index.html lacks {}", row.image);
+    }
+    assert!(md.contains("gpu (extra)"));
+    assert!(html.contains("<svg"), "no chart in index.html");
+    assert!(temp_files(&out).is_empty());
+}
+
+#[test]
+fn ground_plane_filter_ranking_against_a_16x16_reference() {
+    let d = Dir::new("ranking");
+    let out = d.arg("report");
+    ok(&[
+        "compare",
+        "builtin:ground",
+        "--size",
+        "192x108",
+        "--spp",
+        "256",
+        "--filters",
+        "nearest,bilinear,trilinear,aniso16,ewa",
+        "--out",
+        &out,
+    ]);
+    let report =
+        Report::from_json(&std::fs::read_to_string(d.join("report/report.json")).unwrap()).unwrap();
+    let psnr = |name: &str| {
+        report
+            .rows
+            .iter()
+            .find(|r| r.name == name)
+            .unwrap()
+            .psnr_all
+    };
+    let (n, b, t, a, e) = (
+        psnr("nearest"),
+        psnr("bilinear"),
+        psnr("trilinear"),
+        psnr("aniso16"),
+        psnr("ewa"),
+    );
+    assert!(e > t && a > t, "ewa {e} aniso16 {a} trilinear {t}");
+    assert!(t > b, "trilinear {t} bilinear {b}");
+    assert!(b > n, "bilinear {b} nearest {n}");
+}

@@ -1,0 +1,105 @@
+//! `texel demo` and `texel bench`.
+
+use texel_quality::Report;
+
+use crate::util::*;
+
+#[test]
+fn demo_compares_every_builtin_scene_with_an_index() {
+    let d = Dir::new("demo");
+    let out = d.arg("demo");
+    let run = ok(&["demo", "--size", "64x36", "--spp", "4", "--out", &out]);
+    assert!(stdout(&run).contains("index.html"), "{}", stdout(&run));
+    let index = std::fs::read_to_string(d.join("demo/index.html")).unwrap();
+    for scene in BUILTINS {
+        assert!(
+            index.contains(&format!("href=\"{scene}/index.html\"")),
+            "index.html does not link {scene}"
+        );
+        let dir = d.join(&format!("demo/{scene}"));
+        assert!(dir.join("index.html").is_file() && dir.join("report.md").is_file());
+        let report =
+            Report::from_json(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+        assert_eq!(
+            (report.width, report.height, report.spp),
+            (64, 36, 4),
+            "{scene}"
+        );
+        let names: Vec<&str> = report.rows.iter().map(|r| r.name.as_str()).collect();
+        assert_eq!(names, FILTERS, "{scene}");
+        for row in &report.rows {
+            assert_eq!(load(dir.join(&row.image)).size(), (64, 36));
+        }
+    }
+    assert!(temp_files(&d.join("demo")).is_empty());
+}
+
+#[test]
+fn bench_json_has_the_llvmpipe_shape() {
+    let run = ok(&[
+        "bench",
+        "--size",
+        "64x36",
+        "--frames",
+        "3",
+        "--warmup",
+        "1",
+        "--threads",
+        "1",
+        "--filters",
+        "nearest,trilinear,ewa",
+        "--json",
+    ]);
+    let v: serde_json::Value =
+        serde_json::from_str(&stdout(&run)).unwrap_or_else(|e| panic!("{e}: {}", stdout(&run)));
+    let obj = v.as_object().unwrap();
+    let mut keys: Vec<&str> = obj.keys().map(String::as_str).collect();
+    keys.sort_unstable();
+    assert_eq!(
+        keys,
+        [
+            "clear_ms",
+            "frames",
+            "height",
+            "median_ms",
+            "renderer",
+            "threads",
+            "width"
+        ]
+    );
+    assert_eq!(v["renderer"], "texel");
+    assert_eq!(v["threads"], 1);
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(64), Some(36))
+    );
+    assert_eq!(v["frames"], 3);
+    for key in ["median_ms", "clear_ms"] {
+        let medians = v[key].as_object().unwrap();
+        let mut filters: Vec<&str> = medians.keys().map(String::as_str).collect();
+        filters.sort_unstable();
+        assert_eq!(filters, ["ewa", "nearest", "trilinear"], "{key}");
+        for (f, ms) in medians {
+            assert!(
+                ms.as_f64().is_some_and(|ms| ms.is_finite() && ms >= 0.0),
+                "{key} {f}: {ms}"
+            );
+        }
+    }
+    // Without --json: a table with one line per filter.
+    let run = ok(&[
+        "bench",
+        &ground_toml(),
+        "--size",
+        "64x36",
+        "--frames",
+        "1",
+        "--filters",
+        "bilinear,sat",
+    ]);
+    let text = stdout(&run);
+    assert!(
+        text.contains("median ms") && text.contains("\nbilinear ") && text.contains("\nsat "),
+        "{text}"
+    );
+}

@@ -1,0 +1,175 @@
+//! `texel render`: every filter, lab mode, view and option; the shipped ground scene.
+
+use crate::util::*;
+
+#[test]
+fn render_every_filter_and_lab_mode() {
+    let d = Dir::new("render-filters");
+    let mut images = Vec::new();
+    for f in FILTERS {
+        let out = d.arg(&format!("{f}.png"));
+        ok(&["render", "--size", "64x36", "--filter", f, "-o", &out]);
+        let img = load(&out);
+        assert_eq!(img.size(), (64, 36), "{f}");
+        images.push(img);
+    }
+    // The default scene is the ground plane, and different filters give different images.
+    assert_ne!(images[0], images[4], "nearest and trilinear render alike");
+    assert_ne!(images[4], images[9], "trilinear and ewa render alike");
+    // The lab's numbered modes are the named filters.
+    let lab = [
+        "nearest",
+        "bilinear",
+        "mip-nearest",
+        "trilinear",
+        "aniso2",
+        "aniso4",
+        "aniso8",
+        "aniso16",
+    ];
+    for (k, name) in lab.iter().enumerate() {
+        let mode = (k + 1).to_string();
+        let out = d.arg(&format!("lab{mode}.png"));
+        ok(&[
+            "render",
+            "builtin:ground",
+            "--size",
+            "64x36",
+            "--lab-mode",
+            &mode,
+            "-o",
+            &out,
+        ]);
+        assert_eq!(
+            file_bytes(&out),
+            file_bytes(d.join(&format!("{name}.png"))),
+            "--lab-mode {mode} is not {name}"
+        );
+    }
+}
+
+#[test]
+fn render_every_view() {
+    let d = Dir::new("render-views");
+    let views = [
+        "color",
+        "uv",
+        "mip",
+        "lod",
+        "aniso",
+        "fetches",
+        "barycentric",
+    ];
+    let mut images = Vec::new();
+    for v in views {
+        let out = d.arg(&format!("{v}.png"));
+        ok(&[
+            "render", "--size", "64x36", "--filter", "aniso16", "--view", v, "-o", &out,
+        ]);
+        let img = load(&out);
+        assert_eq!(img.size(), (64, 36), "{v}");
+        images.push(img);
+    }
+    for i in 0..views.len() {
+        for j in i + 1..views.len() {
+            assert_ne!(
+                images[i], images[j],
+                "--view {} and --view {} render alike",
+                views[i], views[j]
+            );
+        }
+    }
+}
+
+#[test]
+fn render_options_derivatives_perspective_color_threads() {
+    let d = Dir::new("render-options");
+    let render = |name: &str, extra: &[&str]| -> Vec<u8> {
+        let out = d.arg(name);
+        let mut args = vec!["render", "builtin:ground", "--size", "80x45"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", &out]);
+        ok(&args);
+        assert_eq!(load(&out).size(), (80, 45));
+        file_bytes(&out)
+    };
+    let base = render("base.png", &["--filter", "trilinear"]);
+    // The number of threads does not change the image.
+    assert_eq!(
+        render("t1.png", &["--filter", "trilinear", "--threads", "1"]),
+        base
+    );
+    assert_eq!(
+        render("t3.png", &["--filter", "trilinear", "--threads", "3"]),
+        base
+    );
+    // Quad derivatives change the level of detail, affine interpolation the whole plane.
+    assert_ne!(
+        render(
+            "quad.png",
+            &["--filter", "trilinear", "--derivatives", "quad"]
+        ),
+        base
+    );
+    assert_ne!(
+        render(
+            "affine.png",
+            &["--filter", "trilinear", "--perspective", "affine"]
+        ),
+        base
+    );
+    // --color raw: the black and white checks are 0 and 255 either way, so nearest is unchanged;
+    // filtered greys are linear bytes (0.5 -> 128) instead of sRGB (0.5 -> 188), so trilinear changes.
+    assert_eq!(
+        render("near-raw.png", &["--filter", "nearest", "--color", "raw"]),
+        render("near.png", &["--filter", "nearest"])
+    );
+    assert_ne!(
+        render("raw.png", &["--filter", "trilinear", "--color", "raw"]),
+        base
+    );
+}
+
+#[test]
+fn shipped_ground_scene_renders_like_the_builtin() {
+    let d = Dir::new("ground-file");
+    let (file, builtin, default) = (
+        d.arg("file.png"),
+        d.arg("builtin.png"),
+        d.arg("default.png"),
+    );
+    ok(&[
+        "render",
+        &ground_toml(),
+        "--size",
+        "96x54",
+        "--filter",
+        "ewa",
+        "-o",
+        &file,
+    ]);
+    ok(&[
+        "render",
+        "builtin:ground",
+        "--size",
+        "96x54",
+        "--filter",
+        "ewa",
+        "-o",
+        &builtin,
+    ]);
+    ok(&[
+        "render", "--size", "96x54", "--filter", "ewa", "-o", &default,
+    ]);
+    assert_eq!(load(&file).size(), (96, 54));
+    assert_eq!(file_bytes(&file), file_bytes(&builtin));
+    assert_eq!(file_bytes(&default), file_bytes(&builtin));
+    // The black background above the horizon, the plane's checks resolved in the bottom row.
+    let img = load(&file);
+    assert_eq!(img.pixel(48, 0), Some([0, 0, 0, 255]));
+    let bottom: Vec<u8> = (0..96).map(|x| img.pixel(x, 53).unwrap()[0]).collect();
+    assert!(
+        bottom.iter().any(|&v| v > 200) && bottom.iter().any(|&v| v < 80),
+        "{bottom:?}"
+    );
+}
