@@ -30,6 +30,14 @@ const INTERRUPTED: i32 = 130;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // A decoder panic that texel_texture::input::guarded turns into an error is not reported as a
+    // panic; every other panic is.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !texel_texture::input::in_guarded_decode() {
+            default_hook(info);
+        }
+    }));
     // An interrupted run deletes its unpublished temporary files and staging directories.
     if let Err(e) = ctrlc::set_handler(|| texel_quality::remove_pending_and_exit(INTERRUPTED)) {
         eprintln!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files");

@@ -580,6 +580,23 @@ fn non_finite_texels_are_named_or_replaced() {
 }
 
 #[test]
+fn decoder_panics_are_one_line_errors() {
+    // A JPEG that makes the image crate's JPEG decoder (zune-jpeg 0.5.15, AVX2 path) panic.
+    let jpg = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../texel-texture/tests/data/zune-avx2-idct-panic.jpg"
+    );
+    let d = Dir::new("hostile-decoder-panic");
+    let out = texel(&["mips", jpg, "--out", &d.arg("m")]);
+    let err = stderr(&out);
+    assert!(!err.contains("panicked"), "{err}");
+    if !out.status.success() {
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+}
+
+#[test]
 fn truncated_images_are_errors() {
     let d = Dir::new("hostile-trunc");
     let jpeg = small_jpeg();

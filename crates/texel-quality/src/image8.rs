@@ -191,7 +191,17 @@ impl Image8 {
         limits.max_image_width = Some(MAX_SIDE);
         limits.max_image_height = Some(MAX_SIDE);
         reader.limits(limits);
-        let img = reader.decode().map_err(img_err)?.into_rgba8();
+        let img = texel_texture::input::guarded(|| reader.decode())
+            .map_err(|msg| {
+                img_err(image::ImageError::Decoding(
+                    image::error::DecodingError::new(
+                        image::error::ImageFormatHint::Unknown,
+                        format!("the decoder failed on this file: {msg}"),
+                    ),
+                ))
+            })?
+            .map_err(img_err)?
+            .into_rgba8();
         let (w, h) = img.dimensions();
         Self::from_rgba_bytes(w, h, img.as_raw())
     }

@@ -123,6 +123,10 @@ pub enum TextureError {
         /// The value found.
         value: f32,
     },
+    /// The image decoder crashed on the file (a panic caught by [`crate::input::guarded`]): the
+    /// file is corrupt, or uses a feature the decoder mishandles.
+    #[error("cannot decode image: the decoder failed on this file (corrupt, or a feature it mishandles): {0}")]
+    DecoderFailed(String),
     /// The image file ends before its data does.
     #[error("truncated image: {0}")]
     Truncated(String),

@@ -3,11 +3,45 @@
 //! A FIFO, a device or a directory where an input file belongs is an error before anything is
 //! opened (opening a FIFO for reading blocks until a writer appears, and `/dev/zero` never ends);
 //! a file larger than the caller's bound is an error carrying both figures, before it is read.
-//! Every input texel reads (images, scene files, OBJ, glTF and their buffers) goes through here.
+//! Every input texel reads (images, scene files, OBJ, glTF and their buffers) goes through here,
+//! and every third-party image decoder runs inside [`guarded`].
 
+use std::cell::Cell;
 use std::fs::File;
 use std::io::{self, Read};
+use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
+
+thread_local! {
+    /// Set while [`guarded`] runs a decoder on this thread.
+    static GUARDED: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Whether this thread is inside [`guarded`]: a panic hook can stay quiet for a decoder panic that
+/// [`guarded`] turns into an error (the `texel` binary's hook does).
+pub fn in_guarded_decode() -> bool {
+    GUARDED.with(Cell::get)
+}
+
+/// Run a third-party decoder, turning a panic inside it into `Err(message)`.
+///
+/// Decoders are fuzzed upstream but not bug-free: zune-jpeg 0.5.15 (the `image` crate's JPEG
+/// decoder) panics in its AVX2 IDCT on some valid-looking sampling factors (found by texel's
+/// `image_decode` fuzz target). A corrupt file must be an error, never a crash, so every decode of
+/// untrusted bytes goes through here. The closure must not leave shared state half-updated (the
+/// decoders own everything they touch).
+pub fn guarded<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+    let was = GUARDED.with(|g| g.replace(true));
+    let r = catch_unwind(AssertUnwindSafe(f));
+    GUARDED.with(|g| g.set(was));
+    r.map_err(|payload| {
+        payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".to_string())
+    })
+}
 
 /// Open `path` for reading if it is a regular file (symbolic links followed).
 ///

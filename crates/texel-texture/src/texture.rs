@@ -478,7 +478,8 @@ impl Texture {
         if format == Some(image::ImageFormat::Jpeg) {
             check_jpeg_complete(bytes, width, height)?;
         }
-        let img = image::DynamicImage::from_decoder(decoder)?;
+        let img = crate::input::guarded(|| image::DynamicImage::from_decoder(decoder))
+            .map_err(TextureError::DecoderFailed)??;
         use image::ColorType as C;
         match img.color() {
             C::L8 | C::La8 | C::Rgb8 | C::Rgba8 => {

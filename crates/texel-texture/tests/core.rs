@@ -870,3 +870,18 @@ fn summed_area_far_beyond_clamped_edges_is_the_edge_texel() {
         }
     }
 }
+
+/// Regression (fuzz target `image_decode`): this 1.5 KB JPEG makes zune-jpeg 0.5.15 panic in its
+/// AVX2 IDCT (`Option::unwrap()` on `None` storing a block of an unusual sampling layout). The
+/// panic is caught and reported as an error.
+#[test]
+fn a_decoder_panic_is_an_error() {
+    let bytes = include_bytes!("data/zune-avx2-idct-panic.jpg");
+    match Texture::decode(bytes, ColorSpace::Srgb, &Limits::default()) {
+        Err(TextureError::DecoderFailed(msg)) => assert!(!msg.is_empty()),
+        // A decoder version (or a CPU without AVX2) that handles the file is fine too: the point
+        // is that decoding returns.
+        Err(e) => assert!(e.to_string().contains("decode"), "{e}"),
+        Ok(t) => assert!(t.width() > 0),
+    }
+}
