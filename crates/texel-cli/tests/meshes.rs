@@ -2,10 +2,6 @@
 
 use crate::util::*;
 
-/// The quad as OBJ: the same vertices in the same order; OBJ's v axis points up, so vt = 1 - v.
-
-/// The quad's glTF buffer: 4 positions (48 bytes), 4 uvs (32), 6 u16 indices (12).
-
 #[test]
 fn base64_known_values() {
     assert_eq!(base64(b""), "");

@@ -204,11 +204,13 @@ triangles = [[0, 1, 2], [0, 2, 3]]
 // Mesh fixtures: the unit quad as OBJ, glTF buffer and glTF JSON
 // ---------------------------------------------------------------------------------------------
 
+/// The quad as OBJ: the same vertices in the same order; OBJ's v axis points up, so vt = 1 - v.
 pub(crate) const QUAD_OBJ: &str = "# unit quad\n\
 v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n\
 vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
 f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
 
+/// The quad's glTF buffer: 4 positions (48 bytes), 4 uvs (32), 6 u16 indices (12).
 pub(crate) fn quad_buffer() -> Vec<u8> {
     let mut b = Vec::new();
     for v in [
@@ -225,6 +227,7 @@ pub(crate) fn quad_buffer() -> Vec<u8> {
     b
 }
 
+/// A glTF document drawing the quad from the buffer at `uri` (a file name or a data URI).
 pub(crate) fn quad_gltf(uri: &str) -> String {
     format!(
         r#"{{
