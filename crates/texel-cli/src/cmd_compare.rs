@@ -92,8 +92,14 @@ impl Scoring<'_> {
 
 /// What a comparison holds per pixel besides the prepared scene's one frame: the reference frame
 /// ([`FRAME_BYTES_PER_PIXEL`]), the coverage mask (1), the reference and current 8-bit images
-/// (8), the heat map (4) and the encoder's copies (8), rounded up.
+/// (8), the heat map (4) and the encoder's copies (8), rounded up. An `--extra` image, checked
+/// against the comparison's size from its header first, adds [`EXTRA_BYTES_PER_PIXEL`] while it
+/// is decoded and scored.
 pub const COMPARE_BYTES_PER_PIXEL: u64 = FRAME_BYTES_PER_PIXEL + 32;
+
+/// An `--extra` image while it is decoded (the decoder's buffer, up to 16-bit RGBA: 8) and held as
+/// 8-bit RGBA (4), rounded up; one at a time.
+pub const EXTRA_BYTES_PER_PIXEL: u64 = 16;
 
 /// Check `--extra` entries against each other and the filters: every label names one row and one
 /// file, so two labels that are equal, or whose file names would be equal, or a label equal to a
@@ -185,16 +191,16 @@ pub fn compare(
     pb.finish_and_clear();
 
     for (label, path) in extras {
-        let image = Image8::load(path)
-            .with_context(|| format!("cannot load --extra image {label}={}", path.display()))?;
-        if image.size() != (w, h) {
+        let cannot = || format!("cannot load --extra image {label}={}", path.display());
+        // The size comes from the header, so a mismatched (or huge) image is refused undecoded.
+        let (iw, ih) = Image8::dimensions(path).with_context(cannot)?;
+        if (iw, ih) != (w, h) {
             bail!(
-                "--extra image {} is {}x{} but the comparison is {w}x{h} (pass --size to match)",
+                "--extra image {} is {iw}x{ih} but the comparison is {w}x{h} (pass --size to match)",
                 path.display(),
-                image.width(),
-                image.height()
             );
         }
+        let image = Image8::load(path).with_context(cannot)?;
         let stem = format!("extra-{}", slug(label));
         let mut row = scoring.row(label, &stem, &image, true)?;
         row.extra = true;
@@ -246,9 +252,15 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     check_extras(&extras, &filters)?;
     let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let per_pixel = COMPARE_BYTES_PER_PIXEL
+        + if extras.is_empty() {
+            0
+        } else {
+            EXTRA_BYTES_PER_PIXEL
+        };
     input.budget.take(
         "the comparison's reference and images",
-        u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
+        u64::from(scene.width) * u64::from(scene.height) * per_pixel,
     )?;
     let report = publish_dir(&args.out, |dir| {
         compare(&scene, &args.scene.scene, &filters, args.spp, &extras, dir)

@@ -747,4 +747,22 @@ fn errors_name_the_real_cause() {
         1,
         &["extra-a_b.png"],
     );
+    // An --extra image of another size is refused from its header, before it is decoded.
+    fails(
+        &[
+            "compare",
+            "--size",
+            "32x18",
+            "--spp",
+            "1",
+            "--filters",
+            "nearest",
+            "--extra",
+            &format!("gpu={img}"),
+            "--out",
+            &d.arg("c2"),
+        ],
+        1,
+        &["is 16x9 but the comparison is 32x18"],
+    );
 }

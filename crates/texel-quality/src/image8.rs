@@ -206,6 +206,27 @@ impl Image8 {
         Self::from_rgba_bytes(w, h, img.as_raw())
     }
 
+    /// The size an image file's header declares, without decoding its pixels.
+    ///
+    /// # Errors
+    /// As [`Image8::load`].
+    pub fn dimensions(path: impl AsRef<Path>) -> Result<(u32, u32), QualityError> {
+        let path = path.as_ref();
+        let io_err = |source| QualityError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = texel_texture::input::open_regular(path).map_err(io_err)?;
+        image::ImageReader::new(std::io::BufReader::new(file))
+            .with_guessed_format()
+            .map_err(io_err)?
+            .into_dimensions()
+            .map_err(|source| QualityError::Image {
+                path: path.to_path_buf(),
+                source,
+            })
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width
