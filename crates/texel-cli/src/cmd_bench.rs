@@ -101,11 +101,12 @@ pub fn median(v: &mut [f64]) -> f64 {
 pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
     let filters = parse_list(&args.filters)?;
+    let budget = &mut input.budget;
     let timings = with_threads(args.threads, || -> Result<Vec<Timing>> {
         let mut out = Vec::new();
         for filter in &filters {
             let samplers = scene.samplers(*filter)?;
-            scene.prepare(&samplers)?;
+            scene.prepare_within(&samplers, budget)?;
             let draws = scene.draws(&samplers);
             let settings = scene.settings();
             let mut times = time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;

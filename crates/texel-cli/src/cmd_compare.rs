@@ -23,7 +23,7 @@ use crate::output::encoding;
 use crate::prepare::{load_scene, Input};
 use crate::progress;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
-use texel::PreparedScene;
+use texel::{MemoryBudget, PreparedScene};
 
 /// Timed frames per filter in a comparison.
 pub const TIMED_FRAMES: u32 = 3;
@@ -139,6 +139,7 @@ pub fn compare(
     spp: u32,
     extras: &[(String, PathBuf)],
     dir: &Path,
+    budget: &mut MemoryBudget,
 ) -> Result<Report> {
     let enc = encoding(scene.color);
     let reference = reference_frame(scene, spp)?;
@@ -171,7 +172,7 @@ pub fn compare(
     for &filter in filters {
         pb.set_message(filter.name());
         let samplers = scene.samplers(filter)?;
-        let bytes = scene.prepare(&samplers)?;
+        let bytes = scene.prepare_within(&samplers, budget)?;
         let draws = scene.draws(&samplers);
         let settings = scene.settings();
         let mut times = time_frames(&settings, &draws, 1, Duration::ZERO, TIMED_FRAMES)?;
@@ -263,7 +264,15 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         u64::from(scene.width) * u64::from(scene.height) * per_pixel,
     )?;
     let report = publish_dir(&args.out, |dir| {
-        compare(&scene, &args.scene.scene, &filters, args.spp, &extras, dir)
+        compare(
+            &scene,
+            &args.scene.scene,
+            &filters,
+            args.spp,
+            &extras,
+            dir,
+            &mut input.budget,
+        )
     })
     .with_context(|| format!("cannot write the report to {}", args.out.display()))?;
     print!("{}", report.to_markdown());

@@ -37,7 +37,15 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
             let sub = dir.join(name);
             std::fs::create_dir(&sub)
                 .with_context(|| format!("cannot create {}", sub.display()))?;
-            let report = compare(&scene, &label, &Filter::ALL, args.spp, &[], &sub)?;
+            let report = compare(
+                &scene,
+                &label,
+                &Filter::ALL,
+                args.spp,
+                &[],
+                &sub,
+                &mut scene_input.budget,
+            )?;
             reports.push((name.to_string(), report));
         }
         let html = index_html(&reports, started.elapsed().as_secs_f64());

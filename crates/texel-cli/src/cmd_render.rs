@@ -20,7 +20,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         Some(f) => scene.samplers(f)?,
         None => scene.default_samplers()?,
     };
-    scene.prepare(&samplers)?;
+    scene.prepare_within(&samplers, &mut input.budget)?;
     let mut settings = scene.settings();
     settings.derivatives = match args.derivatives {
         DerivativesArg::Analytic => Derivatives::Analytic,

@@ -20,6 +20,16 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
         ColorArg::Srgb => ColorSpace::Srgb,
         ColorArg::Raw => ColorSpace::Linear,
     };
+    if let Some(s) = args.size {
+        let pixels = u64::from(s.width) * u64::from(s.height);
+        if pixels > MAX_WARP_PIXELS {
+            bail!(
+                "invalid --size {}x{}: {pixels} pixels, over the warp's limit of {MAX_WARP_PIXELS}",
+                s.width,
+                s.height
+            );
+        }
+    }
     let cannot = || format!("cannot load image {}", args.input.display());
     let bytes = texel_texture::input::read_regular(&args.input, input.budget.remaining())
         .with_context(cannot)?;
@@ -39,7 +49,6 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
         &format!("the {w}x{h} output"),
         u64::from(w) * u64::from(h) * FRAME_BYTES_PER_PIXEL,
     )?;
-    input.budget.take("the image file", bytes.len() as u64)?;
     let options = LoadOptions {
         replace_non_finite: input.sanitize,
         ..LoadOptions::new(

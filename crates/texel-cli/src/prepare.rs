@@ -1,7 +1,8 @@
 //! Loading a scene for a command: [`texel::PreparedScene`] with the command line's memory account,
 //! `--sanitize` policy and error wording.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
+use texel::memory::{TRIANGLE_BYTES, VERTEX_BYTES};
 use texel::{MemoryBudget, PreparedScene, Scene, SceneLimits, SceneOptions};
 use texel_texture::TextureError;
 
@@ -48,6 +49,23 @@ impl Input {
     }
 }
 
+/// The scene limits that fit in `remaining` bytes: [`SceneLimits::default`], lowered where the
+/// account is smaller. Allowances read off the loaders, not measured peaks: a glTF/GLB file is held
+/// up to three times while it loads (the file, its binary chunk, the buffers) and an OBJ file about
+/// as often with `tobj`'s vectors, so files get a quarter of what is left; the TOML parser's tables
+/// get a sixteenth for the text; a triangle may bring three vertices of its own.
+pub fn scene_limits(remaining: u64) -> SceneLimits {
+    let d = SceneLimits::default();
+    SceneLimits {
+        max_scene_bytes: d.max_scene_bytes.min(remaining / 16),
+        max_mesh_file_bytes: d.max_mesh_file_bytes.min(remaining / 4),
+        max_triangles: d
+            .max_triangles
+            .min(remaining / (TRIANGLE_BYTES + 3 * VERTEX_BYTES)),
+        max_vertices: d.max_vertices.min(remaining / VERTEX_BYTES),
+    }
+}
+
 /// Load `scene` (a path or `builtin:NAME`) and its textures within `input`'s account.
 pub fn load_scene(
     scene: &str,
@@ -55,8 +73,20 @@ pub fn load_scene(
     size: Option<Size>,
     input: &mut Input,
 ) -> Result<PreparedScene> {
-    let loaded = Scene::load_with(scene, &SceneLimits::default())
-        .with_context(|| format!("cannot load scene {scene}"))?;
+    let limits = scene_limits(input.budget.remaining());
+    let lowered = limits != SceneLimits::default();
+    let loaded = Scene::load_with(scene, &limits).map_err(|e| {
+        // A size limit lowered to fit the account says so.
+        let note = if lowered && e.to_string().contains("over the limit") {
+            format!(
+                " (its size limits are scaled down to fit {})",
+                input.budget.name()
+            )
+        } else {
+            String::new()
+        };
+        anyhow::Error::new(e).context(format!("cannot load scene {scene}{note}"))
+    })?;
     let options = SceneOptions {
         size: size.map(|s| (s.width, s.height)),
         color: color.into(),

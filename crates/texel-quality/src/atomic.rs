@@ -87,6 +87,15 @@ enum Destination {
 /// Follow `path` through symbolic links (without following the last component of a missing one)
 /// and classify what it names.
 fn resolve(path: &Path) -> Result<Destination, QualityError> {
+    // What the path finally names, links followed by the kernel: anything neither a regular file
+    // nor a directory (a device, a FIFO, a pipe behind /dev/stdout or /proc/self/fd/N) is written
+    // through at the path as given.
+    if let Ok(meta) = fs::metadata(path) {
+        let ft = meta.file_type();
+        if !ft.is_file() && !ft.is_dir() && !is_socket(&ft) {
+            return Ok(Destination::Special(path.to_path_buf()));
+        }
+    }
     let mut p = path.to_path_buf();
     for _ in 0..=MAX_LINKS {
         let meta = match fs::symlink_metadata(&p) {
@@ -267,32 +276,14 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), QualityError> {
     result
 }
 
-/// Whether an existing directory may be replaced by [`publish_dir`]: it is empty, it holds
-/// [`OUTPUT_MARKER`], or (outputs of texel before the marker) it holds only files texel writes
-/// (`.png`, `.json`, `.md`, `.html`, `.svg`) and directories of the same kind.
-fn replaceable_dir(dir: &Path, depth: usize) -> bool {
-    let Ok(entries) = fs::read_dir(dir) else {
-        return false;
-    };
-    let mut entries = entries.peekable();
-    if entries.peek().is_none() {
-        return true;
+/// Whether an existing directory may be replaced by [`publish_dir`]: it is empty, or it holds
+/// [`OUTPUT_MARKER`] (every directory `publish_dir` publishes does). Anything else may hold a
+/// user's own files and is never replaced.
+fn replaceable_dir(dir: &Path) -> bool {
+    match fs::read_dir(dir) {
+        Ok(mut entries) => entries.next().is_none() || dir.join(OUTPUT_MARKER).is_file(),
+        Err(_) => false,
     }
-    if dir.join(OUTPUT_MARKER).is_file() {
-        return true;
-    }
-    entries.all(|e| {
-        let Ok(e) = e else { return false };
-        let Ok(ft) = e.file_type() else { return false };
-        let p = e.path();
-        if ft.is_dir() {
-            return depth < 2 && replaceable_dir(&p, depth + 1);
-        }
-        ft.is_file()
-            && p.extension()
-                .and_then(|x| x.to_str())
-                .is_some_and(|x| matches!(x, "png" | "json" | "md" | "html" | "svg"))
-    })
 }
 
 /// Publish a multi-file output at `dest` as a whole: `fill` writes everything into a new staging
@@ -336,7 +327,7 @@ pub fn publish_dir<T, E: From<QualityError>>(
                 .into()),
             }
         };
-    if exists && !replaceable_dir(&target, 0) {
+    if exists && !replaceable_dir(&target) {
         return Err(refuse(
             dest,
             std::io::ErrorKind::AlreadyExists,

@@ -183,23 +183,34 @@ impl Image8 {
             path: path.to_path_buf(),
             source,
         };
-        let file = texel_texture::input::open_regular(path).map_err(io_err)?;
-        let mut reader = image::ImageReader::new(std::io::BufReader::new(file))
+        // At most a 16384 x 16384 image of 16-bit RGBA: no larger file is a valid input.
+        let bytes = texel_texture::input::read_regular(path, 8 * u64::from(MAX_SIDE).pow(2))
+            .map_err(io_err)?;
+        let decode_err = |msg: String| {
+            img_err(image::ImageError::Decoding(
+                image::error::DecodingError::new(image::error::ImageFormatHint::Unknown, msg),
+            ))
+        };
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
             .with_guessed_format()
             .map_err(io_err)?;
         let mut limits = image::Limits::default();
         limits.max_image_width = Some(MAX_SIDE);
         limits.max_image_height = Some(MAX_SIDE);
         reader.limits(limits);
+        if reader.format() == Some(image::ImageFormat::Jpeg) {
+            let (w, h) = texel_texture::input::guarded(|| {
+                image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+                    .with_guessed_format()
+                    .map_err(io_err)?
+                    .into_dimensions()
+                    .map_err(img_err)
+            })
+            .map_err(decode_err)??;
+            texel_texture::input::check_jpeg_complete(&bytes, w, h).map_err(decode_err)?;
+        }
         let img = texel_texture::input::guarded(|| reader.decode())
-            .map_err(|msg| {
-                img_err(image::ImageError::Decoding(
-                    image::error::DecodingError::new(
-                        image::error::ImageFormatHint::Unknown,
-                        format!("the decoder failed on this file: {msg}"),
-                    ),
-                ))
-            })?
+            .map_err(|msg| decode_err(format!("the decoder failed on this file: {msg}")))?
             .map_err(img_err)?
             .into_rgba8();
         let (w, h) = img.dimensions();
@@ -217,14 +228,23 @@ impl Image8 {
             source,
         };
         let file = texel_texture::input::open_regular(path).map_err(io_err)?;
-        image::ImageReader::new(std::io::BufReader::new(file))
+        let reader = image::ImageReader::new(std::io::BufReader::new(file))
             .with_guessed_format()
-            .map_err(io_err)?
-            .into_dimensions()
-            .map_err(|source| QualityError::Image {
-                path: path.to_path_buf(),
-                source,
-            })
+            .map_err(io_err)?;
+        let img_err = |source| QualityError::Image {
+            path: path.to_path_buf(),
+            source,
+        };
+        texel_texture::input::guarded(|| reader.into_dimensions())
+            .map_err(|msg| {
+                img_err(image::ImageError::Decoding(
+                    image::error::DecodingError::new(
+                        image::error::ImageFormatHint::Unknown,
+                        format!("the decoder failed on this file: {msg}"),
+                    ),
+                ))
+            })?
+            .map_err(img_err)
     }
 
     /// Width in pixels.

@@ -364,7 +364,16 @@ impl Scene {
             .collect::<Result<_, _>>()?;
         let mut all = Vec::new();
         for (i, m) in raw.meshes.into_iter().enumerate() {
-            all.extend(meshes(i, m, &base, limits)?);
+            // Each mesh file gets what the meshes before it left of the scene's limits.
+            let (tris, verts) = all.iter().fold((0u64, 0u64), |(t, v), m: &Mesh| {
+                (t + m.triangles.len() as u64, v + m.positions.len() as u64)
+            });
+            let left = SceneLimits {
+                max_triangles: limits.max_triangles.saturating_sub(tris),
+                max_vertices: limits.max_vertices.saturating_sub(verts),
+                ..*limits
+            };
+            all.extend(meshes(i, m, &base, &left)?);
         }
         let tris: u64 = all.iter().map(|m| m.triangles.len() as u64).sum();
         let verts: u64 = all.iter().map(|m| m.positions.len() as u64).sum();

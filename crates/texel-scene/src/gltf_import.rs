@@ -170,6 +170,10 @@ impl Ctx<'_> {
                 ),
                 None => (AddressMode::Repeat, AddressMode::Repeat, None),
             };
+            if triangles.is_empty() {
+                // Nothing to draw (glTF allows it); the file is refused only if nothing is left.
+                continue;
+            }
             self.out.push(Mesh {
                 positions,
                 uvs,
@@ -212,14 +216,25 @@ fn check_hierarchy(document: &gltf::Document) -> Result<(), String> {
             parent[c] = Some(node.index());
         }
     }
-    // With one parent each, a cycle is a chain of parents that comes back to its start.
+    // With one parent each, a cycle is a chain of parents that comes back on itself. Each node is
+    // walked over once: a walk stops at a node an earlier walk already cleared.
+    let mut state = vec![0u8; n]; // 0 unvisited, 1 on the current walk, 2 cleared
     for start in 0..n {
         let mut at = start;
-        for _ in 0..=n {
+        while state[at] == 0 {
+            state[at] = 1;
             match parent[at] {
-                Some(p) if p == start => {
-                    return Err(format!("node {start} is its own ancestor (a cycle)"))
-                }
+                Some(p) => at = p,
+                None => break,
+            }
+        }
+        if state[at] == 1 && parent[at].is_some() {
+            return Err(format!("node {at} is its own ancestor (a cycle)"));
+        }
+        let mut at = start;
+        while state[at] == 1 {
+            state[at] = 2;
+            match parent[at] {
                 Some(p) => at = p,
                 None => break,
             }
@@ -234,6 +249,66 @@ fn check_hierarchy(document: &gltf::Document) -> Result<(), String> {
                     scene.index()
                 ));
             }
+        }
+    }
+    Ok(())
+}
+
+/// Check what the gltf crate's readers assume and do not check (its readers hit `unreachable!`
+/// on other types): POSITION and NORMAL `VEC3` floats, TEXCOORD_0 `VEC2` of floats or normalised
+/// u8/u16, COLOR_0 `VEC3`/`VEC4` of those, indices scalar u8/u16/u32; every attribute with as many
+/// elements as POSITION (glTF 2.0 3.7.2.1), and at most `3 * max_triangles + 2` indices (read
+/// before the mode is looked at). Counts are checked here, before a sparse accessor of billions
+/// of elements is expanded.
+fn check_primitive(prim: &gltf::Primitive, limits: &SceneLimits) -> Result<(), String> {
+    use gltf::accessor::{DataType as T, Dimensions as D};
+    use gltf::Semantic;
+    let n = prim
+        .get(&Semantic::Positions)
+        .map_or(0, |a| a.count() as u64);
+    for (semantic, a) in prim.attributes() {
+        let ok = match &semantic {
+            Semantic::Positions | Semantic::Normals => {
+                (a.data_type(), a.dimensions()) == (T::F32, D::Vec3)
+            }
+            Semantic::TexCoords(_) => {
+                matches!(a.data_type(), T::F32 | T::U8 | T::U16) && a.dimensions() == D::Vec2
+            }
+            Semantic::Colors(_) => {
+                matches!(a.data_type(), T::F32 | T::U8 | T::U16)
+                    && matches!(a.dimensions(), D::Vec3 | D::Vec4)
+            }
+            _ => true,
+        };
+        if !ok {
+            return Err(format!(
+                "attribute {semantic:?} is {:?} {:?}, which glTF 2.0 does not allow for it",
+                a.data_type(),
+                a.dimensions()
+            ));
+        }
+        if a.count() as u64 != n {
+            return Err(format!(
+                "attribute {semantic:?} has {} elements but POSITION has {n}",
+                a.count()
+            ));
+        }
+    }
+    if let Some(a) = prim.indices() {
+        if !matches!(a.data_type(), T::U8 | T::U16 | T::U32) || a.dimensions() != D::Scalar {
+            return Err(format!(
+                "indices are {:?} {:?}; glTF 2.0 needs scalar u8, u16 or u32",
+                a.data_type(),
+                a.dimensions()
+            ));
+        }
+        let max = limits.max_triangles.saturating_mul(3).saturating_add(2);
+        if a.count() as u64 > max {
+            return Err(format!(
+                "{} indices, over the {max} that {} triangles can use",
+                a.count(),
+                limits.max_triangles
+            ));
         }
     }
     Ok(())
@@ -455,13 +530,21 @@ pub fn load_gltf_slice(
             stack.extend(node.children());
         }
     }
+    for mesh in document.meshes() {
+        for (pi, prim) in mesh.primitives().enumerate() {
+            check_primitive(&prim, limits)
+                .map_err(|e| bad(format!("mesh {} primitive {pi}: {e}", mesh.index())))?;
+        }
+    }
     if tris > limits.max_triangles || verts > limits.max_vertices {
         return Err(bad(format!(
             "the scene instantiates {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",
             limits.max_triangles, limits.max_vertices
         )));
     }
-    let total: u64 = document.buffers().map(|b| b.length() as u64).sum();
+    let total = document
+        .buffers()
+        .fold(0u64, |t, b| t.saturating_add(b.length() as u64));
     if total > limits.max_mesh_file_bytes {
         return Err(bad(format!(
             "its buffers declare {total} bytes, over the limit of {} bytes",
@@ -488,7 +571,7 @@ pub fn load_gltf_slice(
             ctx.node(node, Mat4::IDENTITY, 0)?;
         }
     }
-    if ctx.out.iter().all(|m| m.triangles.is_empty()) {
+    if ctx.out.is_empty() {
         return Err(bad("no triangles in the file's scene".into()));
     }
     Ok(ctx.out)

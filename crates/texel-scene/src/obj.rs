@@ -46,19 +46,16 @@ pub fn load_obj_with(path: &Path, texture: &str, limits: &SceneLimits) -> Result
 }
 
 /// What an OBJ text declares, counted before parsing: triangles (a polygon of n corners is n - 2),
-/// vertices, and the first face (1-based line, text) with an index out of range: a negative
-/// (relative) index reaching back past the first `v`, `vt` or `vn` line above it, or a positive one
-/// past the file's count (`tobj` accepts forward references). Such a face is an error anyway, and
-/// `tobj` computes `vt * 2 + 1` from the index before checking it, which overflows.
+/// `v` lines, and the first element line (1-based line, text) with an index out of range: one
+/// reaching past the `v`, `vt` or `vn` lines above it, counting back for a negative (relative)
+/// index. Such a line is an error anyway, and `tobj` computes `vt * 2 + 1` from the index before
+/// checking it, which overflows. Lines are split as `tobj` splits them (Unicode whitespace), and
+/// `l` and `p` lines count too: `tobj` triangulates an `l` or `p` of three or more corners like an
+/// `f`.
 struct Declared {
     triangles: u64,
     vertices: u64,
     bad_index: Option<(usize, String)>,
-}
-
-fn tokens(line: &[u8]) -> impl Iterator<Item = &[u8]> {
-    line.split(|b| b.is_ascii_whitespace())
-        .filter(|t| !t.is_empty())
 }
 
 fn declared(text: &[u8]) -> Declared {
@@ -67,56 +64,39 @@ fn declared(text: &[u8]) -> Declared {
         vertices: 0,
         bad_index: None,
     };
-    let kind = |line: &[u8]| match tokens(line).next() {
-        Some(b"v") => Some(0),
-        Some(b"vt") => Some(1),
-        Some(b"vn") => Some(2),
-        _ => None,
-    };
-    let mut totals = [0u64; 3];
-    for line in text.split(|&b| b == b'\n') {
-        if let Some(k) = kind(line) {
-            totals[k] += 1;
-        }
-    }
-    // Elements defined so far that a face index may refer to: v, vt, vn.
+    // Elements defined so far that an index may refer to: v, vt, vn.
     let mut counts = [0u64; 3];
     for (n, line) in text.split(|&b| b == b'\n').enumerate() {
-        let mut t = tokens(line);
+        let line = String::from_utf8_lossy(line);
+        let mut t = line.split_whitespace();
         match t.next() {
-            Some(b"v") => counts[0] += 1,
-            Some(b"vt") => counts[1] += 1,
-            Some(b"vn") => counts[2] += 1,
-            Some(b"f") => {
-                let corners: Vec<&[u8]> = t.collect();
+            Some("v") => counts[0] += 1,
+            Some("vt") => counts[1] += 1,
+            Some("vn") => counts[2] += 1,
+            Some("f" | "l" | "p") => {
+                let corners: Vec<&str> = t.collect();
                 d.triangles += (corners.len() as u64).saturating_sub(2);
-                let out_of_range = |c: &&[u8]| {
-                    c.split(|&b| b == b'/').zip(counts).any(|(i, count)| {
-                        // Unparsable indices are tobj's to report; over-long ones are out of range.
-                        match std::str::from_utf8(i)
-                            .ok()
-                            .and_then(|i| i.parse::<i64>().ok())
-                        {
-                            Some(i) => i.unsigned_abs() > count,
-                            None => {
-                                i.len() > 18 && i.iter().all(|b| b.is_ascii_digit() || *b == b'-')
+                let out_of_range = |c: &&str| {
+                    c.split('/')
+                        .zip(counts)
+                        .any(|(i, count)| match i.parse::<i64>() {
+                            Ok(i) => i.unsigned_abs() > count,
+                            // Unparsable indices are tobj's to report; over-long numbers are out of
+                            // range.
+                            Err(_) => {
+                                i.len() > 18 && i.bytes().all(|b| b.is_ascii_digit() || b == b'-')
                             }
-                        }
-                    })
+                        })
                 };
                 if d.bad_index.is_none() && corners.iter().any(out_of_range) {
-                    let shown = String::from_utf8_lossy(line)
-                        .trim_end()
-                        .chars()
-                        .take(60)
-                        .collect();
+                    let shown = line.trim_end().chars().take(60).collect();
                     d.bad_index = Some((n + 1, shown));
                 }
             }
             _ => {}
         }
     }
-    d.vertices = totals[0];
+    d.vertices = counts[0];
     d
 }
 
@@ -205,10 +185,14 @@ pub fn load_obj_bytes(
     }
     let (models, _materials) = parse(bytes).map_err(|source| SceneError::Obj {
         path: path.to_path_buf(),
-        at: failing_line(bytes).map(|(line, text)| match text {
-            Some(t) => format!("line {line} ({t:?})"),
-            None => format!("line {line} (not UTF-8 text: is this an OBJ file?)"),
-        }),
+        // Locating the line costs about log2(lines) more parses: done for files up to 64 MiB.
+        at: (bytes.len() <= 64 << 20)
+            .then(|| failing_line(bytes))
+            .flatten()
+            .map(|(line, text)| match text {
+                Some(t) => format!("line {line} ({t:?})"),
+                None => format!("line {line} (not UTF-8 text: is this an OBJ file?)"),
+            }),
         source,
     })?;
     let no_triangles = || {

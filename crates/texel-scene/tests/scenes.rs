@@ -588,11 +588,67 @@ fn fuzz_regressions_are_errors() {
     let later = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf -1/-1 -2/-2 -3/-3\nvt 1 0\nvt 0 1\n";
     let e = load_obj_bytes(later, Path::new("f.obj"), "t", &limits).unwrap_err();
     assert!(e.to_string().contains("line 5"), "{e}");
+    // An `l` line of several corners is triangulated by tobj too: its indices are checked.
+    let line = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nl 1 -2/-2 -3/-3 0 0\nvt 1 0\nvt 0 1\n";
+    let e = load_obj_bytes(line, Path::new("f.obj"), "t", &limits).unwrap_err();
+    assert!(e.to_string().contains("line 5"), "{e}");
     let gltf = br#"{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}}]}]}"#;
     let e = load_gltf_slice(gltf, None, Path::new("f.gltf"), "t", &limits).unwrap_err();
     assert!(
         e.to_string()
             .contains("refers to accessor 0, but the file has 0"),
+        "{e}"
+    );
+}
+
+/// Review findings: accessor types the gltf crate's readers do not handle (they hit
+/// `unreachable!`), an attribute with more elements than POSITION (a sparse accessor can claim
+/// billions for a few bytes), and a long node chain (the ancestor walk is linear, not quadratic)
+/// are errors, not crashes, out-of-memory aborts or hangs.
+#[test]
+fn gltf_accessors_and_chains_are_checked_before_reading() {
+    use texel_scene::{load_gltf_slice, SceneLimits};
+    let limits = SceneLimits::default();
+    let doc = |accessors: &str, nodes: &str| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}], "nodes": [{nodes}],
+            "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}}}]}}],
+            "buffers": [{{"byteLength": 80, "uri": "data:application/octet-stream;base64,{}"}}],
+            "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 32}}],
+            "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}}, {accessors}]}}"#,
+            "A".repeat(108)
+        )
+    };
+    let load =
+        |text: String| load_gltf_slice(text.as_bytes(), None, Path::new("f.gltf"), "t", &limits);
+    // The well-formed document loads (the buffer is zeros: a degenerate but valid triangle).
+    let uv = r#"{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}"#;
+    assert!(load(doc(uv, r#"{"mesh": 0}"#)).is_ok());
+    // TEXCOORD_0 as u32: the gltf crate would reach unreachable!().
+    let e = load(doc(&uv.replace("5126", "5125"), r#"{"mesh": 0}"#)).unwrap_err();
+    assert!(e.to_string().contains("TexCoords(0)"), "{e}");
+    // A sparse TEXCOORD_0 claiming four billion elements.
+    let sparse = r#"{"componentType": 5126, "count": 4000000000, "type": "VEC2",
+        "sparse": {"count": 1, "indices": {"bufferView": 0, "componentType": 5125}, "values": {"bufferView": 1}}}"#;
+    let e = load(doc(sparse, r#"{"mesh": 0}"#)).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("4000000000 elements but POSITION has 3"),
+        "{e}"
+    );
+    // A chain of 200 000 nodes: refused for its depth, after a linear check.
+    let chain: Vec<String> = (0..200_000)
+        .map(|k| {
+            if k + 1 < 200_000 {
+                format!(r#"{{"mesh": 0, "children": [{}]}}"#, k + 1)
+            } else {
+                r#"{"mesh": 0}"#.to_string()
+            }
+        })
+        .collect();
+    let e = load(doc(uv, &chain.join(","))).unwrap_err();
+    assert!(
+        e.to_string().contains("deeper than 256") || e.to_string().contains("triangles"),
         "{e}"
     );
 }

@@ -112,7 +112,7 @@ pub enum TextureError {
         max: u64,
     },
     /// A float texel (level 0, pixel `x, y` of the image, row 0 at the top) is NaN or infinite.
-    #[error("texel ({x}, {y}) channel {channel} is {value}: textures must be finite (pass --sanitize to replace NaN with 0 and infinities with +-65504)")]
+    #[error("texel ({x}, {y}) channel {channel} is {value}: textures must be finite (the texel CLI's --sanitize, or LoadOptions::replace_non_finite, replaces NaN with 0 and infinities with +-65504)")]
     NonFiniteTexel {
         /// Column of the texel.
         x: u32,

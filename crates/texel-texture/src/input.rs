@@ -126,6 +126,87 @@ fn too_large(len: u64, max: u64) -> io::Error {
     )
 }
 
+/// Check that a JPEG whose header claims `width x height` is whole, by walking its marker segments
+/// from SOI to EOI (ITU T.81 B.1): every segment's length must fit in the file, every scan's
+/// entropy-coded data must end in a marker, and EOI must come before the bytes run out (data
+/// after EOI, such as a motion photo's video, is ignored). The scans must also hold at least one
+/// bit per 8x8 block of the full-resolution component: every block's DC difference is a Huffman
+/// code of at least one bit (F.1.2.1; arithmetic coding, which could go below, is not decoded by
+/// texel's decoder anyway). The decoder itself fills what is missing with grey, so a truncated
+/// file would otherwise load.
+///
+/// # Errors
+/// A message saying where the stream ends or how many bytes are missing.
+pub fn check_jpeg_complete(bytes: &[u8], width: u32, height: u32) -> Result<(), String> {
+    let cut = |at: usize| {
+        format!(
+            "the JPEG ({} bytes) ends at byte {at}, before its end-of-image marker",
+            bytes.len()
+        )
+    };
+    if !bytes.starts_with(&[0xFF, 0xD8]) {
+        return Err("the JPEG does not start with a start-of-image marker".into());
+    }
+    let mut i = 2;
+    let mut coded = 0u64;
+    loop {
+        // Skip to the next marker (fill bytes 0xFF included).
+        while i < bytes.len() && bytes[i] != 0xFF {
+            i += 1;
+        }
+        while i < bytes.len() && bytes[i] == 0xFF {
+            i += 1;
+        }
+        let Some(&m) = bytes.get(i) else {
+            return Err(cut(bytes.len()));
+        };
+        i += 1;
+        match m {
+            0xD9 => break,
+            0xD0..=0xD7 | 0x01 => continue,
+            _ => {
+                let len = match bytes.get(i..i + 2) {
+                    Some(l) => usize::from(u16::from_be_bytes([l[0], l[1]])),
+                    None => return Err(cut(bytes.len())),
+                };
+                if len < 2 {
+                    return Err(format!(
+                        "the JPEG has a segment of length {len} at byte {i}"
+                    ));
+                }
+                i += len;
+                if i > bytes.len() {
+                    return Err(cut(bytes.len()));
+                }
+                if m == 0xDA {
+                    // Entropy-coded data: up to a marker that is not a stuffed 0xFF00 or an RSTn.
+                    let start = i;
+                    loop {
+                        match bytes.get(i..i + 2) {
+                            Some([0xFF, n])
+                                if *n != 0x00 && !(0xD0..=0xD7).contains(n) && *n != 0xFF =>
+                            {
+                                break
+                            }
+                            Some(_) => i += 1,
+                            None => return Err(cut(bytes.len())),
+                        }
+                    }
+                    coded += (i - start) as u64;
+                }
+            }
+        }
+    }
+    let blocks = u64::from(width.div_ceil(8)) * u64::from(height.div_ceil(8));
+    let need = blocks.div_ceil(8);
+    if coded < need {
+        return Err(format!(
+            "a {width}x{height} JPEG has {blocks} blocks and needs at least {need} bytes of coded data, but its scans hold {coded}"
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -210,29 +210,8 @@ pub fn replace_non_finite(texels: &mut [[f32; 4]]) -> u64 {
     n
 }
 
-/// A JPEG whose header claims `width x height` must end in its EOI marker after its last scan, and
-/// hold at least one bit per 8x8 block of its full-resolution component: every block's DC
-/// difference is a Huffman code of at least one bit (ITU T.81, F.1.2.1; arithmetic coding, which
-/// could go below, is not decoded by texel's decoder anyway). The decoder itself fills what is
-/// missing with grey.
 fn check_jpeg_complete(bytes: &[u8], width: u32, height: u32) -> Result<(), TextureError> {
-    let last_sos = bytes.windows(2).rposition(|w| w == [0xFF, 0xDA]);
-    let eoi_after = last_sos.is_some_and(|s| bytes[s..].windows(2).any(|w| w == [0xFF, 0xD9]));
-    if !eoi_after {
-        return Err(TextureError::Truncated(format!(
-            "the JPEG ({} bytes) has no end-of-image marker after its last scan",
-            bytes.len()
-        )));
-    }
-    let blocks = u64::from(width.div_ceil(8)) * u64::from(height.div_ceil(8));
-    let need = blocks.div_ceil(8);
-    if (bytes.len() as u64) < need {
-        return Err(TextureError::Truncated(format!(
-            "a {width}x{height} JPEG has {blocks} blocks and needs at least {need} bytes of coded data, but the file has {}",
-            bytes.len()
-        )));
-    }
-    Ok(())
+    crate::input::check_jpeg_complete(bytes, width, height).map_err(TextureError::Truncated)
 }
 
 /// Where one mip level lives in the texture's storage.
@@ -450,9 +429,9 @@ impl Texture {
     /// # Errors
     /// [`TextureError::Decode`] for an unknown format or a corrupt header.
     pub fn header(bytes: &[u8]) -> Result<(u32, u32, image::ColorType), TextureError> {
-        let decoder = image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()?
-            .into_decoder()?;
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format()?;
+        let decoder = crate::input::guarded(|| reader.into_decoder())
+            .map_err(TextureError::DecoderFailed)??;
         let (w, h) = image::ImageDecoder::dimensions(&decoder);
         Ok((w, h, image::ImageDecoder::color_type(&decoder)))
     }
@@ -471,7 +450,8 @@ impl Texture {
         l.max_image_height = Some(limits.max_dimension);
         l.max_alloc = Some(limits.max_bytes);
         reader.limits(l);
-        let decoder = reader.into_decoder()?;
+        let decoder = crate::input::guarded(|| reader.into_decoder())
+            .map_err(TextureError::DecoderFailed)??;
         let (width, height) = image::ImageDecoder::dimensions(&decoder);
         let decoded_color = image::ImageDecoder::color_type(&decoder);
         limits.check_load(bytes.len() as u64, width, height, decoded_color)?;

@@ -885,3 +885,28 @@ fn a_decoder_panic_is_an_error() {
         Ok(t) => assert!(t.width() > 0),
     }
 }
+
+/// A JPEG is checked by walking its segments to the end-of-image marker: data after EOI (a motion
+/// photo's video, which may contain 0xFFDA) is ignored, a cut anywhere before EOI is an error.
+#[test]
+fn jpeg_completeness_walks_the_segments() {
+    let img = image::RgbImage::from_fn(40, 24, |x, y| {
+        image::Rgb([(x * 6) as u8, (y * 9) as u8, 77])
+    });
+    let mut jpeg = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 85)
+        .encode_image(&img)
+        .unwrap();
+    let limits = Limits::default();
+    assert!(Texture::decode(&jpeg, ColorSpace::Srgb, &limits).is_ok());
+    let mut trailing = jpeg.clone();
+    trailing.extend_from_slice(b"\xFF\xDA\x00\x08ftypmp42 and more video bytes");
+    assert!(Texture::decode(&trailing, ColorSpace::Srgb, &limits).is_ok());
+    for cut in [jpeg.len() - 2, jpeg.len() / 2, 30] {
+        let e = Texture::decode(&jpeg[..cut], ColorSpace::Srgb, &limits).unwrap_err();
+        assert!(
+            e.to_string().contains("before its end-of-image marker"),
+            "{cut}: {e}"
+        );
+    }
+}

@@ -2,7 +2,8 @@
 //! the rasterizer's vertices, the camera into `clip_from_world`, and one sampler per mesh for a
 //! filter. The CLI, the examples and (later) the GPU path and the viewer all draw through this.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+use std::sync::Mutex;
 
 use texel_raster::{DrawCall, RenderSettings, Vertex};
 use texel_scene::Scene;
@@ -52,6 +53,8 @@ pub struct PreparedScene {
     /// Per texture, the non-finite channel values replaced (only with
     /// [`SceneOptions::replace_non_finite`]; textures with none are not listed).
     pub replaced: Vec<(String, u64)>,
+    /// The (texture, structure) pairs [`PreparedScene::prepare_within`] has charged.
+    charged: Mutex<BTreeSet<(String, &'static str)>>,
 }
 
 impl PreparedScene {
@@ -128,6 +131,7 @@ impl PreparedScene {
             height,
             color: options.color,
             replaced,
+            charged: Mutex::new(BTreeSet::new()),
         })
     }
 
@@ -185,6 +189,35 @@ impl PreparedScene {
             *e = (*e).max(b);
         }
         Ok(bytes.values().sum())
+    }
+
+    /// [`PreparedScene::prepare`], charging `budget` for each ripmap and summed-area table before
+    /// it is built (once per texture and kind: they are kept for later frames).
+    ///
+    /// # Errors
+    /// [`Error::OverBudget`], and those of [`PreparedScene::prepare`].
+    pub fn prepare_within(
+        &self,
+        samplers: &[Sampler],
+        budget: &mut MemoryBudget,
+    ) -> Result<u64, Error> {
+        for (mesh, sampler) in self.scene.meshes.iter().zip(samplers) {
+            let kind = match sampler.descriptor().min_filter {
+                texel_texture::FilterMode::Ripmap => "ripmap",
+                texel_texture::FilterMode::SummedArea => "summed-area table",
+                _ => continue,
+            };
+            let key = (mesh.texture.clone(), kind);
+            let mut charged = self.charged.lock().unwrap_or_else(|e| e.into_inner());
+            if charged.contains(&key) {
+                continue;
+            }
+            let tex = &self.textures[&mesh.texture];
+            let extra = tex.structure_bytes(sampler.descriptor()) - tex.pyramid_bytes();
+            budget.take(&format!("the {kind} of texture {:?}", mesh.texture), extra)?;
+            charged.insert(key);
+        }
+        self.prepare(samplers)
     }
 
     /// The draw calls of the whole scene with `samplers` (one per mesh).
