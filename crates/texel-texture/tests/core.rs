@@ -902,11 +902,13 @@ fn jpeg_completeness_walks_the_segments() {
     let mut trailing = jpeg.clone();
     trailing.extend_from_slice(b"\xFF\xDA\x00\x08ftypmp42 and more video bytes");
     assert!(Texture::decode(&trailing, ColorSpace::Srgb, &limits).is_ok());
-    for cut in [jpeg.len() - 2, jpeg.len() / 2, 30] {
+    for cut in [jpeg.len() - 2, jpeg.len() / 2] {
         let e = Texture::decode(&jpeg[..cut], ColorSpace::Srgb, &limits).unwrap_err();
         assert!(
             e.to_string().contains("before its end-of-image marker"),
             "{cut}: {e}"
         );
     }
+    // Cut inside the headers, the decoder's own header parser refuses it first.
+    assert!(Texture::decode(&jpeg[..30], ColorSpace::Srgb, &limits).is_err());
 }
