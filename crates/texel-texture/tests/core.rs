@@ -890,8 +890,13 @@ fn a_decoder_panic_is_an_error() {
 /// photo's video, which may contain 0xFFDA) is ignored, a cut anywhere before EOI is an error.
 #[test]
 fn jpeg_completeness_walks_the_segments() {
-    let img = image::RgbImage::from_fn(40, 24, |x, y| {
-        image::Rgb([(x * 6) as u8, (y * 9) as u8, 77])
+    // Detailed enough that its scan data is most of the file.
+    let img = image::RgbImage::from_fn(200, 120, |x, y| {
+        image::Rgb([
+            (x * 37 % 251) as u8,
+            (y * 53 % 241) as u8,
+            ((x ^ y) * 7) as u8,
+        ])
     });
     let mut jpeg = Vec::new();
     image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 85)
@@ -902,6 +907,7 @@ fn jpeg_completeness_walks_the_segments() {
     let mut trailing = jpeg.clone();
     trailing.extend_from_slice(b"\xFF\xDA\x00\x08ftypmp42 and more video bytes");
     assert!(Texture::decode(&trailing, ColorSpace::Srgb, &limits).is_ok());
+    assert!(jpeg.len() > 4000, "{}", jpeg.len());
     for cut in [jpeg.len() - 2, jpeg.len() / 2] {
         let e = Texture::decode(&jpeg[..cut], ColorSpace::Srgb, &limits).unwrap_err();
         assert!(
