@@ -53,7 +53,9 @@ impl Input {
 /// account is smaller. Allowances read off the loaders, not measured peaks: a glTF/GLB file is held
 /// up to three times while it loads (the file, its binary chunk, the buffers) and an OBJ file about
 /// as often with `tobj`'s vectors, so files get a quarter of what is left; the TOML parser's tables
-/// get a sixteenth for the text; a triangle may bring three vertices of its own.
+/// get a sixteenth for the text; a triangle may bring three vertices of its own and needs at least
+/// one rasterizer set-up and bin entry (about 700 bytes; `texel::memory::raster_bytes` counts them
+/// exactly once the mesh is loaded).
 pub fn scene_limits(remaining: u64) -> SceneLimits {
     let d = SceneLimits::default();
     SceneLimits {
@@ -61,7 +63,7 @@ pub fn scene_limits(remaining: u64) -> SceneLimits {
         max_mesh_file_bytes: d.max_mesh_file_bytes.min(remaining / 4),
         max_triangles: d
             .max_triangles
-            .min(remaining / (TRIANGLE_BYTES + 3 * VERTEX_BYTES)),
+            .min(remaining / (TRIANGLE_BYTES + 3 * VERTEX_BYTES + 700)),
         max_vertices: d.max_vertices.min(remaining / VERTEX_BYTES),
     }
 }

@@ -18,9 +18,70 @@ pub const FRAME_BYTES_PER_PIXEL: u64 = 40;
 /// and the rasterizer's [`texel_raster::Vertex`].
 pub const VERTEX_BYTES: u64 = 48 + std::mem::size_of::<texel_raster::Vertex>() as u64;
 
-/// What a scene keeps per triangle: its indices (12 bytes) and an allowance of 244 bytes for the
-/// rasterizer's per-frame triangle set-up and bins.
-pub const TRIANGLE_BYTES: u64 = 256;
+/// What a scene keeps per triangle: its indices (12 bytes). The rasterizer's per-frame set-up and
+/// tile bins depend on where the triangle lands on screen: [`raster_bytes`].
+pub const TRIANGLE_BYTES: u64 = 12;
+
+/// One rasterizer set-up (`texel_raster::setup::TriangleSetup`), kept twice at most: the reference
+/// renderer concatenates the per-chunk vectors, and a chunk's vector may double once when clipping
+/// adds sub-triangles.
+const SETUP_BYTES: u64 = 2 * std::mem::size_of::<texel_raster::setup::TriangleSetup>() as u64;
+
+/// One tile-bin entry (a set-up reference of at most 16 bytes), twice for the vectors' growth.
+const BIN_ENTRY_BYTES: u64 = 32;
+
+/// An upper bound of what the rasterizer allocates per frame for `scene`'s triangles at
+/// `width x height`: per triangle, its set-ups (one if all three vertices lie inside the clip
+/// volume and the guard band, else up to eight sub-triangles of the clipped polygon) and one bin
+/// entry per 64 x 64 tile its screen box overlaps (every tile for a clipped triangle). One pass
+/// over the vertices, projected as the rasterizer projects them.
+pub fn raster_bytes(scene: &texel_scene::Scene, width: u32, height: u32) -> u64 {
+    const TILE: u64 = 64;
+    const GUARD: f64 = 8.0;
+    let (w, h) = (f64::from(width), f64::from(height));
+    let tiles_x = u64::from(width).div_ceil(TILE);
+    let tiles_y = u64::from(height).div_ceil(TILE);
+    let all_tiles = tiles_x * tiles_y;
+    let m = scene
+        .camera
+        .clip_from_world(width as f32 / height as f32)
+        .as_dmat4();
+    let mut bytes = 0u64;
+    for mesh in &scene.meshes {
+        // Screen position of each vertex, or None outside the clip volume or the guard band.
+        let screen: Vec<Option<(f64, f64)>> = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                let c = m * p.as_dvec3().extend(1.0);
+                let inside = c.w > 0.0
+                    && c.z.abs() <= c.w
+                    && c.x.abs() <= GUARD * c.w
+                    && c.y.abs() <= GUARD * c.w;
+                inside.then(|| ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h))
+            })
+            .collect();
+        for t in &mesh.triangles {
+            let v = t.map(|i| screen.get(i as usize).copied().flatten());
+            let (setups, tiles) = match v {
+                [Some(a), Some(b), Some(c)] => {
+                    let tile =
+                        |x: f64, n: u64| ((x.max(0.0) as u64) / TILE).min(n.saturating_sub(1));
+                    let (x0, x1) = (a.0.min(b.0).min(c.0), a.0.max(b.0).max(c.0));
+                    let (y0, y1) = (a.1.min(b.1).min(c.1), a.1.max(b.1).max(c.1));
+                    let nx = tile(x1, tiles_x) - tile(x0, tiles_x) + 1;
+                    let ny = tile(y1, tiles_y) - tile(y0, tiles_y) + 1;
+                    (1, nx * ny)
+                }
+                _ => (8, all_tiles),
+            };
+            bytes = bytes
+                .saturating_add(setups * SETUP_BYTES)
+                .saturating_add(tiles * BIN_ENTRY_BYTES);
+        }
+    }
+    bytes
+}
 
 /// The budget when the machine's memory cannot be read: 8 GiB.
 pub const FALLBACK_BYTES: u64 = 8 << 30;
@@ -142,5 +203,52 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("y needs about 2.0 MiB, over X: raise"), "{e}");
+    }
+}
+
+#[cfg(test)]
+mod raster_tests {
+    use super::*;
+
+    fn scene(z_third: f32) -> texel_scene::Scene {
+        let text = format!(
+            r#"[output]
+width = 128
+height = 128
+[camera]
+eye = [0.0, 0.0, 3.0]
+target = [0.0, 0.0, 0.0]
+fovy_deg = 90.0
+near = 0.1
+far = 10.0
+[textures.t]
+procedural = "solid"
+[[meshes]]
+texture = "t"
+positions = [[-2.9, -2.9, 0.0], [2.9, -2.9, 0.0], [0.0, 2.9, {z_third}]]
+uvs = [[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]]
+triangles = [[0, 1, 2]]
+"#
+        );
+        texel_scene::Scene::from_toml_str(&text, std::path::Path::new("t.toml")).unwrap()
+    }
+
+    #[test]
+    fn raster_bytes_counts_setups_and_tiles() {
+        // On screen, spanning all four 64x64 tiles of a 128x128 frame: one set-up, four bins.
+        assert_eq!(
+            raster_bytes(&scene(0.0), 128, 128),
+            SETUP_BYTES + 4 * BIN_ENTRY_BYTES
+        );
+        // At 256x256 the frame has 16 tiles and the triangle's box covers all of them.
+        assert_eq!(
+            raster_bytes(&scene(0.0), 256, 256),
+            SETUP_BYTES + 16 * BIN_ENTRY_BYTES
+        );
+        // A vertex behind the eye: the clipped polygon may make eight set-ups and cover every tile.
+        assert_eq!(
+            raster_bytes(&scene(5.0), 128, 128),
+            8 * SETUP_BYTES + 4 * BIN_ENTRY_BYTES
+        );
     }
 }

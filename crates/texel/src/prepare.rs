@@ -10,7 +10,7 @@ use texel_scene::Scene;
 use texel_texture::color::srgb_to_linear;
 use texel_texture::{ColorSpace, Limits, Sampler, Texture};
 
-use crate::memory::{FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_BYTES};
+use crate::memory::{raster_bytes, FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_BYTES};
 use crate::{Error, Filter, MemoryBudget};
 
 /// How 8-bit texture bytes and output bytes are interpreted (the CLI's `--color`).
@@ -77,6 +77,10 @@ impl PreparedScene {
             (v + m.positions.len() as u64, t + m.triangles.len() as u64)
         });
         budget.take("the meshes", verts * VERTEX_BYTES + tris * TRIANGLE_BYTES)?;
+        budget.take(
+            &format!("rasterizing {tris} triangles at {width}x{height}"),
+            raster_bytes(&scene, width, height),
+        )?;
         budget.take(
             &format!("a {width}x{height} frame"),
             u64::from(width) * u64::from(height) * FRAME_BYTES_PER_PIXEL,
