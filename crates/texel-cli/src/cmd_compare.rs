@@ -118,7 +118,8 @@ pub fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<
                     "--extra label {label:?} is given twice: each extra image needs its own label"
                 );
             }
-            if slug(other) == slug(label) {
+            // Case-insensitive file systems (macOS, Windows) would merge `a` and `A`.
+            if slug(other).eq_ignore_ascii_case(&slug(label)) {
                 bail!(
                     "--extra labels {other:?} and {label:?} would both be written as extra-{}.png: make them differ in letters, digits, - or _",
                     slug(label)
@@ -313,6 +314,10 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(msg.contains("extra-a_b.png"), "{msg}");
+        let msg = check_extras(&[e("gpu"), e("GPU")], &f)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("extra-GPU.png"), "{msg}");
         let msg = check_extras(&[e("trilinear")], &f).unwrap_err().to_string();
         assert!(msg.contains("compared filter"), "{msg}");
     }
