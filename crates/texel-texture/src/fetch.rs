@@ -1,5 +1,7 @@
-//! How filters read texels: per-level [`Fetch`] views, the whole-pyramid [`Pyramid`] view, and the
-//! [`Counted`] wrapper that counts every texel read.
+//! How filters read texels: per-level [`Fetch`] views ([`U8Level`] decodes 8-bit texels through a
+//! table, [`F32Level`] reads floats), the whole-pyramid [`Pyramid`] view, and the [`Counted`]
+//! wrapper that counts every texel read. This is the one home of texel reading; `texture.rs` owns
+//! the storage.
 //!
 //! Every filter is generic over these traits, so the same code serves 8-bit and float textures and the
 //! statistics mode: counting is a wrapper type, not a flag, and costs nothing when it is not used
@@ -10,9 +12,104 @@ use std::cell::Cell;
 use glam::Vec4;
 
 use crate::color::{srgb_table, unorm8_table};
-use crate::texture::{F32Level, Format, LevelInfo, Storage, Texture, U8Level};
+use crate::texture::{Format, LevelInfo, Storage, Texture};
 
-pub(crate) use crate::texture::Fetch;
+/// One mip level of an 8-bit texture; decodes through a 256-entry table (alpha always linear).
+#[derive(Clone, Copy)]
+pub(crate) struct U8Level<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub texels: &'a [[u8; 4]],
+    pub table: &'static [f32; 256],
+    pub alpha: &'static [f32; 256],
+}
+
+/// One mip level of a float texture.
+#[derive(Clone, Copy)]
+pub(crate) struct F32Level<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub texels: &'a [[f32; 4]],
+}
+
+/// Read access to one mip level's texels by already-wrapped integer index.
+pub(crate) trait Fetch: Copy {
+    /// Level size in texels.
+    fn size(&self) -> (u32, u32);
+    /// Texel `(i, j)` in linear RGBA; `i < width`, `j < height`.
+    fn texel(&self, i: u32, j: u32) -> Vec4;
+    /// The 2x2 texels `[(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]`; `i + 1 < width`,
+    /// `j + 1 < height` (no wrapping). The storage views read them as two 2-texel row slices,
+    /// so a bilinear lookup inside the level pays two bounds checks instead of four.
+    #[inline(always)]
+    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
+        [
+            self.texel(i, j),
+            self.texel(i + 1, j),
+            self.texel(i, j + 1),
+            self.texel(i + 1, j + 1),
+        ]
+    }
+}
+
+/// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level.
+#[inline(always)]
+fn rows2<T>(texels: &[T], width: u32, i: u32, j: u32) -> (&[T], &[T]) {
+    let w = width as usize;
+    let k = j as usize * w + i as usize;
+    (&texels[k..k + 2], &texels[k + w..k + w + 2])
+}
+
+impl Fetch for U8Level<'_> {
+    #[inline(always)]
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+    #[inline(always)]
+    fn texel(&self, i: u32, j: u32) -> Vec4 {
+        self.decode(self.texels[j as usize * self.width as usize + i as usize])
+    }
+    #[inline(always)]
+    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
+        let (r0, r1) = rows2(self.texels, self.width, i, j);
+        [
+            self.decode(r0[0]),
+            self.decode(r0[1]),
+            self.decode(r1[0]),
+            self.decode(r1[1]),
+        ]
+    }
+}
+
+impl U8Level<'_> {
+    /// One packed texel to linear RGBA: one table load per channel (RGB through the level's colour
+    /// table, alpha always `b / 255`).
+    #[inline(always)]
+    fn decode(&self, t: [u8; 4]) -> Vec4 {
+        Vec4::new(
+            self.table[t[0] as usize],
+            self.table[t[1] as usize],
+            self.table[t[2] as usize],
+            self.alpha[t[3] as usize],
+        )
+    }
+}
+
+impl Fetch for F32Level<'_> {
+    #[inline(always)]
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+    #[inline(always)]
+    fn texel(&self, i: u32, j: u32) -> Vec4 {
+        Vec4::from_array(self.texels[j as usize * self.width as usize + i as usize])
+    }
+    #[inline(always)]
+    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
+        let (r0, r1) = rows2(self.texels, self.width, i, j);
+        [r0[0], r0[1], r1[0], r1[1]].map(Vec4::from_array)
+    }
+}
 
 /// All mip levels of a texture.
 pub(crate) trait Pyramid {
