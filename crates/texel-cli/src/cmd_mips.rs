@@ -7,9 +7,9 @@
 
 use anyhow::{Context, Result};
 use texel_quality::{publish_dir, Image8, MAX_SIDE};
-use texel_texture::{ColorSpace, Limits, LoadOptions, Texture};
+use texel_texture::Texture;
 
-use crate::cli::{ColorArg, MipsArgs};
+use crate::cli::MipsArgs;
 use crate::output::{encoding, write_image};
 use crate::prepare::Input;
 
@@ -19,20 +19,7 @@ pub const ENCODE_BYTES_PER_PIXEL: u64 = 16;
 
 /// Run `texel mips`.
 pub fn run(args: &MipsArgs, input: &mut Input) -> Result<()> {
-    let color = match args.color {
-        ColorArg::Srgb => ColorSpace::Srgb,
-        ColorArg::Raw => ColorSpace::Linear,
-    };
-    let options = LoadOptions {
-        replace_non_finite: input.sanitize,
-        ..LoadOptions::new(
-            color,
-            Limits {
-                max_bytes: input.budget.remaining(),
-                ..Limits::default()
-            },
-        )
-    };
+    let options = input.texture_options(args.color);
     let loaded = Texture::load_with(&args.texture, &options)
         .map_err(|e| input.explain(e.into()))
         .with_context(|| format!("cannot load texture {}", args.texture.display()))?;

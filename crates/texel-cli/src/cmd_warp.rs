@@ -7,19 +7,15 @@
 use anyhow::{bail, Context, Result};
 use glam::DVec2;
 use texel_texture::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
-use texel_texture::{AddressMode, ColorSpace, Limits, LoadOptions, Sampler, Texture};
+use texel_texture::{AddressMode, Sampler, Texture};
 
-use crate::cli::{ColorArg, WarpArgs};
+use crate::cli::WarpArgs;
 use crate::output::write_png;
 use crate::prepare::Input;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
 
 /// Run `texel warp`.
 pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
-    let color = match args.color {
-        ColorArg::Srgb => ColorSpace::Srgb,
-        ColorArg::Raw => ColorSpace::Linear,
-    };
     if let Some(s) = args.size {
         let pixels = u64::from(s.width) * u64::from(s.height);
         if pixels > MAX_WARP_PIXELS {
@@ -49,16 +45,7 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
         &format!("the {w}x{h} output"),
         u64::from(w) * u64::from(h) * FRAME_BYTES_PER_PIXEL,
     )?;
-    let options = LoadOptions {
-        replace_non_finite: input.sanitize,
-        ..LoadOptions::new(
-            color,
-            Limits {
-                max_bytes: input.budget.remaining(),
-                ..Limits::default()
-            },
-        )
-    };
+    let options = input.texture_options(args.color);
     let loaded = Texture::decode_with(&bytes, &options)
         .map_err(|e| input.explain(e.into()))
         .with_context(cannot)?;

@@ -4,7 +4,7 @@
 use anyhow::Result;
 use texel::memory::{TRIANGLE_BYTES, VERTEX_BYTES};
 use texel::{MemoryBudget, PreparedScene, Scene, SceneLimits, SceneOptions};
-use texel_texture::TextureError;
+use texel_texture::{ColorSpace, Limits, LoadOptions, TextureError};
 
 use crate::cli::{ColorArg, Size};
 
@@ -17,6 +17,25 @@ pub struct Input {
 }
 
 impl Input {
+    /// How a command-line image is read: `color` for 8-bit data, `--sanitize`, and a memory limit
+    /// of what the account has left.
+    pub fn texture_options(&self, color: ColorArg) -> LoadOptions {
+        let color = match color {
+            ColorArg::Srgb => ColorSpace::Srgb,
+            ColorArg::Raw => ColorSpace::Linear,
+        };
+        LoadOptions {
+            replace_non_finite: self.sanitize,
+            ..LoadOptions::new(
+                color,
+                Limits {
+                    max_bytes: self.budget.remaining(),
+                    ..Limits::default()
+                },
+            )
+        }
+    }
+
     /// Print a warning when `--sanitize` replaced values of texture `name`.
     pub fn warn_replaced(&self, name: &str, replaced: u64) {
         if replaced > 0 {

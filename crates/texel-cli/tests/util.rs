@@ -10,21 +10,8 @@ use texel_quality::Image8;
 // Helpers
 // ---------------------------------------------------------------------------------------------
 
-/// Every filter name, in the CLI's order.
-pub(crate) const FILTERS: [&str; 12] = [
-    "nearest",
-    "bilinear",
-    "bicubic",
-    "mip-nearest",
-    "trilinear",
-    "aniso2",
-    "aniso4",
-    "aniso8",
-    "aniso16",
-    "ewa",
-    "ripmap",
-    "sat",
-];
+/// Every filter name, in the CLI's order (the library's one list).
+pub(crate) const FILTERS: [&str; 12] = texel::Filter::NAMES;
 
 /// The built-in scenes the demo covers.
 pub(crate) const BUILTINS: [&str; 6] = [
