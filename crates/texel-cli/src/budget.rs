@@ -1,7 +1,7 @@
 //! `--max-memory`: parsing the size, and the account every command charges before it allocates
 //! ([`texel::MemoryBudget`]; the figures per pixel and per element are in [`texel::memory`]).
 
-use texel::memory::{machine_memory, mib, FALLBACK_BYTES};
+use texel::memory::mib;
 use texel::MemoryBudget;
 
 /// A byte count from the command line: a whole number with an optional unit K, M, G, T (powers
@@ -42,7 +42,7 @@ pub fn budget(max_memory: Option<ByteSize>) -> MemoryBudget {
     match max_memory {
         Some(ByteSize(b)) => MemoryBudget::new(b, format!("--max-memory {}", mib(b))),
         None => {
-            let limit = machine_memory().map_or(FALLBACK_BYTES, |m| m / 2);
+            let limit = MemoryBudget::half_of_machine().limit();
             MemoryBudget::new(
                 limit,
                 format!(

@@ -73,6 +73,16 @@ impl Default for Limits {
     }
 }
 
+/// How a decoded image of `color` is stored: 8-bit images as RGBA8 (sRGB or not: same size),
+/// 16-bit and float images as RGBA32F ([`Texture::decode`]'s conversion).
+fn stored_format(color: image::ColorType) -> Format {
+    use image::ColorType as C;
+    match color {
+        C::L8 | C::La8 | C::Rgb8 | C::Rgba8 => Format::Rgba8Unorm,
+        _ => Format::Rgba32Float,
+    }
+}
+
 impl Limits {
     /// The bytes [`Texture::decode`] holds at once, at most, for an encoded file of `file_bytes`
     /// whose header says `width x height` pixels of `color`: the file, the decoded image, two
@@ -80,13 +90,7 @@ impl Limits {
     /// with their `f32` build scratch. An upper bound, not a measurement of one run.
     pub fn load_bytes(file_bytes: u64, width: u32, height: u32, color: image::ColorType) -> u64 {
         let px = u64::from(width) * u64::from(height);
-        let texel = match color {
-            image::ColorType::L8
-            | image::ColorType::La8
-            | image::ColorType::Rgb8
-            | image::ColorType::Rgba8 => 4,
-            _ => 16,
-        };
+        let texel = stored_format(color).texel_bytes();
         let below = pyramid::pyramid_texels(width, height) - px;
         file_bytes
             .saturating_add(px.saturating_mul(u64::from(color.bytes_per_pixel())))
@@ -107,12 +111,7 @@ impl Limits {
         height: u32,
         color: image::ColorType,
     ) -> Result<(), TextureError> {
-        use image::ColorType as C;
-        let format = match color {
-            C::L8 | C::La8 | C::Rgb8 | C::Rgba8 => Format::Rgba8Unorm,
-            _ => Format::Rgba32Float,
-        };
-        self.check(width, height, format)?;
+        self.check(width, height, stored_format(color))?;
         let bytes = Self::load_bytes(file_bytes, width, height, color);
         if bytes > self.max_bytes {
             return Err(TextureError::OverMemoryLimit {
