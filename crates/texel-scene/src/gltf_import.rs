@@ -434,13 +434,7 @@ pub fn load_gltf_with(
     texture: &str,
     limits: &SceneLimits,
 ) -> Result<Vec<Mesh>, SceneError> {
-    let bytes =
-        texel_texture::input::read_regular(path, limits.max_mesh_file_bytes).map_err(|source| {
-            SceneError::Io {
-                path: path.to_path_buf(),
-                source,
-            }
-        })?;
+    let bytes = limits.read_mesh_file(path)?;
     let base = path.parent().unwrap_or(Path::new("."));
     load_gltf_slice(&bytes, Some(base), path, texture, limits)
 }

@@ -1,5 +1,9 @@
 //! Bounds on what a scene may make texel read and allocate, checked before the allocation.
 
+use std::path::Path;
+
+use crate::error::SceneError;
+
 /// How much a scene and its mesh files may hold. Checked from file sizes and headers (glTF
 /// accessor counts, OBJ face lines) before anything proportional is allocated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -26,5 +30,18 @@ impl Default for SceneLimits {
             max_triangles: 1 << 25,
             max_vertices: 1 << 25,
         }
+    }
+}
+
+impl SceneLimits {
+    /// Read a mesh file (OBJ, glTF, GLB): a regular file of at most
+    /// [`SceneLimits::max_mesh_file_bytes`] ([`texel_texture::input::read_regular`]).
+    pub(crate) fn read_mesh_file(&self, path: &Path) -> Result<Vec<u8>, SceneError> {
+        texel_texture::input::read_regular(path, self.max_mesh_file_bytes).map_err(|source| {
+            SceneError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })
     }
 }

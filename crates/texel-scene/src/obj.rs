@@ -35,13 +35,7 @@ pub fn load_obj(path: &Path, texture: &str) -> Result<Mesh, SceneError> {
 /// [`SceneError::Io`] (unreadable, not a regular file, too large) and those of
 /// [`load_obj_bytes`].
 pub fn load_obj_with(path: &Path, texture: &str, limits: &SceneLimits) -> Result<Mesh, SceneError> {
-    let bytes =
-        texel_texture::input::read_regular(path, limits.max_mesh_file_bytes).map_err(|source| {
-            SceneError::Io {
-                path: path.to_path_buf(),
-                source,
-            }
-        })?;
+    let bytes = limits.read_mesh_file(path)?;
     load_obj_bytes(&bytes, path, texture, limits)
 }
 
