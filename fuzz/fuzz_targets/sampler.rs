@@ -108,7 +108,7 @@ fuzz_target!(|input: Input| {
         dvdx,
         dvdy,
     };
-    if tex.prepare(&sampler).is_err() {
+    if tex.build_structures(&sampler).is_err() {
         return;
     }
     let c = sampler.sample(&tex, &fp);

@@ -17,7 +17,7 @@ use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
 use crate::cli::BenchArgs;
 use crate::filters::parse_list;
-use crate::prepare::{load_scene, Input};
+use crate::input::{load_scene, Input};
 use crate::threads::{thread_count, with_threads};
 
 /// One filter's timings in milliseconds.
@@ -106,7 +106,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         let mut out = Vec::new();
         for filter in &filters {
             let samplers = scene.samplers(*filter)?;
-            scene.prepare_within(&samplers, budget)?;
+            scene.build_structures_within(&samplers, budget)?;
             let draws = scene.draws(&samplers);
             let settings = scene.settings();
             let mut times = time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;

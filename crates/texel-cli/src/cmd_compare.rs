@@ -19,8 +19,8 @@ use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
 use crate::cmd_reference::reference_frame;
 use crate::filters::{parse_list, Filter};
+use crate::input::{load_scene, Input};
 use crate::output::encoding;
-use crate::prepare::{load_scene, Input};
 use crate::progress;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
 use texel::{MemoryBudget, PreparedScene};
@@ -173,7 +173,7 @@ pub fn compare(
     for &filter in filters {
         pb.set_message(filter.name());
         let samplers = scene.samplers(filter)?;
-        let bytes = scene.prepare_within(&samplers, budget)?;
+        let bytes = scene.build_structures_within(&samplers, budget)?;
         let draws = scene.draws(&samplers);
         let settings = scene.settings();
         let mut times = time_frames(&settings, &draws, 1, Duration::ZERO, TIMED_FRAMES)?;

@@ -13,7 +13,7 @@ use texel_quality::{publish_dir, write_atomic, Report};
 use crate::cli::{ColorArg, DemoArgs};
 use crate::cmd_compare::{compare, COMPARE_BYTES_PER_PIXEL};
 use crate::filters::Filter;
-use crate::prepare::{load_scene, Input};
+use crate::input::{load_scene, Input};
 
 /// Run `texel demo`: every scene's report is written into one staging directory, published as a
 /// whole at `--out` when all are done.

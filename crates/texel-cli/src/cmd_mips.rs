@@ -10,8 +10,8 @@ use texel_quality::{publish_dir, Image8, MAX_SIDE};
 use texel_texture::Texture;
 
 use crate::cli::MipsArgs;
+use crate::input::Input;
 use crate::output::{encoding, write_image};
-use crate::prepare::Input;
 
 /// What writing one image holds per pixel: the 8-bit image (4), its RGBA bytes for the encoder
 /// (4) and the PNG (at most about 4 plus headers), rounded up.

@@ -5,8 +5,8 @@ use texel_raster::render_reference_strata;
 
 use crate::cli::ReferenceArgs;
 use crate::filters::Filter;
+use crate::input::{load_scene, Input};
 use crate::output::write_png;
-use crate::prepare::{load_scene, Input};
 use crate::progress;
 use texel::PreparedScene;
 

@@ -5,8 +5,8 @@ use texel_raster::{render, Derivatives, Perspective, View};
 
 use crate::cli::{ColorArg, DerivativesArg, PerspectiveArg, RenderArgs, ViewArg};
 use crate::filters::Filter;
+use crate::input::{load_scene, Input};
 use crate::output::write_png;
-use crate::prepare::{load_scene, Input};
 use crate::threads::with_threads;
 
 /// Run `texel render`.
@@ -20,7 +20,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         Some(f) => scene.samplers(f)?,
         None => scene.default_samplers()?,
     };
-    scene.prepare_within(&samplers, &mut input.budget)?;
+    scene.build_structures_within(&samplers, &mut input.budget)?;
     let mut settings = scene.settings();
     settings.derivatives = match args.derivatives {
         DerivativesArg::Analytic => Derivatives::Analytic,

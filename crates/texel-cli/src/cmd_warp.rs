@@ -10,8 +10,8 @@ use texel_texture::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
 use texel_texture::{AddressMode, Sampler, Texture};
 
 use crate::cli::WarpArgs;
+use crate::input::Input;
 use crate::output::write_png;
-use crate::prepare::Input;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
 
 /// Run `texel warp`.

@@ -14,8 +14,8 @@ mod cmd_reference;
 mod cmd_render;
 mod cmd_warp;
 mod filters;
+mod input;
 mod output;
-mod prepare;
 mod progress;
 mod threads;
 
@@ -42,7 +42,7 @@ fn main() -> ExitCode {
     if let Err(e) = ctrlc::set_handler(|| texel_quality::remove_pending_and_exit(INTERRUPTED)) {
         eprintln!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files");
     }
-    let mut input = prepare::Input {
+    let mut input = input::Input {
         budget: budget::budget(cli.max_memory),
         sanitize: cli.sanitize,
     };

@@ -46,7 +46,6 @@ mod error;
 mod frame;
 pub mod interp;
 pub mod reference;
-mod rng;
 mod settings;
 pub mod setup;
 mod shade;

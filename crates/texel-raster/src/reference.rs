@@ -32,11 +32,11 @@ use texel_texture::{FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor};
 use crate::draw::DrawCall;
 use crate::error::RasterError;
 use crate::frame::Frame;
-use crate::rng::SplitMix64;
 use crate::settings::{Perspective, RenderSettings};
 use crate::setup::{setup_draws, validate_draws, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
 use crate::tile::{bin, split_rows, tile_counts, TILE};
+use texel_texture::rng::SplitMix64;
 
 /// The largest samples-per-pixel side (`64 x 64 = 4096` samples per pixel).
 pub const MAX_SPP_SIDE: u32 = 64;

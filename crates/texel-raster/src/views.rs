@@ -16,7 +16,7 @@
 
 use glam::DVec3;
 use texel_texture::color::srgb_to_linear;
-use texel_texture::mip::mip_nearest_level;
+use texel_texture::mip::nearest_level;
 use texel_texture::{Footprint, Sampler, Texture};
 
 /// One displayed (sRGB 8-bit) colour per mip level, cycling after 16 levels.
@@ -88,7 +88,7 @@ pub fn uv_color(u: f64, v: f64) -> [f32; 4] {
 /// The mip-level view: the palette colour of the level the nearest-level rule reads.
 pub fn mip_color(sampler: &Sampler, texture: &Texture, fp: &Footprint) -> [f32; 4] {
     let last = texture.levels().len() - 1;
-    let level = mip_nearest_level(sampler.lod(texture, fp), last);
+    let level = nearest_level(sampler.lod(texture, fp), last);
     displayed(byte_color(MIP_PALETTE[level % MIP_PALETTE.len()]))
 }
 

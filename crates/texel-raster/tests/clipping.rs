@@ -160,7 +160,7 @@ fn huge_coordinates_do_not_overflow() {
         assert!(frame.color.iter().all(|c| c.iter().all(|x| x.is_finite())));
     }
     // Random huge triangles: no panic, finite output.
-    let mut rng = Rng(9);
+    let mut rng = Rng::new(9);
     let mut r = || ((rng.next_f64() - 0.5) * 2e7) as f32;
     let vertices: Vec<Vertex> = (0..300).map(|_| v(r(), r(), r() * 1e-7)).collect();
     let triangles: Vec<[u32; 3]> = (0..100).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();

@@ -62,7 +62,7 @@ fn analytic_derivatives_match_finite_differences_on_the_ground() {
 fn analytic_derivatives_match_finite_differences_on_random_triangles() {
     let (w, h) = (96, 64);
     let (tex, sampler) = common::white();
-    let mut rng = Rng(42);
+    let mut rng = Rng::new(42);
     let mut r = |a: f64, b: f64| (a + (b - a) * rng.next_f64()) as f32;
     let proj = camera::perspective(1.0, 1.5, 0.1, 100.0);
     let view = camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);

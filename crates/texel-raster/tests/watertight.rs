@@ -100,7 +100,7 @@ fn grid(
 #[test]
 fn jittered_grids_cover_each_pixel_once() {
     for seed in 0..6 {
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         let (v, t) = grid(97, 61, 23, 17, 0.3, &mut rng);
         let counts = coverage_counts(&v, &t, 97, 61);
         assert_exactly_once(&counts, 97, &format!("grid seed {seed}"));
@@ -152,7 +152,7 @@ fn grid_through_pixel_centres_covers_each_pixel_once() {
 fn random_fans_cover_each_pixel_once() {
     let (w, h) = (83, 59);
     for seed in 0..6 {
-        let mut rng = Rng(100 + seed);
+        let mut rng = Rng::new(100 + seed);
         let centre = (rng.next_f64() * f64::from(w), rng.next_f64() * f64::from(h));
         let mut vertices = vec![screen_vertex(centre.0, centre.1, w, h)];
         // A closed ring around the frame's border (outside it), at random positions along each side.

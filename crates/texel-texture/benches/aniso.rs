@@ -103,7 +103,7 @@ fn sampling(c: &mut Criterion) {
         let fps = footprints(ratio);
         for (name, desc) in filters() {
             let s = Sampler::new(desc.with_address_mode(AddressMode::Repeat)).unwrap();
-            tex.prepare(&s).unwrap();
+            tex.build_structures(&s).unwrap();
             let reads: u64 = fps
                 .iter()
                 .map(|f| u64::from(s.sample_counted(&tex, f).1))

@@ -86,30 +86,35 @@ impl BorderColor {
     }
 }
 
-/// The u and v address modes and the border colour, resolved once per sampler.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Address {
+/// The u and v address modes and the border colour: how a sampler (or a summed-area table's box
+/// query) extends the texture beyond its edges. [`Sampler`](crate::Sampler) resolves one from its
+/// descriptor ([`Address::of`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Address {
+    /// Address mode along u (texture x).
     pub u: AddressMode,
+    /// Address mode along v (texture y).
     pub v: AddressMode,
+    /// Linear RGBA read outside the texture under [`AddressMode::ClampToBorder`].
     pub border: Vec4,
 }
 
-/// Texel coordinate: from continuous `xy` (float) to an `i64` index, saturating; NaN gives 0.
-///
-/// Equal to `x.floor() as i64` for every `x`, but computed by truncating conversion and a compare:
-/// on the x86-64 baseline (no SSE4.1 `roundss`) `f32::floor` is a call into libm, a measurable
-/// share of a trilinear ground frame (docs/perf-log.md). For `|x| < 2^63` the result converts back
-/// to `x.floor()` exactly (below 2^24 every integer is an `f32`; above, `x` is itself an integer).
-#[inline(always)]
-pub(crate) fn floor_index(x: f32) -> i64 {
-    let t = x as i64; // truncates toward zero, saturates, NaN -> 0
-    t.saturating_sub(i64::from((t as f32) > x))
+impl Address {
+    /// The address modes and border colour of `desc`.
+    pub fn of(desc: &crate::SamplerDescriptor) -> Address {
+        Address {
+            u: desc.address_mode_u,
+            v: desc.address_mode_v,
+            border: Vec4::from_array(desc.border_color.rgba()),
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::AddressMode::*;
     use super::*;
+    use crate::floor::floor_index;
 
     /// (mode, index, n, expected) straight from the documented examples.
     const TABLE: &[(AddressMode, i64, u32, Option<u32>)] = &[
@@ -179,44 +184,6 @@ mod tests {
                     }
                 }
             }
-        }
-        assert_eq!(floor_index(f32::NAN), 0);
-        assert_eq!(floor_index(f32::INFINITY), i64::MAX);
-        assert_eq!(floor_index(f32::NEG_INFINITY), i64::MIN);
-    }
-
-    /// The integer floor agrees with `f32::floor` on every kind of value, edges included.
-    #[test]
-    fn floor_index_matches_floor() {
-        let mut xs = vec![
-            0.0f32,
-            -0.0,
-            0.5,
-            -0.5,
-            1.0,
-            -1.0,
-            0.999_999_9,
-            -0.999_999_9,
-            1e-30,
-            -1e-30,
-            16_777_215.5,
-            -16_777_215.5,
-            16_777_216.0,
-            -16_777_217.0,
-            2.5e11,
-            -2.5e11,
-            1e18,
-            -1e18,
-            9.2e18,
-            -9.2e18,
-        ];
-        // A sweep of quarter steps and of values just below integers.
-        for k in -2000..2000 {
-            xs.push(k as f32 * 0.25);
-            xs.push(f32::from_bits((k as f32).to_bits().wrapping_sub(1)));
-        }
-        for x in xs {
-            assert_eq!(floor_index(x), x.floor() as i64, "x = {x}");
         }
     }
 }

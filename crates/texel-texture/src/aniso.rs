@@ -47,14 +47,14 @@
 //!   probe lod uses [`crate::footprint::fast_log2`] (within 1.2 units in the last place), for the
 //!   single-sample path too, so both paths agree bit for bit.
 
-use glam::Vec4;
+use glam::{Vec2, Vec4};
 
-use crate::address::Address;
 use crate::batch::{self, Probes};
 use crate::fetch::{Fetch, Pyramid};
-use crate::footprint::{fast_log2, log2_normal, Footprint};
-use crate::mip::{trilinear, Linear};
-use crate::sampler::SamplerDescriptor;
+use crate::floor::ceil_i32;
+use crate::footprint::{fast_log2, log2_normal, Footprint, Query};
+use crate::mip::{linear_levels, trilinear};
+use crate::sampler::{FilterMode, Sampler};
 
 /// Relative tolerance applied to `|Pmax| / |Pmin|` before rounding up (see the module docs).
 pub const RATIO_TOLERANCE: f32 = 1e-5;
@@ -73,31 +73,16 @@ pub fn probe_count(major: f32, minor: f32, max_anisotropy: u32) -> u32 {
     if r > max_anisotropy as f32 {
         return max_anisotropy.max(1);
     }
-    // `ceil(r)` for `0 <= r <= max_anisotropy` (at most 2^32) without libm's `ceilf` (the x86-64
-    // baseline has no rounding instruction, so `ceilf` is a call; docs/perf-log.md): truncate, and
-    // add one where truncation went down. `r < 2^24` here in practice, where every step is exact.
-    let t = r as u32;
-    let n = if (t as f32) < r { t + 1 } else { t };
-    n.clamp(1, max_anisotropy.max(1))
+    // `0 <= r <= max_anisotropy <= 64` here.
+    (ceil_i32(r) as u32).clamp(1, max_anisotropy.max(1))
 }
 
-/// Anisotropic filtering of `fp` (with `(u, v)` already made finite) at most `max` probes;
-/// `lod_iso` is the sampler's isotropic lod (already known to be `> 0`).
-#[allow(clippy::too_many_arguments)]
+/// Anisotropic filtering of query `q` (whose lod, the isotropic one, is `> 0`) by `s`'s
+/// `anisotropy_clamp`: the formula above, as [`plan`] and [`filter_planned`] evaluate it.
 #[inline]
-pub(crate) fn anisotropic<P: Pyramid>(
-    p: &P,
-    addr: &Address,
-    d: &SamplerDescriptor,
-    fp: &Footprint,
-    u: f32,
-    v: f32,
-    lod_iso: f32,
-    max: u32,
-) -> Vec4 {
-    let (w, h) = p.level(0).size();
-    let (plan, _) = plan(fp, w, h, d, max, fast_log2);
-    filter_planned(p, addr, &plan, u, v, lod_iso, &mut Probes::new())
+pub(crate) fn anisotropic<P: Pyramid>(p: &P, s: &Sampler, q: &Query) -> Vec4 {
+    let (plan, _) = plan(s, p.level(0).size(), &q.fp, fast_log2);
+    filter_planned(p, q, &plan, &mut Probes::new(s.address()))
 }
 
 /// What a sample's probes need from its footprint ([`plan`]).
@@ -107,32 +92,29 @@ pub(crate) struct Plan {
     pub n: u32,
     /// The probes' lod, `log2(|Pmax| / N) + bias` clamped (unused when `n == 1`).
     pub lod: f32,
-    /// The major axis in uv units, u component.
-    pub au: f32,
-    /// As `au`, v component.
-    pub av: f32,
+    /// The major axis in uv units, `Pmax_uv`.
+    pub axis: Vec2,
 }
 
-/// The [`Plan`] of footprint `fp` on a `w x h` level 0 (`max` clamped to `1..=64`), with `log2`
-/// either [`fast_log2`] or its branch-free normal-input path [`log2_normal`]; also whether `rho =
-/// |Pmax| / N` is zero or subnormal, where the latter is wrong and the plan must be made again
-/// with [`fast_log2`]. [`Footprint::axes`], [`probe_count`] and [`lod_from_rho`]'s arithmetic
-/// (clamping by `max`/`min`, which equals `clamp` for the non-NaN values reaching it), inlined so
-/// that [`plan_chunk`]'s loop over a chunk pipelines.
+/// The [`Plan`] of footprint `fp` on a `size` level 0 under `s` (its lod bias and clamps, its
+/// `anisotropy_clamp` as the most probes), with `log2` either [`fast_log2`] or its branch-free
+/// normal-input path [`log2_normal`]; also whether `rho = |Pmax| / N` is zero or subnormal, where
+/// the latter is wrong and the plan must be made again with [`fast_log2`]. [`Footprint::axes`],
+/// [`probe_count`] and [`crate::footprint::lod_from_rho`]'s arithmetic (clamping by `max`/`min`,
+/// which equals `clamp` for the non-NaN values reaching it), inlined so that [`plan_chunk`]'s loop
+/// over a chunk pipelines.
 #[inline(always)]
 pub(crate) fn plan(
+    s: &Sampler,
+    (w, h): (u32, u32),
     fp: &Footprint,
-    w: u32,
-    h: u32,
-    d: &SamplerDescriptor,
-    max: u32,
     log2: impl Fn(f32) -> f32,
 ) -> (Plan, bool) {
+    let d = s.descriptor();
     let axes = fp.axes(w, h);
     let (major, minor) = (axes.major.length(), axes.minor.length());
-    let (au, av) = (axes.major_uv.x, axes.major_uv.y);
     let n = if major.is_finite() && axes.major_uv.is_finite() {
-        probe_count(major, minor, max.clamp(1, 64))
+        probe_count(major, minor, u32::from(d.anisotropy_clamp).clamp(1, 64))
     } else {
         1
     };
@@ -147,78 +129,72 @@ pub(crate) fn plan(
         l
     };
     let special = rho.is_finite() & (rho < f32::MIN_POSITIVE);
-    (Plan { n, lod, au, av }, special)
+    let axis = axes.major_uv;
+    (Plan { n, lod, axis }, special)
 }
 
-/// The plans of a chunk of footprints (at most [`batch::CHUNK`]) on a `w x h` level 0: one
+/// The plans of a chunk of footprints (at most [`batch::CHUNK`]) on a `size` level 0: one
 /// vectorised pass with [`log2_normal`], then the rare zero or subnormal `rho` again with
 /// [`fast_log2`], so every plan equals [`plan`] with [`fast_log2`] (what [`anisotropic`] uses).
 pub(crate) fn plan_chunk(
+    s: &Sampler,
+    size: (u32, u32),
     fps: &[Footprint],
-    w: u32,
-    h: u32,
-    d: &SamplerDescriptor,
-    max: u32,
     out: &mut [Plan; batch::CHUNK],
 ) {
     let mut special = false;
     for (o, fp) in out.iter_mut().zip(fps) {
-        let (p, s) = plan(fp, w, h, d, max, log2_normal);
+        let (p, sub) = plan(s, size, fp, log2_normal);
         *o = p;
-        special |= s;
+        special |= sub;
     }
     if special {
         for (o, fp) in out.iter_mut().zip(fps) {
-            let (p, s) = plan(fp, w, h, d, max, fast_log2);
-            if s {
+            let (p, sub) = plan(s, size, fp, fast_log2);
+            if sub {
                 *o = p;
             }
         }
     }
 }
 
-/// Anisotropic filtering at finite `(u, v)` by a [`Plan`]: `N` probes, or trilinear at `lod_iso`
-/// (`> 0`) when `N = 1`. `s` is scratch (reused across a batch: `Sampler::sample_batch`); the
-/// result does not depend on its contents.
+/// Anisotropic filtering of `q` by its [`Plan`]:
+/// `c = 1/N sum_{i=0}^{N-1} trilinear(uv + ((i + 0.5) / N - 0.5) Pmax_uv, plan.lod)`, or trilinear
+/// at the isotropic lod when `N = 1`. `probes` is scratch (reused across a batch:
+/// `Sampler::sample_batch`); the result does not depend on its contents.
 #[inline]
 pub(crate) fn filter_planned<P: Pyramid>(
     p: &P,
-    addr: &Address,
+    q: &Query,
     plan: &Plan,
-    u: f32,
-    v: f32,
-    lod_iso: f32,
-    s: &mut Probes,
+    probes: &mut Probes,
 ) -> Vec4 {
     let n = plan.n;
     if n == 1 {
-        return trilinear(p, Linear, addr, u, v, lod_iso);
+        return trilinear(p, &FilterMode::Linear, probes.address(), q);
     }
     let inv = 1.0 / n as f32;
     let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
-    // Every probe shares the lod: choose the two levels once (the same rule and the same
-    // arithmetic as `mip::trilinear`, so each probe is bit for bit a trilinear sample).
-    let last = p.level_count() - 1;
-    let dl = plan.lod.clamp(0.0, last as f32);
-    let k = dl as usize;
-    let delta = dl - k as f32;
-    let coarse = delta > 0.0 && k < last;
-    // The probes' coordinates, then their staged trilinear sum (`batch::probe_sum`, the same
-    // arithmetic as `mip::trilinear` with `Linear` per probe). `n <= 64` (`plan`).
+    // The probes' positions along the major axis (`n <= 64`: `plan`).
     let n = (n as usize).min(batch::CHUNK);
-    for (i, (pu, pv)) in s.u[..n].iter_mut().zip(&mut s.v[..n]).enumerate() {
+    let at = &mut probes.at;
+    at.n = n;
+    for (i, (pu, pv)) in at.u[..n].iter_mut().zip(&mut at.v[..n]).enumerate() {
         let t = (i as f32 + 0.5) * inv - 0.5;
-        *pu = finite(u + t * plan.au);
-        *pv = finite(v + t * plan.av);
+        *pu = finite(q.fp.u + t * plan.axis.x);
+        *pv = finite(q.fp.v + t * plan.axis.y);
     }
-    batch::probe_sum(p, addr, k, coarse, delta, n, s) * inv
+    // Every probe shares the lod, so the two levels are chosen once; the probes' trilinear
+    // samples are then staged (`Probes::trilinear_sum`).
+    probes.trilinear_sum(p, linear_levels(plan.lod, p.level_count() - 1)) * inv
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bilinear::bilinear;
     use crate::fetch::pyramid_of;
-    use crate::mip::LevelFilter;
+    use crate::sampler::SamplerDescriptor;
     use crate::texture::{Format, Limits, Texture};
 
     /// The staged probes (`batch::probe_sum`) equal the plain probe loop bit for bit: each probe a
@@ -238,12 +214,13 @@ mod tests {
         let crate::fetch::AnyPyramid::U8(p) = pyramid_of(&tex) else {
             unreachable!()
         };
-        let d = SamplerDescriptor::anisotropic(16);
-        let addr = crate::address::Address {
-            u: crate::address::AddressMode::Repeat,
-            v: crate::address::AddressMode::MirrorRepeat,
-            border: Vec4::ZERO,
+        let d = SamplerDescriptor {
+            address_mode_u: crate::address::AddressMode::Repeat,
+            address_mode_v: crate::address::AddressMode::MirrorRepeat,
+            ..SamplerDescriptor::anisotropic(16)
         };
+        let sampler = Sampler::new(d).unwrap();
+        let addr = sampler.address();
         let mut checked = 0;
         for s in 0..4000u32 {
             let f = |k: u32| ((s.wrapping_mul(2_654_435_761) >> k) % 1000) as f32 / 1000.0;
@@ -271,15 +248,16 @@ mod tests {
             for i in 0..n {
                 let t = (i as f32 + 0.5) * inv - 0.5;
                 let (pu, pv) = (fp.u + t * axes.major_uv.x, fp.v + t * axes.major_uv.y);
-                let a = Linear.apply(&p.level(k), &addr, pu, pv);
+                let uv = Vec2::new(pu, pv);
+                let a = bilinear(&p.level(k), &addr, uv);
                 sum += if delta > 0.0 && k < last {
-                    a + (Linear.apply(&p.level(k + 1), &addr, pu, pv) - a) * delta
+                    a + (bilinear(&p.level(k + 1), &addr, uv) - a) * delta
                 } else {
                     a
                 };
             }
             let want = (sum * inv).to_array().map(f32::to_bits);
-            let got = anisotropic(&p, &addr, &d, &fp, fp.u, fp.v, 1.0, 16);
+            let got = anisotropic(&p, &sampler, &Query { fp, lod: 1.0 });
             assert_eq!(got.to_array().map(f32::to_bits), want, "{fp:?}");
             checked += 1;
         }

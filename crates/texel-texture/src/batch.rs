@@ -1,88 +1,152 @@
-//! Specialised kernels behind [`crate::Sampler::sample_batch`] for the four core filters: nearest
-//! or bilinear inside a level, with no mipmapping (level 0), the nearest level, or trilinear.
+//! The batched path behind [`crate::Sampler::sample_batch`]: the same kernels as the one-sample
+//! path ([`crate::bilinear`], [`crate::nearest`], [`crate::mip`]), staged over a chunk of samples.
 //!
-//! The per-sample path ([`crate::Sampler::sample`]) walks one sample through lod, level choice,
-//! a run-time dispatch on the filter, coordinate set-up, range checks, texel loads and blends. Here a
-//! chunk of samples goes through the same steps in stages, each a short loop over the chunk:
+//! The one-sample path ([`crate::Sampler::sample`]) walks one sample through its query (uv made
+//! finite, the lod), level choice, texel set-up, loads and blends: one long dependency chain per
+//! sample. Here a chunk of samples goes through the same steps in stages, each a short loop over the
+//! chunk whose iterations are independent, so they pipeline and (stages 0 to 2) vectorise:
 //!
-//! 1. levels: each sample's level (and, for trilinear, its second level and weight);
-//! 2. coordinates: per level pass, `x = u * W` (`- 1/2` for bilinear), the integer texel index by
-//!    a clamp and a truncating conversion, the fractions, and whether every texel the sample reads
-//!    lies inside the level. Branch-free, with no calls: the compiler vectorises it;
-//! 3. texels: loads, decodes and blends for the samples inside the level; the few near an edge
-//!    go through the general filter ([`crate::nearest`], [`crate::bilinear`]) with address wrapping.
+//! 0. [`queries`]: every sample's finite `uv` and lod;
+//! 1. levels: [`mip::nearest_level`] or [`mip::linear_levels`] per sample;
+//! 2. [`Pass::coordinates`]: per level pass, the filter's `origin` (`u * W`, or `u * W - 1/2` for
+//!    bilinear), its floor ([`floor_clamped`], the staged floor), the fractions, and whether every
+//!    texel the sample reads lies inside the level;
+//! 3. [`Pass::filtered`]: loads and [`bilinear::blend`] for the samples inside the level; the few
+//!    near an edge call the one-sample filter ([`nearest`], [`bilinear`]) with address wrapping.
 //!
-//! Every stage performs the per-sample path's floating-point operations in the same order, so the
-//! results are bit for bit those of [`crate::Sampler::sample`] (`tests/core.rs`, `batch_equals_single`,
-//! over every filter, mipmap mode, address mode and texel format).
+//! Every stage calls the one-sample path's kernels with the same operands, so the results are bit
+//! for bit those of [`crate::Sampler::sample`] (`tests/core.rs`, `batch_equals_single`, over every
+//! filter, mipmap mode, address mode and texel format). The staged floor agrees with the scalar one
+//! because coordinates are clamped to `[-1, W]` first: inside that range it is the floor, and the
+//! floor of the clamped value lies in `[0, W)` exactly when the floor of `x` does; for samples
+//! inside the level the clamp is the identity, so the fractions are the one-sample path's.
 //!
-//! Short calls (at most 16 footprints) run with 16-sample scratch: zeroing and filling 64-sample
-//! scratch (about 6 KB per call) costs more than sampling a small triangle's few pixels (the
-//! 100k-triangle mesh of `texel-raster`'s benchmarks; figures in docs/perf-log.md).
-//!
-//! Why the index is exact: the per-sample path's `floor_index(x)` is `floor(x)` as an `i64`. Here
-//! `x` is first clamped to `[-1, W]`; inside that range truncation toward zero, minus one where it
-//! rounded up, is the floor, and the floor of the clamped value lies in `[0, W)` exactly when the
-//! floor of `x` does. For samples inside the level the clamp is the identity, so the fractions
-//! `x - floor(x)` are the per-sample path's.
+//! Short calls (at most 16 footprints: a small triangle's fragments) run with 16-sample scratch:
+//! zeroing and filling 64-sample scratch (about 6 KB per call) costs more than sampling a small
+//! triangle's few pixels (figures in docs/perf-log.md).
 
-use glam::Vec4;
+use glam::{Vec2, Vec4};
 
 use crate::address::Address;
-use crate::bilinear::bilinear;
+use crate::bilinear::{self, bilinear, blend, lerp};
 use crate::fetch::{Fetch, Pyramid};
-use crate::footprint::{lod_from_rho_squared, log2_normal, rho_squared, Footprint};
-use crate::mip::mip_nearest_level;
-use crate::nearest::nearest;
-use crate::sampler::finite_uv;
+use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
+use crate::footprint::{
+    finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, Query,
+};
+use crate::mip;
+use crate::nearest::{self, nearest};
+use crate::sampler::{FilterMode, MipmapFilterMode, Sampler};
 
 /// Samples per stage (the sampler's chunk).
 pub(crate) const CHUNK: usize = 64;
 
-/// Level views kept per call: a power of two above the 23 levels of a `MAX_SIDE` texture, so that
-/// `% LEVELS` is a mask.
+/// Level views kept per call: a power of two above the 23 levels of a [`MAX_SIDE`] texture, so
+/// that `% LEVELS` is a mask.
 const LEVELS: usize = 32;
 
-/// The filter inside a level.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Within {
-    /// One texel.
-    Nearest,
-    /// Bilinear, 2x2 texels.
-    Linear,
+/// Largest level-0 side the staged kernels accept: [`floor_clamped`]'s limit. Larger textures
+/// take the one-sample path sample by sample.
+pub(crate) const MAX_SIDE: u32 = STAGED_F32_LIMIT as u32;
+
+/// A chunk of up to `N` queries, as arrays (so the stages vectorise); the first `n` are valid.
+pub(crate) struct Chunk<const N: usize> {
+    /// Finite `u` ([`finite_uv`]).
+    pub u: [f32; N],
+    /// Finite `v`.
+    pub v: [f32; N],
+    /// The isotropic lod (0 for a lod-free sampler).
+    pub lod: [f32; N],
+    /// Valid entries.
+    pub n: usize,
 }
 
-/// How levels are chosen from the lod.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Levels {
-    /// Level 0 whatever the lod (no mipmapping, `mag_filter == min_filter`).
-    Base,
-    /// The Vulkan nearest level ([`mip_nearest_level`]); level 0 for `lod <= 0`.
-    Nearest,
-    /// Trilinear between `floor(d)` and `floor(d) + 1`, `d = clamp(lod, 0, last)`.
-    Linear,
+impl<const N: usize> Chunk<N> {
+    pub(crate) fn new() -> Self {
+        Chunk {
+            u: [0.0; N],
+            v: [0.0; N],
+            lod: [0.0; N],
+            n: 0,
+        }
+    }
+
+    /// Query `k` of the chunk, whose footprint (derivatives) is `fp`.
+    #[inline(always)]
+    pub(crate) fn query(&self, k: usize, fp: &Footprint) -> Query {
+        Query {
+            fp: Footprint {
+                u: self.u[k],
+                v: self.v[k],
+                ..*fp
+            },
+            lod: self.lod[k],
+        }
+    }
+
+    #[inline(always)]
+    fn uv(&self, k: usize) -> Vec2 {
+        Vec2::new(self.u[k], self.v[k])
+    }
 }
 
-/// A kernel: the filter inside a level and the level rule. Valid when `mag_filter == min_filter`
-/// (then the magnification branch, `lod <= 0`, is the level rule at level 0 with weight 0).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Kernel {
-    pub within: Within,
-    pub levels: Levels,
+/// Stage 0: the queries of `fps` (at most `N`) on a `size` level 0, as `Sampler::query` makes one:
+/// [`finite_uv`], and `rho^2` ([`rho_squared`]) into [`lod_from_rho_squared`] with
+/// [`crate::footprint::fast_log2`]'s normal-input path written branch-free, so the loop
+/// vectorises. The inputs that path does not cover (`rho^2` zero or subnormal) are rare; a second
+/// loop recomputes those lanes with the scalar functions.
+#[inline(always)]
+pub(crate) fn queries<const N: usize>(
+    s: &Sampler,
+    size: (u32, u32),
+    fps: &[Footprint],
+    out: &mut Chunk<N>,
+) {
+    out.n = fps.len().min(N);
+    for ((f, u), v) in fps.iter().zip(out.u.iter_mut()).zip(out.v.iter_mut()) {
+        *u = finite_uv(f.u);
+        *v = finite_uv(f.v);
+    }
+    if !s.uses_derivatives() {
+        out.lod[..out.n].fill(0.0);
+        return;
+    }
+    let d = s.descriptor();
+    let (bias, min, max) = (d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
+    let (w, h) = (size.0 as f32, size.1 as f32);
+    let mut special = false;
+    for (f, lod) in fps.iter().zip(out.lod.iter_mut()) {
+        // `rho_squared`: the squared lengths of the texel-space axes, +inf if either is not finite.
+        let (ax, ay) = (f.dudx * w, f.dvdx * h);
+        let (bx, by) = (f.dudy * w, f.dvdy * h);
+        let a = ax * ax + ay * ay;
+        let b = bx * bx + by * by;
+        let finite = a.is_finite() & b.is_finite();
+        let rho2 = a.max(b);
+        // `lod_from_rho_squared` with `fast_log2` for normal positive input; non-finite rho^2
+        // gives lod_max.
+        let l = (0.5 * log2_normal(rho2) + bias).clamp(min, max);
+        *lod = if finite { l } else { max };
+        special |= finite & (rho2 < f32::MIN_POSITIVE);
+    }
+    if special {
+        for (f, lod) in fps.iter().zip(out.lod.iter_mut()) {
+            let rho2 = rho_squared(f, size.0, size.1);
+            if rho2 < f32::MIN_POSITIVE {
+                *lod = lod_from_rho_squared(rho2, bias, min, max);
+            }
+        }
+    }
 }
 
-/// Level sizes as the coordinate stage reads them, indexed by the level masked to `LEVELS` (no
-/// bounds checks).
-struct Dims {
-    /// `W` and `H` as `f32` (scales) and as clamp bounds.
-    w: [f32; LEVELS],
-    h: [f32; LEVELS],
-}
-
-/// Per-sample scratch of one level pass, for up to `N` samples.
+/// One level pass over a chunk: the within-level filter (Nearest or Linear) and the address
+/// modes it applies, and per sample its level, first tap, fractions and whether it is inside.
 struct Pass<const N: usize> {
+    /// `FilterMode::Nearest` or `FilterMode::Linear` (anything else is treated as Linear).
+    filter: FilterMode,
+    addr: Address,
     level: [u8; N],
-    /// Top-left texel index (nearest: the texel).
+    /// First tap (nearest: the texel).
     i: [i32; N],
     j: [i32; N],
     /// Bilinear fractions.
@@ -93,8 +157,10 @@ struct Pass<const N: usize> {
 }
 
 impl<const N: usize> Pass<N> {
-    fn new() -> Self {
+    fn new(filter: FilterMode, addr: Address) -> Self {
         Pass {
+            filter,
+            addr,
             level: [0; N],
             i: [0; N],
             j: [0; N],
@@ -104,31 +170,22 @@ impl<const N: usize> Pass<N> {
         }
     }
 
-    /// Stage 2 for the first `n` samples at their `level`s, whose sizes `size(level)` gives.
+    /// Stage 2 for the chunk's samples at their `level`s, whose sizes `size(level)` gives:
+    /// the filter's origin and the staged floor, branch-free, with no calls.
     #[inline(always)]
-    fn coordinates(
-        &mut self,
-        within: Within,
-        size: impl Fn(u8) -> (f32, f32),
-        us: &[f32],
-        vs: &[f32],
-    ) {
-        let n = us.len();
-        let half = match within {
-            Within::Nearest => 0.0,
-            Within::Linear => 0.5,
-        };
+    fn coordinates<const M: usize>(&mut self, size: impl Fn(u8) -> (f32, f32), at: &Chunk<M>) {
+        let nearest = self.filter == FilterMode::Nearest;
         // Bilinear reads texel i0 + 1 too: i0 must be below W - 1.
-        let reach = match within {
-            Within::Nearest => 0.0,
-            Within::Linear => 1.0,
-        };
-        for k in 0..n {
+        let reach = if nearest { 0.0 } else { 1.0 };
+        for k in 0..at.n.min(N) {
             let (w, h) = size(self.level[k]);
-            let x = us[k] * w - half;
-            let y = vs[k] * h - half;
-            let (i, fi) = clamped_floor(x, w);
-            let (j, fj) = clamped_floor(y, h);
+            let (x, y) = if nearest {
+                (nearest::origin(at.u[k], w), nearest::origin(at.v[k], h))
+            } else {
+                (bilinear::origin(at.u[k], w), bilinear::origin(at.v[k], h))
+            };
+            let (i, fi) = floor_clamped(x, w);
+            let (j, fj) = floor_clamped(y, h);
             self.i[k] = i;
             self.j[k] = j;
             self.a[k] = x - fi;
@@ -136,110 +193,32 @@ impl<const N: usize> Pass<N> {
             self.inside[k] = fi >= 0.0 && fi < w - reach && fj >= 0.0 && fj < h - reach;
         }
     }
-}
 
-/// Largest level-0 side the kernels accept (2^22): [`clamped_floor`] is exact below it. Larger
-/// textures take the generic path.
-pub(crate) const MAX_SIDE: u32 = 1 << 22;
-
-/// `1.5 * 2^23`: added to an `f32` of magnitude below `2^22`, the sum lies in `[2^23, 2^24)`, where
-/// the spacing is 1, so it is rounded to an integer, which its low mantissa bits hold.
-const ROUND: f32 = 12_582_912.0;
-
-/// `floor(x)` for `x` clamped to `[-1, hi]`, as an integer and as an `f32`; `1 <= hi < 2^22`, `x`
-/// finite. Rounds by adding and subtracting [`ROUND`] and reads the integer from the sum's bits:
-/// no float-to-integer conversion, whose saturating semantics (NaN to 0, out of range to the
-/// limits) cost about 20 instructions per sample on SSE2 (callgrind).
-#[inline(always)]
-fn clamped_floor(x: f32, hi: f32) -> (i32, f32) {
-    let c = x.max(-1.0).min(hi);
-    let sum = c + ROUND;
-    let rounded = sum - ROUND;
-    // Integer value of the rounded sum: its bits minus those of ROUND.
-    let r = sum.to_bits() as i32 - ROUND.to_bits() as i32;
-    let down = rounded > c;
-    (
-        r - i32::from(down),
-        if down { rounded - 1.0 } else { rounded },
-    )
-}
-
-/// What the lod stage needs: level 0's size and the sampler's bias and clamps.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct LodParams {
-    pub width: u32,
-    pub height: u32,
-    pub bias: f32,
-    pub min: f32,
-    pub max: f32,
-}
-
-/// Stage 0: finite `(u, v)` ([`finite_uv`]) and, with `lod` (the sampler is not lod-free), the lod
-/// of every footprint, as `Sampler::prepare` computes them: `rho^2` ([`rho_squared`]) and
-/// [`lod_from_rho_squared`] with [`crate::footprint::fast_log2`]'s normal-input path written
-/// branch-free, so the loop vectorises. The inputs that path does not cover (`rho^2` zero or
-/// subnormal) are rare; a second loop recomputes those lanes with the scalar functions.
-#[inline(always)]
-pub(crate) fn prepare(
-    fps: &[Footprint],
-    lod: Option<LodParams>,
-    us: &mut [f32],
-    vs: &mut [f32],
-    lods: &mut [f32],
-) {
-    for ((f, u), v) in fps.iter().zip(us.iter_mut()).zip(vs.iter_mut()) {
-        *u = finite_uv(f.u);
-        *v = finite_uv(f.v);
-    }
-    let Some(q) = lod else {
-        lods[..fps.len()].fill(0.0);
-        return;
-    };
-    let (w, h) = (q.width as f32, q.height as f32);
-    let mut special = false;
-    for (f, lod) in fps.iter().zip(lods.iter_mut()) {
-        // `rho_squared`: the squared lengths of the texel-space axes, +inf if either is not finite.
-        let (ax, ay) = (f.dudx * w, f.dvdx * h);
-        let (bx, by) = (f.dudy * w, f.dvdy * h);
-        let a = ax * ax + ay * ay;
-        let b = bx * bx + by * by;
-        let finite = a.is_finite() & b.is_finite();
-        let rho2 = a.max(b);
-        // `fast_log2` for normal positive input.
-        let log2 = log2_normal(rho2);
-        // `lod_from_rho_squared`: non-finite rho^2 gives lod_max.
-        let l = (0.5 * log2 + q.bias).clamp(q.min, q.max);
-        *lod = if finite { l } else { q.max };
-        special |= finite & (rho2 < f32::MIN_POSITIVE);
-    }
-    if special {
-        for (f, lod) in fps.iter().zip(lods.iter_mut()) {
-            let rho2 = rho_squared(f, q.width, q.height);
-            if rho2 < f32::MIN_POSITIVE {
-                *lod = lod_from_rho_squared(rho2, q.bias, q.min, q.max);
-            }
+    /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value.
+    #[inline(always)]
+    fn filtered<F: Fetch>(&self, level: &F, k: usize, uv: Vec2) -> Vec4 {
+        let inside = self.inside[k];
+        match self.filter {
+            FilterMode::Nearest if inside => level.texel(self.i[k] as u32, self.j[k] as u32),
+            FilterMode::Nearest => nearest(level, &self.addr, uv),
+            _ if inside => blend(
+                level.quad(self.i[k] as u32, self.j[k] as u32),
+                self.a[k],
+                self.b[k],
+            ),
+            _ => bilinear(level, &self.addr, uv),
         }
     }
 }
 
-/// Filter `footprints` with `kernel` into `out` (same length): `lod` is `None` for a lod-free
-/// sampler (no mipmapping, `mag_filter == min_filter`), whose lods are all 0.
-///
-/// Short calls (at most 16 footprints: a small triangle's fragments) use 16-sample scratch: the
-/// per-call set-up of 64-sample scratch (about 6 KB of stores) costs more than sampling three or
-/// four pixels (see the module docs).
-pub(crate) fn run<P: Pyramid>(
-    p: &P,
-    addr: &Address,
-    kernel: Kernel,
-    lod: Option<LodParams>,
-    footprints: &[Footprint],
-    out: &mut [[f32; 4]],
-) {
+/// Filter `footprints` into `out` (same length) with `s`'s core kernel: `min_filter` Nearest or
+/// Linear (equal to `mag_filter`), any `mipmap_filter`, level 0 below [`MAX_SIDE`] per side
+/// (`Sampler::new` decides; see `Sampler::sample_batch`).
+pub(crate) fn run<P: Pyramid>(p: &P, s: &Sampler, footprints: &[Footprint], out: &mut [[f32; 4]]) {
     if footprints.len() <= 16 {
-        run_in::<P, 16, 1>(p, addr, kernel, lod, footprints, out);
+        run_in::<P, 16, 1>(p, s, footprints, out);
     } else {
-        run_in::<P, CHUNK, LEVELS>(p, addr, kernel, lod, footprints, out);
+        run_in::<P, CHUNK, LEVELS>(p, s, footprints, out);
     }
 }
 
@@ -249,24 +228,19 @@ pub(crate) fn run<P: Pyramid>(
 #[inline(always)]
 fn run_in<P: Pyramid, const N: usize, const V: usize>(
     p: &P,
-    addr: &Address,
-    kernel: Kernel,
-    lod: Option<LodParams>,
+    s: &Sampler,
     footprints: &[Footprint],
     out: &mut [[f32; 4]],
 ) {
-    // Level 0 is below 2^22 per side (`MAX_SIDE`), so there are at most 23 levels.
+    // Level 0 is at most 2^22 per side (`MAX_SIDE`), so there are at most 23 levels.
     let levels = p.level_count().min(LEVELS);
-    let mut dims = Dims {
-        w: [0.0; LEVELS],
-        h: [0.0; LEVELS],
-    };
+    let (mut dims_w, mut dims_h) = ([0.0f32; LEVELS], [0.0f32; LEVELS]);
     let base = p.level(0);
     let mut views = [base; V];
     for l in 0..levels {
         let view = p.level(l);
         let (w, h) = view.size();
-        (dims.w[l], dims.h[l]) = (w as f32, h as f32);
+        (dims_w[l], dims_h[l]) = (w as f32, h as f32);
         if V == LEVELS {
             views[l % V] = view;
         }
@@ -278,187 +252,114 @@ fn run_in<P: Pyramid, const N: usize, const V: usize>(
             p.level(l as usize)
         }
     };
-    let mut first = Pass::<N>::new();
-    let mut second = Pass::<N>::new();
+    let d = s.descriptor();
+    let mut first = Pass::<N>::new(d.min_filter, s.address());
+    let mut second = Pass::<N>::new(d.min_filter, s.address());
     let mut delta = [0.0f32; N];
-    let (mut us, mut vs, mut lods) = ([0.0f32; N], [0.0f32; N], [0.0f32; N]);
+    let mut chunk = Chunk::<N>::new();
     let last = levels - 1;
+    let size0 = base.size();
+    let trilinear = d.mipmap_filter == MipmapFilterMode::Linear;
     for (fps, out) in footprints.chunks(N).zip(out.chunks_mut(N)) {
         let n = fps.len();
-        prepare(fps, lod, &mut us, &mut vs, &mut lods);
-        let (us, vs, lods) = (&us[..n], &vs[..n], &lods[..n]);
+        queries(s, size0, fps, &mut chunk);
         // Stage 1: levels (u8: at most 32 levels for a 2^31 side; textures are far smaller).
-        match kernel.levels {
-            Levels::Base => first.level[..n].fill(0),
-            Levels::Nearest => {
-                for (l, &lod) in first.level[..n].iter_mut().zip(lods) {
-                    *l = mip_nearest_level(lod, last) as u8;
+        match d.mipmap_filter {
+            MipmapFilterMode::None => first.level[..n].fill(0),
+            MipmapFilterMode::Nearest => {
+                for (l, &lod) in first.level[..n].iter_mut().zip(&chunk.lod) {
+                    *l = mip::nearest_level(lod, last) as u8;
                 }
             }
-            Levels::Linear => {
-                let top = last as f32;
-                for k in 0..n {
-                    // As `mip::trilinear`: `d = clamp(lod, 0, last)`, level `floor(d)`, weight
-                    // `d - floor(d)`; NaN gives level 0 and a NaN weight, which reads level 0 only.
-                    let d = lods[k].clamp(0.0, top);
-                    let (l, fl) = clamped_floor(if d.is_nan() { 0.0 } else { d }, top);
+            MipmapFilterMode::Linear => {
+                for (k, &lod) in chunk.lod[..n].iter().enumerate() {
+                    let (l, t) = mip::linear_levels(lod, last);
                     first.level[k] = l as u8;
                     second.level[k] = (l as u8 + 1).min(last as u8);
-                    delta[k] = d - fl;
+                    delta[k] = t;
                 }
             }
         }
         // Stages 2 and 3.
         let size = |l: u8| {
             let l = l as usize & (LEVELS - 1);
-            (dims.w[l], dims.h[l])
+            (dims_w[l], dims_h[l])
         };
-        first.coordinates(kernel.within, size, us, vs);
-        let trilinear = kernel.levels == Levels::Linear;
+        first.coordinates(size, &chunk);
         if trilinear {
-            second.coordinates(kernel.within, size, us, vs);
+            second.coordinates(size, &chunk);
         }
         for k in 0..n {
-            let level = &view(first.level[k]);
-            let a = texels(level, addr, kernel.within, &first, k, us[k], vs[k]);
-            let c = if trilinear && delta[k] > 0.0 && (first.level[k] as usize) < last {
-                let level = &view(second.level[k]);
-                let b = texels(level, addr, kernel.within, &second, k, us[k], vs[k]);
-                a + (b - a) * delta[k]
+            let uv = chunk.uv(k);
+            let a = first.filtered(&view(first.level[k]), k, uv);
+            // As `mip::trilinear`: the coarser level only when it is weighed.
+            out[k] = if trilinear && delta[k] > 0.0 && (first.level[k] as usize) < last {
+                lerp(a, second.filtered(&view(second.level[k]), k, uv), delta[k])
             } else {
                 a
-            };
-            out[k] = c.to_array();
+            }
+            .to_array();
         }
     }
 }
 
-/// Stage 3 for sample `k` of a pass, in its level `level`: the filtered value.
-#[inline(always)]
-fn texels<F: Fetch, const N: usize>(
-    level: &F,
-    addr: &Address,
-    within: Within,
-    pass: &Pass<N>,
-    k: usize,
-    u: f32,
-    v: f32,
-) -> Vec4 {
-    let inside = pass.inside[k];
-    match within {
-        Within::Nearest if inside => level.texel(pass.i[k] as u32, pass.j[k] as u32),
-        Within::Nearest => nearest(level, addr, u, v),
-        Within::Linear if inside => {
-            let [t00, t10, t01, t11] = level.quad(pass.i[k] as u32, pass.j[k] as u32);
-            let (a, b) = (pass.a[k], pass.b[k]);
-            let top = t00 + (t10 - t00) * a;
-            let bottom = t01 + (t11 - t01) * a;
-            top + (bottom - top) * b
-        }
-        Within::Linear => bilinear(level, addr, u, v),
-    }
-}
-
-/// Scratch for [`probe_sum`]: the probes' coordinates and their two level passes, made once per
-/// [`crate::Sampler::sample_batch`] call and reused by every sample (zeroing scratch per sample
-/// costs measurable frame time: docs/perf-log.md). Entries beyond a sample's probe count are stale
-/// and never read.
+/// The anisotropic probes' stage ([`crate::aniso`]): their coordinates, written by the caller, and
+/// two bilinear level passes. Made once per [`crate::Sampler::sample_batch`] call and reused by
+/// every sample (zeroing scratch per sample costs measurable frame time: docs/perf-log.md).
+/// Entries beyond a sample's probe count are stale and never read.
 pub(crate) struct Probes {
-    /// Probe coordinates, written by the caller for the first `n` probes.
-    pub u: [f32; CHUNK],
-    /// As `u`.
-    pub v: [f32; CHUNK],
+    /// The probes' coordinates (`lod` unused), written by the caller for the first `at.n`.
+    pub at: Chunk<CHUNK>,
     fine: Pass<CHUNK>,
     next: Pass<CHUNK>,
 }
 
 impl Probes {
-    /// Zeroed scratch.
-    pub(crate) fn new() -> Self {
+    /// Scratch for probes under the address modes `addr`.
+    pub(crate) fn new(addr: Address) -> Self {
         Probes {
-            u: [0.0; CHUNK],
-            v: [0.0; CHUNK],
-            fine: Pass::new(),
-            next: Pass::new(),
+            at: Chunk::new(),
+            fine: Pass::new(FilterMode::Linear, addr),
+            next: Pass::new(FilterMode::Linear, addr),
         }
     }
-}
 
-/// The sum over the first `n` anisotropic probes at `(s.u[i], s.v[i])` (`n` at most [`CHUNK`]) of
-/// a trilinear sample between levels `k` and `k + 1` with weight `delta`, the coarser level read
-/// only when `coarse` (the probes of [`crate::aniso`], staged as above: bit for bit the probe
-/// loop's sum).
-#[inline]
-pub(crate) fn probe_sum<P: Pyramid>(
-    p: &P,
-    addr: &Address,
-    k: usize,
-    coarse: bool,
-    delta: f32,
-    n: usize,
-    s: &mut Probes,
-) -> Vec4 {
-    let n = n.min(CHUNK);
-    let (us, vs) = (&s.u[..n], &s.v[..n]);
-    let (fine, next) = (&mut s.fine, &mut s.next);
-    let mut sum = Vec4::ZERO;
-    // Every probe reads the same one or two levels: their views are made once.
-    let fine_level = p.level(k);
-    let next_level = p.level(if coarse { k + 1 } else { k });
-    let size_of = |level: &P::Level<'_>| {
-        let (w, h) = level.size();
-        (w as f32, h as f32)
-    };
-    let fine_size = size_of(&fine_level);
-    fine.coordinates(Within::Linear, |_| fine_size, us, vs);
-    if coarse {
-        let next_size = size_of(&next_level);
-        next.coordinates(Within::Linear, |_| next_size, us, vs);
+    /// The address modes the probes apply.
+    pub(crate) fn address(&self) -> &Address {
+        &self.fine.addr
     }
-    for i in 0..n {
-        let a = texels(&fine_level, addr, Within::Linear, fine, i, us[i], vs[i]);
-        sum += if coarse {
-            a + (texels(&next_level, addr, Within::Linear, next, i, us[i], vs[i]) - a) * delta
-        } else {
-            a
+
+    /// The sum over the probes at `self.at` of a trilinear sample in `levels` (the finer level
+    /// and the blend weight from [`mip::linear_levels`]; the coarser level read only when weighed,
+    /// as in [`mip::trilinear`]): stages 2 and 3 of [`run`] with every probe in the same levels,
+    /// so their views are made once. Bit for bit the sum of [`mip::trilinear`] per probe, in order.
+    #[inline]
+    pub(crate) fn trilinear_sum<P: Pyramid>(&mut self, p: &P, (k, delta): (usize, f32)) -> Vec4 {
+        let last = p.level_count() - 1;
+        let coarse = delta > 0.0 && k < last;
+        let n = self.at.n.min(CHUNK);
+        let fine_level = p.level(k);
+        let next_level = p.level(if coarse { k + 1 } else { k });
+        let size_of = |level: &P::Level<'_>| {
+            let (w, h) = level.size();
+            (w as f32, h as f32)
         };
-    }
-    sum
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The rounding floor equals `f32::floor` of the clamped value everywhere it is used: level
-    /// sides up to `MAX_SIDE`, fractions, negatives clamped to -1, values beyond `hi`.
-    #[test]
-    fn clamped_floor_is_the_floor() {
-        let his = [1.0f32, 2.0, 3.0, 37.0, 1024.0, 16_384.0, MAX_SIDE as f32];
-        let mut xs = vec![
-            -1e30f32,
-            -2.5,
-            -1.0,
-            -0.999_999_9,
-            -1e-30,
-            -0.0,
-            0.0,
-            1e-30,
-            0.5,
-        ];
-        for k in 0..20_000 {
-            xs.push(k as f32 * 0.173_205_08 - 3.0);
+        let fine_size = size_of(&fine_level);
+        self.fine.coordinates(|_| fine_size, &self.at);
+        if coarse {
+            let next_size = size_of(&next_level);
+            self.next.coordinates(|_| next_size, &self.at);
         }
-        for e in [1.0f32, 2.0, 16_384.0, MAX_SIDE as f32] {
-            xs.extend([e - 0.5, e - 1e-3 * e.max(1.0).sqrt(), e, e + 0.25, e * 2.0]);
+        let mut sum = Vec4::ZERO;
+        for i in 0..n {
+            let uv = self.at.uv(i);
+            let a = self.fine.filtered(&fine_level, i, uv);
+            sum += if coarse {
+                lerp(a, self.next.filtered(&next_level, i, uv), delta)
+            } else {
+                a
+            };
         }
-        for &hi in &his {
-            for &x in &xs {
-                let c = x.max(-1.0).min(hi);
-                let (i, f) = clamped_floor(x, hi);
-                assert_eq!(f, c.floor(), "x {x} hi {hi}");
-                assert_eq!(i as f32, c.floor(), "x {x} hi {hi}");
-            }
-        }
+        sum
     }
 }

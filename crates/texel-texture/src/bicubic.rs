@@ -14,11 +14,12 @@
 //! `(1, 0)` has non-negative weights and never overshoots; Mitchell `(1/3, 1/3)` is the compromise.
 //! All weights of one axis sum to 1 for every (B, C).
 
-use glam::Vec4;
+use glam::{Vec2, Vec4};
 
-use crate::address::{floor_index, Address};
-use crate::bilinear::texel_or_border;
+use crate::address::Address;
+use crate::bilinear::{origin, texel_or_border};
 use crate::fetch::Fetch;
+use crate::floor::floor_index;
 
 /// Largest `|B|` and `|C|` a sampler accepts. Mitchell and Netravali's family is drawn for B and C
 /// in `[0, 1]` and Keys' cubics need C up to 1; unbounded values overflow `f32` (found by fuzzing:
@@ -84,14 +85,15 @@ impl Cubic {
 
 /// Bicubic sample of `level` at normalised `(u, v)` (finite).
 #[inline]
-pub(crate) fn bicubic<F: Fetch>(level: &F, addr: &Address, cubic: &Cubic, u: f32, v: f32) -> Vec4 {
+pub(crate) fn bicubic<F: Fetch>(level: &F, addr: &Address, cubic: &Cubic, uv: Vec2) -> Vec4 {
     let (w, h) = level.size();
-    let x = u * w as f32 - 0.5;
-    let y = v * h as f32 - 0.5;
-    let (x0, y0) = (x.floor(), y.floor());
-    let wx = cubic.weights(x - x0);
-    let wy = cubic.weights(y - y0);
-    let (i0, j0) = (floor_index(x0), floor_index(y0));
+    // The taps start where bilinear's do, one texel further out on each side.
+    let x = origin(uv.x, w as f32);
+    let y = origin(uv.y, h as f32);
+    let (i0, j0) = (floor_index(x), floor_index(y));
+    // `i0 as f32` is `x.floor()` exactly (see `floor_index`).
+    let wx = cubic.weights(x - i0 as f32);
+    let wy = cubic.weights(y - j0 as f32);
     let is: [Option<u32>; 4] =
         std::array::from_fn(|k| addr.u.wrap(i0.saturating_add(k as i64 - 1), w));
     let mut acc = Vec4::ZERO;

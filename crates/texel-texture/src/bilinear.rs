@@ -2,19 +2,46 @@
 //!
 //! `base = floor(xy - 0.5)`, `(a, b) = fract(xy - 0.5)` (Vulkan spec "Texel Selection", LINEAR,
 //! eq. for `i0 = floor(u - 1/2)`); the result is
-//! `(1-a)(1-b) T[i0,j0] + a(1-b) T[i1,j0] + (1-a) b T[i0,j1] + a b T[i1,j1]`. Each of the four indices
-//! is wrapped separately, so an edge texel blends with the opposite edge under Repeat and with the
-//! border colour under ClampToBorder. Four texel reads.
+//! `(1-a)(1-b) T[i0,j0] + a(1-b) T[i1,j0] + (1-a) b T[i0,j1] + a b T[i1,j1]`, computed as two
+//! horizontal [`lerp`]s and a vertical one ([`blend`]). Each of the four indices is wrapped
+//! separately, so an edge texel blends with the opposite edge under Repeat and with the border
+//! colour under ClampToBorder. Four texel reads.
 //!
-//! Fast path: when all four texels lie inside the level (every address mode is the identity there)
-//! they are read as two 2-texel row slices ([`Fetch::quad`]), skipping the four wraps and the
-//! border test; only samples within half a texel of an edge take the general path. Results are
-//! bit-identical to the general path.
+//! The kernels here — where the taps start ([`origin`]), the quad blend ([`blend`]) and the whole
+//! filter ([`bilinear`]) — are the ones every path runs: the one-sample path calls [`bilinear`],
+//! and the batched path (`batch.rs`) stages the same [`origin`], floor and [`blend`] over a chunk
+//! of samples, so the results are bit for bit equal.
+//!
+//! When all four texels lie inside the level (every address mode is the identity there) they are
+//! read as two 2-texel row slices ([`Fetch::quad`]), skipping the four wraps and the border test;
+//! only samples within half a texel of an edge wrap their indices. Results are the same either way.
 
-use glam::Vec4;
+use glam::{Vec2, Vec4};
 
-use crate::address::{floor_index, Address};
+use crate::address::Address;
 use crate::fetch::Fetch;
+use crate::floor::floor_index;
+
+/// `a + (b - a) * t`: the one interpolation every filter blends with (bilinear's three, the
+/// lerp between mip levels, the ripmap's and EWA's level blends).
+#[inline(always)]
+pub(crate) fn lerp(a: Vec4, b: Vec4, t: f32) -> Vec4 {
+    a + (b - a) * t
+}
+
+/// The bilinear blend of the quad `[T00, T10, T01, T11]` (as [`Fetch::quad`] orders it) with
+/// fractions `a` (along x) and `b` (along y).
+#[inline(always)]
+pub(crate) fn blend([t00, t10, t01, t11]: [Vec4; 4], a: f32, b: f32) -> Vec4 {
+    lerp(lerp(t00, t10, a), lerp(t01, t11, a), b)
+}
+
+/// The continuous texel coordinate of the top-left tap along one axis: `u * n - 1/2` for a level
+/// `n` texels long (texel centres sit at half-integers).
+#[inline(always)]
+pub(crate) fn origin(u: f32, n: f32) -> f32 {
+    u * n - 0.5
+}
 
 /// Read texel `(i, j)` if both indices survived wrapping, else the border colour.
 #[inline(always)]
@@ -30,30 +57,27 @@ pub(crate) fn texel_or_border<F: Fetch>(
     }
 }
 
-/// Bilinear sample of `level` at normalised `(u, v)` (finite).
+/// Bilinear sample of `level` at normalised `uv` (finite).
 #[inline(always)]
-pub(crate) fn bilinear<F: Fetch>(level: &F, addr: &Address, u: f32, v: f32) -> Vec4 {
+pub(crate) fn bilinear<F: Fetch>(level: &F, addr: &Address, uv: Vec2) -> Vec4 {
     let (w, h) = level.size();
-    let x = u * w as f32 - 0.5;
-    let y = v * h as f32 - 0.5;
+    let x = origin(uv.x, w as f32);
+    let y = origin(uv.y, h as f32);
     let (i0, j0) = (floor_index(x), floor_index(y));
-    // `i0 as f32` is `x.floor()` exactly (see `floor_index`), so the weights are unchanged.
+    // `i0 as f32` is `x.floor()` exactly (see `floor_index`).
     let (a, b) = (x - i0 as f32, y - j0 as f32);
-    let [t00, t10, t01, t11] =
-        if (0..i64::from(w) - 1).contains(&i0) && (0..i64::from(h) - 1).contains(&j0) {
-            // Fast path: all four texels inside the level, where every address mode is the identity.
-            level.quad(i0 as u32, j0 as u32)
-        } else {
-            let i = [addr.u.wrap(i0, w), addr.u.wrap(i0.saturating_add(1), w)];
-            let j = [addr.v.wrap(j0, h), addr.v.wrap(j0.saturating_add(1), h)];
-            [
-                texel_or_border(level, addr, i[0], j[0]),
-                texel_or_border(level, addr, i[1], j[0]),
-                texel_or_border(level, addr, i[0], j[1]),
-                texel_or_border(level, addr, i[1], j[1]),
-            ]
-        };
-    let top = t00 + (t10 - t00) * a;
-    let bottom = t01 + (t11 - t01) * a;
-    top + (bottom - top) * b
+    let quad = if (0..i64::from(w) - 1).contains(&i0) && (0..i64::from(h) - 1).contains(&j0) {
+        // All four texels inside the level, where every address mode is the identity.
+        level.quad(i0 as u32, j0 as u32)
+    } else {
+        let i = [addr.u.wrap(i0, w), addr.u.wrap(i0.saturating_add(1), w)];
+        let j = [addr.v.wrap(j0, h), addr.v.wrap(j0.saturating_add(1), h)];
+        [
+            texel_or_border(level, addr, i[0], j[0]),
+            texel_or_border(level, addr, i[1], j[0]),
+            texel_or_border(level, addr, i[0], j[1]),
+            texel_or_border(level, addr, i[1], j[1]),
+        ]
+    };
+    blend(quad, a, b)
 }

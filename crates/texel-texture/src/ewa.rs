@@ -88,11 +88,12 @@ use std::sync::OnceLock;
 use glam::{DVec2, Vec2, Vec4};
 
 use crate::address::{Address, AddressMode};
-use crate::bilinear::{bilinear, texel_or_border};
+use crate::bilinear::{bilinear, lerp, texel_or_border};
 use crate::fetch::{Fetch, Pyramid};
-use crate::footprint::{lod_from_rho, Footprint};
-use crate::mip::trilinear;
-use crate::sampler::{FilterMode, SamplerDescriptor};
+use crate::floor::{ceil_f64, floor_f64};
+use crate::footprint::{lod_from_rho, Query};
+use crate::mip::{linear_levels, trilinear};
+use crate::sampler::{FilterMode, Sampler};
 
 /// Entries of the Gaussian weight table, indexed by `floor(r^2 * LUT_SIZE)` for `r^2` in `[0, 1)`.
 pub const LUT_SIZE: usize = 128;
@@ -226,184 +227,103 @@ pub struct LevelEllipse {
     pub det: f64,
 }
 
-/// A run of consecutive texels handed over by [`LevelEllipse::for_each_run`]: texel `k` of the run
-/// is `(i0 + k, j0)` along a row, or `(i0, j0 + k)` along a column (`vertical`). Unwrapped indices.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Run {
-    /// Column of the first texel.
-    pub i0: i64,
-    /// Row of the first texel.
-    pub j0: i64,
-    /// Whether the run goes down a column (else along a row).
-    pub vertical: bool,
-}
-
-impl Run {
-    /// Unwrapped indices `(i, j)` of texel `k` of the run.
-    pub fn texel(&self, k: usize) -> (i64, i64) {
-        step(self.i0, self.j0, self.vertical, k)
-    }
-}
-
-/// Texel `k` from `(i0, j0)` along a row, or down a column when `vertical` (unwrapped, saturating).
-fn step(i0: i64, j0: i64, vertical: bool, k: usize) -> (i64, i64) {
-    if vertical {
-        (i0, j0.saturating_add(k as i64))
-    } else {
-        (i0.saturating_add(k as i64), j0)
-    }
-}
-
 impl LevelEllipse {
     /// Area in texels of the level: `pi sqrt(det Q)`.
     pub fn area(&self) -> f64 {
         std::f64::consts::PI * self.det.max(0.0).sqrt()
     }
 
-    /// Call `f(i, j, weight)` for every texel (unwrapped integer indices) whose centre lies inside
-    /// the ellipse centred at continuous texel position `(x, y)`, with its unnormalised LUT weight.
-    /// Visits at most [`MAX_VISITS`] texels and rows together; returns how many it visited.
-    pub fn for_each_weight(&self, x: f32, y: f32, mut f: impl FnMut(i64, i64, f32)) -> u32 {
-        self.for_each_run(x, y, |run, weights| {
-            for (k, &w) in weights.iter().enumerate() {
-                if w > 0.0 {
-                    let (i, j) = run.texel(k);
-                    f(i, j, w);
-                }
-            }
-        })
+    /// `r^2 = d^T Q^{-1} d = (q11 dx^2 - 2 q01 dx dy + q00 dy^2) / det Q` for the offset
+    /// `d = (dx, dy)` from the centre (texels of the level): below 1 inside the ellipse.
+    pub fn r2(&self, dx: f64, dy: f64) -> f64 {
+        (self.q11 * dx * dx - 2.0 * self.q01 * dx * dy + self.q00 * dy * dy) / self.det
     }
 
-    /// As [`LevelEllipse::for_each_weight`], a [`Run`] of consecutive texels at a time, along a row
-    /// or (for an ellipse taller than wide) along a column, with weight 0 for the rare centre that
-    /// rounding puts just outside the ellipse. Runs are at most [`RUN`] texels long: each
-    /// [`Line`] of [`LevelEllipse::for_each_line`] cut into pieces, its weights in a buffer.
-    pub fn for_each_run(&self, x: f32, y: f32, mut f: impl FnMut(Run, &[f32])) -> u32 {
-        let mut buf = [0.0f32; RUN];
-        self.for_each_line(x, y, |line| {
-            let mut weights = line.weights();
-            let mut done = 0u32;
-            while done < line.texels() {
-                let len = (line.texels() - done).min(RUN as u32) as usize;
-                for (w, x) in buf[..len].iter_mut().zip(&mut weights) {
-                    *w = x;
-                }
-                let (i0, j0) = line.texel(done as usize);
-                let run = Run {
-                    i0,
-                    j0,
-                    vertical: line.vertical,
-                };
-                f(run, &buf[..len]);
-                done += len as u32;
-            }
-        })
-    }
-
-    /// Call `f` for every line of texel centres inside the ellipse centred at continuous texel
-    /// position `(x, y)`: rows when it is at least as wide as tall (`q00 >= q11`), else columns.
-    /// Visits at most [`MAX_VISITS`] texels and lines together; returns how many it visited.
+    /// The scan: call `f` for every line of texel centres inside the ellipse centred at continuous
+    /// texel position `(x, y)` — rows when it is at least as wide as tall (`q00 >= q11`), else
+    /// columns — each line exactly the span where `r^2 < 1` (the roots of a quadratic in the offset
+    /// along the line). Visits at most [`MAX_VISITS`] texels and lines together; returns how many
+    /// it visited.
     ///
     /// The scan follows the ellipse's wider side: each line costs a square root, a floor and a ceil
     /// and the set-up of its differences, and a tall, thin ellipse (the ground plane's footprints
     /// near the horizon stretch along v) has many rows of one to four texels but few long
     /// columns. Timings: docs/perf-log.md.
-    pub fn for_each_line(&self, x: f32, y: f32, mut f: impl FnMut(Line)) -> u32 {
-        if self.q00 >= self.q11 {
-            self.lines(x, y, self.q00, self.q11, |a0, b, weights| {
-                f(Line {
-                    i0: a0,
-                    j0: b,
-                    vertical: false,
-                    weights,
-                })
-            })
-        } else {
-            // Transposed: x and y swap roles, and so do q00 and q11.
-            self.lines(y, x, self.q11, self.q00, |a0, b, weights| {
-                f(Line {
-                    i0: b,
-                    j0: a0,
-                    vertical: true,
-                    weights,
-                })
-            })
-        }
-    }
-
-    /// The row scan of [`LevelEllipse::for_each_line`] in axes `(a, b)`: lines of constant `b`,
-    /// texels along `a`; `q00` and `q11` are `Q`'s diagonal entries for `a` and `b`.
-    /// `f(a0, b, weights)` per line with at least one texel.
-    #[inline(always)]
-    fn lines(
-        &self,
-        x: f32,
-        y: f32,
-        q00: f64,
-        q11: f64,
-        mut f: impl FnMut(i64, i64, Weights),
-    ) -> u32 {
+    pub fn scan(&self, x: f32, y: f32, mut f: impl FnMut(&Line)) -> u32 {
         let lut = weight_lut();
-        let (q01, det) = (self.q01, self.det);
-        if !(det > 0.0 && q11 > 0.0 && q00 > 0.0 && det.is_finite()) {
+        let (wide, det) = (self.q00 >= self.q11, self.det);
+        // Axes (a, b): lines of constant b, texels along a; qaa and qbb are Q's diagonal entries
+        // for them (a = x for rows; transposed for columns, where x and y swap roles).
+        let (qaa, qbb, xa, xb) = if wide {
+            (self.q00, self.q11, x, y)
+        } else {
+            (self.q11, self.q00, y, x)
+        };
+        let q01 = self.q01;
+        if !(det > 0.0 && qbb > 0.0 && qaa > 0.0 && det.is_finite()) {
             return 0;
         }
-        // r^2 = (q11 dx^2 - 2 q01 dx dy + q00 dy^2) / det.
-        let (ca, cb, cc) = (q11 / det, -2.0 * q01 / det, q00 / det);
-        let (xf, yf) = (floor_f64(f64::from(x)), floor_f64(f64::from(y)));
-        let (fx, fy) = (f64::from(x) - xf, f64::from(y) - yf);
-        let (xi, yi) = (xf as i64, yf as i64);
-        // Rows: centre offset dy = m + 0.5 - fy with |dy| <= sqrt(q11).
-        let hy = q11.sqrt();
-        let m0 = ceil_f64(fy - 0.5 - hy);
-        let m1 = floor_f64(fy - 0.5 + hy);
+        // r^2 = ca da^2 + cb da db + cc db^2 ([`LevelEllipse::r2`] in the line's axes).
+        let (ca, cb, cc) = (qbb / det, -2.0 * q01 / det, qaa / det);
+        let (af, bf) = (floor_f64(f64::from(xa)), floor_f64(f64::from(xb)));
+        let (fa, fb) = (f64::from(xa) - af, f64::from(xb) - bf);
+        let (ai, bi) = (af as i64, bf as i64);
+        // Lines: centre offset db = m + 0.5 - fb with |db| <= sqrt(qbb).
+        let hb = qbb.sqrt();
+        let m0 = ceil_f64(fb - 0.5 - hb);
+        let m1 = floor_f64(fb - 0.5 + hb);
         if !(m0.is_finite() && m1.is_finite()) {
             return 0;
         }
-        // Integer loop counters (an f64 `m += 1` would stall at 2^53); rows count as visits too.
-        let rows = (m1 - m0 + 1.0).clamp(0.0, f64::from(MAX_VISITS)) as u32;
+        // Integer loop counters (an f64 `m += 1` would stall at 2^53); lines count as visits too.
+        let lines = (m1 - m0 + 1.0).clamp(0.0, f64::from(MAX_VISITS)) as u32;
         let mut visits = 0u32;
-        let inv_q11 = 1.0 / q11;
-        for r in 0..rows {
+        let inv_qbb = 1.0 / qbb;
+        for r in 0..lines {
             if visits >= MAX_VISITS {
                 break;
             }
             visits += 1;
             let m = m0 + f64::from(r);
-            let dy = m + 0.5 - fy;
-            let disc = det * (q11 - dy * dy);
+            let db = m + 0.5 - fb;
+            // The span along a: r^2 < 1 between the quadratic's roots.
+            let disc = det * (qbb - db * db);
             // Also skips NaN (a non-finite centre).
             if disc.is_nan() || disc < 0.0 {
                 continue;
             }
             let sd = disc.sqrt();
-            let lo = (q01 * dy - sd) * inv_q11;
-            let hi = (q01 * dy + sd) * inv_q11;
-            let n0 = ceil_f64(fx - 0.5 + lo);
-            let n1 = floor_f64(fx - 0.5 + hi);
-            let cols = (n1 - n0 + 1.0).clamp(0.0, f64::from(MAX_VISITS - visits)) as u32;
-            if cols == 0 {
+            let lo = (q01 * db - sd) * inv_qbb;
+            let hi = (q01 * db + sd) * inv_qbb;
+            let n0 = ceil_f64(fa - 0.5 + lo);
+            let n1 = floor_f64(fa - 0.5 + hi);
+            let len = (n1 - n0 + 1.0).clamp(0.0, f64::from(MAX_VISITS - visits)) as u32;
+            if len == 0 {
                 continue;
             }
-            visits += cols;
-            let j = yi.saturating_add(m as i64);
-            let i_first = xi.saturating_add(n0 as i64);
-            // r^2 at the first column and its forward differences (exact in f64, then f32).
-            let dx0 = n0 + 0.5 - fx;
-            let weights = Weights {
-                r2: ca * dx0 * dx0 + cb * dx0 * dy + cc * dy * dy,
-                step: ca * (2.0 * dx0 + 1.0) + cb * dy,
-                step2: 2.0 * ca,
-                left: cols,
-                lut,
-            };
-            f(i_first, j, weights);
+            visits += len;
+            let (a0, b) = (ai.saturating_add(n0 as i64), bi.saturating_add(m as i64));
+            // r^2 at the first texel, and its forward differences along the line (exact in f64).
+            let da = n0 + 0.5 - fa;
+            let (i0, j0) = if wide { (a0, b) } else { (b, a0) };
+            f(&Line {
+                i0,
+                j0,
+                vertical: !wide,
+                weights: Weights {
+                    r2: ca * da * da + cb * da * db + cc * db * db,
+                    step: ca * (2.0 * da + 1.0) + cb * db,
+                    step2: 2.0 * ca,
+                    left: len,
+                    lut,
+                },
+            });
         }
         visits
     }
 }
 
-/// One line of texel centres inside an ellipse ([`LevelEllipse::for_each_line`]): texel `k` is
+/// One line of texel centres inside an ellipse ([`LevelEllipse::scan`]): texel `k` is
 /// `(i0 + k, j0)` along a row, or `(i0, j0 + k)` along a column (`vertical`); unwrapped indices.
 #[derive(Clone, Debug)]
 pub struct Line {
@@ -417,9 +337,13 @@ pub struct Line {
 }
 
 impl Line {
-    /// Unwrapped indices `(i, j)` of texel `k` of the line.
+    /// Unwrapped indices `(i, j)` of texel `k` of the line (saturating).
     pub fn texel(&self, k: usize) -> (i64, i64) {
-        step(self.i0, self.j0, self.vertical, k)
+        if self.vertical {
+            (self.i0, self.j0.saturating_add(k as i64))
+        } else {
+            (self.i0.saturating_add(k as i64), self.j0)
+        }
     }
 
     /// Texels on the line (at least 1).
@@ -427,15 +351,16 @@ impl Line {
         self.weights.left
     }
 
-    /// The unnormalised LUT weights of the line's texels, in order (0 for the rare centre
-    /// that rounding puts just outside the ellipse).
+    /// The unnormalised weights `LUT[floor(r^2 * LUT_SIZE)]` of the line's texels, in order (0
+    /// for the rare centre that rounding puts just outside the ellipse).
     pub fn weights(&self) -> Weights {
         self.weights.clone()
     }
 }
 
-/// The weights of a [`Line`], one per texel: `r^2` is a quadratic in the offset along the line,
-/// updated by forward differences (two additions per texel) instead of being re-evaluated.
+/// The weights of a [`Line`], one per texel. Along the line `r^2` ([`LevelEllipse::r2`]) is a
+/// quadratic in the texel offset `k`: `r^2(k + 1) - r^2(k) = ca (2 da + 2 k + 1) + cb db`, so it is
+/// carried by forward differences (two additions per texel) instead of being re-evaluated.
 #[derive(Clone, Debug)]
 pub struct Weights {
     r2: f64,
@@ -472,145 +397,99 @@ impl Iterator for Weights {
 
 impl ExactSizeIterator for Weights {}
 
-/// `floor` without a libm call (the x86-64 baseline has no rounding instruction, so libm's
-/// `floor`/`ceil` are calls, a visible share of an EWA frame's profile: docs/perf-log.md). Exact
-/// for `|x| < 2^63`; NaN stays NaN; beyond that range the result saturates, which the callers'
-/// visit bounds absorb.
+/// The weighted sum's one loop: add `w * texel(k)` and `w` over the line's texels to `acc`.
+/// `texel` reads texel `k` of the line; [`ewa_level`] picks it once per line (direct reads for a
+/// line inside the level, address wrapping for one crossing an edge).
 #[inline(always)]
-fn floor_f64(x: f64) -> f64 {
-    if x.is_nan() {
-        return x;
-    }
-    let t = x as i64 as f64;
-    if t > x {
-        t - 1.0
-    } else {
-        t
+fn add_line(line: &Line, texel: impl Fn(usize) -> Vec4, acc: &mut (Vec4, f32)) {
+    for (k, w) in line.weights().enumerate() {
+        acc.0 += texel(k) * w;
+        acc.1 += w;
     }
 }
 
-/// `ceil` as [`floor_f64`]: `-floor(-x)`.
-#[inline(always)]
-fn ceil_f64(x: f64) -> f64 {
-    -floor_f64(-x)
-}
-
-/// Longest run of texels [`LevelEllipse::for_each_run`] hands over at once.
-pub const RUN: usize = 64;
-
-/// EWA in one level; `None` if no texel got a weight.
-///
-/// Lines that lie inside the level read their texels directly, in the loop that makes their
-/// weights; only lines crossing an edge wrap each index through the address modes.
+/// EWA in one level at normalised `uv`: `sum(w T) / sum(w)` over the ellipse `q`'s scan; `None`
+/// if no texel got a weight.
 #[inline]
-fn ewa_level<F: Fetch>(
-    level: &F,
-    addr: &Address,
-    q: &LevelEllipse,
-    u: f32,
-    v: f32,
-) -> Option<Vec4> {
+fn ewa_level<F: Fetch>(level: &F, addr: &Address, q: &LevelEllipse, uv: Vec2) -> Option<Vec4> {
     let (w, h) = level.size();
-    let (x, y) = (u * w as f32, v * h as f32);
-    let mut sum = Vec4::ZERO;
-    let mut wsum = 0.0f32;
-    q.for_each_line(x, y, |line| {
+    let (x, y) = (uv.x * w as f32, uv.y * h as f32);
+    let mut acc = (Vec4::ZERO, 0.0f32);
+    q.scan(x, y, |line| {
         let len = i64::from(line.texels());
-        // The line's fixed index wrapped once; the line inside the level along its own axis.
+        // The line's fixed index wrapped once, and whether it lies inside the level along its
+        // own axis (then every address mode is the identity on it).
         let (fixed, inside) = if line.vertical {
             let j0 = line.j0;
-            (
-                addr.u.wrap(line.i0, w),
-                j0 >= 0 && j0.saturating_add(len) <= i64::from(h),
-            )
+            let inside = j0 >= 0 && j0.saturating_add(len) <= i64::from(h);
+            (addr.u.wrap(line.i0, w), inside)
         } else {
             let i0 = line.i0;
-            (
-                addr.v.wrap(line.j0, h),
-                i0 >= 0 && i0.saturating_add(len) <= i64::from(w),
-            )
+            let inside = i0 >= 0 && i0.saturating_add(len) <= i64::from(w);
+            (addr.v.wrap(line.j0, h), inside)
         };
         match fixed {
-            Some(fixed) if inside && line.vertical => {
+            Some(i) if inside && line.vertical => {
                 let j0 = line.j0 as u32;
-                for (k, wt) in line.weights().enumerate() {
-                    sum += level.texel(fixed, j0 + k as u32) * wt;
-                    wsum += wt;
-                }
+                add_line(line, |k| level.texel(i, j0 + k as u32), &mut acc);
             }
-            Some(fixed) if inside => {
+            Some(j) if inside => {
                 let i0 = line.i0 as u32;
-                for (k, wt) in line.weights().enumerate() {
-                    sum += level.texel(i0 + k as u32, fixed) * wt;
-                    wsum += wt;
-                }
+                add_line(line, |k| level.texel(i0 + k as u32, j), &mut acc);
             }
-            _ => {
-                for (k, wt) in line.weights().enumerate() {
+            _ => add_line(
+                line,
+                |k| {
                     let (i, j) = line.texel(k);
-                    let t = texel_or_border(level, addr, addr.u.wrap(i, w), addr.v.wrap(j, h));
-                    sum += t * wt;
-                    wsum += wt;
-                }
-            }
+                    texel_or_border(level, addr, addr.u.wrap(i, w), addr.v.wrap(j, h))
+                },
+                &mut acc,
+            ),
         }
     });
+    let (sum, wsum) = acc;
     (wsum > 0.0).then(|| sum / wsum)
 }
 
-/// EWA at level `k`, moving to coarser levels while the ellipse exceeds [`MAX_ELLIPSE_AREA`].
-fn ewa_at<P: Pyramid>(p: &P, addr: &Address, e: &Ellipse, k: usize, u: f32, v: f32) -> Vec4 {
-    let last = p.level_count() - 1;
+/// EWA filtering of query `q` (lod `> 0`), eccentricity clamped to `max`: the ellipse of the
+/// footprint's axes, its level `floor(lod)` and the next blended by `fract(lod)` ([`linear_levels`])
+/// with `lod = log2(minor semi-axis) + bias`; non-finite axes fall back to trilinear at `q.lod`.
+pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Sampler, q: &Query, max: f32) -> Vec4 {
+    let addr = s.address();
+    let d = s.descriptor();
     let (w0, h0) = p.level(0).size();
+    let (px, py) = q.fp.texel_axes(w0, h0);
+    let Some(e) = Ellipse::from_axes(px, py, max) else {
+        return trilinear(p, &FilterMode::Linear, &addr, q);
+    };
+    let lod = lod_from_rho(e.minor as f32, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
+    let last = p.level_count() - 1;
+    let (k, t) = linear_levels(lod, last);
     let scale = |k: usize| {
         let (w, h) = p.level(k).size();
         DVec2::new(f64::from(w) / f64::from(w0), f64::from(h) / f64::from(h0))
     };
-    let mut k = k.min(last);
-    while k < last && e.in_level(scale(k), false).area() > MAX_ELLIPSE_AREA {
-        k += 1;
-    }
-    let level = p.level(k);
-    // A 1x1 level maps every texel index to its one texel (all modes but ClampToBorder): the
-    // normalised average is that texel, however large the ellipse.
-    if level.size() == (1, 1)
-        && addr.u != AddressMode::ClampToBorder
-        && addr.v != AddressMode::ClampToBorder
-    {
-        return level.texel(0, 0);
-    }
-    let q = e.in_level(scale(k), true);
-    ewa_level(&level, addr, &q, u, v).unwrap_or_else(|| bilinear(&level, addr, u, v))
-}
-
-/// EWA filtering of `fp` (with `(u, v)` already made finite), eccentricity clamped to `max`;
-/// `lod_iso` is the sampler's isotropic lod, used only by the non-finite fallback.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn ewa<P: Pyramid>(
-    p: &P,
-    addr: &Address,
-    d: &SamplerDescriptor,
-    fp: &Footprint,
-    u: f32,
-    v: f32,
-    lod_iso: f32,
-    max: f32,
-) -> Vec4 {
-    let (w0, h0) = p.level(0).size();
-    let (px, py) = fp.texel_axes(w0, h0);
-    let Some(e) = Ellipse::from_axes(px, py, max) else {
-        return trilinear(p, &FilterMode::Linear, addr, u, v, lod_iso);
+    // EWA at level `k`, moving to coarser levels while the ellipse exceeds MAX_ELLIPSE_AREA.
+    let at = |k: usize| {
+        let mut k = k.min(last);
+        while k < last && e.in_level(scale(k), false).area() > MAX_ELLIPSE_AREA {
+            k += 1;
+        }
+        let level = p.level(k);
+        // A 1x1 level maps every texel index to its one texel (all modes but ClampToBorder):
+        // the normalised average is that texel, however large the ellipse.
+        if level.size() == (1, 1)
+            && addr.u != AddressMode::ClampToBorder
+            && addr.v != AddressMode::ClampToBorder
+        {
+            return level.texel(0, 0);
+        }
+        let ql = e.in_level(scale(k), true);
+        ewa_level(&level, &addr, &ql, q.uv()).unwrap_or_else(|| bilinear(&level, &addr, q.uv()))
     };
-    let lod = lod_from_rho(e.minor as f32, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
-    let last = p.level_count() - 1;
-    let dl = lod.clamp(0.0, last as f32);
-    let k = dl.floor();
-    let t = dl - k;
-    let k = k as usize;
-    let a = ewa_at(p, addr, &e, k, u, v);
+    let a = at(k);
     if t > 0.0 && k < last {
-        let b = ewa_at(p, addr, &e, k + 1, u, v);
-        a + (b - a) * t
+        lerp(a, at(k + 1), t)
     } else {
         a
     }
@@ -619,6 +498,8 @@ pub(crate) fn ewa<P: Pyramid>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::footprint::Footprint;
+    use crate::sampler::SamplerDescriptor;
 
     /// An ellipse far larger than the texture ends at the 1x1 level, which is read once (it used
     /// to be revisited up to the 4096-texel area cap), and equals that level's texel.
@@ -662,27 +543,6 @@ mod tests {
     }
 
     #[test]
-    fn integer_floor_and_ceil_match_libm() {
-        for x in [
-            0.0,
-            -0.0,
-            0.5,
-            -0.5,
-            1.0,
-            -1.0,
-            2.999,
-            -2.999,
-            1e15 + 0.5,
-            -1e15 - 0.5,
-            4.0e18,
-        ] {
-            assert_eq!(floor_f64(x), x.floor(), "floor {x}");
-            assert_eq!(ceil_f64(x), x.ceil(), "ceil {x}");
-        }
-        assert!(floor_f64(f64::NAN).is_nan() && ceil_f64(f64::NAN).is_nan());
-    }
-
-    #[test]
     fn lut_matches_generator_and_decreases() {
         let lut = weight_lut();
         assert!((lut[0] - (1.0 - (-2.0f32).exp())).abs() < 1e-6);
@@ -714,36 +574,51 @@ mod tests {
         assert_eq!((z.major, z.minor), (0.0, 0.0));
     }
 
-    /// The row spans visit exactly the texels a brute-force bounding-box scan finds inside, and
-    /// the normalised weights sum to one.
+    /// Every `(i, j, weight)` the scan hands over, in scan order.
+    fn scanned(q: &LevelEllipse, x: f32, y: f32) -> Vec<(i64, i64, f32)> {
+        let mut got = Vec::new();
+        q.scan(x, y, |line| {
+            for (k, w) in line.weights().enumerate() {
+                let (i, j) = line.texel(k);
+                got.push((i, j, w));
+            }
+        });
+        got
+    }
+
+    /// The scan visits exactly the texels a brute-force bounding-box scan finds inside, and each
+    /// weight (carried along its line by forward differences) is the table entry of `r^2`
+    /// evaluated directly at that texel's centre.
     #[test]
-    fn spans_match_bounding_box_scan_and_weights_sum_to_one() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f32 / (1u64 << 53) as f32
-        };
+    fn scan_matches_bounding_box_and_direct_weights() {
+        let mut rng = crate::rng::SplitMix64::new(0x2545_f491_4f6c_dd1d);
+        let mut rnd = || rng.next_f64() as f32;
+        let lut = weight_lut();
+        let mut weighed = 0;
         for _ in 0..500 {
             let px = Vec2::new(rnd() * 20.0 - 10.0, rnd() * 20.0 - 10.0);
             let py = Vec2::new(rnd() * 6.0 - 3.0, rnd() * 6.0 - 3.0);
             let e = Ellipse::from_axes(px, py, 16.0).unwrap();
             let q = e.in_level(DVec2::splat(0.5), true);
             let (x, y) = (rnd() * 100.0 - 50.0, rnd() * 100.0 - 50.0);
-            let mut got = Vec::new();
-            q.for_each_weight(x, y, |i, j, w| got.push((i, j, w)));
+            let mut got = scanned(&q, x, y);
             assert!(!got.is_empty(), "the +I term keeps a texel centre inside");
-            let total: f64 = got.iter().map(|g| f64::from(g.2)).sum();
-            let normalised: f64 = got.iter().map(|g| f64::from(g.2) / total).sum();
-            assert!((normalised - 1.0).abs() < 1e-9);
+            let r2_at =
+                |i: i64, j: i64| q.r2(i as f64 + 0.5 - f64::from(x), j as f64 + 0.5 - f64::from(y));
+            for &(i, j, w) in &got {
+                let r2 = r2_at(i, j);
+                let bucket = r2 * LUT_SIZE as f64;
+                // Centres within rounding of a table boundary may fall either side.
+                if (bucket - bucket.round()).abs() > 1e-6 && r2 < 1.0 - 1e-6 {
+                    assert_eq!(w, lut[bucket as usize], "texel ({i}, {j}) r2 {r2}");
+                    weighed += 1;
+                }
+            }
             let r = (q.q00.max(q.q11)).sqrt().ceil() as i64 + 2;
             let mut brute = Vec::new();
             for j in (y.floor() as i64 - r)..=(y.floor() as i64 + r) {
                 for i in (x.floor() as i64 - r)..=(x.floor() as i64 + r) {
-                    let dx = (i as f64 + 0.5) - f64::from(x);
-                    let dy = (j as f64 + 0.5) - f64::from(y);
-                    let r2 = (q.q11 * dx * dx - 2.0 * q.q01 * dx * dy + q.q00 * dy * dy) / q.det;
+                    let r2 = r2_at(i, j);
                     // Skip centres within float rounding of the boundary.
                     if r2 < 1.0 - 1e-4 {
                         brute.push((i, j));
@@ -759,6 +634,7 @@ mod tests {
             brute.sort_unstable();
             assert_eq!(got, brute);
         }
+        assert!(weighed > 5_000, "{weighed}");
     }
 
     #[test]
@@ -767,17 +643,19 @@ mod tests {
         let q = e.in_level(DVec2::splat(1.0), true);
         assert!(q.area() <= MAX_ELLIPSE_AREA * 1.0001);
         let mut n = 0;
-        let visits = q.for_each_weight(3.3, -7.1, |_, _, _| n += 1);
+        let visits = q.scan(3.3, -7.1, |line| n += line.texels());
         assert!(visits <= MAX_VISITS && n > 0);
         // Not shrunk: the visit cap still bounds the loop.
         let q = e.in_level(DVec2::splat(1.0), false);
-        assert!(q.for_each_weight(0.0, 0.0, |_, _, _| {}) <= MAX_VISITS);
-        // Non-finite centre: no weights, no panic.
+        assert!(q.scan(0.0, 0.0, |_| {}) <= MAX_VISITS);
+        // Non-finite centre: no positive weight, no panic.
         let q = Ellipse::from_axes(Vec2::ONE, Vec2::ZERO, 16.0)
             .unwrap()
             .in_level(DVec2::ONE, true);
-        let mut called = false;
-        q.for_each_weight(f32::INFINITY, 0.0, |_, _, _| called = true);
-        assert!(!called);
+        let mut weighed = false;
+        q.scan(f32::INFINITY, 0.0, |line| {
+            weighed |= line.weights().any(|w| w > 0.0)
+        });
+        assert!(!weighed);
     }
 }

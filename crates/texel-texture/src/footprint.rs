@@ -128,6 +128,43 @@ impl Footprint {
     }
 }
 
+/// Largest |u| or |v| honoured (2^24): coordinates beyond are clamped to it.
+pub const UV_LIMIT: f32 = 16_777_216.0;
+
+/// A sample coordinate made usable: NaN and infinities sample at 0; beyond `+-2^24`
+/// ([`UV_LIMIT`]) an `f32` has no fractional bits left, so clamping there changes nothing a caller
+/// could rely on and keeps `u * W` finite for every level.
+#[inline(always)]
+pub(crate) fn finite_uv(x: f32) -> f32 {
+    if x.is_finite() {
+        x.clamp(-UV_LIMIT, UV_LIMIT)
+    } else {
+        0.0
+    }
+}
+
+/// One sample as every filter receives it, made once by the sampler (`Sampler::query`, or
+/// `batch::queries` for a chunk): the footprint with its `u, v` made finite ([`finite_uv`]) and the
+/// isotropic lod. Filters read `uv` from here only; the derivatives are as the caller gave them,
+/// and each filter's documented fallback handles non-finite ones (they also make `lod` the
+/// coarsest allowed level).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Query {
+    /// The footprint; `u` and `v` are finite and within [`UV_LIMIT`].
+    pub fp: Footprint,
+    /// `log2(rho) + lod_bias` clamped to the sampler's lod range ([`lod_from_rho_squared`]); 0 for a
+    /// sampler whose result does not depend on it (no mipmapping, `mag_filter == min_filter`).
+    pub lod: f32,
+}
+
+impl Query {
+    /// The sample point, normalised (finite).
+    #[inline(always)]
+    pub fn uv(&self) -> Vec2 {
+        Vec2::new(self.fp.u, self.fp.v)
+    }
+}
+
 /// `lod = log2(rho) + bias` clamped to `[lod_min, lod_max]`, with non-finite `rho` giving `lod_max`
 /// (the coarsest allowed level) and `rho = 0` giving `lod_min`. `log2` is [`fast_log2`], as for
 /// the isotropic lod ([`lod_from_rho_squared`]).

@@ -25,7 +25,7 @@
 //!   images are stored again because their separable reduction is quantised differently).
 //! - Reductions use the pyramid's exact box taps (odd sizes with fractional weights), in linear
 //!   `f32` from the previous unquantised image, x first, then each column chain along y.
-//! - Built on first use (a `OnceLock` in the [`Texture`]) or by [`Texture::prepare`]; the size is
+//! - Built on first use (a `OnceLock` in the [`Texture`]) or by [`Texture::build_structures`]; the size is
 //!   checked against the texture's [`crate::Limits`] first (pyramid + other structures + ripmap +
 //!   `f32` build scratch of `40 W H` bytes). Over the limit, sampling falls back to trilinear.
 //! - Reads: up to four bilinear lookups, at most 16 texels.
@@ -37,14 +37,14 @@
 use glam::Vec4;
 use rayon::prelude::*;
 
-use crate::address::Address;
-use crate::bilinear::bilinear;
+use crate::bilinear::{bilinear, lerp};
 use crate::color::{linear_to_srgb8, unorm8};
 use crate::error::TextureError;
 use crate::fetch::{with_pyramid, Fetch, Pyramid};
-use crate::footprint::{lod_from_rho, Footprint};
+use crate::footprint::{lod_from_rho, Query};
+use crate::mip::linear_levels;
 use crate::pyramid::{axis_taps, level_count};
-use crate::sampler::SamplerDescriptor;
+use crate::sampler::Sampler;
 use crate::texture::{Format, LevelInfo, Storage, Texture};
 
 /// All anisotropic reductions of a texture's level 0 (see the module docs).
@@ -92,7 +92,13 @@ impl Ripmap {
     /// structures, the ripmap and the build scratch together exceed the texture's
     /// [`crate::Limits::max_bytes`].
     pub fn build(texture: &Texture) -> Result<Ripmap, TextureError> {
-        check(texture).map_err(|bytes| over_limit(texture, bytes))?;
+        Self::build_within(texture).map_err(|bytes| over_limit(texture, bytes))
+    }
+
+    /// [`Ripmap::build`], or `Err(bytes)` with the bytes it would need in all (what
+    /// [`Texture::ripmap`] remembers).
+    pub(crate) fn build_within(texture: &Texture) -> Result<Ripmap, u64> {
+        check(texture)?;
         Ok(with_pyramid!(texture, |p| build_from(texture, &p.level(0))))
     }
 
@@ -141,7 +147,7 @@ fn check(texture: &Texture) -> Result<(), u64> {
     texture.structure_budget(Ripmap::bytes_for(w, h, texture.format()), scratch)
 }
 
-fn over_limit(texture: &Texture, bytes: u64) -> TextureError {
+pub(crate) fn over_limit(texture: &Texture, bytes: u64) -> TextureError {
     texture.over_budget("ripmap", bytes)
 }
 
@@ -261,63 +267,42 @@ fn encode_u8(c: Vec4, srgb: bool) -> [u8; 4] {
     [rgb(c.x), rgb(c.y), rgb(c.z), unorm8(c.w)]
 }
 
-impl Texture {
-    /// The texture's ripmap, built from level 0 on first call (thread-safe, once).
-    ///
-    /// # Errors
-    /// [`TextureError::StructureOverMemoryLimit`] if it does not fit the texture's limits (the
-    /// failure is remembered; later calls return the same error without retrying).
-    pub fn ripmap(&self) -> Result<&Ripmap, TextureError> {
-        let r = self.ripmap.get_or_init(|| match check(self) {
-            Ok(()) => Ok(with_pyramid!(self, |p| build_from(self, &p.level(0)))),
-            Err(bytes) => Err(bytes),
-        });
-        r.as_ref().map_err(|&bytes| over_limit(self, bytes))
-    }
-}
-
-/// Ripmap filtering of `fp` (with `(u, v)` already made finite).
-#[allow(clippy::too_many_arguments)]
+/// Ripmap filtering of query `q` (lod `> 0`) in `rip`, the ripmap of `p`'s texture: per axis,
+/// the image `a = floor(l)` and the next blended by `fract(l)`, `l = log2(extent) + bias`
+/// clamped ([`lod_from_rho`]), where the extents are the footprint's bounding box
+/// (`|Px.x| + |Py.x|` by `|Px.y| + |Py.y|` texels of level 0); bilinear in each of the four images.
 #[inline]
-pub(crate) fn ripmap<P: Pyramid>(
-    p: &P,
-    rip: &Ripmap,
-    addr: &Address,
-    d: &SamplerDescriptor,
-    fp: &Footprint,
-    u: f32,
-    v: f32,
-) -> Vec4 {
-    let (px, py) = fp.texel_axes(rip.width, rip.height);
+pub(crate) fn ripmap<P: Pyramid>(p: &P, rip: &Ripmap, s: &Sampler, q: &Query) -> Vec4 {
+    let (d, addr, uv) = (s.descriptor(), s.address(), q.uv());
+    let (px, py) = q.fp.texel_axes(rip.width, rip.height);
     let bx = px.x.abs() + py.x.abs();
     let by = px.y.abs() + py.y.abs();
-    let lod = |extent: f32, n: usize| {
+    // The image along one axis and the weight toward the next: the linear level rule.
+    let images = |extent: f32, n: usize| {
         let l = lod_from_rho(extent, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
-        let l = l.clamp(0.0, (n - 1) as f32);
-        let k = l.floor();
-        (k as usize, l - k)
+        linear_levels(l, n - 1)
     };
-    let (a, s) = lod(bx, rip.nx);
-    let (b, t) = lod(by, rip.ny);
+    let (a, wa) = images(bx, rip.nx);
+    let (b, wb) = images(by, rip.ny);
     let sample = |a: usize, b: usize| {
         if (a, b) == (0, 0) {
-            bilinear(&p.level(0), addr, u, v)
+            bilinear(&p.level(0), &addr, uv)
         } else {
             let view = p.image(&rip.infos[a * rip.ny + b], &rip.storage);
-            bilinear(&view, addr, u, v)
+            bilinear(&view, &addr, uv)
         }
     };
     let row = |b: usize| {
         let c = sample(a, b);
-        if s > 0.0 && a + 1 < rip.nx {
-            c + (sample(a + 1, b) - c) * s
+        if wa > 0.0 && a + 1 < rip.nx {
+            lerp(c, sample(a + 1, b), wa)
         } else {
             c
         }
     };
     let top = row(b);
-    if t > 0.0 && b + 1 < rip.ny {
-        top + (row(b + 1) - top) * t
+    if wb > 0.0 && b + 1 < rip.ny {
+        lerp(top, row(b + 1), wb)
     } else {
         top
     }

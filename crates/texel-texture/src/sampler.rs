@@ -26,7 +26,7 @@
 //! - `anisotropy_clamp` is EWA's eccentricity clamp; its WebGPU default of 1 ("not requested")
 //!   means 16 for EWA ([`EWA_DEFAULT_ANISOTROPY`]). Ripmap and summed-area table ignore it
 //!   (their box has no eccentricity limit);
-//! - the ripmap and the summed-area table are built on first use, or by [`Texture::prepare`]; if
+//! - the ripmap and the summed-area table are built on first use, or by [`Texture::build_structures`]; if
 //!   one would exceed the texture's [`crate::Limits`], sampling falls back to trilinear.
 //!
 //! ## Performance design
@@ -61,34 +61,17 @@ use glam::Vec4;
 
 use crate::address::{Address, AddressMode, BorderColor};
 use crate::aniso::{anisotropic, filter_planned, plan_chunk, Plan};
-use crate::batch::{self, Kernel, Levels, LodParams, Probes, Within};
+use crate::batch::{self, Chunk, Probes};
 use crate::bicubic::Cubic;
 use crate::error::TextureError;
 use crate::ewa::ewa;
 use crate::fetch::{with_pyramid, Counted, Fetch, Pyramid};
-use crate::footprint::{lod_from_rho_squared, rho_squared, Footprint};
-use crate::mip::{mip_nearest, trilinear, LevelFilter, Linear};
+pub use crate::footprint::UV_LIMIT;
+use crate::footprint::{finite_uv, lod_from_rho_squared, rho_squared, Footprint, Query};
+use crate::mip::{filter_level, mip_nearest, trilinear};
 use crate::ripmap::ripmap;
 use crate::sat::summed_area;
 use crate::texture::Texture;
-
-/// Footprints [`Sampler::sample_batch`] prepares (lods) at once before filtering them.
-const BATCH_CHUNK: usize = batch::CHUNK;
-
-/// Largest |u| or |v| honoured (2^24): coordinates beyond are clamped to it.
-pub const UV_LIMIT: f32 = 16_777_216.0;
-
-/// A sample coordinate made usable: NaN and infinities sample at 0; beyond `+-2^24`
-/// ([`UV_LIMIT`]) an `f32` has no fractional bits left, so clamping there changes nothing a caller
-/// could rely on and keeps `u * W` finite for every level.
-#[inline(always)]
-pub(crate) fn finite_uv(x: f32) -> f32 {
-    if x.is_finite() {
-        x.clamp(-UV_LIMIT, UV_LIMIT)
-    } else {
-        0.0
-    }
-}
 
 /// Filter used within one mip level (WebGPU `GPUFilterMode`, plus cubic).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -249,8 +232,8 @@ impl SamplerDescriptor {
 enum Technique {
     /// `mipmap_filter` with `min_filter` inside the levels (nearest, bilinear, bicubic, trilinear).
     Mip,
-    /// Hardware-style anisotropic with at most this many trilinear probes (2..=64).
-    Anisotropic(u32),
+    /// Hardware-style anisotropic with at most `anisotropy_clamp` trilinear probes (2..=64).
+    Anisotropic,
     /// EWA with this eccentricity clamp (1..=64).
     Ewa(f32),
     /// Ripmap.
@@ -267,9 +250,10 @@ pub struct Sampler {
     /// The result does not depend on the lod (no mipmapping and `mag_filter == min_filter`), so
     /// the per-sample lod computation is skipped.
     lod_free: bool,
-    /// The staged kernel of [`Sampler::sample_batch`] for the core filters (see [`crate::batch`]).
-    kernel: Option<Kernel>,
-    pub(crate) addr: Address,
+    /// [`Sampler::sample_batch`] runs the staged core kernels (`batch::run`): nearest or bilinear
+    /// inside the levels, any `mipmap_filter`, `mag_filter == min_filter`.
+    batched: bool,
+    addr: Address,
 }
 
 impl Sampler {
@@ -321,43 +305,28 @@ impl Sampler {
                 {
                     return Err(TextureError::AnisotropyNeedsLinear(clamp));
                 }
-                Technique::Anisotropic(u32::from(clamp))
+                Technique::Anisotropic
             }
             _ => Technique::Mip,
         };
-        let border = desc.border_color.rgba();
         let lod_free = technique == Technique::Mip
             && desc.mipmap_filter == MipmapFilterMode::None
             && desc.mag_filter == desc.min_filter;
-        let within = match desc.min_filter {
-            FilterMode::Nearest => Some(Within::Nearest),
-            FilterMode::Linear => Some(Within::Linear),
-            _ => None,
-        };
-        let kernel = match within {
-            Some(within) if technique == Technique::Mip && desc.mag_filter == desc.min_filter => {
-                Some(Kernel {
-                    within,
-                    levels: match desc.mipmap_filter {
-                        MipmapFilterMode::None => Levels::Base,
-                        MipmapFilterMode::Nearest => Levels::Nearest,
-                        MipmapFilterMode::Linear => Levels::Linear,
-                    },
-                })
-            }
-            _ => None,
-        };
+        let batched = technique == Technique::Mip
+            && desc.mag_filter == desc.min_filter
+            && matches!(desc.min_filter, FilterMode::Nearest | FilterMode::Linear);
         Ok(Sampler {
             desc,
             technique,
             lod_free,
-            kernel,
-            addr: Address {
-                u: desc.address_mode_u,
-                v: desc.address_mode_v,
-                border: Vec4::from_array(border),
-            },
+            batched,
+            addr: Address::of(&desc),
         })
+    }
+
+    /// The address modes and border colour samples are read with.
+    pub fn address(&self) -> Address {
+        self.addr
     }
 
     /// Whether samples depend on the footprint's derivatives. `false` when there is no
@@ -417,55 +386,41 @@ impl Sampler {
             "sample_batch: footprints and out differ in length"
         );
         with_pyramid!(texture, |p| {
-            let (w, h) = p.level(0).size();
-            let d = &self.desc;
-            let lod = (!self.lod_free).then_some(LodParams {
-                width: w,
-                height: h,
-                bias: d.lod_bias,
-                min: d.lod_min_clamp,
-                max: d.lod_max_clamp,
-            });
-            let small = w <= batch::MAX_SIDE && h <= batch::MAX_SIDE;
-            if let Some(kernel) = self.kernel.filter(|_| small) {
-                return batch::run(&p, &self.addr, kernel, lod, footprints, out);
+            let size = p.level(0).size();
+            if self.batched && size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE {
+                return batch::run(&p, self, footprints, out);
             }
-            // Two stages per chunk: all lods first (`batch::prepare`, `prepare`'s arithmetic
-            // vectorised), then all filters.
-            let mut us = [0.0f32; BATCH_CHUNK];
-            let mut vs = [0.0f32; BATCH_CHUNK];
-            let mut lods = [0.0f32; BATCH_CHUNK];
-            if let Technique::Anisotropic(max) = self.technique {
+            // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
+            // arithmetic vectorised), then all filters.
+            let mut chunk = Chunk::<{ batch::CHUNK }>::new();
+            let chunks = footprints
+                .chunks(batch::CHUNK)
+                .zip(out.chunks_mut(batch::CHUNK));
+            if self.technique == Technique::Anisotropic {
                 // A third stage between the two: every sample's probe plan (axes, probe count,
                 // probe lod), vectorised as the lods are; the probes' scratch is made once.
-                let mut plans = [Plan::default(); BATCH_CHUNK];
-                let mut scratch = Probes::new();
-                for (fps, outs) in footprints
-                    .chunks(BATCH_CHUNK)
-                    .zip(out.chunks_mut(BATCH_CHUNK))
-                {
-                    batch::prepare(fps, lod, &mut us, &mut vs, &mut lods);
-                    plan_chunk(fps, w, h, d, max, &mut plans);
-                    for (k, (o, f)) in outs.iter_mut().zip(fps).enumerate() {
-                        let (u, v, l) = (us[k], vs[k], lods[k]);
+                let mut plans = [Plan::default(); batch::CHUNK];
+                let mut probes = Probes::new(self.addr);
+                for (fps, outs) in chunks {
+                    batch::queries(self, size, fps, &mut chunk);
+                    plan_chunk(self, size, fps, &mut plans);
+                    for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
+                        let q = chunk.query(k, fp);
                         // As `filter`: magnification first.
-                        *o = if l > 0.0 {
-                            filter_planned(&p, &self.addr, &plans[k], u, v, l, &mut scratch)
+                        *o = if q.lod > 0.0 {
+                            filter_planned(&p, &q, &plans[k], &mut probes)
                         } else {
-                            self.filter(&p, f, u, v, l)
+                            self.filter(&p, &q)
                         }
                         .to_array();
                     }
                 }
                 return;
             }
-            for (fps, outs) in footprints
-                .chunks(BATCH_CHUNK)
-                .zip(out.chunks_mut(BATCH_CHUNK))
-            {
-                batch::prepare(fps, lod, &mut us, &mut vs, &mut lods);
-                for (k, (o, f)) in outs.iter_mut().zip(fps).enumerate() {
-                    *o = self.filter(&p, f, us[k], vs[k], lods[k]).to_array();
+            for (fps, outs) in chunks {
+                batch::queries(self, size, fps, &mut chunk);
+                for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
+                    *o = self.filter(&p, &chunk.query(k, fp)).to_array();
                 }
             }
         })
@@ -474,18 +429,19 @@ impl Sampler {
     /// The whole per-sample path, generic over the texel storage (and the counting wrapper).
     #[inline]
     pub(crate) fn sample_pyramid<P: Pyramid>(&self, p: &P, fp: &Footprint) -> Vec4 {
-        let (w, h) = p.level(0).size();
-        let (u, v, lod) = self.prepare(w, h, fp);
-        self.filter(p, fp, u, v, lod)
+        let q = self.query(p.level(0).size(), fp);
+        self.filter(p, &q)
     }
 
-    /// First stage of a sample: `(u, v)` made finite and the lod, for a `w x h` level 0.
+    /// First stage of a sample: its [`Query`] on a `size` level 0 — `(u, v)` made finite and the
+    /// isotropic lod.
     ///
     /// Split from [`Sampler::filter`] so that [`Sampler::sample_batch`] can run it over many
-    /// footprints in a short, independent loop: the lod is a long dependency chain (square, log2,
-    /// clamp) that pipelines across footprints there instead of stalling each sample.
+    /// footprints in a short, independent loop (`batch::queries`): the lod is a long dependency
+    /// chain (square, log2, clamp) that pipelines across footprints there instead of stalling
+    /// each sample.
     #[inline(always)]
-    fn prepare(&self, w: u32, h: u32, fp: &Footprint) -> (f32, f32, f32) {
+    fn query(&self, (w, h): (u32, u32), fp: &Footprint) -> Query {
         let d = &self.desc;
         let lod = if self.lod_free {
             // Both branches of `filter` read level 0 with the same filter: any lod gives the
@@ -499,36 +455,39 @@ impl Sampler {
                 d.lod_max_clamp,
             )
         };
-        (finite_uv(fp.u), finite_uv(fp.v), lod)
+        Query {
+            fp: Footprint {
+                u: finite_uv(fp.u),
+                v: finite_uv(fp.v),
+                ..*fp
+            },
+            lod,
+        }
     }
 
-    /// Second stage of a sample: the filter at finite `(u, v)` and `lod` (from [`Sampler::prepare`]).
+    /// Second stage of a sample: the filter for query `q` (from [`Sampler::query`]).
     #[inline(always)]
-    fn filter<P: Pyramid>(&self, p: &P, fp: &Footprint, u: f32, v: f32, lod: f32) -> Vec4 {
+    fn filter<P: Pyramid>(&self, p: &P, q: &Query) -> Vec4 {
         let d = &self.desc;
         let addr = &self.addr;
-        if lod <= 0.0 {
-            return (&d.mag_filter).apply(&p.level(0), addr, u, v);
+        if q.lod <= 0.0 {
+            return filter_level(&d.mag_filter, &p.level(0), addr, q.uv());
         }
         match self.technique {
-            // Specialising these calls at compile time (`Linear` instead of `&FilterMode`) cuts
-            // their instructions but makes mip-nearest and trilinear ground frames slower (code
-            // layout; docs/perf-log.md), so they keep the run-time dispatch; the anisotropic
-            // probes, where specialising pays, do use `Linear`.
             Technique::Mip => match d.mipmap_filter {
-                MipmapFilterMode::None => (&d.min_filter).apply(&p.level(0), addr, u, v),
-                MipmapFilterMode::Nearest => mip_nearest(p, &d.min_filter, addr, u, v, lod),
-                MipmapFilterMode::Linear => trilinear(p, &d.min_filter, addr, u, v, lod),
+                MipmapFilterMode::None => filter_level(&d.min_filter, &p.level(0), addr, q.uv()),
+                MipmapFilterMode::Nearest => mip_nearest(p, &d.min_filter, addr, q),
+                MipmapFilterMode::Linear => trilinear(p, &d.min_filter, addr, q),
             },
-            Technique::Anisotropic(max) => anisotropic(p, addr, d, fp, u, v, lod, max),
-            Technique::Ewa(max) => ewa(p, addr, d, fp, u, v, lod, max),
+            Technique::Anisotropic => anisotropic(p, self, q),
+            Technique::Ewa(max) => ewa(p, self, q, max),
             Technique::Ripmap => match p.texture().ripmap() {
-                Ok(r) => ripmap(p, r, addr, d, fp, u, v),
-                Err(_) => trilinear(p, Linear, addr, u, v, lod),
+                Ok(r) => ripmap(p, r, self, q),
+                Err(_) => trilinear(p, &FilterMode::Linear, addr, q),
             },
             Technique::SummedArea => match p.texture().summed_area_table() {
-                Ok(t) => summed_area(p, t, addr, d, fp, u, v),
-                Err(_) => trilinear(p, Linear, addr, u, v, lod),
+                Ok(t) => summed_area(p, t, self, q),
+                Err(_) => trilinear(p, &FilterMode::Linear, addr, q),
             },
         }
     }

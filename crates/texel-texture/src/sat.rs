@@ -46,11 +46,11 @@
 use glam::Vec4;
 use rayon::prelude::*;
 
-use crate::address::{Address, AddressMode, BorderColor};
+use crate::address::{Address, AddressMode};
 use crate::error::TextureError;
 use crate::fetch::{with_pyramid, Fetch, Pyramid};
-use crate::footprint::{lod_from_rho, Footprint};
-use crate::sampler::SamplerDescriptor;
+use crate::footprint::{lod_from_rho, Query};
+use crate::sampler::Sampler;
 use crate::texture::Texture;
 
 /// Boxes narrower than this (texels) are widened to it, centred: the mean of a vanishing box is
@@ -198,7 +198,13 @@ impl SummedAreaTable {
     /// [`TextureError::StructureOverMemoryLimit`] if the texture's pyramid, its other built
     /// structures and the table together exceed the texture's [`crate::Limits::max_bytes`].
     pub fn build(texture: &Texture) -> Result<SummedAreaTable, TextureError> {
-        check(texture).map_err(|bytes| over_limit(texture, bytes))?;
+        Self::build_within(texture).map_err(|bytes| over_limit(texture, bytes))
+    }
+
+    /// [`SummedAreaTable::build`], or `Err(bytes)` with the bytes it would need in all (what
+    /// [`Texture::summed_area_table`] remembers).
+    pub(crate) fn build_within(texture: &Texture) -> Result<SummedAreaTable, u64> {
+        check(texture)?;
         Ok(with_pyramid!(texture, |p| build_from(&p.level(0))))
     }
 
@@ -254,42 +260,27 @@ impl SummedAreaTable {
         acc
     }
 
-    /// Mean of the texture (linear RGBA) over the box `[x0, x1) x [y0, y1)` in continuous texel
-    /// coordinates of level 0 (`xy = uv * (W, H)`), outside the texture extended by `mode_u` /
-    /// `mode_v` exactly as the samplers' address modes extend it (`border` under ClampToBorder).
+    /// Mean of the texture (linear RGBA) over the box `[x0, x1) x [y0, y1)` (`x = [x0, x1]`,
+    /// `y = [y0, y1]`) in continuous texel coordinates of level 0 (`xy = uv * (W, H)`), outside the
+    /// texture extended by `addr` exactly as the samplers' address modes extend it (its border
+    /// colour under ClampToBorder).
     ///
     /// The corners may come in either order; a side narrower than [`MIN_BOX_WIDTH`] is widened to
     /// it about its centre. Non-finite coordinates give NaN (no panic). Example: on a 4x1 texture
     /// `[0, 1, 2, 3]` with Repeat, the box `[3.5, 5)` (half of texel 3, then texel 0) has mean
     /// `(0.5 * 3 + 0) / 1.5 = 1`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn box_mean(
-        &self,
-        x0: f64,
-        y0: f64,
-        x1: f64,
-        y1: f64,
-        mode_u: AddressMode,
-        mode_v: AddressMode,
-        border: BorderColor,
-    ) -> [f64; 4] {
-        let b = border.rgba().map(f64::from);
-        self.box_mean_counted(x0, y0, x1, y1, mode_u, mode_v, b, &mut 0)
+    pub fn box_mean(&self, x: [f64; 2], y: [f64; 2], addr: &Address) -> [f64; 4] {
+        self.box_mean_counted(x, y, addr).0
     }
 
-    /// [`SummedAreaTable::box_mean`] that adds the table entries it reads to `reads`.
-    #[allow(clippy::too_many_arguments)]
+    /// [`SummedAreaTable::box_mean`] and the number of table entries it read.
     pub(crate) fn box_mean_counted(
         &self,
-        x0: f64,
-        y0: f64,
-        x1: f64,
-        y1: f64,
-        mode_u: AddressMode,
-        mode_v: AddressMode,
-        border: [f64; 4],
-        reads: &mut u32,
-    ) -> [f64; 4] {
+        [x0, x1]: [f64; 2],
+        [y0, y1]: [f64; 2],
+        addr: &Address,
+    ) -> ([f64; 4], u32) {
+        let mut reads = 0;
         let widen = |a: f64, b: f64| {
             let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
             if hi - lo >= MIN_BOX_WIDTH {
@@ -302,14 +293,14 @@ impl SummedAreaTable {
         let (x0, x1) = widen(x0, x1);
         let (y0, y1) = widen(y0, y1);
         if !(x0.is_finite() && x1.is_finite() && y0.is_finite() && y1.is_finite()) {
-            return [f64::NAN; 4];
+            return ([f64::NAN; 4], reads);
         }
-        let tx = axis_terms(mode_u, self.width, x0, x1);
-        let ty = axis_terms(mode_v, self.height, y0, y1);
+        let tx = axis_terms(addr.u, self.width, x0, x1);
+        let ty = axis_terms(addr.v, self.height, y0, y1);
         let mut sum = [0.0f64; 4];
         for &(cy, py) in ty.as_slice() {
             for &(cx, px) in tx.as_slice() {
-                let v = self.integral(px, py, reads);
+                let v = self.integral(px, py, &mut reads);
                 for c in 0..4 {
                     sum[c] += cx * cy * v[c];
                 }
@@ -318,11 +309,12 @@ impl SummedAreaTable {
         let area = (x1 - x0) * (y1 - y0);
         let outside = area - tx.inside * ty.inside;
         if outside > 0.0 {
+            let border = addr.border.to_array().map(f64::from);
             for c in 0..4 {
                 sum[c] += border[c] * outside;
             }
         }
-        sum.map(|s| s / area)
+        (sum.map(|s| s / area), reads)
     }
 }
 
@@ -334,7 +326,7 @@ fn check(texture: &Texture) -> Result<(), u64> {
     )
 }
 
-fn over_limit(texture: &Texture, bytes: u64) -> TextureError {
+pub(crate) fn over_limit(texture: &Texture, bytes: u64) -> TextureError {
     texture.over_budget("summed-area table", bytes)
 }
 
@@ -373,52 +365,25 @@ fn build_from<F: Fetch + Sync>(level0: &F) -> SummedAreaTable {
     }
 }
 
-impl Texture {
-    /// The texture's summed-area table, built from level 0 on first call (thread-safe, once).
-    ///
-    /// # Errors
-    /// [`TextureError::StructureOverMemoryLimit`] if it does not fit the texture's limits (the
-    /// failure is remembered; later calls return the same error without retrying).
-    pub fn summed_area_table(&self) -> Result<&SummedAreaTable, TextureError> {
-        let r = self.sat.get_or_init(|| match check(self) {
-            Ok(()) => Ok(with_pyramid!(self, |p| build_from(&p.level(0)))),
-            Err(bytes) => Err(bytes),
-        });
-        r.as_ref().map_err(|&bytes| over_limit(self, bytes))
-    }
-}
-
-/// Summed-area filtering of `fp` (with `(u, v)` already made finite).
+/// Summed-area filtering of query `q` (lod `> 0`) with `t`, the table of `p`'s texture: the box
+/// mean over the footprint's bounding box (`|Px.x| + |Py.x|` by `|Px.y| + |Py.y|` texels of level
+/// 0), each side `2^clamp(log2(extent) + bias)` texels, centred on `uv`.
 #[inline]
-pub(crate) fn summed_area<P: Pyramid>(
-    p: &P,
-    t: &SummedAreaTable,
-    addr: &Address,
-    d: &SamplerDescriptor,
-    fp: &Footprint,
-    u: f32,
-    v: f32,
-) -> Vec4 {
-    let (px, py) = fp.texel_axes(t.width, t.height);
+pub(crate) fn summed_area<P: Pyramid>(p: &P, t: &SummedAreaTable, s: &Sampler, q: &Query) -> Vec4 {
+    let (d, addr) = (s.descriptor(), s.address());
+    let (px, py) = q.fp.texel_axes(t.width, t.height);
     let side = |extent: f32| {
         let l = lod_from_rho(extent, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
         f64::from(l.clamp(0.0, MAX_LOD)).exp2()
     };
     let sx = side(px.x.abs() + py.x.abs());
     let sy = side(px.y.abs() + py.y.abs());
-    let x = f64::from(u) * f64::from(t.width);
-    let y = f64::from(v) * f64::from(t.height);
-    let border = addr.border.to_array().map(f64::from);
-    let mut reads = 0;
-    let m = t.box_mean_counted(
-        x - 0.5 * sx,
-        y - 0.5 * sy,
-        x + 0.5 * sx,
-        y + 0.5 * sy,
-        addr.u,
-        addr.v,
-        border,
-        &mut reads,
+    let x = f64::from(q.fp.u) * f64::from(t.width);
+    let y = f64::from(q.fp.v) * f64::from(t.height);
+    let (m, reads) = t.box_mean_counted(
+        [x - 0.5 * sx, x + 0.5 * sx],
+        [y - 0.5 * sy, y + 0.5 * sy],
+        &addr,
     );
     p.note_reads(reads);
     Vec4::from_array(m.map(|c| c as f32))
@@ -427,7 +392,19 @@ pub(crate) fn summed_area<P: Pyramid>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::address::BorderColor;
+    use crate::sampler::SamplerDescriptor;
     use crate::texture::{Format, Limits};
+
+    /// How `u`, `v` and `border` extend the texture, as a sampler with them would.
+    fn ext(u: AddressMode, v: AddressMode, border: BorderColor) -> Address {
+        Address::of(&SamplerDescriptor {
+            address_mode_u: u,
+            address_mode_v: v,
+            border_color: border,
+            ..SamplerDescriptor::default()
+        })
+    }
 
     fn ramp4() -> Texture {
         Texture::from_fn(4, 1, Format::Rgba32Float, &Limits::default(), |i, _| {
@@ -445,13 +422,13 @@ mod tests {
         assert_eq!(t.entry(3, 0).unwrap()[0], 0.0);
         assert_eq!(t.entry(5, 1), None);
         let m = t.box_mean(
-            3.5,
-            0.0,
-            5.0,
-            1.0,
-            AddressMode::Repeat,
-            AddressMode::Repeat,
-            BorderColor::TransparentBlack,
+            [3.5, 5.0],
+            [0.0, 1.0],
+            &ext(
+                AddressMode::Repeat,
+                AddressMode::Repeat,
+                BorderColor::TransparentBlack,
+            ),
         );
         assert!((m[0] - 1.0).abs() < 1e-12);
     }
@@ -482,13 +459,9 @@ mod tests {
         ];
         for &(mode, x0, x1, want) in cases {
             let m = t.box_mean(
-                x0,
-                0.0,
-                x1,
-                1.0,
-                mode,
-                Repeat,
-                BorderColor::TransparentBlack,
+                [x0, x1],
+                [0.0, 1.0],
+                &ext(mode, Repeat, BorderColor::TransparentBlack),
             );
             assert!(
                 (m[0] - want).abs() < 1e-9,
@@ -498,13 +471,9 @@ mod tests {
         }
         // ClampToBorder with an opaque white border: alpha stays 1, red picks up the border.
         let m = t.box_mean(
-            -2.0,
-            0.0,
-            2.0,
-            1.0,
-            ClampToBorder,
-            Repeat,
-            BorderColor::OpaqueWhite,
+            [-2.0, 2.0],
+            [0.0, 1.0],
+            &ext(ClampToBorder, Repeat, BorderColor::OpaqueWhite),
         );
         assert!((m[0] - (1.0 + 2.0) / 4.0).abs() < 1e-12 && (m[3] - 1.0).abs() < 1e-12);
     }
@@ -515,16 +484,16 @@ mod tests {
         let t = tex.summed_area_table().unwrap();
         let r = AddressMode::Repeat;
         let b = BorderColor::TransparentBlack;
-        let m = t.box_mean(2.5, 0.5, 2.5, 0.5, r, r, b);
+        let m = t.box_mean([2.5, 2.5], [0.5, 0.5], &ext(r, r, b));
         assert!((m[0] - 2.0).abs() < 1e-6);
-        assert!(t.box_mean(f64::NAN, 0.0, 1.0, 1.0, r, r, b)[0].is_nan());
-        assert!(t.box_mean(0.0, 0.0, f64::INFINITY, 1.0, r, r, b)[0].is_nan());
-        let m = t.box_mean(-1e15, 0.0, 1e15, 1.0, r, r, b);
+        assert!(t.box_mean([f64::NAN, 1.0], [0.0, 1.0], &ext(r, r, b))[0].is_nan());
+        assert!(t.box_mean([0.0, f64::INFINITY], [0.0, 1.0], &ext(r, r, b))[0].is_nan());
+        let m = t.box_mean([-1e15, 1e15], [0.0, 1.0], &ext(r, r, b));
         assert!((m[0] - 1.5).abs() < 1e-6);
         for mode in [AddressMode::ClampToEdge, AddressMode::ClampToBorder] {
-            assert!(t.box_mean(-1e12, -1e12, 1e12, 1e12, mode, mode, b)[0].is_finite());
+            assert!(t.box_mean([-1e12, 1e12], [-1e12, 1e12], &ext(mode, mode, b))[0].is_finite());
             // Overflowing areas may give NaN, but never panic.
-            let _ = t.box_mean(-1e300, -1e300, 1e300, 1e300, mode, mode, b);
+            let _ = t.box_mean([-1e300, 1e300], [-1e300, 1e300], &ext(mode, mode, b));
         }
     }
 }

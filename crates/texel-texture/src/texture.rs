@@ -237,7 +237,7 @@ pub(crate) enum Storage {
 ///
 /// The ripmap and the summed-area table that [`FilterMode::Ripmap`] and
 /// [`FilterMode::SummedArea`] need are built from level 0 on first use (thread-safe, once; `Texture`
-/// is `Sync`), or ahead of time by [`Texture::prepare`]. Their size is checked against the
+/// is `Sync`), or ahead of time by [`Texture::build_structures`]. Their size is checked against the
 /// [`Limits`] the texture was created with before anything is allocated.
 #[derive(Debug)]
 pub struct Texture {
@@ -512,6 +512,27 @@ impl Texture {
         &self.limits
     }
 
+    /// The texture's ripmap, built from level 0 on first call (thread-safe, once).
+    ///
+    /// # Errors
+    /// [`TextureError::StructureOverMemoryLimit`] if it does not fit the texture's limits (the
+    /// failure is remembered; later calls return the same error without retrying).
+    pub fn ripmap(&self) -> Result<&Ripmap, TextureError> {
+        let r = self.ripmap.get_or_init(|| Ripmap::build_within(self));
+        r.as_ref()
+            .map_err(|&bytes| crate::ripmap::over_limit(self, bytes))
+    }
+
+    /// The texture's summed-area table, built from level 0 on first call (thread-safe, once).
+    ///
+    /// # Errors
+    /// As [`Texture::ripmap`].
+    pub fn summed_area_table(&self) -> Result<&SummedAreaTable, TextureError> {
+        let r = self.sat.get_or_init(|| SummedAreaTable::build_within(self));
+        r.as_ref()
+            .map_err(|&bytes| crate::sat::over_limit(self, bytes))
+    }
+
     /// Build ahead of time whatever acceleration structure `sampler` needs (the ripmap for
     /// [`FilterMode::Ripmap`], the summed-area table for [`FilterMode::SummedArea`]; nothing for the
     /// other filters), so that later samples (and frame timings) do not pay for the build.
@@ -520,7 +541,7 @@ impl Texture {
     /// # Errors
     /// [`TextureError::StructureOverMemoryLimit`] if the structure would exceed the texture's
     /// [`Limits::max_bytes`]. Sampling still works then: it falls back to trilinear filtering.
-    pub fn prepare(&self, sampler: &Sampler) -> Result<(), TextureError> {
+    pub fn build_structures(&self, sampler: &Sampler) -> Result<(), TextureError> {
         match sampler.descriptor().min_filter {
             FilterMode::Ripmap => self.ripmap().map(|_| ()),
             FilterMode::SummedArea => self.summed_area_table().map(|_| ()),

@@ -3,9 +3,19 @@
 
 use proptest::prelude::*;
 use texel_texture::{
-    AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Limits,
+    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Limits,
     MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
 };
+
+/// How `u`, `v` and `border` extend the texture, as a sampler with them would.
+fn ext(u: AddressMode, v: AddressMode, border: BorderColor) -> Address {
+    Address::of(&SamplerDescriptor {
+        address_mode_u: u,
+        address_mode_v: v,
+        border_color: border,
+        ..SamplerDescriptor::default()
+    })
+}
 
 const ADDRESS_MODES: [AddressMode; 5] = [
     AddressMode::ClampToEdge,
@@ -854,13 +864,9 @@ fn summed_area_far_beyond_clamped_edges_is_the_edge_texel() {
             },
         );
         let m = t.box_mean(
-            x,
-            y,
-            x + 1.0,
-            y + 1.0,
-            mode,
-            mode,
-            BorderColor::TransparentBlack,
+            [x, x + 1.0],
+            [y, y + 1.0],
+            &ext(mode, mode, BorderColor::TransparentBlack),
         );
         for c in 0..4 {
             assert!(

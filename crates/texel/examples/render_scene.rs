@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(f) => prepared.samplers(f)?,
         None => prepared.default_samplers()?,
     };
-    let structure_bytes = prepared.prepare(&samplers)?;
+    let structure_bytes = prepared.build_structures(&samplers)?;
     let started = std::time::Instant::now();
     let frame = render(&prepared.settings(), &prepared.draws(&samplers))?;
     let ms = started.elapsed().as_secs_f64() * 1e3;

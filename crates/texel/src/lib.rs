@@ -85,7 +85,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Err
         Some(f) => prepared.samplers(f)?,
         None => prepared.default_samplers()?,
     };
-    prepared.prepare_within(&samplers, &mut budget)?;
+    prepared.build_structures_within(&samplers, &mut budget)?;
     let mut settings = prepared.settings();
     settings.view = options.view;
     Ok(render(&settings, &prepared.draws(&samplers))?)

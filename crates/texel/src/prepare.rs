@@ -53,7 +53,7 @@ pub struct PreparedScene {
     /// Per texture, the non-finite channel values replaced (only with
     /// [`SceneOptions::replace_non_finite`]; textures with none are not listed).
     pub replaced: Vec<(String, u64)>,
-    /// The (texture, structure) pairs [`PreparedScene::prepare_within`] has charged.
+    /// The (texture, structure) pairs [`PreparedScene::build_structures_within`] has charged.
     charged: Mutex<BTreeSet<(String, &'static str)>>,
 }
 
@@ -183,11 +183,11 @@ impl PreparedScene {
     ///
     /// # Errors
     /// [`Error::Texture`] when a structure does not fit the texture's memory limit.
-    pub fn prepare(&self, samplers: &[Sampler]) -> Result<u64, Error> {
+    pub fn build_structures(&self, samplers: &[Sampler]) -> Result<u64, Error> {
         let mut bytes = BTreeMap::new();
         for (mesh, sampler) in self.scene.meshes.iter().zip(samplers) {
             let tex = &self.textures[&mesh.texture];
-            tex.prepare(sampler)?;
+            tex.build_structures(sampler)?;
             let b = tex.structure_bytes(sampler.descriptor());
             let e = bytes.entry(mesh.texture.clone()).or_insert(0u64);
             *e = (*e).max(b);
@@ -200,7 +200,7 @@ impl PreparedScene {
     ///
     /// # Errors
     /// [`Error::OverBudget`], and those of [`PreparedScene::prepare`].
-    pub fn prepare_within(
+    pub fn build_structures_within(
         &self,
         samplers: &[Sampler],
         budget: &mut MemoryBudget,
@@ -221,7 +221,7 @@ impl PreparedScene {
             budget.take(&format!("the {kind} of texture {:?}", mesh.texture), extra)?;
             charged.insert(key);
         }
-        self.prepare(samplers)
+        self.build_structures(samplers)
     }
 
     /// The draw calls of the whole scene with `samplers` (one per mesh).

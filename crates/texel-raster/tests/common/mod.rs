@@ -1,5 +1,5 @@
 //! Shared test scenes: the ground plane of `shared/scenes/ground.toml`, built inline.
-#![allow(dead_code)]
+#![allow(dead_code, unused_imports)]
 
 use glam::{DMat4, DVec2, DVec4, Mat4, Vec2, Vec3};
 use texel_raster::{camera, DrawCall, Vertex};
@@ -109,18 +109,8 @@ impl Ground {
     }
 }
 
-/// A tiny deterministic generator for test geometry (SplitMix64).
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+/// The project's deterministic generator (SplitMix64), for test geometry.
+pub use texel_texture::rng::SplitMix64 as Rng;
 
 /// A vertex given in pixel coordinates of a `width x height` frame, for `clip_from_world = I`.
 pub fn screen_vertex(x: f64, y: f64, width: u32, height: u32) -> Vertex {
