@@ -7,6 +7,10 @@
 //! `a = sum_k lambda_k a_k` then has `da/dx = sum_k a_k d lambda_k / dx`: this is exactly
 //! `du/dx = (q_x r - q r_x) / r^2` for `q = u / w`, evaluated in `f64`.
 //! Affine: `lambda_k` is itself a plane and its derivatives are constants.
+//!
+//! The two formulas are the kernels [`lambda`] and [`lambda_derivative`]: the one-pixel API
+//! ([`TriangleSetup::barycentrics`]) and the rasterizer's span stages (`tile.rs`, a span of
+//! fragments at a time) both call them, so both give the same bits.
 
 use glam::{DVec2, DVec3};
 
@@ -41,6 +45,19 @@ impl Barycentrics {
     }
 }
 
+/// Perspective-correct barycentric `lambda_k = q_k / r`, given `q_k` and `1 / r` at the pixel.
+#[inline(always)]
+pub(crate) fn lambda(q: f64, inv_r: f64) -> f64 {
+    q * inv_r
+}
+
+/// `d lambda_k / dx = (q_k,x - lambda_k r_x) / r` (or `/ dy` with the `y` slopes), given the
+/// slopes `dq` of `q_k` and `dr` of `r`, `lambda_k` and `1 / r` at the pixel.
+#[inline(always)]
+pub(crate) fn lambda_derivative(dq: f64, lambda: f64, dr: f64, inv_r: f64) -> f64 {
+    (dq - lambda * dr) * inv_r
+}
+
 impl TriangleSetup {
     /// Barycentrics at continuous pixel coordinates `(x, y)` (pixel centres are at `+0.5`), without
     /// derivatives. Outside the triangle the planes extrapolate (as for a GPU's helper pixels); beyond
@@ -50,7 +67,7 @@ impl TriangleSetup {
         match perspective {
             Perspective::Correct => {
                 let inv_r = 1.0 / self.r.at(x, y);
-                DVec3::new(self.q[0].at(x, y), self.q[1].at(x, y), self.q[2].at(x, y)) * inv_r
+                DVec3::from_array(self.q.map(|q| lambda(q.at(x, y), inv_r)))
             }
             Perspective::Affine => DVec3::new(
                 self.affine[0].at(x, y),
@@ -66,14 +83,13 @@ impl TriangleSetup {
         match perspective {
             Perspective::Correct => {
                 let inv_r = 1.0 / self.r.at(x, y);
-                let q = DVec3::new(self.q[0].at(x, y), self.q[1].at(x, y), self.q[2].at(x, y));
-                let lambda = q * inv_r;
-                let qx = DVec3::new(self.q[0].dx, self.q[1].dx, self.q[2].dx);
-                let qy = DVec3::new(self.q[0].dy, self.q[1].dy, self.q[2].dy);
+                let l = self.q.map(|q| lambda(q.at(x, y), inv_r));
+                let r = self.r;
+                let d = |k: usize, dq: f64, dr: f64| lambda_derivative(dq, l[k], dr, inv_r);
                 Barycentrics {
-                    lambda,
-                    dx: (qx - lambda * self.r.dx) * inv_r,
-                    dy: (qy - lambda * self.r.dy) * inv_r,
+                    lambda: DVec3::from_array(l),
+                    dx: DVec3::from_array(std::array::from_fn(|k| d(k, self.q[k].dx, r.dx))),
+                    dy: DVec3::from_array(std::array::from_fn(|k| d(k, self.q[k].dy, r.dy))),
                 }
             }
             Perspective::Affine => Barycentrics {

@@ -12,6 +12,7 @@
 //! instead of losing 1/64 texel.
 
 use glam::{DVec2, DVec3, Vec3, Vec4};
+use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};
 use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
 use crate::draw::{DrawCall, Vertex};
@@ -50,26 +51,20 @@ fn inv_period(mode: AddressMode) -> f64 {
 }
 
 /// `x - p * floor(x / p)` for a period `p > 0`; `x` unchanged for `p = 0`, non-finite `x` or
-/// `|x / p| >= 2^51` (where f64 has at most one fraction bit left to keep).
+/// `|x / p| >=` [`STAGED_F64_LIMIT`] (`2^51`, where f64 has at most one fraction bit left to keep).
 ///
-/// Branch-free so that [`crate::tile`]'s span loops vectorise: the floor is `t` rounded to the
-/// nearest integer by adding and subtracting `1.5 * 2^52` (exact for `|t| < 2^51`, where the sum
-/// lies in `[2^52, 2^53)` and has no fraction bits), minus one where that rounded up. Without
-/// SSE4.1, `f64::floor` is a libm call (a measurable share of a nearest-filtered ground frame:
-/// docs/perf-log.md), and an integer-conversion floor (`t as i64`) has no packed form before
-/// AVX-512.
+/// Branch-free so that [`crate::tile`]'s span loops vectorise: the floor is the staged one
+/// ([`floor_staged_f64`]; `f64::floor` is a libm call without SSE4.1, and an integer-conversion
+/// floor has no packed form before AVX-512).
 ///
 /// `inv_p` is `1 / p` (0 for `p = 0`): the periods are 1 and 2, whose reciprocals are exact, so
 /// `x * inv_p` equals `x / p` bit for bit without a division (a `divsd` per coordinate would sit on
 /// every pixel's critical path).
 #[inline(always)]
 fn reduce(x: f64, p: f64, inv_p: f64) -> f64 {
-    const ROUND: f64 = 6_755_399_441_055_744.0; // 1.5 * 2^52
-    const LIMIT: f64 = 2_251_799_813_685_248.0; // 2^51
     let t = x * inv_p;
-    let r = (t + ROUND) - ROUND;
-    let q = if r > t { r - 1.0 } else { r };
-    if p > 0.0 && t.abs() < LIMIT {
+    let q = floor_staged_f64(t);
+    if p > 0.0 && t.abs() < STAGED_F64_LIMIT {
         x - p * q
     } else {
         x

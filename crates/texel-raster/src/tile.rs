@@ -42,7 +42,7 @@ use texel_texture::Footprint;
 
 use crate::draw::DrawCall;
 use crate::frame::Frame;
-use crate::interp::quad_differences;
+use crate::interp::{self, quad_differences};
 use crate::settings::{Derivatives, Perspective, RenderSettings, View};
 use crate::setup::{pixel_center_fixed, setup_chunks, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
@@ -286,8 +286,8 @@ impl Span {
     }
 
     /// Barycentrics of the span's fragments at their pixel centres, with the derivatives when
-    /// asked: the operations of [`TriangleSetup::barycentrics`] (and `lambda_at`) in the same
-    /// order, so the same bits.
+    /// asked: [`interp::lambda`] and [`interp::lambda_derivative`], the kernels of
+    /// [`TriangleSetup::barycentrics`], staged over the span (so the same bits).
     #[inline(always)]
     fn barycentrics(&mut self, t: &TriangleSetup, perspective: Perspective, deriv: bool) {
         let n = self.n;
@@ -301,7 +301,7 @@ impl Span {
                 for (q, l) in t.q.iter().zip(&mut self.l) {
                     let it = xys.clone().zip(&self.inv_r[..n]);
                     for (l, ((&x, &y), &inv)) in l[..n].iter_mut().zip(it) {
-                        *l = q.at(x, y) * inv;
+                        *l = interp::lambda(q.at(x, y), inv);
                     }
                 }
                 if deriv {
@@ -310,8 +310,8 @@ impl Span {
                         let it = self.l[k][..n].iter().zip(&self.inv_r[..n]);
                         let out = self.ldx[k][..n].iter_mut().zip(&mut self.ldy[k][..n]);
                         for ((dx, dy), (&l, &inv)) in out.zip(it) {
-                            *dx = (q.dx - l * r.dx) * inv;
-                            *dy = (q.dy - l * r.dy) * inv;
+                            *dx = interp::lambda_derivative(q.dx, l, r.dx, inv);
+                            *dy = interp::lambda_derivative(q.dy, l, r.dy, inv);
                         }
                     }
                 }

@@ -1,5 +1,5 @@
-//! How filters read texels: per-level [`Fetch`] views ([`U8Level`] decodes 8-bit texels through a
-//! table, [`F32Level`] reads floats), the whole-pyramid [`Pyramid`] view, and the [`Counted`]
+//! How filters read texels: per-level [`Fetch`] views ([`Level`], decoding 8-bit texels through a
+//! table ([`Table8`]) or reading floats ([`Float`])), the whole-pyramid [`Pyramid`] view, and the [`Counted`]
 //! wrapper that counts every texel read. This is the one home of texel reading; `texture.rs` owns
 //! the storage.
 //!
@@ -14,22 +14,74 @@ use glam::Vec4;
 use crate::color::{srgb_table, unorm8_table};
 use crate::texture::{Format, LevelInfo, Storage, Texture};
 
-/// One mip level of an 8-bit texture; decodes through a 256-entry table (alpha always linear).
+/// How a stored texel becomes linear RGBA, per storage format: [`Table8`] for 8-bit texels,
+/// [`Float`] for `f32` ones. The level and pyramid views below are generic over it, so the two
+/// formats share one implementation and each monomorphises to a bare load (and table lookups).
+pub(crate) trait Decode: Copy {
+    /// The stored texel.
+    type Texel: Copy + 'static;
+    /// A 1x1 transparent-black image, for [`Pyramid::image`] on a storage of the other format.
+    const BLACK: &'static [Self::Texel];
+    /// The texel in linear RGBA.
+    fn decode(&self, t: Self::Texel) -> Vec4;
+    /// The texels of `storage` if it holds this format.
+    fn texels(storage: &Storage) -> Option<&[Self::Texel]>;
+}
+
+/// 8-bit texels: one table load per channel (RGB through the colour table, sRGB or linear;
+/// alpha always `b / 255`).
 #[derive(Clone, Copy)]
-pub(crate) struct U8Level<'a> {
-    pub width: u32,
-    pub height: u32,
-    pub texels: &'a [[u8; 4]],
+pub(crate) struct Table8 {
     pub table: &'static [f32; 256],
     pub alpha: &'static [f32; 256],
 }
 
-/// One mip level of a float texture.
+impl Decode for Table8 {
+    type Texel = [u8; 4];
+    const BLACK: &'static [[u8; 4]] = &[[0; 4]];
+    #[inline(always)]
+    fn decode(&self, t: [u8; 4]) -> Vec4 {
+        Vec4::new(
+            self.table[t[0] as usize],
+            self.table[t[1] as usize],
+            self.table[t[2] as usize],
+            self.alpha[t[3] as usize],
+        )
+    }
+    fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
+        match storage {
+            Storage::U8(v) => Some(v),
+            Storage::F32(_) => None,
+        }
+    }
+}
+
+/// Linear `f32` texels, read as they are.
 #[derive(Clone, Copy)]
-pub(crate) struct F32Level<'a> {
+pub(crate) struct Float;
+
+impl Decode for Float {
+    type Texel = [f32; 4];
+    const BLACK: &'static [[f32; 4]] = &[[0.0; 4]];
+    #[inline(always)]
+    fn decode(&self, t: [f32; 4]) -> Vec4 {
+        Vec4::from_array(t)
+    }
+    fn texels(storage: &Storage) -> Option<&[[f32; 4]]> {
+        match storage {
+            Storage::F32(v) => Some(v),
+            Storage::U8(_) => None,
+        }
+    }
+}
+
+/// One mip level (or ripmap image) of stored texels, row-major, decoded by `D`.
+#[derive(Clone, Copy)]
+pub(crate) struct Level<'a, D: Decode> {
     pub width: u32,
     pub height: u32,
-    pub texels: &'a [[f32; 4]],
+    pub texels: &'a [D::Texel],
+    pub decode: D,
 }
 
 /// Read access to one mip level's texels by already-wrapped integer index.
@@ -60,54 +112,20 @@ fn rows2<T>(texels: &[T], width: u32, i: u32, j: u32) -> (&[T], &[T]) {
     (&texels[k..k + 2], &texels[k + w..k + w + 2])
 }
 
-impl Fetch for U8Level<'_> {
+impl<D: Decode> Fetch for Level<'_, D> {
     #[inline(always)]
     fn size(&self) -> (u32, u32) {
         (self.width, self.height)
     }
     #[inline(always)]
     fn texel(&self, i: u32, j: u32) -> Vec4 {
-        self.decode(self.texels[j as usize * self.width as usize + i as usize])
+        self.decode
+            .decode(self.texels[j as usize * self.width as usize + i as usize])
     }
     #[inline(always)]
     fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
         let (r0, r1) = rows2(self.texels, self.width, i, j);
-        [
-            self.decode(r0[0]),
-            self.decode(r0[1]),
-            self.decode(r1[0]),
-            self.decode(r1[1]),
-        ]
-    }
-}
-
-impl U8Level<'_> {
-    /// One packed texel to linear RGBA: one table load per channel (RGB through the level's colour
-    /// table, alpha always `b / 255`).
-    #[inline(always)]
-    fn decode(&self, t: [u8; 4]) -> Vec4 {
-        Vec4::new(
-            self.table[t[0] as usize],
-            self.table[t[1] as usize],
-            self.table[t[2] as usize],
-            self.alpha[t[3] as usize],
-        )
-    }
-}
-
-impl Fetch for F32Level<'_> {
-    #[inline(always)]
-    fn size(&self) -> (u32, u32) {
-        (self.width, self.height)
-    }
-    #[inline(always)]
-    fn texel(&self, i: u32, j: u32) -> Vec4 {
-        Vec4::from_array(self.texels[j as usize * self.width as usize + i as usize])
-    }
-    #[inline(always)]
-    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
-        let (r0, r1) = rows2(self.texels, self.width, i, j);
-        [r0[0], r0[1], r1[0], r1[1]].map(Vec4::from_array)
+        [r0[0], r0[1], r1[0], r1[1]].map(|t| self.decode.decode(t))
     }
 }
 
@@ -135,34 +153,21 @@ pub(crate) trait Pyramid {
     fn note_reads(&self, _n: u32) {}
 }
 
-/// The fallback image of [`Pyramid::image`] for a storage of the wrong format.
-static BLACK_U8: [[u8; 4]; 1] = [[0; 4]];
-/// As [`BLACK_U8`], float.
-static BLACK_F32: [[f32; 4]; 1] = [[0.0; 4]];
-
-/// The pyramid of an 8-bit texture.
-pub(crate) struct U8Pyramid<'a> {
+/// The pyramid of a texture whose storage `D` decodes.
+pub(crate) struct Stored<'a, D: Decode> {
     pub tex: &'a Texture,
     pub levels: &'a [LevelInfo],
-    pub texels: &'a [[u8; 4]],
-    pub table: &'static [f32; 256],
-    pub alpha: &'static [f32; 256],
-}
-
-/// The pyramid of a float texture.
-pub(crate) struct F32Pyramid<'a> {
-    pub tex: &'a Texture,
-    pub levels: &'a [LevelInfo],
-    pub texels: &'a [[f32; 4]],
+    pub texels: &'a [D::Texel],
+    pub decode: D,
 }
 
 fn level_slice<'t, T>(info: &LevelInfo, all: &'t [T]) -> &'t [T] {
     &all[info.offset..info.offset + info.width as usize * info.height as usize]
 }
 
-impl Pyramid for U8Pyramid<'_> {
+impl<D: Decode> Pyramid for Stored<'_, D> {
     type Level<'b>
-        = U8Level<'b>
+        = Level<'b, D>
     where
         Self: 'b;
     #[inline(always)]
@@ -170,14 +175,13 @@ impl Pyramid for U8Pyramid<'_> {
         self.levels.len()
     }
     #[inline(always)]
-    fn level(&self, k: usize) -> U8Level<'_> {
+    fn level(&self, k: usize) -> Level<'_, D> {
         let info = &self.levels[k];
-        U8Level {
+        Level {
             width: info.width,
             height: info.height,
             texels: level_slice(info, self.texels),
-            table: self.table,
-            alpha: self.alpha,
+            decode: self.decode,
         }
     }
     #[inline(always)]
@@ -185,56 +189,16 @@ impl Pyramid for U8Pyramid<'_> {
         self.tex
     }
     #[inline]
-    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> U8Level<'s> {
-        let (width, height, texels) = match storage {
-            Storage::U8(v) => (info.width, info.height, level_slice(info, v)),
-            Storage::F32(_) => (1, 1, &BLACK_U8[..]),
+    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> Level<'s, D> {
+        let (width, height, texels) = match D::texels(storage) {
+            Some(v) => (info.width, info.height, level_slice(info, v)),
+            None => (1, 1, D::BLACK),
         };
-        U8Level {
+        Level {
             width,
             height,
             texels,
-            table: self.table,
-            alpha: self.alpha,
-        }
-    }
-}
-
-impl Pyramid for F32Pyramid<'_> {
-    type Level<'b>
-        = F32Level<'b>
-    where
-        Self: 'b;
-    #[inline(always)]
-    fn level_count(&self) -> usize {
-        self.levels.len()
-    }
-    #[inline(always)]
-    fn level(&self, k: usize) -> F32Level<'_> {
-        let info = &self.levels[k];
-        F32Level {
-            width: info.width,
-            height: info.height,
-            texels: level_slice(info, self.texels),
-        }
-    }
-    #[inline(always)]
-    fn texture(&self) -> &Texture {
-        self.tex
-    }
-    #[inline]
-    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> F32Level<'s> {
-        match storage {
-            Storage::F32(v) => F32Level {
-                width: info.width,
-                height: info.height,
-                texels: level_slice(info, v),
-            },
-            Storage::U8(_) => F32Level {
-                width: 1,
-                height: 1,
-                texels: &BLACK_F32[..],
-            },
+            decode: self.decode,
         }
     }
 }
@@ -310,27 +274,35 @@ macro_rules! with_pyramid {
 pub(crate) use with_pyramid;
 
 pub(crate) enum AnyPyramid<'a> {
-    U8(U8Pyramid<'a>),
-    F32(F32Pyramid<'a>),
+    U8(Stored<'a, Table8>),
+    F32(Stored<'a, Float>),
+}
+
+/// The decoding of an 8-bit texture's texels in `format` (sRGB or linear colour table).
+pub(crate) fn table8(format: Format) -> Table8 {
+    Table8 {
+        table: if format == Format::Rgba8Srgb {
+            srgb_table()
+        } else {
+            unorm8_table()
+        },
+        alpha: unorm8_table(),
+    }
 }
 
 pub(crate) fn pyramid_of(tex: &Texture) -> AnyPyramid<'_> {
     match tex.storage() {
-        Storage::U8(v) => AnyPyramid::U8(U8Pyramid {
+        Storage::U8(v) => AnyPyramid::U8(Stored {
             tex,
             levels: tex.levels(),
             texels: v,
-            table: if tex.format() == Format::Rgba8Srgb {
-                srgb_table()
-            } else {
-                unorm8_table()
-            },
-            alpha: unorm8_table(),
+            decode: table8(tex.format()),
         }),
-        Storage::F32(v) => AnyPyramid::F32(F32Pyramid {
+        Storage::F32(v) => AnyPyramid::F32(Stored {
             tex,
             levels: tex.levels(),
             texels: v,
+            decode: Float,
         }),
     }
 }

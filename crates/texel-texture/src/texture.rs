@@ -17,7 +17,7 @@ use glam::Vec4;
 
 use crate::color::{linear_to_srgb8, srgb_table, srgb_to_linear, unorm8, unorm8_table};
 use crate::error::TextureError;
-use crate::fetch::{F32Level, Fetch, U8Level};
+use crate::fetch::{table8, Fetch, Float, Level};
 use crate::pyramid;
 use crate::ripmap::Ripmap;
 use crate::sampler::{FilterMode, Sampler, SamplerDescriptor};
@@ -269,16 +269,11 @@ impl Texture {
         };
         limits.check(width, height, format)?;
         check_len(width, height, texels.len())?;
-        let table = match color {
-            ColorSpace::Srgb => srgb_table(),
-            ColorSpace::Linear => unorm8_table(),
-        };
-        let level0 = U8Level {
+        let level0 = Level {
             width,
             height,
             texels: &texels,
-            table,
-            alpha: unorm8_table(),
+            decode: table8(format),
         };
         let (levels, below) = pyramid::build(width, height, |i, j| level0.texel(i, j));
         let total = levels
@@ -326,10 +321,11 @@ impl Texture {
                 value: texels[k][channel],
             });
         }
-        let level0 = F32Level {
+        let level0 = Level {
             width,
             height,
             texels: &texels,
+            decode: Float,
         };
         let (levels, below) = pyramid::build(width, height, |i, j| level0.texel(i, j));
         let mut all = texels;
