@@ -8,7 +8,7 @@
 //! `du/dx = (q_x r - q r_x) / r^2` for `q = u / w`, evaluated in `f64`.
 //! Affine: `lambda_k` is itself a plane and its derivatives are constants.
 //!
-//! The two formulas are the kernels [`lambda`] and [`lambda_derivative`]: the one-pixel API
+//! The two formulas are the kernels `lambda` and `lambda_derivative`: the one-pixel API
 //! ([`TriangleSetup::barycentrics`]) and the rasterizer's span stages (`tile.rs`, a span of
 //! fragments at a time) both call them, so both give the same bits.
 

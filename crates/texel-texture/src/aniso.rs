@@ -34,18 +34,15 @@
 //! against a brute-force Gaussian (RMS error 0.0138 for 16x vs 0.0230 for trilinear) is in
 //! [`crate::ewa`].
 //!
-//! Performance design (how each step moved the frame times, and the image comparisons that found
-//! no bit changed by it: docs/perf-log.md):
-//! - The probes call the trilinear filter specialised to bilinear at compile time
-//!   ([`crate::mip`]'s `Linear`), not through the run-time `FilterMode` dispatch.
-//! - Probes share their two levels: they are chosen once per sample, not once per probe.
-//! - The probes' scratch (coordinates and two level passes, about 2.8 KB) is made once per
-//!   `sample_batch` call (`batch::Probes`) instead of zeroed per sample.
-//! - Staged plans: in `sample_batch` each sample's set-up (axes, their lengths, the probe count,
-//!   the probe lod) runs for a chunk of 64 footprints in one loop (`plan_chunk`) before any probe
-//!   is read, as the isotropic lods do (`batch::prepare`). That needs a `log2` without a call: the
-//!   probe lod uses [`crate::footprint::fast_log2`] (within 1.2 units in the last place), for the
-//!   single-sample path too, so both paths agree bit for bit.
+//! The code path: `anisotropic` is `plan` (axes, `N`, the probes' lod) then `filter_planned`
+//! (the sum above). The probes share their lod, so `crate::mip::linear_levels` picks their two
+//! levels once, and their trilinear samples run through the batched path's stages
+//! (`batch::Probes::trilinear_sum`: the same bilinear kernels, staged over the probes).
+//! [`crate::Sampler::sample_batch`] makes the plans of a chunk of 64 footprints in one loop
+//! (`plan_chunk`) before reading any probe, as it does the isotropic lods; that needs a `log2`
+//! without a call, so the probe lod uses [`crate::footprint::fast_log2`] (within 1.2 units in the
+//! last place) in both paths, which therefore agree bit for bit. How each of these steps moved
+//! the frame times: docs/perf-log.md.
 
 use glam::{Vec2, Vec4};
 
@@ -197,8 +194,8 @@ mod tests {
     use crate::sampler::SamplerDescriptor;
     use crate::texture::{Format, Limits, Texture};
 
-    /// The staged probes (`batch::probe_sum`) equal the plain probe loop bit for bit: each probe a
-    /// `Linear` trilinear sample in the shared levels, summed in order.
+    /// The staged probes (`Probes::trilinear_sum`) equal the formula's plain loop bit for bit:
+    /// each probe a bilinear-in-two-levels trilinear sample in the shared levels, summed in order.
     #[test]
     fn staged_probes_equal_the_probe_loop() {
         let tex = Texture::from_fn(61, 34, Format::Rgba8Srgb, &Limits::default(), |i, j| {

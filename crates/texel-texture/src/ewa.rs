@@ -56,21 +56,16 @@
 //! centroid and effective blur vary with the sub-texel position; a level one finer would cost 4x the
 //! reads.
 //!
-//! Inner loop: the ellipse is scanned line by line along its wider side (columns for a tall
-//! ellipse, rows otherwise; [`LevelEllipse::for_each_run`]). Footprints near the ground's horizon
-//! are long in v, and scanning them by rows would give many lines one to four texels long, each
-//! paying a square root, a floor, a ceil and its differences' set-up. Along a line `r^2` (in
-//! `f64`) is updated by forward differences, and weights and texels are read in one loop
-//! ([`LevelEllipse::for_each_line`], [`Weights`]), so a line has a single loop exit: separate
-//! weight and texel loops, whose lengths vary from line to line, would each mispredict their exit.
-//! Lines inside the level read texels without address wrapping; `floor`/`ceil` avoid libm calls;
-//! the LUT index goes through an `i32` conversion (an `f64` to `u64` conversion needs a range
-//! fix-up on x86-64) with a branch-free select. The ellipse's axes come from the eigenvector in
-//! closed form ([`Ellipse::from_axes`]: no `atan2`, `sin`, `cos` or `hypot`). Measured and not
-//! adopted (no gain, or slower; docs/perf-log.md): two interleaved accumulators for the texel sum
-//! (the sum is not the latency bound); `r^2` evaluated directly at every centre instead of by
-//! forward differences; one bounds check per run instead of per texel; `floor_f64` with selects
-//! instead of its branch.
+//! The code path: `ewa` builds the [`Ellipse`] in `f64` (eigen-axes in closed form: no `atan2`,
+//! `sin`, `cos` or `hypot`), picks its levels with `crate::mip::linear_levels`, and in each level
+//! runs one scan ([`LevelEllipse::scan`]) and one weighted-sum loop over the scan's lines. The scan
+//! follows the ellipse's wider side (columns for a tall ellipse, rows otherwise): footprints near
+//! the ground's horizon are long in v, and rows would give many lines one to four texels long, each
+//! paying a square root, a floor and a ceil. Along a line `r^2` ([`LevelEllipse::r2`]) is a
+//! quadratic in the offset, carried in `f64` by forward differences ([`Weights`]), and weights and
+//! texels are read in the same loop, so a line has a single loop exit. Lines inside the level read
+//! texels without address wrapping. Alternatives measured and not adopted (two accumulators,
+//! `r^2` evaluated directly per texel, one bounds check per run): docs/perf-log.md.
 //!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below

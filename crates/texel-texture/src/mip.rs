@@ -5,7 +5,7 @@
 //! Selection") with `level_base = 0` and `q` the last level: `d' = clamp(lod, 0, q)`;
 //! - nearest level ([`nearest_level`]): `d = ceil(d' + 1/2) - 1` (so `lod = 0.5` still picks level
 //!   0, `0.5 + eps` level 1);
-//! - linear ([`linear_levels`]): `d_hi = floor(d')`, `d_lo = min(d_hi + 1, q)`, `delta = fract(d')`,
+//! - linear (`linear_levels`): `d_hi = floor(d')`, `d_lo = min(d_hi + 1, q)`, `delta = fract(d')`,
 //!   and the result is `lerp(filter(d_hi), filter(d_lo), delta)`; the last level holds.
 //!
 //! When `delta == 0` the second level is not read (the lerp would return the first value exactly),

@@ -29,33 +29,28 @@
 //! - the ripmap and the summed-area table are built on first use, or by [`Texture::build_structures`]; if
 //!   one would exceed the texture's [`crate::Limits`], sampling falls back to trilinear.
 //!
-//! ## Performance design
+//! ## The code path
 //!
-//! The per-sample path: integer floor/ceil instead of libm `floorf`/`ceilf` (not inlined on the
-//! x86-64 baseline); bilinear and nearest read inside the level without address wrapping
-//! ([`crate::address`] only at the edges); the lod is `0.5 * log2(rho^2)` with
-//! [`crate::footprint::fast_log2`] (no square root, no libm call; exact on integer lods); the lod
-//! is skipped when it cannot matter (no mipmapping and `mag_filter == min_filter`); anisotropic
-//! probes use a trilinear specialised to bilinear at compile time. The ground scene's images are
-//! bit-identical with and without these shortcuts (docs/perf-log.md).
+//! [`Sampler::sample`] is two stages: `Sampler::query` makes the sample's query once (`uv` made
+//! finite, the isotropic lod `0.5 * log2(rho^2)` with [`crate::footprint::fast_log2`]; skipped when
+//! it cannot matter: no mipmapping and `mag_filter == min_filter`), then `Sampler::filter`
+//! dispatches on the resolved technique to one filter, each a function of the pyramid, the sampler
+//! and the query ([`crate::mip`], [`crate::aniso`], [`crate::ewa`], [`crate::ripmap`],
+//! [`crate::sat`]).
 //!
-//! [`Sampler::sample_batch`] computes the lods of 64 footprints before filtering any: the
-//! per-pixel path is latency-bound (one long dependency chain per sample), so cutting instructions
-//! alone does not move the wall time, while a batch lets the independent lod computations overlap.
-//! It then runs the core filters through `batch` (`batch.rs`) in stages (levels, then branch-free
-//! coordinates for the whole chunk, then texels), and anisotropic probes through the same stages,
-//! whose set-up is planned per chunk too ([`crate::aniso`]); results are bit-identical to
+//! [`Sampler::sample_batch`] runs the same stages over chunks of 64 footprints: all queries first
+//! (the one-sample path is latency-bound, one long dependency chain per sample, so letting the
+//! independent lod computations overlap is what moves the wall time), then the filters. The core
+//! filters (nearest or bilinear inside the levels, any mipmap mode) go through `batch.rs`, which
+//! stages the very kernels of `crate::bilinear` and [`crate::mip`] over the chunk; anisotropic
+//! probes are planned per chunk ([`crate::aniso`]). Results are bit-identical to
 //! [`Sampler::sample`] (tested).
 //!
-//! What bounds the 8-bit path: over half of a trilinear frame is the sampler's kernel (texel
-//! loads, the four table loads that decode each sRGB texel, the `Vec4` blends). The sampler
-//! bench's `bound/*` group times the loads, table decodes and blends of the 1:1 bilinear walk
-//! alone, every index and fraction precomputed, and the same samplers on a float copy of the
-//! texture (no decode): the table decode alone runs at about the one-core bilinear throughput
-//! target, leaving nothing for coordinates, lods and edges, and AVX2 gathers
-//! (`experiments/avx2_gather`) decode slower than the scalar table loop. Compiling everything for
-//! AVX2 is not adopted (see ARCHITECTURE.md). The figures and profiles are in README.md's
-//! Benchmarks section; how each change moved them is in docs/perf-log.md.
+//! What bounds the 8-bit path: over half of a trilinear frame is texel loads, the four table loads
+//! that decode each sRGB texel, and the `Vec4` blends. The sampler bench's `bound/*` group times
+//! those alone (every index and fraction precomputed) and on a float copy of the texture (no
+//! decode). The figures are in README.md's Benchmarks section; how each change moved them is in
+//! docs/perf-log.md; why AVX2 builds are not adopted is in ARCHITECTURE.md.
 
 use glam::Vec4;
 

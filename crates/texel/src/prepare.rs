@@ -195,11 +195,11 @@ impl PreparedScene {
         Ok(bytes.values().sum())
     }
 
-    /// [`PreparedScene::prepare`], charging `budget` for each ripmap and summed-area table before
+    /// `PreparedScene::prepare`, charging `budget` for each ripmap and summed-area table before
     /// it is built (once per texture and kind: they are kept for later frames).
     ///
     /// # Errors
-    /// [`Error::OverBudget`], and those of [`PreparedScene::prepare`].
+    /// [`Error::OverBudget`], and those of `PreparedScene::prepare`.
     pub fn build_structures_within(
         &self,
         samplers: &[Sampler],
