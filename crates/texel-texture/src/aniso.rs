@@ -47,11 +47,12 @@
 use glam::{Vec2, Vec4};
 
 use crate::batch::{self, Probes};
+use crate::bilinear::Bilinear;
 use crate::fetch::{Fetch, Pyramid};
 use crate::floor::ceil_i32;
 use crate::footprint::{fast_log2, log2_normal, Footprint, Query};
 use crate::mip::{linear_levels, trilinear};
-use crate::sampler::{FilterMode, Sampler};
+use crate::sampler::Sampler;
 
 /// Relative tolerance applied to `|Pmax| / |Pmin|` before rounding up (see the module docs).
 pub const RATIO_TOLERANCE: f32 = 1e-5;
@@ -159,7 +160,7 @@ pub(crate) fn plan_chunk(
 /// `c = 1/N sum_{i=0}^{N-1} trilinear(uv + ((i + 0.5) / N - 0.5) Pmax_uv, plan.lod)`, or trilinear
 /// at the isotropic lod when `N = 1`. `probes` is scratch (reused across a batch:
 /// `Sampler::sample_batch`); the result does not depend on its contents.
-#[inline]
+#[inline(always)]
 pub(crate) fn filter_planned<P: Pyramid>(
     p: &P,
     q: &Query,
@@ -168,7 +169,7 @@ pub(crate) fn filter_planned<P: Pyramid>(
 ) -> Vec4 {
     let n = plan.n;
     if n == 1 {
-        return trilinear(p, &FilterMode::Linear, probes.address(), q);
+        return trilinear(p, Bilinear, probes.address(), q);
     }
     let inv = 1.0 / n as f32;
     let finite = |x: f32| if x.is_finite() { x } else { 0.0 };

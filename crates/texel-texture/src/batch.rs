@@ -7,12 +7,15 @@
 //! chunk whose iterations are independent, so they pipeline and (stages 0 to 2) vectorise:
 //!
 //! 0. [`queries`]: every sample's finite `uv` and lod;
-//! 1. levels: [`mip::nearest_level`] or [`mip::linear_levels`] per sample;
-//! 2. [`Pass::coordinates`]: per level pass, the filter's `origin` (`u * W`, or `u * W - 1/2` for
+//! 1. levels: `mip::nearest_level` or `mip::linear_levels_staged` per sample;
+//! 2. `Pass::coordinates`: per level pass, the filter's origin (`u * W`, or `u * W - 1/2` for
 //!    bilinear), its floor ([`floor_clamped`], the staged floor), the fractions, and whether every
 //!    texel the sample reads lies inside the level;
-//! 3. [`Pass::filtered`]: loads and [`bilinear::blend`] for the samples inside the level; the few
-//!    near an edge call the one-sample filter ([`nearest`], [`bilinear`]) with address wrapping.
+//! 3. `Pass::filtered`: loads and the blend for the samples inside the level; the few near an edge
+//!    call the one-sample filter with address wrapping.
+//!
+//! The filters enter through [`Taps`], which `nearest.rs` and `bilinear.rs` implement with their
+//! own kernels (`bilinear::blend`, `bilinear::bilinear`, ...).
 //!
 //! Every stage calls the one-sample path's kernels with the same operands, so the results are bit
 //! for bit those of [`crate::Sampler::sample`] (`tests/core.rs`, `batch_equals_single`, over every
@@ -28,14 +31,14 @@
 use glam::{Vec2, Vec4};
 
 use crate::address::Address;
-use crate::bilinear::{self, bilinear, blend, lerp};
+use crate::bilinear::{lerp, Bilinear};
 use crate::fetch::{Fetch, Pyramid};
 use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
 use crate::footprint::{
     finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, Query,
 };
-use crate::mip;
-use crate::nearest::{self, nearest};
+use crate::mip::{self, LevelFilter};
+use crate::nearest::Point;
 use crate::sampler::{FilterMode, MipmapFilterMode, Sampler};
 
 /// Samples per stage (the sampler's chunk).
@@ -139,74 +142,75 @@ pub(crate) fn queries<const N: usize>(
     }
 }
 
-/// One level pass over a chunk: the within-level filter (Nearest or Linear) and the address
-/// modes it applies, and per sample its level, first tap, fractions and whether it is inside.
-struct Pass<const N: usize> {
-    /// `FilterMode::Nearest` or `FilterMode::Linear` (anything else is treated as Linear).
-    filter: FilterMode,
-    addr: Address,
+/// A within-level filter's staged form: what a level pass needs of it. Implemented next to each
+/// one-sample filter, from its own kernels ([`nearest::Point`], [`bilinear::Bilinear`]).
+pub(crate) trait Taps: LevelFilter {
+    /// Offset of the first tap, in texels: the pass's origin is `u * W - HALF` (the filter's
+    /// `origin`; `x - 0` is `x`).
+    const HALF: f32;
+    /// Taps beyond the first along each axis: a sample is inside when its first tap lies in
+    /// `[0, W - REACH)`.
+    const REACH: f32;
+    /// The value of a sample whose taps lie inside `level`: first tap `(i, j)`, fractions `ab`.
+    fn inside<F: Fetch>(level: &F, i: u32, j: u32, ab: (f32, f32)) -> Vec4;
+}
+
+/// One level pass over a chunk with the within-level filter `T`, under the address modes `addr`:
+/// per sample its level, first tap, fractions and whether all its taps lie inside the level.
+struct Pass<const N: usize, T> {
     level: [u8; N],
     /// First tap (nearest: the texel).
     i: [i32; N],
     j: [i32; N],
-    /// Bilinear fractions.
+    /// Fractions (bilinear weights).
     a: [f32; N],
     b: [f32; N],
-    /// Every texel read lies inside the level.
+    /// Every tap lies inside the level.
     inside: [bool; N],
+    addr: Address,
+    taps: T,
 }
 
-impl<const N: usize> Pass<N> {
-    fn new(filter: FilterMode, addr: Address) -> Self {
+impl<const N: usize, T: Taps> Pass<N, T> {
+    fn new(taps: T, addr: Address) -> Self {
         Pass {
-            filter,
-            addr,
             level: [0; N],
             i: [0; N],
             j: [0; N],
             a: [0.0; N],
             b: [0.0; N],
             inside: [false; N],
+            addr,
+            taps,
         }
     }
 
     /// Stage 2 for the chunk's samples at their `level`s, whose sizes `size(level)` gives:
     /// the filter's origin and the staged floor, branch-free, with no calls.
     #[inline(always)]
-    fn coordinates<const M: usize>(&mut self, size: impl Fn(u8) -> (f32, f32), at: &Chunk<M>) {
-        let nearest = self.filter == FilterMode::Nearest;
-        // Bilinear reads texel i0 + 1 too: i0 must be below W - 1.
-        let reach = if nearest { 0.0 } else { 1.0 };
-        for k in 0..at.n.min(N) {
+    fn coordinates(&mut self, size: impl Fn(u8) -> (f32, f32), us: &[f32], vs: &[f32]) {
+        for k in 0..us.len() {
             let (w, h) = size(self.level[k]);
-            let (x, y) = if nearest {
-                (nearest::origin(at.u[k], w), nearest::origin(at.v[k], h))
-            } else {
-                (bilinear::origin(at.u[k], w), bilinear::origin(at.v[k], h))
-            };
+            let (x, y) = (us[k] * w - T::HALF, vs[k] * h - T::HALF);
             let (i, fi) = floor_clamped(x, w);
             let (j, fj) = floor_clamped(y, h);
             self.i[k] = i;
             self.j[k] = j;
             self.a[k] = x - fi;
             self.b[k] = y - fj;
-            self.inside[k] = fi >= 0.0 && fi < w - reach && fj >= 0.0 && fj < h - reach;
+            self.inside[k] = fi >= 0.0 && fi < w - T::REACH && fj >= 0.0 && fj < h - T::REACH;
         }
     }
 
     /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value.
     #[inline(always)]
     fn filtered<F: Fetch>(&self, level: &F, k: usize, uv: Vec2) -> Vec4 {
-        let inside = self.inside[k];
-        match self.filter {
-            FilterMode::Nearest if inside => level.texel(self.i[k] as u32, self.j[k] as u32),
-            FilterMode::Nearest => nearest(level, &self.addr, uv),
-            _ if inside => blend(
-                level.quad(self.i[k] as u32, self.j[k] as u32),
-                self.a[k],
-                self.b[k],
-            ),
-            _ => bilinear(level, &self.addr, uv),
+        if self.inside[k] {
+            let ab = (self.a[k], self.b[k]);
+            T::inside(level, self.i[k] as u32, self.j[k] as u32, ab)
+        } else {
+            // Near an edge: the one-sample filter, wrapping addresses.
+            self.taps.filter(level, &self.addr, uv)
         }
     }
 }
@@ -215,10 +219,24 @@ impl<const N: usize> Pass<N> {
 /// Linear (equal to `mag_filter`), any `mipmap_filter`, level 0 below [`MAX_SIDE`] per side
 /// (`Sampler::new` decides; see `Sampler::sample_batch`).
 pub(crate) fn run<P: Pyramid>(p: &P, s: &Sampler, footprints: &[Footprint], out: &mut [[f32; 4]]) {
+    match s.descriptor().min_filter {
+        FilterMode::Nearest => run_with(p, Point, s, (footprints, out)),
+        _ => run_with(p, Bilinear, s, (footprints, out)),
+    }
+}
+
+/// [`run`] with the within-level filter `T`.
+#[inline(always)]
+fn run_with<P: Pyramid, T: Taps>(
+    p: &P,
+    taps: T,
+    s: &Sampler,
+    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
+) {
     if footprints.len() <= 16 {
-        run_in::<P, 16, 1>(p, s, footprints, out);
+        run_in::<P, T, 16, 1>(p, taps, s, (footprints, out));
     } else {
-        run_in::<P, CHUNK, LEVELS>(p, s, footprints, out);
+        run_in::<P, T, CHUNK, LEVELS>(p, taps, s, (footprints, out));
     }
 }
 
@@ -226,11 +244,11 @@ pub(crate) fn run<P: Pyramid>(p: &P, s: &Sampler, footprints: &[Footprint], out:
 /// each sample's view made when it is read, which is cheaper for a handful of samples than making
 /// 32 views.
 #[inline(always)]
-fn run_in<P: Pyramid, const N: usize, const V: usize>(
+fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     p: &P,
+    taps: T,
     s: &Sampler,
-    footprints: &[Footprint],
-    out: &mut [[f32; 4]],
+    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
 ) {
     // Level 0 is at most 2^22 per side (`MAX_SIDE`), so there are at most 23 levels.
     let levels = p.level_count().min(LEVELS);
@@ -253,8 +271,8 @@ fn run_in<P: Pyramid, const N: usize, const V: usize>(
         }
     };
     let d = s.descriptor();
-    let mut first = Pass::<N>::new(d.min_filter, s.address());
-    let mut second = Pass::<N>::new(d.min_filter, s.address());
+    let mut first = Pass::<N, T>::new(taps, s.address());
+    let mut second = Pass::<N, T>::new(taps, s.address());
     let mut delta = [0.0f32; N];
     let mut chunk = Chunk::<N>::new();
     let last = levels - 1;
@@ -273,7 +291,7 @@ fn run_in<P: Pyramid, const N: usize, const V: usize>(
             }
             MipmapFilterMode::Linear => {
                 for (k, &lod) in chunk.lod[..n].iter().enumerate() {
-                    let (l, t) = mip::linear_levels(lod, last);
+                    let (l, t) = mip::linear_levels_staged(lod, last);
                     first.level[k] = l as u8;
                     second.level[k] = (l as u8 + 1).min(last as u8);
                     delta[k] = t;
@@ -285,9 +303,9 @@ fn run_in<P: Pyramid, const N: usize, const V: usize>(
             let l = l as usize & (LEVELS - 1);
             (dims_w[l], dims_h[l])
         };
-        first.coordinates(size, &chunk);
+        first.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
         if trilinear {
-            second.coordinates(size, &chunk);
+            second.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
         }
         for k in 0..n {
             let uv = chunk.uv(k);
@@ -310,8 +328,8 @@ fn run_in<P: Pyramid, const N: usize, const V: usize>(
 pub(crate) struct Probes {
     /// The probes' coordinates (`lod` unused), written by the caller for the first `at.n`.
     pub at: Chunk<CHUNK>,
-    fine: Pass<CHUNK>,
-    next: Pass<CHUNK>,
+    fine: Pass<CHUNK, Bilinear>,
+    next: Pass<CHUNK, Bilinear>,
 }
 
 impl Probes {
@@ -319,8 +337,8 @@ impl Probes {
     pub(crate) fn new(addr: Address) -> Self {
         Probes {
             at: Chunk::new(),
-            fine: Pass::new(FilterMode::Linear, addr),
-            next: Pass::new(FilterMode::Linear, addr),
+            fine: Pass::new(Bilinear, addr),
+            next: Pass::new(Bilinear, addr),
         }
     }
 
@@ -333,7 +351,7 @@ impl Probes {
     /// and the blend weight from [`mip::linear_levels`]; the coarser level read only when weighed,
     /// as in [`mip::trilinear`]): stages 2 and 3 of [`run`] with every probe in the same levels,
     /// so their views are made once. Bit for bit the sum of [`mip::trilinear`] per probe, in order.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn trilinear_sum<P: Pyramid>(&mut self, p: &P, (k, delta): (usize, f32)) -> Vec4 {
         let last = p.level_count() - 1;
         let coarse = delta > 0.0 && k < last;
@@ -345,10 +363,11 @@ impl Probes {
             (w as f32, h as f32)
         };
         let fine_size = size_of(&fine_level);
-        self.fine.coordinates(|_| fine_size, &self.at);
+        let (us, vs) = (&self.at.u[..n], &self.at.v[..n]);
+        self.fine.coordinates(|_| fine_size, us, vs);
         if coarse {
             let next_size = size_of(&next_level);
-            self.next.coordinates(|_| next_size, &self.at);
+            self.next.coordinates(|_| next_size, us, vs);
         }
         let mut sum = Vec4::ZERO;
         for i in 0..n {

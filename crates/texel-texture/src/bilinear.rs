@@ -19,8 +19,10 @@
 use glam::{Vec2, Vec4};
 
 use crate::address::Address;
+use crate::batch::Taps;
 use crate::fetch::Fetch;
 use crate::floor::floor_index;
+use crate::mip::LevelFilter;
 
 /// `a + (b - a) * t`: the one interpolation every filter blends with (bilinear's three, the
 /// lerp between mip levels, the ripmap's and EWA's level blends).
@@ -36,11 +38,14 @@ pub(crate) fn blend([t00, t10, t01, t11]: [Vec4; 4], a: f32, b: f32) -> Vec4 {
     lerp(lerp(t00, t10, a), lerp(t01, t11, a), b)
 }
 
+/// The offset of the first tap in texels: bilinear's taps start half a texel before the sample point (texel centres sit at half-integers).
+pub(crate) const HALF: f32 = 0.5;
+
 /// The continuous texel coordinate of the top-left tap along one axis: `u * n - 1/2` for a level
 /// `n` texels long (texel centres sit at half-integers).
 #[inline(always)]
 pub(crate) fn origin(u: f32, n: f32) -> f32 {
-    u * n - 0.5
+    u * n - HALF
 }
 
 /// Read texel `(i, j)` if both indices survived wrapping, else the border colour.
@@ -80,4 +85,25 @@ pub(crate) fn bilinear<F: Fetch>(level: &F, addr: &Address, uv: Vec2) -> Vec4 {
         ]
     };
     blend(quad, a, b)
+}
+
+/// Bilinear as a type: the one-sample filter ([`LevelFilter`]) and its staged form for the batched
+/// path (`batch.rs`'s `Taps`: the same origin, blend and edge filter).
+#[derive(Clone, Copy)]
+pub(crate) struct Bilinear;
+
+impl LevelFilter for Bilinear {
+    #[inline(always)]
+    fn filter<F: Fetch>(self, level: &F, addr: &Address, uv: Vec2) -> Vec4 {
+        bilinear(level, addr, uv)
+    }
+}
+
+impl Taps for Bilinear {
+    const HALF: f32 = HALF;
+    const REACH: f32 = 1.0;
+    #[inline(always)]
+    fn inside<F: Fetch>(level: &F, i: u32, j: u32, (a, b): (f32, f32)) -> Vec4 {
+        blend(level.quad(i, j), a, b)
+    }
 }

@@ -83,12 +83,12 @@ use std::sync::OnceLock;
 use glam::{DVec2, Vec2, Vec4};
 
 use crate::address::{Address, AddressMode};
-use crate::bilinear::{bilinear, lerp, texel_or_border};
+use crate::bilinear::{bilinear, lerp, texel_or_border, Bilinear};
 use crate::fetch::{Fetch, Pyramid};
 use crate::floor::{ceil_f64, floor_f64};
 use crate::footprint::{lod_from_rho, Query};
 use crate::mip::{linear_levels, trilinear};
-use crate::sampler::{FilterMode, Sampler};
+use crate::sampler::Sampler;
 
 /// Entries of the Gaussian weight table, indexed by `floor(r^2 * LUT_SIZE)` for `r^2` in `[0, 1)`.
 pub const LUT_SIZE: usize = 128;
@@ -455,7 +455,7 @@ pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Sampler, q: &Query, max: f32) -> Vec4 {
     let (w0, h0) = p.level(0).size();
     let (px, py) = q.fp.texel_axes(w0, h0);
     let Some(e) = Ellipse::from_axes(px, py, max) else {
-        return trilinear(p, &FilterMode::Linear, &addr, q);
+        return trilinear(p, Bilinear, &addr, q);
     };
     let lod = lod_from_rho(e.minor as f32, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
     let last = p.level_count() - 1;
@@ -494,7 +494,7 @@ pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Sampler, q: &Query, max: f32) -> Vec4 {
 mod tests {
     use super::*;
     use crate::footprint::Footprint;
-    use crate::sampler::SamplerDescriptor;
+    use crate::sampler::{FilterMode, SamplerDescriptor};
 
     /// An ellipse far larger than the texture ends at the 1x1 level, which is read once (it used
     /// to be revisited up to the 4096-texel area cap), and equals that level's texel.

@@ -125,7 +125,13 @@ impl<D: Decode> Fetch for Level<'_, D> {
     #[inline(always)]
     fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
         let (r0, r1) = rows2(self.texels, self.width, i, j);
-        [r0[0], r0[1], r1[0], r1[1]].map(|t| self.decode.decode(t))
+        let d = &self.decode;
+        [
+            d.decode(r0[0]),
+            d.decode(r0[1]),
+            d.decode(r1[0]),
+            d.decode(r1[1]),
+        ]
     }
 }
 

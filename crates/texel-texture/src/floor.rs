@@ -28,6 +28,21 @@ pub fn floor_index(x: f32) -> i64 {
     t.saturating_sub(i64::from((t as f32) > x))
 }
 
+/// `floor(x)` for `0 <= x < 2^31`, as an integer and as an `f32` (truncation is the floor there);
+/// NaN gives 0. The scalar form of [`floor_nonneg_staged`].
+#[inline(always)]
+pub fn floor_nonneg(x: f32) -> (i32, f32) {
+    let k = x as i32;
+    (k, k as f32)
+}
+
+/// [`floor_nonneg`] staged: for `0 <= x <= hi`, `1 <= hi <=` [`STAGED_F32_LIMIT`], NaN giving 0,
+/// through [`floor_clamped`] (no conversion, so loops over many values vectorise).
+#[inline(always)]
+pub fn floor_nonneg_staged(x: f32, hi: f32) -> (i32, f32) {
+    floor_clamped(if x.is_nan() { 0.0 } else { x }, hi)
+}
+
 /// `ceil(x)` as an `i32` for `|x| < 2^31`; NaN gives 0, larger values saturate.
 ///
 /// Used where a count or a level is rounded up: the Vulkan nearest-level rule
@@ -155,6 +170,19 @@ mod tests {
         assert_eq!(floor_index(f32::NAN), 0);
         assert_eq!(floor_index(f32::INFINITY), i64::MAX);
         assert_eq!(floor_index(f32::NEG_INFINITY), i64::MIN);
+    }
+
+    #[test]
+    fn nonneg_floors_are_the_floor() {
+        for x in samples().into_iter().filter(|x| (0.0..1e9).contains(x)) {
+            assert_eq!(floor_nonneg(x), (x.floor() as i32, x.floor()), "x = {x}");
+            if x <= STAGED_F32_LIMIT {
+                let hi = STAGED_F32_LIMIT;
+                assert_eq!(floor_nonneg_staged(x, hi), (x.floor() as i32, x.floor()));
+            }
+        }
+        assert_eq!(floor_nonneg(f32::NAN), (0, 0.0));
+        assert_eq!(floor_nonneg_staged(f32::NAN, 4.0), (0, 0.0));
     }
 
     #[test]

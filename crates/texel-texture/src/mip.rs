@@ -17,7 +17,7 @@ use crate::address::Address;
 use crate::bicubic::bicubic;
 use crate::bilinear::{bilinear, lerp};
 use crate::fetch::{Fetch, Pyramid};
-use crate::floor::{ceil_i32, floor_clamped};
+use crate::floor::{ceil_i32, floor_nonneg, floor_nonneg_staged};
 use crate::footprint::Query;
 use crate::nearest::nearest;
 use crate::sampler::FilterMode;
@@ -54,33 +54,69 @@ pub fn nearest_level(lod: f32, last: usize) -> usize {
 /// The Vulkan linear-level rule: the finer level `floor(d)` and the blend weight `d - floor(d)`
 /// toward level `floor(d) + 1`, with `d = clamp(lod, 0, last)`. NaN gives level 0 and a NaN weight,
 /// which reads level 0 only (the weight fails every `delta > 0` test).
-///
-/// Branch-free (selects and [`floor_clamped`], no conversion), so the batched path's loop over a
-/// chunk of lods vectorises; the one-sample path calls the same function.
 #[inline(always)]
 pub(crate) fn linear_levels(lod: f32, last: usize) -> (usize, f32) {
-    let top = last as f32;
-    let d = lod.clamp(0.0, top);
-    // `top >= 1` for `floor_clamped`; with one level `d` is 0 and so is its floor.
-    let (k, fk) = floor_clamped(if d.is_nan() { 0.0 } else { d }, top.max(1.0));
+    linear_levels_by(lod, last, floor_nonneg)
+}
+
+/// [`linear_levels`] for the batched path's level stage: the same rule with the staged floor, so
+/// a loop over a chunk of lods vectorises.
+#[inline(always)]
+pub(crate) fn linear_levels_staged(lod: f32, last: usize) -> (usize, f32) {
+    let top = (last as f32).max(1.0);
+    linear_levels_by(lod, last, |d| floor_nonneg_staged(d, top))
+}
+
+/// The linear-level rule with `floor`, a floor for `[0, last]` that maps NaN to 0.
+#[inline(always)]
+fn linear_levels_by(lod: f32, last: usize, floor: impl Fn(f32) -> (i32, f32)) -> (usize, f32) {
+    let d = lod.clamp(0.0, last as f32);
+    let (k, fk) = floor(d);
     (k as usize, d - fk)
 }
 
-/// Nearest-level mipmapping: `mode` in level [`nearest_level`] of `q.lod`.
-#[inline]
-pub(crate) fn mip_nearest<P: Pyramid>(p: &P, mode: &FilterMode, addr: &Address, q: &Query) -> Vec4 {
-    let level = nearest_level(q.lod, p.level_count() - 1);
-    filter_level(mode, &p.level(level), addr, q.uv())
+/// A filter inside one level at a normalised point: the kernels' own types (`bilinear::Bilinear`,
+/// `nearest::Point`) resolve at compile time, a `&FilterMode` at run time ([`filter_level`]).
+/// The mip rules below are generic over it, so each caller's filter is compiled into them (the
+/// anisotropic probes' bilinear costs no dispatch).
+pub(crate) trait LevelFilter: Copy {
+    /// Filter `level` at `uv` under `addr`.
+    fn filter<F: Fetch>(self, level: &F, addr: &Address, uv: Vec2) -> Vec4;
 }
 
-/// Trilinear (linear-between-levels) mipmapping at `q.lod` with `mode` inside each level.
+impl LevelFilter for &FilterMode {
+    #[inline(always)]
+    fn filter<F: Fetch>(self, level: &F, addr: &Address, uv: Vec2) -> Vec4 {
+        filter_level(self, level, addr, uv)
+    }
+}
+
+/// Nearest-level mipmapping: `filter` in level [`nearest_level`] of `q.lod`.
 #[inline]
-pub(crate) fn trilinear<P: Pyramid>(p: &P, mode: &FilterMode, addr: &Address, q: &Query) -> Vec4 {
+pub(crate) fn mip_nearest<P: Pyramid>(
+    p: &P,
+    filter: impl LevelFilter,
+    addr: &Address,
+    q: &Query,
+) -> Vec4 {
+    let level = nearest_level(q.lod, p.level_count() - 1);
+    filter.filter(&p.level(level), addr, q.uv())
+}
+
+/// Trilinear (linear-between-levels) mipmapping at `q.lod` with `filter` inside each level: the
+/// levels and weight of [`linear_levels`], the coarser level read only when weighed.
+#[inline]
+pub(crate) fn trilinear<P: Pyramid>(
+    p: &P,
+    filter: impl LevelFilter,
+    addr: &Address,
+    q: &Query,
+) -> Vec4 {
     let last = p.level_count() - 1;
     let (k, delta) = linear_levels(q.lod, last);
-    let a = filter_level(mode, &p.level(k), addr, q.uv());
+    let a = filter.filter(&p.level(k), addr, q.uv());
     if delta > 0.0 && k < last {
-        lerp(a, filter_level(mode, &p.level(k + 1), addr, q.uv()), delta)
+        lerp(a, filter.filter(&p.level(k + 1), addr, q.uv()), delta)
     } else {
         a
     }
@@ -121,7 +157,8 @@ mod tests {
 mod level_tests {
     use super::*;
 
-    /// The staged linear rule equals its definition with libm's floor, NaN and the edges included.
+    /// Both forms of the linear rule equal its definition with libm's floor, NaN and the edges
+    /// included.
     #[test]
     fn linear_levels_match_the_float_formula() {
         for last in [0usize, 1, 5, 12] {
@@ -129,14 +166,18 @@ mod level_tests {
                 let lod = k as f32 * 0.0123;
                 for lod in [lod, f32::from_bits(lod.to_bits() + 1)] {
                     let d = lod.clamp(0.0, last as f32);
-                    let (level, delta) = linear_levels(lod, last);
-                    assert_eq!(level, d.floor() as usize, "lod {lod} last {last}");
-                    assert_eq!(delta.to_bits(), (d - d.floor()).to_bits(), "lod {lod}");
+                    for rule in [linear_levels, linear_levels_staged] {
+                        let (level, delta) = rule(lod, last);
+                        assert_eq!(level, d.floor() as usize, "lod {lod} last {last}");
+                        assert_eq!(delta.to_bits(), (d - d.floor()).to_bits(), "lod {lod}");
+                    }
                 }
             }
-            let (level, delta) = linear_levels(f32::NAN, last);
-            assert_eq!(level, 0);
-            assert!(delta.is_nan());
+            for rule in [linear_levels, linear_levels_staged] {
+                let (level, delta) = rule(f32::NAN, last);
+                assert_eq!(level, 0);
+                assert!(delta.is_nan());
+            }
         }
     }
 }

@@ -7,9 +7,14 @@
 use glam::{Vec2, Vec4};
 
 use crate::address::Address;
+use crate::batch::Taps;
 use crate::bilinear::texel_or_border;
 use crate::fetch::Fetch;
 use crate::floor::floor_index;
+use crate::mip::LevelFilter;
+
+/// The offset of the first tap in texels: nearest reads the texel containing the sample point: no offset.
+pub(crate) const HALF: f32 = 0.0;
 
 /// The continuous texel coordinate whose floor is the texel read along one axis: `u * n` for a
 /// level `n` texels long.
@@ -31,4 +36,25 @@ pub(crate) fn nearest<F: Fetch>(level: &F, addr: &Address, uv: Vec2) -> Vec4 {
         return level.texel(i as u32, j as u32);
     }
     texel_or_border(level, addr, addr.u.wrap(i, w), addr.v.wrap(j, h))
+}
+
+/// Nearest as a type: the one-sample filter ([`LevelFilter`]) and its staged form for the batched
+/// path (`batch.rs`'s `Taps`: the same origin, one texel, and the edge filter).
+#[derive(Clone, Copy)]
+pub(crate) struct Point;
+
+impl LevelFilter for Point {
+    #[inline(always)]
+    fn filter<F: Fetch>(self, level: &F, addr: &Address, uv: Vec2) -> Vec4 {
+        nearest(level, addr, uv)
+    }
+}
+
+impl Taps for Point {
+    const HALF: f32 = HALF;
+    const REACH: f32 = 0.0;
+    #[inline(always)]
+    fn inside<F: Fetch>(level: &F, i: u32, j: u32, _: (f32, f32)) -> Vec4 {
+        level.texel(i, j)
+    }
 }

@@ -58,6 +58,7 @@ use crate::address::{Address, AddressMode, BorderColor};
 use crate::aniso::{anisotropic, filter_planned, plan_chunk, Plan};
 use crate::batch::{self, Chunk, Probes};
 use crate::bicubic::Cubic;
+use crate::bilinear::Bilinear;
 use crate::error::TextureError;
 use crate::ewa::ewa;
 use crate::fetch::{with_pyramid, Counted, Fetch, Pyramid};
@@ -468,21 +469,22 @@ impl Sampler {
         if q.lod <= 0.0 {
             return filter_level(&d.mag_filter, &p.level(0), addr, q.uv());
         }
+        let min = &d.min_filter;
         match self.technique {
             Technique::Mip => match d.mipmap_filter {
-                MipmapFilterMode::None => filter_level(&d.min_filter, &p.level(0), addr, q.uv()),
-                MipmapFilterMode::Nearest => mip_nearest(p, &d.min_filter, addr, q),
-                MipmapFilterMode::Linear => trilinear(p, &d.min_filter, addr, q),
+                MipmapFilterMode::None => filter_level(min, &p.level(0), addr, q.uv()),
+                MipmapFilterMode::Nearest => mip_nearest(p, min, addr, q),
+                MipmapFilterMode::Linear => trilinear(p, min, addr, q),
             },
             Technique::Anisotropic => anisotropic(p, self, q),
             Technique::Ewa(max) => ewa(p, self, q, max),
             Technique::Ripmap => match p.texture().ripmap() {
                 Ok(r) => ripmap(p, r, self, q),
-                Err(_) => trilinear(p, &FilterMode::Linear, addr, q),
+                Err(_) => trilinear(p, Bilinear, addr, q),
             },
             Technique::SummedArea => match p.texture().summed_area_table() {
                 Ok(t) => summed_area(p, t, self, q),
-                Err(_) => trilinear(p, &FilterMode::Linear, addr, q),
+                Err(_) => trilinear(p, Bilinear, addr, q),
             },
         }
     }
