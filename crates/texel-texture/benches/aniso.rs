@@ -21,21 +21,13 @@ use texel_texture::{
 const SIZE: u32 = 2048;
 const BATCH: usize = 4096;
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+use texel_texture::rng::SplitMix64 as Rng;
 
 fn texels() -> Vec<[u8; 4]> {
-    let mut rng = Rng(42);
+    let mut rng = Rng::new(42);
     (0..SIZE * SIZE)
         .map(|_| {
-            let b = (rng.next() * 255.0) as u8;
+            let b = (rng.next_f32() * 255.0) as u8;
             [b, b.wrapping_mul(3), b.wrapping_add(90), 255]
         })
         .collect()
@@ -43,16 +35,16 @@ fn texels() -> Vec<[u8; 4]> {
 
 /// `BATCH` footprints: minor axis 2 texels, major `2 * ratio`, random angle and position.
 fn footprints(ratio: f32) -> Vec<Footprint> {
-    let mut rng = Rng(7 + ratio as u64);
+    let mut rng = Rng::new(7 + ratio as u64);
     let s = SIZE as f32;
     (0..BATCH)
         .map(|_| {
-            let a = rng.next() * std::f32::consts::TAU;
+            let a = rng.next_f32() * std::f32::consts::TAU;
             let d = Vec2::new(a.cos(), a.sin());
             let (px, py) = (d * 2.0 * ratio, d.perp() * 2.0);
             Footprint {
-                u: rng.next(),
-                v: rng.next(),
+                u: rng.next_f32(),
+                v: rng.next_f32(),
                 dudx: px.x / s,
                 dvdx: px.y / s,
                 dudy: py.x / s,

@@ -100,13 +100,18 @@ pub struct Address {
 }
 
 impl Address {
+    /// Modes `u` and `v`, and `border` read outside under ClampToBorder.
+    pub fn new(u: AddressMode, v: AddressMode, border: BorderColor) -> Address {
+        Address {
+            u,
+            v,
+            border: Vec4::from_array(border.rgba()),
+        }
+    }
+
     /// The address modes and border colour of `desc`.
     pub fn of(desc: &crate::SamplerDescriptor) -> Address {
-        Address {
-            u: desc.address_mode_u,
-            v: desc.address_mode_v,
-            border: Vec4::from_array(desc.border_color.rgba()),
-        }
+        Address::new(desc.address_mode_u, desc.address_mode_v, desc.border_color)
     }
 }
 

@@ -45,13 +45,13 @@
 //!
 //! | filter | RMS error | texels read per sample (mean) |
 //! |---|---|---|
-//! | trilinear | 0.0230 | 8.0 |
-//! | anisotropic 16x | 0.0138 | 71.4 |
-//! | EWA | 0.0119 | 87.4 |
+//! | trilinear | 0.0252 | 8.0 |
+//! | anisotropic 16x | 0.0158 | 72.3 |
+//! | EWA | 0.0121 | 91.1 |
 //!
 //! Rotation invariance (`ewa_circular_footprint_is_rotation_invariant`, circular footprints of
 //! radius 1.5 to 5.5 texels on a radial cosine of period 64 texels, texture rotated 30 degrees):
-//! relative difference RMS 0.52 %, worst 2.6 % (trilinear: 0.37 %, 2.2 %). Known weakness: at the
+//! relative difference RMS 0.41 %, worst 1.5 % (trilinear: 0.32 %, 1.5 %). Known weakness: at the
 //! coarse level of the lerp the ellipse holds only about 4 to 15 texels, so the discrete kernel's
 //! centroid and effective blur vary with the sub-texel position; a level one finer would cost 4x the
 //! reads.
@@ -72,7 +72,8 @@
 //! anisotropic 16x there (ground scene, 640x360, 256 spp: EWA 23.5 dB, aniso16 29.8 dB). Matching the
 //! box's variance (`ALPHA = 6`, sigma^2 = 1/12 pixel^2) raised EWA to 27.5 dB but left only about one
 //! texel per standard deviation at the chosen level: rotation invariance fell to 1.5 % RMS (worst 7 %)
-//! and the RMS error against its own brute-force Gaussian rose from 0.0119 to 0.0196, behind aniso16.
+//! and the RMS error against its own brute-force Gaussian rose from 0.0119 to 0.0196, behind aniso16
+//! (figures of an earlier noise texture, where pbrt's falloff scored 0.0119).
 //! Keeping it would need a level one finer (4x the reads); pbrt's falloff stays.
 //!
 //! Cost: throughput and texels read per sample at anisotropy ratios 1 to 64 are in README.md's

@@ -241,16 +241,19 @@ pub(crate) fn log2_normal(x: f32) -> f32 {
 mod tests {
     use super::*;
 
+    /// Axes of 4 and 2 texels on a 256 x 256 texture, along x and y.
+    const AXES_4_BY_2: Footprint = Footprint {
+        u: 0.5,
+        v: 0.5,
+        dudx: 4.0 / 256.0,
+        dudy: 0.0,
+        dvdx: 0.0,
+        dvdy: 1.0 / 128.0,
+    };
+
     #[test]
     fn rho_and_axes() {
-        let f = Footprint {
-            u: 0.5,
-            v: 0.5,
-            dudx: 4.0 / 256.0,
-            dudy: 0.0,
-            dvdx: 0.0,
-            dvdy: 1.0 / 128.0,
-        };
+        let f = AXES_4_BY_2;
         assert_eq!(f.rho(256, 256), 4.0);
         let a = f.axes(256, 256);
         assert_eq!(a.major, Vec2::new(4.0, 0.0));
@@ -311,14 +314,7 @@ mod tests {
 
     #[test]
     fn squared_lod_matches_rho_lod() {
-        let f = Footprint {
-            u: 0.5,
-            v: 0.5,
-            dudx: 4.0 / 256.0,
-            dudy: 0.0,
-            dvdx: 0.0,
-            dvdy: 1.0 / 128.0,
-        };
+        let f = AXES_4_BY_2;
         assert_eq!(rho_squared(&f, 256, 256), 16.0);
         assert_eq!(lod_from_rho_squared(16.0, 0.0, 0.0, 32.0), 2.0);
         assert_eq!(lod_from_rho_squared(16.0, 0.5, 0.0, 32.0), 2.5);

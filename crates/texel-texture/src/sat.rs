@@ -393,18 +393,7 @@ pub(crate) fn summed_area<P: Pyramid>(p: &P, t: &SummedAreaTable, s: &Sampler, q
 mod tests {
     use super::*;
     use crate::address::BorderColor;
-    use crate::sampler::SamplerDescriptor;
     use crate::texture::{Format, Limits};
-
-    /// How `u`, `v` and `border` extend the texture, as a sampler with them would.
-    fn ext(u: AddressMode, v: AddressMode, border: BorderColor) -> Address {
-        Address::of(&SamplerDescriptor {
-            address_mode_u: u,
-            address_mode_v: v,
-            border_color: border,
-            ..SamplerDescriptor::default()
-        })
-    }
 
     fn ramp4() -> Texture {
         Texture::from_fn(4, 1, Format::Rgba32Float, &Limits::default(), |i, _| {
@@ -424,7 +413,7 @@ mod tests {
         let m = t.box_mean(
             [3.5, 5.0],
             [0.0, 1.0],
-            &ext(
+            &Address::new(
                 AddressMode::Repeat,
                 AddressMode::Repeat,
                 BorderColor::TransparentBlack,
@@ -461,7 +450,7 @@ mod tests {
             let m = t.box_mean(
                 [x0, x1],
                 [0.0, 1.0],
-                &ext(mode, Repeat, BorderColor::TransparentBlack),
+                &Address::new(mode, Repeat, BorderColor::TransparentBlack),
             );
             assert!(
                 (m[0] - want).abs() < 1e-9,
@@ -473,7 +462,7 @@ mod tests {
         let m = t.box_mean(
             [-2.0, 2.0],
             [0.0, 1.0],
-            &ext(ClampToBorder, Repeat, BorderColor::OpaqueWhite),
+            &Address::new(ClampToBorder, Repeat, BorderColor::OpaqueWhite),
         );
         assert!((m[0] - (1.0 + 2.0) / 4.0).abs() < 1e-12 && (m[3] - 1.0).abs() < 1e-12);
     }
@@ -484,16 +473,23 @@ mod tests {
         let t = tex.summed_area_table().unwrap();
         let r = AddressMode::Repeat;
         let b = BorderColor::TransparentBlack;
-        let m = t.box_mean([2.5, 2.5], [0.5, 0.5], &ext(r, r, b));
+        let m = t.box_mean([2.5, 2.5], [0.5, 0.5], &Address::new(r, r, b));
         assert!((m[0] - 2.0).abs() < 1e-6);
-        assert!(t.box_mean([f64::NAN, 1.0], [0.0, 1.0], &ext(r, r, b))[0].is_nan());
-        assert!(t.box_mean([0.0, f64::INFINITY], [0.0, 1.0], &ext(r, r, b))[0].is_nan());
-        let m = t.box_mean([-1e15, 1e15], [0.0, 1.0], &ext(r, r, b));
+        assert!(t.box_mean([f64::NAN, 1.0], [0.0, 1.0], &Address::new(r, r, b))[0].is_nan());
+        assert!(t.box_mean([0.0, f64::INFINITY], [0.0, 1.0], &Address::new(r, r, b))[0].is_nan());
+        let m = t.box_mean([-1e15, 1e15], [0.0, 1.0], &Address::new(r, r, b));
         assert!((m[0] - 1.5).abs() < 1e-6);
         for mode in [AddressMode::ClampToEdge, AddressMode::ClampToBorder] {
-            assert!(t.box_mean([-1e12, 1e12], [-1e12, 1e12], &ext(mode, mode, b))[0].is_finite());
+            assert!(
+                t.box_mean([-1e12, 1e12], [-1e12, 1e12], &Address::new(mode, mode, b))[0]
+                    .is_finite()
+            );
             // Overflowing areas may give NaN, but never panic.
-            let _ = t.box_mean([-1e300, 1e300], [-1e300, 1e300], &ext(mode, mode, b));
+            let _ = t.box_mean(
+                [-1e300, 1e300],
+                [-1e300, 1e300],
+                &Address::new(mode, mode, b),
+            );
         }
     }
 }

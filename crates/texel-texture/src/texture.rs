@@ -113,6 +113,12 @@ impl Limits {
     ) -> Result<(), TextureError> {
         self.check(width, height, stored_format(color))?;
         let bytes = Self::load_bytes(file_bytes, width, height, color);
+        self.check_bytes(width, height, bytes)
+    }
+
+    /// `Err(OverMemoryLimit)` with the figures if `bytes` for a `width x height` image exceed
+    /// [`Limits::max_bytes`].
+    fn check_bytes(&self, width: u32, height: u32, bytes: u64) -> Result<(), TextureError> {
         if bytes > self.max_bytes {
             return Err(TextureError::OverMemoryLimit {
                 width,
@@ -145,15 +151,7 @@ impl Limits {
             .checked_mul(format.texel_bytes())
             .and_then(|b| b.checked_add((texels - level0).checked_mul(16)?))
             .unwrap_or(u64::MAX);
-        if bytes > self.max_bytes {
-            return Err(TextureError::OverMemoryLimit {
-                width,
-                height,
-                bytes,
-                max: self.max_bytes,
-            });
-        }
-        Ok(())
+        self.check_bytes(width, height, bytes)
     }
 }
 

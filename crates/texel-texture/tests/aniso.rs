@@ -11,31 +11,13 @@ use texel_texture::{
     SamplerDescriptor, Texture, TextureError,
 };
 
-/// How `u`, `v` and `border` extend the texture, as a sampler with them would.
-fn ext(u: AddressMode, v: AddressMode, border: BorderColor) -> Address {
-    Address::of(&SamplerDescriptor {
-        address_mode_u: u,
-        address_mode_v: v,
-        border_color: border,
-        ..SamplerDescriptor::default()
-    })
-}
-
-/// Deterministic uniform noise in [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+/// Deterministic uniform noise in [0, 1): the project's one generator.
+use texel_texture::rng::SplitMix64 as Rng;
 
 fn noise_texture(w: u32, h: u32, format: Format, seed: u64) -> Texture {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let texels: Vec<[f32; 4]> = (0..w * h)
-        .map(|_| [rng.next(), rng.next(), rng.next(), 1.0])
+        .map(|_| [rng.next_f32(), rng.next_f32(), rng.next_f32(), 1.0])
         .collect();
     Texture::from_fn(w, h, format, &Limits::default(), |i, j| {
         texels[(j * w + i) as usize]
@@ -250,7 +232,7 @@ fn ewa_circular_footprint_is_rotation_invariant() {
     // sampling the rotated texture at p is sampling this one at R(30) p, with the footprint's
     // axes rotated too: a circular EWA footprint must give the same value. "Within 1 %" is the
     // RMS relative difference over 200 random points and radii; single points differ by up to
-    // about 2.6 % (EWA's discrete kernel at the coarse level holds only a few texels, so its
+    // about 1.5 % (EWA's discrete kernel at the coarse level holds only a few texels, so its
     // effective blur varies with the sub-texel position; trilinear shows the same effect). The
     // worst case is bounded at 4 %.
     let n = 256u32;
@@ -263,12 +245,12 @@ fn ewa_circular_footprint_is_rotation_invariant() {
     .unwrap();
     let rot = glam::Mat2::from_angle(30f32.to_radians());
     let measure = |s: &Sampler| {
-        let mut rng = Rng(11);
+        let mut rng = Rng::new(11);
         let (mut worst, mut sum2) = (0.0f32, 0.0f32);
         for _ in 0..200 {
-            let p = Vec2::new(rng.next() - 0.5, rng.next() - 0.5) * 120.0;
-            let radius = 1.5 + 4.0 * rng.next();
-            let (px, py) = axes(radius, 1.0, rng.next() * 6.3);
+            let p = Vec2::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5) * 120.0;
+            let radius = 1.5 + 4.0 * rng.next_f32();
+            let (px, py) = axes(radius, 1.0, rng.next_f32() * 6.3);
             let at = |p: Vec2, px: Vec2, py: Vec2| {
                 let uv = (p + Vec2::splat(c)) / n as f32;
                 s.sample(&tex, &footprint(uv.x, uv.y, px, py, n, n))[0]
@@ -338,8 +320,8 @@ proptest! {
     ) {
         // Texels in [0.1, 1] so that "relative" is meaningful; the border is white.
         let format = if srgb { Format::Rgba8Srgb } else { Format::Rgba32Float };
-        let mut rng = Rng(5);
-        let vals: Vec<f32> = (0..13 * 7 * 3).map(|_| 0.1 + 0.9 * rng.next()).collect();
+        let mut rng = Rng::new(5);
+        let vals: Vec<f32> = (0..13 * 7 * 3).map(|_| 0.1 + 0.9 * rng.next_f32()).collect();
         let tex = Texture::from_fn(13, 7, format, &Limits::default(), |i, j| {
             let k = ((j * 13 + i) * 3) as usize;
             [vals[k], vals[k + 1], vals[k + 2], 1.0]
@@ -351,7 +333,7 @@ proptest! {
         };
         let rect = (x0, y0, x0 + bw, y0 + bh);
         let table = tex.summed_area_table().unwrap();
-        let got = table.box_mean([rect.0, rect.2], [rect.1, rect.3], &ext(mu, mv, BorderColor::OpaqueWhite));
+        let got = table.box_mean([rect.0, rect.2], [rect.1, rect.3], &Address::new(mu, mv, BorderColor::OpaqueWhite));
         let want = brute_box_mean(&tex, rect, mu, mv, [1.0; 4]);
         for c in 0..4 {
             prop_assert!((got[c] - want[c]).abs() <= 1e-6 * want[c].abs(),
@@ -374,7 +356,7 @@ fn summed_area_repeat_across_the_edge() {
         let got = t.box_mean(
             [rect.0, rect.2],
             [rect.1, rect.3],
-            &ext(r, r, BorderColor::TransparentBlack),
+            &Address::new(r, r, BorderColor::TransparentBlack),
         );
         let want = brute_box_mean(&tex, rect, r, r, [0.0; 4]);
         for c in 0..3 {
@@ -442,10 +424,10 @@ fn ripmap_and_sat_blur_not_alias_at_45_degrees() {
     .unwrap();
     let (px, py) = axes(2.0, 16.0, std::f32::consts::FRAC_PI_4);
     let spread = |s: &Sampler| {
-        let mut rng = Rng(21);
+        let mut rng = Rng::new(21);
         let mut dev = 0.0f32;
         for _ in 0..200 {
-            let (u, v) = (rng.next(), rng.next());
+            let (u, v) = (rng.next_f32(), rng.next_f32());
             let c = s.sample(&tex, &footprint(u, v, px, py, n, n))[0];
             dev = dev.max((c - 0.5).abs());
         }
@@ -515,13 +497,13 @@ fn ewa_and_aniso_beat_trilinear_against_brute_force_gaussian() {
         .collect();
     let mut err2 = [0.0f64; 3];
     let mut reads = [0u64; 3];
-    let mut rng = Rng(99);
+    let mut rng = Rng::new(99);
     let count = 300;
     for _ in 0..count {
-        let (u, v) = (rng.next(), rng.next());
-        let minor = 1.5 + 4.5 * rng.next();
-        let ratio = 1.0 + 15.0 * rng.next();
-        let (px, py) = axes(minor, ratio, rng.next() * std::f32::consts::TAU);
+        let (u, v) = (rng.next_f32(), rng.next_f32());
+        let minor = 1.5 + 4.5 * rng.next_f32();
+        let ratio = 1.0 + 15.0 * rng.next_f32();
+        let (px, py) = axes(minor, ratio, rng.next_f32() * std::f32::consts::TAU);
         let fp = footprint(u, v, px, py, n, n);
         let want = brute_gaussian(
             &tex,

@@ -7,16 +7,6 @@ use texel_texture::{
     MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
 };
 
-/// How `u`, `v` and `border` extend the texture, as a sampler with them would.
-fn ext(u: AddressMode, v: AddressMode, border: BorderColor) -> Address {
-    Address::of(&SamplerDescriptor {
-        address_mode_u: u,
-        address_mode_v: v,
-        border_color: border,
-        ..SamplerDescriptor::default()
-    })
-}
-
 const ADDRESS_MODES: [AddressMode; 5] = [
     AddressMode::ClampToEdge,
     AddressMode::Repeat,
@@ -866,7 +856,7 @@ fn summed_area_far_beyond_clamped_edges_is_the_edge_texel() {
         let m = t.box_mean(
             [x, x + 1.0],
             [y, y + 1.0],
-            &ext(mode, mode, BorderColor::TransparentBlack),
+            &Address::new(mode, mode, BorderColor::TransparentBlack),
         );
         for c in 0..4 {
             assert!(
