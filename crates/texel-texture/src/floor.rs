@@ -1,4 +1,7 @@
-//! Rounding to integers, in one place: every floor and ceil the filters and the rasterizer use.
+//! Rounding to integers, in one place: every floor and ceil on the sampling paths (per sample) and
+//! in the rasterizer's span stages. Code off those paths keeps libm's `floor`: the pyramid's and
+//! ripmap's build-time taps, the summed-area table's `f64` box set-up (whose inputs may exceed the
+//! `2^63` these forms are exact to), the rasterizer's fixed-point snapping and the debug views.
 //!
 //! Why not `f32::floor`: the x86-64 baseline (SSE2, no SSE4.1 `roundss`) has no rounding
 //! instruction, so `floor`/`ceil` are calls into libm, a measurable share of a frame

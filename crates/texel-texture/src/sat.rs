@@ -104,8 +104,9 @@ fn clamp_terms(t: &mut Terms, n: f64, x: f64, sign: f64) {
     }
 }
 
-/// Terms of `sign * integral_0^x` of the `mode` extension of an axis of `n` texels.
-fn prefix_terms(t: &mut Terms, mode: AddressMode, n: f64, x: f64, sign: f64) {
+/// Terms of `sign * integral_0^x` of the `mode` extension of an axis of `n` texels
+/// (`extension = (mode, n)`).
+fn prefix_terms(t: &mut Terms, (mode, n): (AddressMode, f64), x: f64, sign: f64) {
     match mode {
         AddressMode::Repeat => {
             let q = (x / n).floor();
@@ -178,8 +179,8 @@ fn axis_terms(mode: AddressMode, n: u32, mut x0: f64, mut x1: f64) -> Terms {
     if mode == AddressMode::ClampToBorder {
         t.inside = x1.clamp(0.0, n) - x0.clamp(0.0, n);
     }
-    prefix_terms(&mut t, mode, n, x1, 1.0);
-    prefix_terms(&mut t, mode, n, x0, -1.0);
+    prefix_terms(&mut t, (mode, n), x1, 1.0);
+    prefix_terms(&mut t, (mode, n), x0, -1.0);
     t
 }
 
