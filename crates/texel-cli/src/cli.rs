@@ -61,6 +61,10 @@ pub enum Command {
     ///
     /// Example: texel bench ../shared/scenes/ground.toml --frames 10 --threads 2 --json
     Bench(BenchArgs),
+    /// List the Vulkan and GL adapters the GPU path (`render --gpu`) can use.
+    ///
+    /// Example: texel gpu-info
+    GpuInfo,
 }
 
 /// Where texture-space derivatives come from (see texel-raster).
@@ -141,6 +145,15 @@ pub struct RenderArgs {
     /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
+    /// Render on a Vulkan or GL device with texel's shaders (texel-gpu): nearest, bilinear,
+    /// mip-nearest, trilinear, aniso2-16 and bicubic; derivatives are the device's 2x2 quad
+    /// differences; colour views only.
+    #[arg(long)]
+    pub gpu: bool,
+    /// With --gpu: the adapter whose name contains NAME (see `texel gpu-info`; default: the
+    /// TEXEL_ADAPTER environment variable, else the first, real GPUs first).
+    #[arg(long, value_name = "NAME", requires = "gpu")]
+    pub adapter: Option<String>,
     /// Output PNG (`-` writes it to standard output).
     #[arg(short, long)]
     pub output: PathBuf,

@@ -1,6 +1,7 @@
 //! `texel render`: one filter (or a debug view), one PNG.
 
-use anyhow::Result;
+use anyhow::{bail, Result};
+use texel_gpu::{Gpu, GpuFilter};
 use texel_raster::{render, Derivatives, Perspective, View};
 
 use crate::cli::{ColorArg, DerivativesArg, PerspectiveArg, RenderArgs, ViewArg};
@@ -40,7 +41,20 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         ViewArg::Barycentric => View::Barycentric,
     };
     let draws = scene.draws(&samplers);
-    let frame = with_threads(args.threads, || render(&settings, &draws))??;
+    let frame = if args.gpu {
+        let name = filter.unwrap_or(Filter::Trilinear).name();
+        let Some(gpu_filter) = GpuFilter::from_name(name) else {
+            bail!(
+                "--gpu has no {name} filter; it renders {}",
+                GpuFilter::NAMES[..9].join(", ")
+            );
+        };
+        settings.derivatives = Derivatives::Quad;
+        let gpu = Gpu::new(args.adapter.as_deref())?;
+        texel_gpu::render(&gpu, &settings, &draws, gpu_filter)?
+    } else {
+        with_threads(args.threads, || render(&settings, &draws))??
+    };
     // Debug views hold display values meant for sRGB encoding whatever --color says.
     let color = if settings.view == View::Color {
         args.scene.color
@@ -48,4 +62,18 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         ColorArg::Srgb
     };
     write_png(&args.output, frame.width, frame.height, &frame.color, color)
+}
+
+/// Run `texel gpu-info`: every adapter, and which one `--gpu` would pick.
+pub fn gpu_info() -> Result<()> {
+    let all = texel_gpu::adapters();
+    if all.is_empty() {
+        bail!(texel_gpu::GpuError::NoAdapter);
+    }
+    for a in &all {
+        println!("{a}");
+    }
+    let gpu = Gpu::new(None)?;
+    println!("--gpu uses: {}", gpu.info().name);
+    Ok(())
 }

@@ -54,6 +54,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => cmd_demo::run(&args, &mut input),
         Command::Warp(args) => cmd_warp::run(&args, &mut input),
         Command::Mips(args) => cmd_mips::run(&args, &mut input),
+        Command::GpuInfo => cmd_render::gpu_info(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

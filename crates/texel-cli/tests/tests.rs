@@ -4,6 +4,7 @@
 mod compare;
 mod demo_bench;
 mod errors;
+mod gpu;
 mod help;
 mod hostile;
 mod meshes;

@@ -62,6 +62,6 @@ pub use sampler::{
 };
 pub use sat::SummedAreaTable;
 pub use texture::{
-    replace_non_finite, ColorSpace, Format, LevelInfo, Limits, LoadOptions, Loaded, Texture,
-    NON_FINITE_CLAMP,
+    replace_non_finite, ColorSpace, Format, LevelInfo, LevelTexels, Limits, LoadOptions, Loaded,
+    Texture, NON_FINITE_CLAMP,
 };

@@ -223,6 +223,15 @@ pub struct LevelInfo {
     pub offset: usize,
 }
 
+/// One level's stored texels ([`Texture::level_texels`]).
+#[derive(Clone, Copy, Debug)]
+pub enum LevelTexels<'a> {
+    /// 8-bit RGBA codes (decode RGB by the texture's colour space, alpha as `b / 255`).
+    Unorm8(&'a [[u8; 4]]),
+    /// Linear `f32` RGBA.
+    Float(&'a [[f32; 4]]),
+}
+
 #[derive(Clone, Debug)]
 pub(crate) enum Storage {
     U8(Vec<[u8; 4]>),
@@ -598,6 +607,18 @@ impl Texture {
             bytes,
             max: self.limits.max_bytes,
         }
+    }
+
+    /// The stored texels of level `level`, row-major, in the texture's own format (8-bit codes,
+    /// sRGB or linear as [`Texture::format`] says, or linear floats): what a GPU upload needs to
+    /// filter the very texels the CPU filters. `None` past the last level.
+    pub fn level_texels(&self, level: usize) -> Option<LevelTexels<'_>> {
+        let info = self.levels.get(level)?;
+        let range = info.offset..info.offset + info.width as usize * info.height as usize;
+        Some(match &self.storage {
+            Storage::U8(v) => LevelTexels::Unorm8(&v[range]),
+            Storage::F32(v) => LevelTexels::Float(&v[range]),
+        })
     }
 
     /// The storage format.

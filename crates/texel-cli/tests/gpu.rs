@@ -1,0 +1,85 @@
+//! `render --gpu` and `gpu-info`. The rendering tests need a Vulkan or GL adapter (Mesa's lavapipe:
+//! `apt-get install mesa-vulkan-drivers`); without one they print why and pass, unless `CI=true`.
+
+use texel_quality::Image8;
+
+use crate::util::*;
+
+/// Whether the machine has an adapter; panics under `CI=true` when it has none.
+fn have_adapter() -> bool {
+    if !texel_gpu::adapters().is_empty() {
+        return true;
+    }
+    assert_ne!(
+        std::env::var("CI").as_deref(),
+        Ok("true"),
+        "CI=true but no Vulkan or GL adapter: install mesa-vulkan-drivers"
+    );
+    eprintln!("skipped: no Vulkan or GL adapter (apt-get install mesa-vulkan-drivers)");
+    false
+}
+
+#[test]
+fn gpu_refuses_filters_it_does_not_have() {
+    let d = Dir::new("gpu-ewa");
+    let out = texel(&["render", "--gpu", "--filter", "ewa", "-o", &d.arg("x.png")]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("--gpu has no ewa filter"), "{err}");
+    assert!(
+        err.contains("aniso16") && !err.contains("panicked"),
+        "{err}"
+    );
+}
+
+#[test]
+fn gpu_names_the_adapters_when_the_requested_one_is_missing() {
+    let d = Dir::new("gpu-adapter");
+    let out = texel(&[
+        "render",
+        "--gpu",
+        "--adapter",
+        "no-such-device",
+        "-o",
+        &d.arg("x.png"),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("no GPU adapter named like \"no-such-device\"; available:")
+            || err.contains("no GPU adapter found"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!d.join("x.png").exists());
+}
+
+#[test]
+fn gpu_renders_the_lab_modes() {
+    if !have_adapter() {
+        return;
+    }
+    let d = Dir::new("gpu-render");
+    for mode in ["1", "4", "8"] {
+        let png = d.arg(&format!("lab{mode}.png"));
+        let out = texel(&[
+            "render",
+            "builtin:ground",
+            "--gpu",
+            "--lab-mode",
+            mode,
+            "--size",
+            "96x64",
+            "-o",
+            &png,
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let img = Image8::load(&png).unwrap();
+        assert_eq!(img.size(), (96, 64));
+        // The ground covers the lower half: it is not all background.
+        assert!(img.pixels().iter().skip(96 * 40).any(|p| p[0] > 0));
+    }
+    let out = texel(&["gpu-info"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("--gpu uses:"));
+}

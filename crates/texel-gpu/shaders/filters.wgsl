@@ -1,0 +1,252 @@
+// texel's filters as a fragment shader that reads the texture only through textureLoad,
+// textureDimensions and textureNumLevels (the filtering lab's rule), with the conventions of
+// ../shared/DESIGN.md: texel (i, j) covers [i, i+1) x [j, j+1) of xy = uv * (W, H); address modes
+// act on integer texel indices; 8-bit sRGB texels are decoded through the same 256-entry table as
+// the CPU path (uploaded), alpha as b / 255.
+
+struct Params {
+    clip_from_world: mat4x4<f32>,
+    border: vec4<f32>,
+    // x: address mode u, y: address mode v (0 clamp-to-edge, 1 repeat, 2 mirror-repeat,
+    // 3 clamp-to-border, 4 mirror-clamp-to-edge)
+    address: vec4<u32>,
+    // x: mode (1-8 the lab's modes, 9 bicubic Catmull-Rom, 20 hardware trilinear,
+    // 21 hardware anisotropic), y: 1 if the texels are sRGB-encoded 8-bit, z: anisotropy clamp
+    mode: vec4<u32>,
+    // x: lod bias, y: lod min clamp, z: lod max clamp
+    lod: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var tex: texture_2d<f32>;
+@group(0) @binding(2) var<storage, read> srgb: array<f32, 256>;
+@group(0) @binding(3) var hw: sampler;
+
+struct VertexIn {
+    @location(0) position: vec3<f32>,
+    @location(1) uv: vec2<f32>,
+    @location(2) color: vec4<f32>,
+}
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) color: vec4<f32>,
+}
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    var out: VertexOut;
+    let c = params.clip_from_world * vec4<f32>(v.position, 1.0);
+    // The camera is OpenGL's (z in [-w, w]); the device clips z to [0, w].
+    out.clip = vec4<f32>(c.x, c.y, 0.5 * (c.z + c.w), c.w);
+    out.uv = v.uv;
+    out.color = v.color;
+    return out;
+}
+
+// ---- Texel fetches -----------------------------------------------------------------------------
+
+// An integer texel index wrapped into [0, n) by an address mode; -1 where the border colour applies.
+fn wrap(i: i32, n: i32, mode: u32) -> i32 {
+    switch mode {
+        case 1u: { // repeat
+            return ((i % n) + n) % n;
+        }
+        case 2u: { // mirror repeat
+            let r = ((i % (2 * n)) + 2 * n) % (2 * n);
+            return select(2 * n - 1 - r, r, r < n);
+        }
+        case 3u: { // clamp to border
+            return select(-1, i, i >= 0 && i < n);
+        }
+        case 4u: { // mirror clamp to edge
+            return min(select(i, -1 - i, i < 0), n - 1);
+        }
+        default: { // clamp to edge
+            return clamp(i, 0, n - 1);
+        }
+    }
+}
+
+// The size of `level`: Vulkan's rule max(1, floor(size0 / 2^level)), from level 0's size. (Asking
+// textureDimensions for a level that differs between neighbouring pixels returned another pixel's
+// level's size on lavapipe 22.3.6, and loads outside the level read zeros.)
+fn level_size(level: i32) -> vec2<i32> {
+    let size0 = textureDimensions(tex);
+    return vec2<i32>(max(size0 >> vec2<u32>(u32(level)), vec2<u32>(1u)));
+}
+
+// Texel (i, j) of `level` in linear RGBA, after address wrapping (or the border colour).
+fn fetch(i: i32, j: i32, level: i32) -> vec4<f32> {
+    let size = level_size(level);
+    let wi = wrap(i, size.x, params.address.x);
+    let wj = wrap(j, size.y, params.address.y);
+    if wi < 0 || wj < 0 {
+        return params.border;
+    }
+    let t = textureLoad(tex, vec2<i32>(wi, wj), level);
+    if params.mode.y == 0u {
+        return t;
+    }
+    // The 8-bit code, exactly: Rgba8Unorm loads b / 255.
+    let b = vec3<u32>(round(t.rgb * 255.0));
+    return vec4<f32>(srgb[b.x], srgb[b.y], srgb[b.z], t.a);
+}
+
+fn size_of(level: i32) -> vec2<f32> {
+    return vec2<f32>(level_size(level));
+}
+
+// ---- Filters inside one level --------------------------------------------------------------------
+
+// Nearest: the texel containing xy = uv * size.
+fn nearest(uv: vec2<f32>, level: i32) -> vec4<f32> {
+    let ij = vec2<i32>(floor(uv * size_of(level)));
+    return fetch(ij.x, ij.y, level);
+}
+
+// Bilinear: the 2x2 texels around xy - 1/2, weighted by the fractions.
+fn bilinear(uv: vec2<f32>, level: i32) -> vec4<f32> {
+    let x = uv * size_of(level) - 0.5;
+    let f = floor(x);
+    let ij = vec2<i32>(f);
+    let ab = x - f;
+    let top = mix(fetch(ij.x, ij.y, level), fetch(ij.x + 1, ij.y, level), ab.x);
+    let bottom = mix(fetch(ij.x, ij.y + 1, level), fetch(ij.x + 1, ij.y + 1, level), ab.x);
+    return mix(top, bottom, ab.y);
+}
+
+// Catmull-Rom weights (Mitchell-Netravali B = 0, C = 1/2) of the four taps around t in [0, 1).
+fn catmull_rom(t: f32) -> vec4<f32> {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    return vec4<f32>(
+        -0.5 * t3 + t2 - 0.5 * t,
+        1.5 * t3 - 2.5 * t2 + 1.0,
+        -1.5 * t3 + 2.0 * t2 + 0.5 * t,
+        0.5 * t3 - 0.5 * t2,
+    );
+}
+
+// Bicubic: 4x4 taps around xy - 1/2.
+fn bicubic(uv: vec2<f32>, level: i32) -> vec4<f32> {
+    let x = uv * size_of(level) - 0.5;
+    let f = floor(x);
+    let ij = vec2<i32>(f);
+    let wx = catmull_rom(x.x - f.x);
+    let wy = catmull_rom(x.y - f.y);
+    var acc = vec4<f32>(0.0);
+    for (var dj = 0; dj < 4; dj++) {
+        var row = vec4<f32>(0.0);
+        for (var di = 0; di < 4; di++) {
+            row += fetch(ij.x + di - 1, ij.y + dj - 1, level) * wx[di];
+        }
+        acc += row * wy[dj];
+    }
+    return acc;
+}
+
+// ---- Levels --------------------------------------------------------------------------------------
+
+fn last_level() -> f32 {
+    return f32(textureNumLevels(tex) - 1u);
+}
+
+// lod = log2(rho) + bias, clamped; rho = the longer screen axis in texels of level 0. A rho that
+// is not finite (derivatives beyond the horizon of a plane) selects the coarsest allowed level, as
+// on the CPU; comparisons with NaN are false, so `rho < FLT_MAX` also rejects NaN.
+fn lod_of(rho: f32) -> f32 {
+    if !(rho < 3.4e38) {
+        return params.lod.z;
+    }
+    return clamp(log2(rho) + params.lod.x, params.lod.y, params.lod.z);
+}
+
+// Vulkan's nearest level: ceil(clamp(lod, 0, q) + 1/2) - 1.
+fn mip_nearest(uv: vec2<f32>, lod: f32) -> vec4<f32> {
+    let level = max(ceil(clamp(lod, 0.0, last_level()) + 0.5) - 1.0, 0.0);
+    return bilinear(uv, i32(level));
+}
+
+// Trilinear: bilinear in levels floor(d) and floor(d) + 1, lerped by fract(d), d = clamp(lod, 0, q).
+fn trilinear(uv: vec2<f32>, lod: f32) -> vec4<f32> {
+    let q = last_level();
+    let d = clamp(lod, 0.0, q);
+    let k = floor(d);
+    let delta = d - k;
+    let a = bilinear(uv, i32(k));
+    if delta > 0.0 && k < q {
+        return mix(a, bilinear(uv, i32(k) + 1), delta);
+    }
+    return a;
+}
+
+// Anisotropic (DESIGN.md, EXT_texture_filter_anisotropic): N = min(ceil(|Pmax| / |Pmin|), max)
+// trilinear probes along the longer axis at lod log2(|Pmax| / N):
+// c = 1/N sum_i trilinear(uv + ((i + 0.5) / N - 0.5) Pmax_uv).
+fn anisotropic(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, px: vec2<f32>, py: vec2<f32>,
+               iso_lod: f32) -> vec4<f32> {
+    let lx = length(px);
+    let ly = length(py);
+    let major = max(lx, ly);
+    let minor = min(lx, ly);
+    let axis = select(duv_dy, duv_dx, lx >= ly);
+    if !(major < 3.4e38) {
+        // Non-finite axes: one trilinear probe at the isotropic lod (the coarsest allowed).
+        return trilinear(uv, iso_lod);
+    }
+    let max_n = f32(params.mode.z);
+    let ratio = major / minor * (1.0 - 1e-5);
+    let n = select(clamp(ceil(ratio), 1.0, max_n), max_n, ratio > max_n);
+    if n <= 1.0 {
+        return trilinear(uv, iso_lod);
+    }
+    let lod = lod_of(major / n);
+    var sum = vec4<f32>(0.0);
+    for (var i = 0.0; i < n; i += 1.0) {
+        sum += trilinear(uv + ((i + 0.5) / n - 0.5) * axis, lod);
+    }
+    return sum / n;
+}
+
+// ---- The fragment shader -------------------------------------------------------------------------
+
+struct FragmentOut {
+    @location(0) color: vec4<f32>,
+    @location(1) coverage: vec4<f32>,
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> FragmentOut {
+    // Derivatives first, in uniform control flow (2x2 quad differences, as the CPU's quad mode).
+    let duv_dx = dpdxFine(in.uv);
+    let duv_dy = dpdyFine(in.uv);
+    let size0 = size_of(0);
+    let px = duv_dx * size0;
+    let py = duv_dy * size0;
+    let lod = lod_of(max(length(px), length(py)));
+    let mode = params.mode.x;
+    var c: vec4<f32>;
+    if mode >= 20u {
+        // The device's own sampler (the hardware rows): sRGB is decoded by the texture format.
+        c = textureSampleGrad(tex, hw, in.uv, duv_dx, duv_dy);
+    } else if mode == 1u {
+        c = nearest(in.uv, 0);
+    } else if mode == 9u {
+        c = bicubic(in.uv, 0);
+    } else if mode == 2u || lod <= 0.0 {
+        // Bilinear without mips, and magnification for modes 3-8 (their mag filter is linear).
+        c = bilinear(in.uv, 0);
+    } else if mode == 3u {
+        c = mip_nearest(in.uv, lod);
+    } else if mode == 4u {
+        c = trilinear(in.uv, lod);
+    } else {
+        c = anisotropic(in.uv, duv_dx, duv_dy, px, py, lod);
+    }
+    var out: FragmentOut;
+    out.color = c * in.color;
+    out.coverage = vec4<f32>(1.0);
+    return out;
+}

@@ -1,0 +1,731 @@
+//! texel-gpu: texel's filters as WGSL shaders on any Vulkan or GL device, through wgpu.
+//!
+//! The fragment shader (`shaders/filters.wgsl`) reads the texture only through `textureLoad`,
+//! `textureDimensions` and `textureNumLevels` — the filtering lab's rule — so every filter's
+//! arithmetic is written out: one function per technique (nearest, bilinear, mip-nearest,
+//! trilinear, anisotropic 2x-16x, bicubic), address modes on integer texel indices and the sRGB
+//! decode through the CPU's own 256-entry table, as `../shared/DESIGN.md` fixes them. The pyramid is
+//! texel-texture's, uploaded level by level in the texture's own format (`Rgba8Unorm` codes or
+//! `Rgba32Float`), so both paths filter the same texels. The hardware sampler is the peer
+//! ([`GpuFilter::HwTrilinear`], [`GpuFilter::HwAniso16`]: `textureSampleGrad`).
+//!
+//! Geometry is the CPU path's: the same vertices and `clip_from_world`, the device clipping,
+//! depth-testing and interpolating perspective-correctly. Derivatives are the device's 2x2 quad
+//! differences (`dpdxFine`/`dpdyFine`), so the CPU frame to compare with is rendered with
+//! [`texel_raster::Derivatives::Quad`].
+//!
+//! ```no_run
+//! # fn main() -> Result<(), texel_gpu::GpuError> {
+//! let gpu = texel_gpu::Gpu::new(None)?; // or Some("llvmpipe"), or TEXEL_ADAPTER
+//! println!("{}", gpu.info());
+//! # Ok(()) }
+//! ```
+
+use std::fmt;
+use std::sync::mpsc;
+
+use texel_raster::{DrawCall, Frame, RenderSettings, View};
+use texel_texture::{AddressMode, Format, LevelTexels, Texture};
+
+/// Environment variable that picks an adapter by name (a case-insensitive substring), as
+/// `--adapter` does.
+pub const ADAPTER_ENV: &str = "TEXEL_ADAPTER";
+
+/// The WGSL source of every filter.
+pub const SHADER: &str = include_str!("../shaders/filters.wgsl");
+
+/// What can go wrong on the GPU path.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No Vulkan or GL adapter at all.
+    #[error(
+        "no GPU adapter found (Vulkan or GL); on Debian install a driver, e.g. \
+         `apt-get install mesa-vulkan-drivers` for Mesa's lavapipe on the CPU"
+    )]
+    NoAdapter,
+    /// No adapter's name contains the requested one.
+    #[error("no GPU adapter named like {wanted:?}; available: {available}")]
+    AdapterNotFound {
+        /// The requested name.
+        wanted: String,
+        /// The adapters there are, comma-separated.
+        available: String,
+    },
+    /// The device could not be created.
+    #[error("could not create a device on {adapter}: {reason}")]
+    Device {
+        /// The adapter's name.
+        adapter: String,
+        /// wgpu's reason.
+        reason: String,
+    },
+    /// A texture or the frame exceeds the device's 2D texture limit.
+    #[error("{what} is {width}x{height}, over this device's limit of {max} texels a side")]
+    TooLarge {
+        /// What was too large.
+        what: &'static str,
+        /// Its width.
+        width: u32,
+        /// Its height.
+        height: u32,
+        /// The device's `max_texture_dimension_2d`.
+        max: u32,
+    },
+    /// What the GPU path does not render (lighting, debug views, counting texels).
+    #[error("the GPU path does not support {0}")]
+    Unsupported(&'static str),
+    /// The device reported an error or was lost while rendering.
+    #[error("the GPU failed while rendering: {0}")]
+    Failed(String),
+}
+
+/// The filters the GPU path renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GpuFilter {
+    /// The lab's modes 1-8: nearest, bilinear, bilinear with the nearest mip level, trilinear,
+    /// anisotropic 2x, 4x, 8x, 16x (trilinear probes).
+    Lab(u8),
+    /// Bicubic Catmull-Rom in level 0.
+    Bicubic,
+    /// The device's sampler, trilinear (`textureSampleGrad`).
+    HwTrilinear,
+    /// The device's sampler, trilinear with `anisotropy_clamp` 16.
+    HwAniso16,
+}
+
+impl GpuFilter {
+    /// The filter for a texel filter name (`trilinear`, `aniso16`, `hw-trilinear`, ...), if the
+    /// GPU path has it.
+    pub fn from_name(name: &str) -> Option<GpuFilter> {
+        Some(match name {
+            "nearest" => GpuFilter::Lab(1),
+            "bilinear" => GpuFilter::Lab(2),
+            "mip-nearest" => GpuFilter::Lab(3),
+            "trilinear" => GpuFilter::Lab(4),
+            "aniso2" => GpuFilter::Lab(5),
+            "aniso4" => GpuFilter::Lab(6),
+            "aniso8" => GpuFilter::Lab(7),
+            "aniso16" => GpuFilter::Lab(8),
+            "bicubic" => GpuFilter::Bicubic,
+            "hw-trilinear" => GpuFilter::HwTrilinear,
+            "hw-aniso16" => GpuFilter::HwAniso16,
+            _ => return None,
+        })
+    }
+
+    /// Every name [`GpuFilter::from_name`] accepts.
+    pub const NAMES: [&'static str; 11] = [
+        "nearest",
+        "bilinear",
+        "mip-nearest",
+        "trilinear",
+        "aniso2",
+        "aniso4",
+        "aniso8",
+        "aniso16",
+        "bicubic",
+        "hw-trilinear",
+        "hw-aniso16",
+    ];
+
+    /// The shader's mode number and anisotropy clamp.
+    fn mode(self) -> (u32, u32) {
+        match self {
+            GpuFilter::Lab(m) => (u32::from(m), if m >= 5 { 1 << (m - 4) } else { 1 }),
+            GpuFilter::Bicubic => (9, 1),
+            GpuFilter::HwTrilinear => (20, 1),
+            GpuFilter::HwAniso16 => (21, 16),
+        }
+    }
+
+    fn is_hardware(self) -> bool {
+        matches!(self, GpuFilter::HwTrilinear | GpuFilter::HwAniso16)
+    }
+}
+
+/// An adapter as [`adapters`] lists it.
+#[derive(Clone, Debug)]
+pub struct AdapterSummary {
+    /// The adapter's name (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)").
+    pub name: String,
+    /// Vulkan or GL.
+    pub backend: String,
+    /// Discrete, integrated, virtual or CPU.
+    pub device_type: String,
+    /// Driver name and version.
+    pub driver: String,
+    /// Largest 2D texture side.
+    pub max_texture_dimension_2d: u32,
+}
+
+impl fmt::Display for AdapterSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} ({}, {}, driver {}; 2D textures up to {})",
+            self.name, self.backend, self.device_type, self.driver, self.max_texture_dimension_2d
+        )
+    }
+}
+
+/// The adapters of one backend.
+fn enumerate(backends: wgpu::Backends) -> Vec<wgpu::Adapter> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+        backends,
+        ..wgpu::InstanceDescriptor::new_without_display_handle_from_env()
+    });
+    pollster::block_on(instance.enumerate_adapters(backends))
+}
+
+/// The Vulkan adapters, or where there are none the GL ones (probing GL through EGL makes Mesa
+/// print warnings on a machine without a display, so it is not done when Vulkan suffices).
+fn all_adapters() -> Vec<wgpu::Adapter> {
+    let vulkan = enumerate(wgpu::Backends::VULKAN);
+    if vulkan.is_empty() {
+        enumerate(wgpu::Backends::GL)
+    } else {
+        vulkan
+    }
+}
+
+fn summary(a: &wgpu::Adapter) -> AdapterSummary {
+    let info = a.get_info();
+    AdapterSummary {
+        name: info.name,
+        backend: format!("{:?}", info.backend),
+        device_type: format!("{:?}", info.device_type),
+        driver: format!("{} {}", info.driver, info.driver_info)
+            .trim()
+            .to_string(),
+        max_texture_dimension_2d: a.limits().max_texture_dimension_2d,
+    }
+}
+
+/// The Vulkan adapters on this machine, or where there are none the GL ones.
+pub fn adapters() -> Vec<AdapterSummary> {
+    all_adapters().iter().map(summary).collect()
+}
+
+/// A device to render on.
+pub struct Gpu {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: AdapterSummary,
+    pipeline: wgpu::RenderPipeline,
+    srgb: wgpu::Buffer,
+}
+
+impl Gpu {
+    /// Open the adapter whose name contains `name` (case-insensitive), or the one
+    /// [`ADAPTER_ENV`] names, or else the first one, preferring real GPUs to software ones
+    /// (Vulkan adapters; GL ones only where there is no Vulkan adapter).
+    ///
+    /// # Errors
+    /// [`GpuError::NoAdapter`], [`GpuError::AdapterNotFound`], [`GpuError::Device`].
+    pub fn new(name: Option<&str>) -> Result<Gpu, GpuError> {
+        let mut all = all_adapters();
+        if all.is_empty() {
+            return Err(GpuError::NoAdapter);
+        }
+        let wanted = name
+            .map(str::to_string)
+            .or_else(|| std::env::var(ADAPTER_ENV).ok().filter(|s| !s.is_empty()));
+        let rank = |a: &wgpu::Adapter| {
+            let i = a.get_info();
+            let kind = match i.device_type {
+                wgpu::DeviceType::DiscreteGpu => 0,
+                wgpu::DeviceType::IntegratedGpu => 1,
+                wgpu::DeviceType::VirtualGpu => 2,
+                _ => 3,
+            };
+            (kind, i.backend != wgpu::Backend::Vulkan)
+        };
+        all.sort_by_key(rank);
+        let adapter = match &wanted {
+            Some(w) => {
+                let lw = w.to_lowercase();
+                let pos = all
+                    .iter()
+                    .position(|a| a.get_info().name.to_lowercase().contains(&lw));
+                match pos {
+                    Some(p) => all.swap_remove(p),
+                    None => {
+                        let names: Vec<String> = all.iter().map(|a| a.get_info().name).collect();
+                        return Err(GpuError::AdapterNotFound {
+                            wanted: w.clone(),
+                            available: names.join(", "),
+                        });
+                    }
+                }
+            }
+            None => all.swap_remove(0),
+        };
+        let info = summary(&adapter);
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("texel"),
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::Device {
+            adapter: info.name.clone(),
+            reason: e.to_string(),
+        })?;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("filters.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let pipeline = create_pipeline(&device, &module);
+        let table: Vec<u8> = texel_texture::color::srgb_table()
+            .iter()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let srgb = buffer(&device, &queue, &table, wgpu::BufferUsages::STORAGE);
+        Ok(Gpu {
+            device,
+            queue,
+            info,
+            pipeline,
+            srgb,
+        })
+    }
+
+    /// The adapter in use.
+    pub fn info(&self) -> &AdapterSummary {
+        &self.info
+    }
+}
+
+const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+const COVERAGE: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// position (3), uv (2), colour (4) as `f32`.
+const VERTEX_FLOATS: usize = 9;
+
+fn create_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule) -> wgpu::RenderPipeline {
+    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x2, 2 => Float32x4];
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("texel filters"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: (VERTEX_FLOATS * 4) as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &attributes,
+            })],
+        },
+        primitive: wgpu::PrimitiveState {
+            front_face: wgpu::FrontFace::Ccw,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(COLOR.into()), Some(COVERAGE.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+fn buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    bytes: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let b = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: (bytes.len() as u64).max(4).next_multiple_of(4),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut padded = bytes.to_vec();
+    padded.resize(b.size() as usize, 0);
+    queue.write_buffer(&b, 0, &padded);
+    b
+}
+
+fn address_code(mode: AddressMode) -> u32 {
+    match mode {
+        AddressMode::ClampToEdge => 0,
+        AddressMode::Repeat => 1,
+        AddressMode::MirrorRepeat => 2,
+        AddressMode::ClampToBorder => 3,
+        AddressMode::MirrorClampToEdge => 4,
+    }
+}
+
+fn wgpu_address(mode: AddressMode) -> wgpu::AddressMode {
+    match mode {
+        AddressMode::ClampToEdge => wgpu::AddressMode::ClampToEdge,
+        AddressMode::Repeat => wgpu::AddressMode::Repeat,
+        AddressMode::MirrorRepeat => wgpu::AddressMode::MirrorRepeat,
+        // The device's border colours are a fixed few; the hardware rows use transparent black.
+        AddressMode::ClampToBorder => wgpu::AddressMode::ClampToBorder,
+        AddressMode::MirrorClampToEdge => wgpu::AddressMode::MirrorRepeat,
+    }
+}
+
+/// Upload `texture`'s pyramid, level by level, in its own format (`hardware`: an sRGB format for
+/// 8-bit sRGB textures, so that the device's sampler decodes).
+fn upload(gpu: &Gpu, texture: &Texture, hardware: bool) -> Result<wgpu::Texture, GpuError> {
+    let max = gpu.device.limits().max_texture_dimension_2d;
+    let (w, h) = (texture.width(), texture.height());
+    if w > max || h > max {
+        return Err(GpuError::TooLarge {
+            what: "a texture",
+            width: w,
+            height: h,
+            max,
+        });
+    }
+    let format = match texture.format() {
+        Format::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
+        Format::Rgba8Srgb if hardware => wgpu::TextureFormat::Rgba8UnormSrgb,
+        _ => wgpu::TextureFormat::Rgba8Unorm,
+    };
+    let levels = texture.levels().len() as u32;
+    let t = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("texel texture"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: levels,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (k, info) in texture.levels().iter().enumerate() {
+        let (bytes, texel_bytes): (Vec<u8>, u32) = match texture.level_texels(k) {
+            Some(LevelTexels::Unorm8(v)) => (v.iter().flatten().copied().collect(), 4),
+            Some(LevelTexels::Float(v)) => (
+                v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect(),
+                16,
+            ),
+            None => continue,
+        };
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &t,
+                mip_level: k as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            &bytes,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(info.width * texel_bytes),
+                rows_per_image: Some(info.height),
+            },
+            wgpu::Extent3d {
+                width: info.width,
+                height: info.height,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    Ok(t)
+}
+
+/// The shader's uniforms for one draw (the layout of `Params` in `filters.wgsl`).
+fn params(draw: &DrawCall, filter: GpuFilter) -> Vec<u8> {
+    let d = draw.sampler.descriptor();
+    let (mode, aniso) = filter.mode();
+    let srgb = u32::from(draw.texture.format() == Format::Rgba8Srgb && !filter.is_hardware());
+    let mut out = Vec::with_capacity(128);
+    for x in draw.clip_from_world.to_cols_array() {
+        out.extend(x.to_le_bytes());
+    }
+    for x in d.border_color.rgba() {
+        out.extend(x.to_le_bytes());
+    }
+    let u32s = [
+        address_code(d.address_mode_u),
+        address_code(d.address_mode_v),
+        0,
+        0,
+        mode,
+        srgb,
+        aniso,
+        0,
+    ];
+    for x in u32s {
+        out.extend(x.to_le_bytes());
+    }
+    for x in [d.lod_bias, d.lod_min_clamp, d.lod_max_clamp, 0.0] {
+        out.extend(x.to_le_bytes());
+    }
+    out
+}
+
+/// Render `draws` with `filter` on `gpu`: the same frame [`texel_raster::render`] makes (linear
+/// colour and coverage; no texel counts), filtered by the shader.
+///
+/// # Errors
+/// [`GpuError::Unsupported`] for lighting, debug views or texel counting;
+/// [`GpuError::TooLarge`] for a frame or texture over the device's limits; [`GpuError::Failed`]
+/// when the device reports an error or is lost.
+pub fn render(
+    gpu: &Gpu,
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+    filter: GpuFilter,
+) -> Result<Frame, GpuError> {
+    if settings.light.is_some() {
+        return Err(GpuError::Unsupported("lighting"));
+    }
+    if settings.view != View::Color {
+        return Err(GpuError::Unsupported("debug views"));
+    }
+    if settings.counts_texels() {
+        return Err(GpuError::Unsupported("counting texels"));
+    }
+    let (w, h) = (settings.width, settings.height);
+    let max = gpu.device.limits().max_texture_dimension_2d;
+    if w > max || h > max {
+        return Err(GpuError::TooLarge {
+            what: "the frame",
+            width: w,
+            height: h,
+            max,
+        });
+    }
+    let device = &gpu.device;
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let target = |format, usage| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    };
+    let copy = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let color = target(COLOR, copy);
+    let coverage = target(COVERAGE, copy);
+    let depth = target(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT);
+    // Per draw: its texture, uniforms, vertices and bind group.
+    let mut prepared = Vec::new();
+    for draw in draws {
+        let texture = upload(gpu, draw.texture, filter.is_hardware())?;
+        let view = texture.create_view(&Default::default());
+        let uniforms = buffer(
+            device,
+            &gpu.queue,
+            &params(draw, filter),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let vertices: Vec<u8> = draw
+            .vertices
+            .iter()
+            .flat_map(|v| {
+                let p = v.position.to_array();
+                let t = v.uv.to_array();
+                let c = v.color.to_array();
+                p.into_iter().chain(t).chain(c).flat_map(f32::to_le_bytes)
+            })
+            .collect();
+        let indices: Vec<u8> = draw
+            .triangles
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        let d = draw.sampler.descriptor();
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: None,
+            address_mode_u: wgpu_address(d.address_mode_u),
+            address_mode_v: wgpu_address(d.address_mode_v),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            lod_min_clamp: d.lod_min_clamp,
+            lod_max_clamp: d.lod_max_clamp,
+            anisotropy_clamp: filter.mode().1 as u16,
+            ..Default::default()
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &gpu.pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: gpu.srgb.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+            ],
+        });
+        let vb = buffer(device, &gpu.queue, &vertices, wgpu::BufferUsages::VERTEX);
+        let ib = buffer(device, &gpu.queue, &indices, wgpu::BufferUsages::INDEX);
+        prepared.push((bind, vb, ib, draw.triangles.len() as u32 * 3));
+    }
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let color_view = color.create_view(&Default::default());
+        let coverage_view = coverage.create_view(&Default::default());
+        let depth_view = depth.create_view(&Default::default());
+        let [r, g, b, a] = settings.background.map(f64::from);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("texel frame"),
+            color_attachments: &[
+                Some(wgpu::RenderPassColorAttachment {
+                    view: &color_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                }),
+                Some(wgpu::RenderPassColorAttachment {
+                    view: &coverage_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                }),
+            ],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_pipeline(&gpu.pipeline);
+        for (bind, vb, ib, count) in &prepared {
+            pass.set_bind_group(0, bind, &[]);
+            pass.set_vertex_buffer(0, vb.slice(..));
+            pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..*count, 0, 0..1);
+        }
+    }
+    let color_bytes = read_back(gpu, &mut encoder, &color, 16);
+    let coverage_bytes = read_back(gpu, &mut encoder, &coverage, 1);
+    gpu.queue.submit([encoder.finish()]);
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(GpuError::Failed(e.to_string()));
+    }
+    let color_data = color_bytes.wait(gpu)?;
+    let coverage_data = coverage_bytes.wait(gpu)?;
+    let mut frame = Frame::new(settings);
+    for (k, px) in frame.color.iter_mut().enumerate() {
+        let o = k * 16;
+        *px = std::array::from_fn(|c| {
+            let b = &color_data[o + 4 * c..o + 4 * c + 4];
+            f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+        });
+    }
+    for (k, c) in frame.coverage.iter_mut().enumerate() {
+        *c = coverage_data[k] > 0;
+    }
+    Ok(frame)
+}
+
+/// A texture's copy into a mappable buffer, with rows padded to wgpu's 256-byte alignment.
+struct ReadBack {
+    buffer: wgpu::Buffer,
+    row: usize,
+    padded: usize,
+    rows: usize,
+}
+
+fn read_back(
+    gpu: &Gpu,
+    encoder: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    texel_bytes: u32,
+) -> ReadBack {
+    let (w, h) = (texture.width(), texture.height());
+    let row = w * texel_bytes;
+    let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: u64::from(padded) * u64::from(h),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(h),
+            },
+        },
+        texture.size(),
+    );
+    ReadBack {
+        buffer,
+        row: row as usize,
+        padded: padded as usize,
+        rows: h as usize,
+    }
+}
+
+impl ReadBack {
+    /// Map the buffer (waiting for the device) and return the unpadded rows.
+    fn wait(self, gpu: &Gpu) -> Result<Vec<u8>, GpuError> {
+        let slice = self.buffer.slice(..);
+        let (tx, rx) = mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        gpu.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Failed(e.to_string()))?;
+        rx.recv()
+            .map_err(|e| GpuError::Failed(e.to_string()))?
+            .map_err(|e| GpuError::Failed(e.to_string()))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| GpuError::Failed(e.to_string()))?;
+        let mut out = Vec::with_capacity(self.row * self.rows);
+        for r in 0..self.rows {
+            out.extend_from_slice(&data[r * self.padded..r * self.padded + self.row]);
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,108 @@
+//! Every GPU mode against texel's CPU path on the built-in scenes, at reduced size: the shader
+//! filters the same texels with the same formulas, so the images must agree to at least 45 dB
+//! PSNR over covered pixels (8-bit sRGB output). They differ by float rounding (`f32` in another
+//! order, libm's `log2` against texel's `fast_log2`) and by the device's sub-pixel precision
+//! (its interpolated uv, and from it the quad derivatives and the lod).
+//!
+//! Needs a Vulkan or GL adapter (Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`). Without
+//! one the tests print why and pass, unless `CI=true`, where a missing adapter fails them.
+
+use texel::raster::Derivatives;
+use texel::{Filter, MemoryBudget, PreparedScene, Scene, SceneOptions};
+use texel_gpu::{Gpu, GpuError, GpuFilter};
+
+/// The device, or `None` (with the reason printed) where there is none and CI does not demand one.
+fn gpu() -> Option<Gpu> {
+    match Gpu::new(None) {
+        Ok(g) => {
+            eprintln!("adapter: {}", g.info());
+            Some(g)
+        }
+        Err(e @ GpuError::NoAdapter) if std::env::var("CI").as_deref() != Ok("true") => {
+            eprintln!("skipped: {e}");
+            None
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// PSNR (dB) of the 8-bit sRGB encodings of `a` and `b` over pixels both cover, and the largest
+/// difference of one 8-bit channel.
+fn psnr(a: &texel::Frame, b: &texel::Frame) -> (f64, u8, usize) {
+    let enc = |x: f32| texel::texture::color::linear_to_srgb8(x);
+    let (mut sum, mut n, mut worst) = (0.0f64, 0usize, 0u8);
+    for k in 0..a.color.len() {
+        if !(a.coverage[k] && b.coverage[k]) {
+            continue;
+        }
+        for c in 0..3 {
+            let d = enc(a.color[k][c]).abs_diff(enc(b.color[k][c]));
+            worst = worst.max(d);
+            sum += f64::from(d) * f64::from(d);
+        }
+        n += 3;
+    }
+    let mse = sum / n.max(1) as f64;
+    let db = if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (255.0f64 * 255.0 / mse).log10()
+    };
+    (db, worst, n / 3)
+}
+
+fn agree(scene: &str, filters: &[&str]) {
+    let Some(gpu) = gpu() else { return };
+    let scene = Scene::load(scene).unwrap();
+    let options = SceneOptions {
+        size: Some((160, 96)),
+        ..SceneOptions::default()
+    };
+    let prepared =
+        PreparedScene::new(scene, &options, &mut MemoryBudget::half_of_machine()).unwrap();
+    let mut settings = prepared.settings();
+    settings.derivatives = Derivatives::Quad;
+    for name in filters {
+        let filter: Filter = name.parse().unwrap();
+        let samplers = prepared.samplers(filter).unwrap();
+        let draws = prepared.draws(&samplers);
+        let cpu = texel::render(&settings, &draws).unwrap();
+        let gpu_frame =
+            texel_gpu::render(&gpu, &settings, &draws, GpuFilter::from_name(name).unwrap())
+                .unwrap();
+        let (db, worst, covered) = psnr(&cpu, &gpu_frame);
+        eprintln!("{name}: {db:.1} dB over {covered} pixels, largest difference {worst}/255");
+        assert!(covered > 1000, "{name}: {covered} covered pixels");
+        assert!(
+            db >= 45.0,
+            "{name}: {db:.1} dB (largest difference {worst}/255)"
+        );
+    }
+}
+
+const LAB: [&str; 9] = [
+    "nearest",
+    "bilinear",
+    "mip-nearest",
+    "trilinear",
+    "aniso2",
+    "aniso4",
+    "aniso8",
+    "aniso16",
+    "bicubic",
+];
+
+#[test]
+fn ground_agrees_with_the_cpu() {
+    agree("builtin:ground", &LAB);
+}
+
+#[test]
+fn zoneplate_agrees_with_the_cpu() {
+    agree("builtin:zoneplate", &LAB);
+}
+
+#[test]
+fn cube_agrees_with_the_cpu() {
+    agree("builtin:cube", &LAB);
+}
