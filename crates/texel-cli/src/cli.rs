@@ -232,6 +232,13 @@ pub struct BenchArgs {
     /// Print JSON in the shape of ../shared/peers/llvmpipe_bench.py.
     #[arg(long)]
     pub json: bool,
+    /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has).
+    /// Wall time per frame: submission, rendering and reading the frame back.
+    #[arg(long)]
+    pub gpu: bool,
+    /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
+    #[arg(long, value_name = "NAME", requires = "gpu")]
+    pub adapter: Option<String>,
 }
 
 /// How 8-bit texture bytes and output bytes are interpreted ([`texel::ColorHandling`]).

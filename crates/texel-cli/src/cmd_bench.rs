@@ -98,33 +98,82 @@ pub fn median(v: &mut [f64]) -> f64 {
 }
 
 /// Run `texel bench`.
+/// `--gpu`: per filter, upload once, then time whole frames (render and read back) on the device.
+fn time_gpu(
+    args: &BenchArgs,
+    scene: &texel::PreparedScene,
+    filters: &[texel::Filter],
+) -> Result<Vec<Timing>> {
+    let gpu = texel_gpu::Gpu::new(args.adapter.as_deref())?;
+    let mut out = Vec::new();
+    for filter in filters {
+        let Some(gpu_filter) = texel_gpu::GpuFilter::from_name(filter.name()) else {
+            anyhow::bail!("--gpu has no {} filter", filter.name());
+        };
+        let samplers = scene.samplers(*filter)?;
+        let draws = scene.draws(&samplers);
+        let mut settings = scene.settings();
+        settings.derivatives = texel_raster::Derivatives::Quad;
+        let prepared = gpu.prepare(&draws, gpu_filter)?;
+        let start = Instant::now();
+        let mut k = 0;
+        while k < args.warmup || (args.warmup > 0 && start.elapsed() < MIN_WARMUP) {
+            std::hint::black_box(prepared.render(&settings)?);
+            k += 1;
+        }
+        let mut times = Vec::new();
+        for _ in 0..args.frames {
+            let t0 = Instant::now();
+            std::hint::black_box(prepared.render(&settings)?);
+            times.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        let (min_ms, max_ms) = times
+            .iter()
+            .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
+        out.push(Timing {
+            filter: filter.name(),
+            median_ms: median(&mut times),
+            min_ms,
+            max_ms,
+            clear_ms: 0.0,
+        });
+    }
+    Ok(out)
+}
+
 pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
     let filters = parse_list(&args.filters)?;
     let budget = &mut input.budget;
-    let timings = with_threads(args.threads, || -> Result<Vec<Timing>> {
-        let mut out = Vec::new();
-        for filter in &filters {
-            let samplers = scene.samplers(*filter)?;
-            scene.build_structures_within(&samplers, budget)?;
-            let draws = scene.draws(&samplers);
-            let settings = scene.settings();
-            let mut times = time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;
-            let (min_ms, max_ms) = times
-                .draw_ms
-                .iter()
-                .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
-            out.push(Timing {
-                filter: filter.name(),
-                median_ms: median(&mut times.draw_ms),
-                min_ms,
-                max_ms,
-                clear_ms: median(&mut times.clear_ms),
-            });
-        }
-        Ok(out)
-    })??;
+    let timings = if args.gpu {
+        time_gpu(args, &scene, &filters)?
+    } else {
+        with_threads(args.threads, || -> Result<Vec<Timing>> {
+            let mut out = Vec::new();
+            for filter in &filters {
+                let samplers = scene.samplers(*filter)?;
+                scene.build_structures_within(&samplers, budget)?;
+                let draws = scene.draws(&samplers);
+                let settings = scene.settings();
+                let mut times =
+                    time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;
+                let (min_ms, max_ms) = times
+                    .draw_ms
+                    .iter()
+                    .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
+                out.push(Timing {
+                    filter: filter.name(),
+                    median_ms: median(&mut times.draw_ms),
+                    min_ms,
+                    max_ms,
+                    clear_ms: median(&mut times.clear_ms),
+                });
+            }
+            Ok(out)
+        })??
+    };
     let threads = thread_count(args.threads);
+    let renderer = if args.gpu { "texel-gpu" } else { "texel" };
     let mut stdout = std::io::stdout().lock();
     if args.json {
         let entries = |value: fn(&Timing) -> f64| {
@@ -136,7 +185,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         };
         writeln!(
             stdout,
-            "{{\n \"renderer\": \"texel\",\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"clear_ms\": {{\n{}\n }}\n}}",
+            "{{\n \"renderer\": \"{renderer}\",\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"clear_ms\": {{\n{}\n }}\n}}",
             scene.width,
             scene.height,
             args.frames,

@@ -475,67 +475,61 @@ fn params(draw: &DrawCall, filter: GpuFilter) -> Vec<u8> {
 }
 
 /// Render `draws` with `filter` on `gpu`: the same frame [`texel_raster::render`] makes (linear
-/// colour and coverage; no texel counts), filtered by the shader.
+/// colour and coverage; no texel counts), filtered by the shader. Uploads the textures and meshes
+/// and renders once; [`GpuDraws`] keeps them for many frames.
 ///
 /// # Errors
-/// [`GpuError::Unsupported`] for lighting, debug views or texel counting;
-/// [`GpuError::TooLarge`] for a frame or texture over the device's limits; [`GpuError::Failed`]
-/// when the device reports an error or is lost.
+/// As [`Gpu::prepare`] and [`GpuDraws::render`].
 pub fn render(
     gpu: &Gpu,
     settings: &RenderSettings,
     draws: &[DrawCall],
     filter: GpuFilter,
 ) -> Result<Frame, GpuError> {
-    if settings.light.is_some() {
-        return Err(GpuError::Unsupported("lighting"));
-    }
-    if settings.view != View::Color {
-        return Err(GpuError::Unsupported("debug views"));
-    }
-    if settings.counts_texels() {
-        return Err(GpuError::Unsupported("counting texels"));
-    }
-    let (w, h) = (settings.width, settings.height);
-    let max = gpu.device.limits().max_texture_dimension_2d;
-    if w > max || h > max {
-        return Err(GpuError::TooLarge {
-            what: "the frame",
-            width: w,
-            height: h,
-            max,
-        });
-    }
-    let device = &gpu.device;
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let target = |format, usage| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
+    gpu.prepare(draws, filter)?.render(settings)
+}
+
+/// Draw calls uploaded to a device with one filter: textures (the whole pyramid), uniforms,
+/// vertices, indices and bind groups, ready to render frames of any size.
+pub struct GpuDraws<'g> {
+    gpu: &'g Gpu,
+    /// Per draw: bind group, vertex buffer, index buffer, index count.
+    draws: Vec<(wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32)>,
+}
+
+impl Gpu {
+    /// Upload `draws` for rendering with `filter`.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for a texture over the device's limit; [`GpuError::Failed`] when
+    /// the device reports an error.
+    pub fn prepare(&self, draws: &[DrawCall], filter: GpuFilter) -> Result<GpuDraws<'_>, GpuError> {
+        let device = &self.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut prepared = Vec::new();
+        for draw in draws {
+            prepared.push(self.prepare_draw(draw, filter)?);
+        }
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Failed(e.to_string()));
+        }
+        Ok(GpuDraws {
+            gpu: self,
+            draws: prepared,
         })
-    };
-    let copy = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let color = target(COLOR, copy);
-    let coverage = target(COVERAGE, copy);
-    let depth = target(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT);
-    // Per draw: its texture, uniforms, vertices and bind group.
-    let mut prepared = Vec::new();
-    for draw in draws {
-        let texture = upload(gpu, draw.texture, filter.is_hardware())?;
+    }
+
+    fn prepare_draw(
+        &self,
+        draw: &DrawCall,
+        filter: GpuFilter,
+    ) -> Result<(wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32), GpuError> {
+        let device = &self.device;
+        let texture = upload(self, draw.texture, filter.is_hardware())?;
         let view = texture.create_view(&Default::default());
         let uniforms = buffer(
             device,
-            &gpu.queue,
+            &self.queue,
             &params(draw, filter),
             wgpu::BufferUsages::UNIFORM,
         );
@@ -570,7 +564,7 @@ pub fn render(
         });
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
-            layout: &gpu.pipeline.get_bind_group_layout(0),
+            layout: &self.pipeline.get_bind_group_layout(0),
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -582,7 +576,7 @@ pub fn render(
                 },
                 wgpu::BindGroupEntry {
                     binding: 2,
-                    resource: gpu.srgb.as_entire_binding(),
+                    resource: self.srgb.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 3,
@@ -590,76 +584,122 @@ pub fn render(
                 },
             ],
         });
-        let vb = buffer(device, &gpu.queue, &vertices, wgpu::BufferUsages::VERTEX);
-        let ib = buffer(device, &gpu.queue, &indices, wgpu::BufferUsages::INDEX);
-        prepared.push((bind, vb, ib, draw.triangles.len() as u32 * 3));
+        let vb = buffer(device, &self.queue, &vertices, wgpu::BufferUsages::VERTEX);
+        let ib = buffer(device, &self.queue, &indices, wgpu::BufferUsages::INDEX);
+        Ok((bind, vb, ib, draw.triangles.len() as u32 * 3))
     }
-    let mut encoder = device.create_command_encoder(&Default::default());
-    {
-        let color_view = color.create_view(&Default::default());
-        let coverage_view = coverage.create_view(&Default::default());
-        let depth_view = depth.create_view(&Default::default());
-        let [r, g, b, a] = settings.background.map(f64::from);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("texel frame"),
-            color_attachments: &[
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                }),
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &coverage_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                }),
-            ],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
-        pass.set_pipeline(&gpu.pipeline);
-        for (bind, vb, ib, count) in &prepared {
-            pass.set_bind_group(0, bind, &[]);
-            pass.set_vertex_buffer(0, vb.slice(..));
-            pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..*count, 0, 0..1);
+}
+
+impl GpuDraws<'_> {
+    /// Render one frame and read it back.
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] for lighting, debug views or texel counting;
+    /// [`GpuError::TooLarge`] for a frame over the device's limits; [`GpuError::Failed`] when the
+    /// device reports an error or is lost.
+    pub fn render(&self, settings: &RenderSettings) -> Result<Frame, GpuError> {
+        if settings.light.is_some() {
+            return Err(GpuError::Unsupported("lighting"));
         }
+        if settings.view != View::Color {
+            return Err(GpuError::Unsupported("debug views"));
+        }
+        if settings.counts_texels() {
+            return Err(GpuError::Unsupported("counting texels"));
+        }
+        let gpu = self.gpu;
+        let (w, h) = (settings.width, settings.height);
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        if w > max || h > max {
+            return Err(GpuError::TooLarge {
+                what: "the frame",
+                width: w,
+                height: h,
+                max,
+            });
+        }
+        let device = &gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let target = |format, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let copy = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let color = target(COLOR, copy);
+        let coverage = target(COVERAGE, copy);
+        let depth = target(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let color_view = color.create_view(&Default::default());
+            let coverage_view = coverage.create_view(&Default::default());
+            let depth_view = depth.create_view(&Default::default());
+            let [r, g, b, a] = settings.background.map(f64::from);
+            let attachment = |view, clear| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(clear),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            };
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("texel frame"),
+                color_attachments: &[
+                    attachment(&color_view, wgpu::Color { r, g, b, a }),
+                    attachment(&coverage_view, wgpu::Color::TRANSPARENT),
+                ],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            pass.set_pipeline(&gpu.pipeline);
+            for (bind, vb, ib, count) in &self.draws {
+                pass.set_bind_group(0, bind, &[]);
+                pass.set_vertex_buffer(0, vb.slice(..));
+                pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..*count, 0, 0..1);
+            }
+        }
+        let color_bytes = read_back(gpu, &mut encoder, &color, 16);
+        let coverage_bytes = read_back(gpu, &mut encoder, &coverage, 1);
+        gpu.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Failed(e.to_string()));
+        }
+        let color_data = color_bytes.wait(gpu)?;
+        let coverage_data = coverage_bytes.wait(gpu)?;
+        let mut frame = Frame::new(settings);
+        for (px, b) in frame.color.iter_mut().zip(color_data.chunks_exact(16)) {
+            *px = std::array::from_fn(|c| {
+                f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])
+            });
+        }
+        for (c, &b) in frame.coverage.iter_mut().zip(&coverage_data) {
+            *c = b > 0;
+        }
+        Ok(frame)
     }
-    let color_bytes = read_back(gpu, &mut encoder, &color, 16);
-    let coverage_bytes = read_back(gpu, &mut encoder, &coverage, 1);
-    gpu.queue.submit([encoder.finish()]);
-    if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(GpuError::Failed(e.to_string()));
-    }
-    let color_data = color_bytes.wait(gpu)?;
-    let coverage_data = coverage_bytes.wait(gpu)?;
-    let mut frame = Frame::new(settings);
-    for (k, px) in frame.color.iter_mut().enumerate() {
-        let o = k * 16;
-        *px = std::array::from_fn(|c| {
-            let b = &color_data[o + 4 * c..o + 4 * c + 4];
-            f32::from_le_bytes([b[0], b[1], b[2], b[3]])
-        });
-    }
-    for (k, c) in frame.coverage.iter_mut().enumerate() {
-        *c = coverage_data[k] > 0;
-    }
-    Ok(frame)
 }
 
 /// A texture's copy into a mappable buffer, with rows padded to wgpu's 256-byte alignment.
