@@ -146,7 +146,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// Render on a Vulkan or GL device with texel's shaders (texel-gpu): nearest, bilinear,
-    /// mip-nearest, trilinear, aniso2-16 and bicubic; derivatives are the device's 2x2 quad
+    /// mip-nearest, trilinear, aniso2-16, bicubic and EWA; derivatives are the device's 2x2 quad
     /// differences; colour views only.
     #[arg(long)]
     pub gpu: bool,

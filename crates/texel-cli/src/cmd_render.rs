@@ -46,7 +46,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         let Some(gpu_filter) = GpuFilter::from_name(name) else {
             bail!(
                 "--gpu has no {name} filter; it renders {}",
-                GpuFilter::NAMES[..9].join(", ")
+                GpuFilter::NAMES[..10].join(", ")
             );
         };
         settings.derivatives = Derivatives::Quad;

@@ -10,8 +10,9 @@ struct Params {
     // x: address mode u, y: address mode v (0 clamp-to-edge, 1 repeat, 2 mirror-repeat,
     // 3 clamp-to-border, 4 mirror-clamp-to-edge)
     address: vec4<u32>,
-    // x: mode (1-8 the lab's modes, 9 bicubic Catmull-Rom, 20 hardware trilinear,
+    // x: mode (1-8 the lab's modes, 9 bicubic Catmull-Rom, 10 EWA, 20 hardware trilinear,
     // 21 hardware anisotropic), y: 1 if the texels are sRGB-encoded 8-bit, z: anisotropy clamp
+    // (EWA's eccentricity clamp)
     mode: vec4<u32>,
     // x: lod bias, y: lod min clamp, z: lod max clamp
     lod: vec4<f32>,
@@ -21,6 +22,9 @@ struct Params {
 @group(0) @binding(1) var tex: texture_2d<f32>;
 @group(0) @binding(2) var<storage, read> srgb: array<f32, 256>;
 @group(0) @binding(3) var hw: sampler;
+// EWA's Gaussian weight table, the CPU's (texel_texture::ewa::weight_lut): LUT[k] for r^2 in
+// [k / 128, (k + 1) / 128).
+@group(0) @binding(4) var<storage, read> ewa_lut: array<f32, 128>;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -210,6 +214,117 @@ fn anisotropic(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, px: vec2<f32
     return sum / n;
 }
 
+// ---- EWA (Heckbert 1989, pbrt-v4's MIPMap::EWA; texel-texture/src/ewa.rs) --------------------
+
+// The filter ellipse of the screen axes px, py (texels of level 0), its minor axis grown so that
+// major / minor <= max_ecc: S = M M^T's eigen-decomposition. Returns (s00, s01, s11, minor).
+fn ellipse(px: vec2<f32>, py: vec2<f32>, max_ecc: f32) -> vec4<f32> {
+    let a = px.x * px.x + py.x * py.x;
+    let b = px.x * px.y + py.x * py.y;
+    let c = px.y * px.y + py.y * py.y;
+    let half = (a - c) * 0.5;
+    let l1 = (a + c) * 0.5 + sqrt(half * half + b * b);
+    let det_m = px.x * py.y - px.y * py.x;
+    let l2 = select(0.0, min(det_m * det_m / l1, l1), l1 > 0.0);
+    // The major axis: the eigenvector of l1, from its cancellation-free form.
+    let v = select(vec2<f32>(b, l1 - a), vec2<f32>(l1 - c, b), a >= c);
+    let len = length(v);
+    let e1 = select(vec2<f32>(1.0, 0.0), v / len, len > 0.0 && len < 3.4e38);
+    let major = sqrt(l1);
+    let minor = max(sqrt(l2), major / max_ecc);
+    let q1 = major * major;
+    let q2 = minor * minor;
+    return vec4<f32>(
+        q1 * e1.x * e1.x + q2 * e1.y * e1.y,
+        (q1 - q2) * e1.x * e1.y,
+        q1 * e1.y * e1.y + q2 * e1.x * e1.x,
+        minor,
+    );
+}
+
+const MAX_ELLIPSE_AREA: f32 = 4096.0;
+const PI: f32 = 3.14159265;
+
+// The ellipse in level `level` convolved with the unit reconstruction filter: Q = D S D + I,
+// D = diag(level size / level-0 size); shrunk to MAX_ELLIPSE_AREA texels when `shrink`.
+// Returns (q00, q01, q11, det Q).
+fn in_level(s: vec4<f32>, level: i32, shrink: bool) -> vec4<f32> {
+    let d = size_of(level) / size_of(0);
+    var q = vec3<f32>(d.x * d.x * s.x + 1.0, d.x * d.y * s.y, d.y * d.y * s.z + 1.0);
+    var det = q.x * q.z - q.y * q.y;
+    let area = PI * sqrt(max(det, 0.0));
+    if shrink && area > MAX_ELLIPSE_AREA {
+        let f = MAX_ELLIPSE_AREA / area;
+        q *= f;
+        det *= f * f;
+    }
+    return vec4<f32>(q, det);
+}
+
+// EWA in one level: sum(w T) / sum(w) over the texel centres with
+// r^2 = (q11 dx^2 - 2 q01 dx dy + q00 dy^2) / det < 1, w = LUT[floor(r^2 * 128)], scanning the
+// ellipse's bounding box (half-extents sqrt(q00), sqrt(q11)); bilinear if no centre is inside.
+fn ewa_level(uv: vec2<f32>, level: i32, q: vec4<f32>) -> vec4<f32> {
+    let xy = uv * size_of(level);
+    let lo = vec2<i32>(ceil(xy - 0.5 - sqrt(vec2<f32>(q.x, q.z))));
+    let hi = vec2<i32>(floor(xy - 0.5 + sqrt(vec2<f32>(q.x, q.z))));
+    var sum = vec4<f32>(0.0);
+    var wsum = 0.0;
+    var visits = 0;
+    for (var j = lo.y; j <= hi.y && visits < 16384; j++) {
+        let dy = f32(j) + 0.5 - xy.y;
+        for (var i = lo.x; i <= hi.x && visits < 16384; i++) {
+            visits++;
+            let dx = f32(i) + 0.5 - xy.x;
+            let r2 = (q.z * dx * dx - 2.0 * q.y * dx * dy + q.x * dy * dy) / q.w;
+            if r2 < 1.0 {
+                let w = ewa_lut[clamp(i32(r2 * 128.0), 0, 127)];
+                sum += fetch(i, j, level) * w;
+                wsum += w;
+            }
+        }
+    }
+    if wsum > 0.0 {
+        return sum / wsum;
+    }
+    return bilinear(uv, level);
+}
+
+// EWA at level k, moving to coarser levels while the ellipse covers more than MAX_ELLIPSE_AREA.
+fn ewa_at(uv: vec2<f32>, s: vec4<f32>, k0: i32) -> vec4<f32> {
+    let last = i32(last_level());
+    var k = min(k0, last);
+    loop {
+        let q = in_level(s, k, false);
+        if k >= last || PI * sqrt(max(q.w, 0.0)) <= MAX_ELLIPSE_AREA {
+            break;
+        }
+        k++;
+    }
+    // A 1x1 level is its one texel under every address mode but clamp-to-border.
+    if all(level_size(k) == vec2<i32>(1)) && params.address.x != 3u && params.address.y != 3u {
+        return fetch(0, 0, k);
+    }
+    return ewa_level(uv, k, in_level(s, k, true));
+}
+
+// EWA: the two levels around lod = log2(minor semi-axis) + bias, lerped by its fraction.
+fn ewa(uv: vec2<f32>, px: vec2<f32>, py: vec2<f32>, iso_lod: f32) -> vec4<f32> {
+    if !(all(abs(px) < vec2<f32>(3.4e38)) && all(abs(py) < vec2<f32>(3.4e38))) {
+        return trilinear(uv, iso_lod);
+    }
+    let s = ellipse(px, py, f32(params.mode.z));
+    let q = last_level();
+    let d = clamp(lod_of(s.w), 0.0, q);
+    let k = floor(d);
+    let t = d - k;
+    let a = ewa_at(uv, s, i32(k));
+    if t > 0.0 && k < q {
+        return mix(a, ewa_at(uv, s, i32(k) + 1), t);
+    }
+    return a;
+}
+
 // ---- The fragment shader -------------------------------------------------------------------------
 
 struct FragmentOut {
@@ -235,6 +350,8 @@ fn fs_main(in: VertexOut) -> FragmentOut {
         c = nearest(in.uv, 0);
     } else if mode == 9u {
         c = bicubic(in.uv, 0);
+    } else if mode == 10u && lod > 0.0 {
+        c = ewa(in.uv, px, py, lod);
     } else if mode == 2u || lod <= 0.0 {
         // Bilinear without mips, and magnification for modes 3-8 (their mag filter is linear).
         c = bilinear(in.uv, 0);

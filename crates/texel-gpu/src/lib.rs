@@ -3,7 +3,7 @@
 //! The fragment shader (`shaders/filters.wgsl`) reads the texture only through `textureLoad`,
 //! `textureDimensions` and `textureNumLevels` — the filtering lab's rule — so every filter's
 //! arithmetic is written out: one function per technique (nearest, bilinear, mip-nearest,
-//! trilinear, anisotropic 2x-16x, bicubic), address modes on integer texel indices and the sRGB
+//! trilinear, anisotropic 2x-16x, bicubic, EWA), address modes on integer texel indices and the sRGB
 //! decode through the CPU's own 256-entry table, as `../shared/DESIGN.md` fixes them. The pyramid is
 //! texel-texture's, uploaded level by level in the texture's own format (`Rgba8Unorm` codes or
 //! `Rgba32Float`), so both paths filter the same texels. The hardware sampler is the peer
@@ -87,6 +87,8 @@ pub enum GpuFilter {
     Lab(u8),
     /// Bicubic Catmull-Rom in level 0.
     Bicubic,
+    /// EWA (eccentricity clamp 16), texel-texture's weight table.
+    Ewa,
     /// The device's sampler, trilinear (`textureSampleGrad`).
     HwTrilinear,
     /// The device's sampler, trilinear with `anisotropy_clamp` 16.
@@ -107,6 +109,7 @@ impl GpuFilter {
             "aniso8" => GpuFilter::Lab(7),
             "aniso16" => GpuFilter::Lab(8),
             "bicubic" => GpuFilter::Bicubic,
+            "ewa" => GpuFilter::Ewa,
             "hw-trilinear" => GpuFilter::HwTrilinear,
             "hw-aniso16" => GpuFilter::HwAniso16,
             _ => return None,
@@ -114,7 +117,7 @@ impl GpuFilter {
     }
 
     /// Every name [`GpuFilter::from_name`] accepts.
-    pub const NAMES: [&'static str; 11] = [
+    pub const NAMES: [&'static str; 12] = [
         "nearest",
         "bilinear",
         "mip-nearest",
@@ -124,6 +127,7 @@ impl GpuFilter {
         "aniso8",
         "aniso16",
         "bicubic",
+        "ewa",
         "hw-trilinear",
         "hw-aniso16",
     ];
@@ -133,6 +137,7 @@ impl GpuFilter {
         match self {
             GpuFilter::Lab(m) => (u32::from(m), if m >= 5 { 1 << (m - 4) } else { 1 }),
             GpuFilter::Bicubic => (9, 1),
+            GpuFilter::Ewa => (10, u32::from(texel_texture::EWA_DEFAULT_ANISOTROPY)),
             GpuFilter::HwTrilinear => (20, 1),
             GpuFilter::HwAniso16 => (21, 16),
         }
@@ -213,6 +218,7 @@ pub struct Gpu {
     info: AdapterSummary,
     pipeline: wgpu::RenderPipeline,
     srgb: wgpu::Buffer,
+    ewa_lut: wgpu::Buffer,
 }
 
 impl Gpu {
@@ -280,12 +286,18 @@ impl Gpu {
             .flat_map(|x| x.to_le_bytes())
             .collect();
         let srgb = buffer(&device, &queue, &table, wgpu::BufferUsages::STORAGE);
+        let lut: Vec<u8> = texel_texture::ewa::weight_lut()
+            .iter()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let ewa_lut = buffer(&device, &queue, &lut, wgpu::BufferUsages::STORAGE);
         Ok(Gpu {
             device,
             queue,
             info,
             pipeline,
             srgb,
+            ewa_lut,
         })
     }
 
@@ -581,6 +593,10 @@ impl Gpu {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: self.ewa_lut.as_entire_binding(),
                 },
             ],
         });

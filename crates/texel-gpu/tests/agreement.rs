@@ -80,7 +80,7 @@ fn agree(scene: &str, filters: &[&str]) {
     }
 }
 
-const LAB: [&str; 9] = [
+const LAB: [&str; 10] = [
     "nearest",
     "bilinear",
     "mip-nearest",
@@ -90,6 +90,7 @@ const LAB: [&str; 9] = [
     "aniso8",
     "aniso16",
     "bicubic",
+    "ewa",
 ];
 
 #[test]
