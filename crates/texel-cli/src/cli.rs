@@ -189,6 +189,14 @@ pub struct CompareArgs {
     /// labels must differ from each other and from the filters compared).
     #[arg(long, value_name = "LABEL=IMAGE")]
     pub extra: Vec<String>,
+    /// Also render every compared filter the GPU path has with texel's shaders (rows gpu-NAME) and
+    /// the device's own sampler (rows hw-trilinear, hw-aniso16), scored against the same
+    /// reference; ms per frame is wall time on the device, reading the frame back included.
+    #[arg(long)]
+    pub gpu: bool,
+    /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
+    #[arg(long, value_name = "NAME", requires = "gpu")]
+    pub adapter: Option<String>,
     /// Output directory: created, or replaced as a whole if texel wrote it before.
     #[arg(long)]
     pub out: PathBuf,

@@ -24,6 +24,7 @@ use crate::output::encoding;
 use crate::progress;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
 use texel::{MemoryBudget, PreparedScene};
+use texel_gpu::GpuFilter;
 
 /// Timed frames per filter in a comparison.
 pub const TIMED_FRAMES: u32 = 3;
@@ -130,6 +131,61 @@ pub fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<
     Ok(())
 }
 
+/// Rows scored beside the filters: images from files (`--extra LABEL=PATH`) and frames rendered
+/// elsewhere (`--gpu`: label, frame, median ms per frame).
+#[derive(Default)]
+pub struct Extras {
+    /// `--extra` images.
+    pub files: Vec<(String, PathBuf)>,
+    /// Rendered frames.
+    pub frames: Vec<(String, Frame, f64)>,
+}
+
+/// Render `filters` (those the GPU path has) with texel's shaders and the device's own sampler:
+/// rows `gpu-NAME`, `hw-trilinear`, `hw-aniso16`, each the last of [`TIMED_FRAMES`] timed frames.
+fn gpu_rows(
+    scene: &PreparedScene,
+    filters: &[Filter],
+    adapter: Option<&str>,
+    budget: &mut MemoryBudget,
+) -> Result<Vec<(String, Frame, f64)>> {
+    let gpu = texel_gpu::Gpu::new(adapter)?;
+    eprintln!("gpu: {}", gpu.info());
+    let mut settings = scene.settings();
+    settings.derivatives = texel_raster::Derivatives::Quad;
+    let mut jobs: Vec<(String, Filter, GpuFilter)> = filters
+        .iter()
+        .filter_map(|&f| {
+            GpuFilter::from_name(f.name()).map(|g| (format!("gpu-{}", f.name()), f, g))
+        })
+        .collect();
+    jobs.push((
+        "hw-trilinear".into(),
+        Filter::Trilinear,
+        GpuFilter::HwTrilinear,
+    ));
+    jobs.push(("hw-aniso16".into(), Filter::Trilinear, GpuFilter::HwAniso16));
+    let mut rows = Vec::new();
+    for (label, filter, gpu_filter) in jobs {
+        budget.take(
+            "a GPU frame",
+            u64::from(settings.width) * u64::from(settings.height) * 21,
+        )?;
+        let samplers = scene.samplers(filter)?;
+        let draws = scene.draws(&samplers);
+        let prepared = gpu.prepare(&draws, gpu_filter)?;
+        let mut times = Vec::new();
+        let mut frame = prepared.render(&settings)?;
+        for _ in 0..TIMED_FRAMES {
+            let t0 = std::time::Instant::now();
+            frame = prepared.render(&settings)?;
+            times.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        rows.push((label, frame, median(&mut times)));
+    }
+    Ok(rows)
+}
+
 /// Compare `filters` on a prepared scene against a `spp` reference, write everything into `dir`
 /// (which must exist: the caller publishes it, see [`texel_quality::publish_dir`]) and return the
 /// report. `label` names the scene in the report.
@@ -138,7 +194,7 @@ pub fn compare(
     label: &str,
     filters: &[Filter],
     spp: u32,
-    extras: &[(String, PathBuf)],
+    extras: &Extras,
     dir: &Path,
     budget: &mut MemoryBudget,
 ) -> Result<Report> {
@@ -192,7 +248,14 @@ pub fn compare(
     }
     pb.finish_and_clear();
 
-    for (label, path) in extras {
+    for (label, frame, ms) in &extras.frames {
+        let image = Image8::from_linear(w, h, &frame.color, enc)?;
+        let mut row = scoring.row(label, label, &image, true)?;
+        row.extra = true;
+        row.ms_per_frame = Some(*ms);
+        rows.push(row);
+    }
+    for (label, path) in &extras.files {
         let cannot = || format!("cannot load --extra image {label}={}", path.display());
         // The size comes from the header, so a mismatched (or huge) image is refused undecoded.
         let (iw, ih) = Image8::dimensions(path).with_context(cannot)?;
@@ -254,8 +317,17 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     check_extras(&extras, &filters)?;
     let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let frames = if args.gpu {
+        gpu_rows(&scene, &filters, args.adapter.as_deref(), &mut input.budget)?
+    } else {
+        Vec::new()
+    };
+    let extras = Extras {
+        files: extras,
+        frames,
+    };
     let per_pixel = COMPARE_BYTES_PER_PIXEL
-        + if extras.is_empty() {
+        + if extras.files.is_empty() {
             0
         } else {
             EXTRA_BYTES_PER_PIXEL

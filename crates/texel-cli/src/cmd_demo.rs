@@ -11,7 +11,7 @@ use texel_quality::html::escape;
 use texel_quality::{publish_dir, write_atomic, Report};
 
 use crate::cli::{ColorArg, DemoArgs};
-use crate::cmd_compare::{compare, COMPARE_BYTES_PER_PIXEL};
+use crate::cmd_compare::{compare, Extras, COMPARE_BYTES_PER_PIXEL};
 use crate::filters::Filter;
 use crate::input::{load_scene, Input};
 
@@ -42,7 +42,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
                 &label,
                 &Filter::ALL,
                 args.spp,
-                &[],
+                &Extras::default(),
                 &sub,
                 &mut scene_input.budget,
             )?;

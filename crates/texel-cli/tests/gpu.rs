@@ -90,3 +90,40 @@ fn gpu_renders_the_lab_modes() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(String::from_utf8_lossy(&out.stdout).contains("--gpu uses:"));
 }
+
+#[test]
+fn compare_gpu_scores_shader_and_hardware_rows() {
+    if !have_adapter() {
+        return;
+    }
+    let d = Dir::new("gpu-compare");
+    let out = texel(&[
+        "compare",
+        "builtin:ground",
+        "--size",
+        "96x64",
+        "--spp",
+        "16",
+        "--filters",
+        "trilinear,aniso16",
+        "--gpu",
+        "--out",
+        &d.arg("report"),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let md = String::from_utf8_lossy(&out.stdout).into_owned();
+    let psnr = |row: &str| -> f64 {
+        let line = md
+            .lines()
+            .find(|l| l.starts_with(&format!("| {row} ")))
+            .unwrap_or_else(|| panic!("no row {row}: {md}"));
+        line.split('|').nth(2).unwrap().trim().parse().unwrap()
+    };
+    // texel's shaders filter as the CPU does: their scores agree to within a tenth of a dB.
+    for f in ["trilinear", "aniso16"] {
+        let (cpu, gpu) = (psnr(f), psnr(&format!("gpu-{f} (extra)")));
+        assert!((cpu - gpu).abs() < 0.1, "{f}: cpu {cpu} gpu {gpu}");
+    }
+    assert!(psnr("hw-trilinear (extra)") > 0.0 && psnr("hw-aniso16 (extra)") > 0.0);
+}

@@ -200,8 +200,9 @@ impl Report {
         let mut s = format!(
             "# texel filter report: {}\n\n{}x{} pixels, reference {} samples per pixel, colour {}. \
              PSNR and SSIM against the reference over the covered pixels; the band is the {} rows \
-             below the horizon. Rows marked (extra) are external images: no time, texel or memory \
-             numbers.\n\n",
+             below the horizon. Rows marked (extra) were rendered elsewhere (an --extra image, or \
+             --gpu: gpu-NAME by texel's shaders, hw-NAME by the device's sampler, ms/frame on the \
+             device): no texel or memory numbers.\n\n",
             md_cell(&self.scene),
             self.width,
             self.height,
