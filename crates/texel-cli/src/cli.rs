@@ -240,8 +240,9 @@ pub struct BenchArgs {
     /// Print JSON in the shape of ../shared/peers/llvmpipe_bench.py.
     #[arg(long)]
     pub json: bool,
-    /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has).
-    /// Wall time per frame: submission, rendering and reading the frame back.
+    /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has):
+    /// wall time per frame (submission, rendering, reading the frame back) and, where the device
+    /// has timestamp queries, the render pass's device time (the last column; `device_ms` in JSON).
     #[arg(long)]
     pub gpu: bool,
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).

@@ -219,6 +219,8 @@ pub struct Gpu {
     pipeline: wgpu::RenderPipeline,
     srgb: wgpu::Buffer,
     ewa_lut: wgpu::Buffer,
+    /// The device writes timestamps around render passes (`Features::TIMESTAMP_QUERY`).
+    timestamps: bool,
 }
 
 impl Gpu {
@@ -267,8 +269,10 @@ impl Gpu {
             None => all.swap_remove(0),
         };
         let info = summary(&adapter);
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("texel"),
+            required_features: features,
             required_limits: adapter.limits(),
             ..Default::default()
         }))
@@ -298,12 +302,18 @@ impl Gpu {
             pipeline,
             srgb,
             ewa_lut,
+            timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
         })
     }
 
     /// The adapter in use.
     pub fn info(&self) -> &AdapterSummary {
         &self.info
+    }
+
+    /// Whether [`GpuDraws::render_timed`] can measure device time (timestamp queries).
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamps
     }
 }
 
@@ -614,6 +624,18 @@ impl GpuDraws<'_> {
     /// [`GpuError::TooLarge`] for a frame over the device's limits; [`GpuError::Failed`] when the
     /// device reports an error or is lost.
     pub fn render(&self, settings: &RenderSettings) -> Result<Frame, GpuError> {
+        Ok(self.render_timed(settings)?.0)
+    }
+
+    /// [`GpuDraws::render`], with the render pass's device time in milliseconds from timestamps
+    /// written at its beginning and end (`None` where the device has no timestamp queries).
+    ///
+    /// # Errors
+    /// As [`GpuDraws::render`].
+    pub fn render_timed(
+        &self,
+        settings: &RenderSettings,
+    ) -> Result<(Frame, Option<f64>), GpuError> {
         if settings.light.is_some() {
             return Err(GpuError::Unsupported("lighting"));
         }
@@ -657,6 +679,13 @@ impl GpuDraws<'_> {
         let coverage = target(COVERAGE, copy);
         let depth = target(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let mut encoder = device.create_command_encoder(&Default::default());
+        let queries = gpu.timestamps.then(|| {
+            device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass time"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            })
+        });
         {
             let color_view = color.create_view(&Default::default());
             let coverage_view = coverage.create_view(&Default::default());
@@ -687,6 +716,11 @@ impl GpuDraws<'_> {
                     }),
                     stencil_ops: None,
                 }),
+                timestamp_writes: queries.as_ref().map(|q| wgpu::RenderPassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
                 ..Default::default()
             });
             pass.set_pipeline(&gpu.pipeline);
@@ -699,6 +733,28 @@ impl GpuDraws<'_> {
         }
         let color_bytes = read_back(gpu, &mut encoder, &color, 16);
         let coverage_bytes = read_back(gpu, &mut encoder, &coverage, 1);
+        let time_bytes = queries.as_ref().map(|q| {
+            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+                label: None,
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            encoder.resolve_query_set(q, 0..2, &resolve, 0);
+            let out = device.create_buffer(&wgpu::BufferDescriptor {
+                label: None,
+                size: 16,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            encoder.copy_buffer_to_buffer(&resolve, 0, &out, 0, 16);
+            ReadBack {
+                buffer: out,
+                row: 16,
+                padded: 16,
+                rows: 1,
+            }
+        });
         gpu.queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Failed(e.to_string()));
@@ -714,7 +770,17 @@ impl GpuDraws<'_> {
         for (c, &b) in frame.coverage.iter_mut().zip(&coverage_data) {
             *c = b > 0;
         }
-        Ok(frame)
+        let ms = match time_bytes {
+            Some(t) => {
+                let b = t.wait(gpu)?;
+                let tick =
+                    |k: usize| u64::from_le_bytes(b[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]));
+                let ticks = tick(1).saturating_sub(tick(0));
+                Some(ticks as f64 * f64::from(gpu.queue.get_timestamp_period()) * 1e-6)
+            }
+            None => None,
+        };
+        Ok((frame, ms))
     }
 }
 

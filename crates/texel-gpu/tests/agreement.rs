@@ -107,3 +107,31 @@ fn zoneplate_agrees_with_the_cpu() {
 fn cube_agrees_with_the_cpu() {
     agree("builtin:cube", &LAB);
 }
+
+/// With timestamp queries (lavapipe has them) the render pass's device time is positive and no
+/// longer than the whole call's wall time; without them it is `None`.
+#[test]
+fn device_time_is_measured_when_the_device_can() {
+    let Some(gpu) = gpu() else { return };
+    let scene = Scene::load("builtin:ground").unwrap();
+    let options = SceneOptions {
+        size: Some((160, 96)),
+        ..SceneOptions::default()
+    };
+    let prepared =
+        PreparedScene::new(scene, &options, &mut MemoryBudget::half_of_machine()).unwrap();
+    let samplers = prepared.samplers(Filter::Trilinear).unwrap();
+    let draws = prepared.draws(&samplers);
+    let gpu_draws = gpu.prepare(&draws, GpuFilter::Lab(4)).unwrap();
+    let t0 = std::time::Instant::now();
+    let (frame, ms) = gpu_draws.render_timed(&prepared.settings()).unwrap();
+    let wall = t0.elapsed().as_secs_f64() * 1e3;
+    assert!(frame.coverage.iter().any(|&c| c));
+    match ms {
+        Some(ms) => {
+            assert!(gpu.has_timestamps());
+            assert!(ms > 0.0 && ms <= wall, "device {ms} ms, wall {wall} ms");
+        }
+        None => assert!(!gpu.has_timestamps()),
+    }
+}
