@@ -18,6 +18,10 @@ struct Params {
     lod: vec4<f32>,
 }
 
+// The mode as a pipeline constant (the same numbers as `params.mode.x`): each mode gets its own
+// pipeline, so the compiler drops the other modes' code instead of branching around it per pixel.
+override MODE: u32 = 4u;
+
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var tex: texture_2d<f32>;
 @group(0) @binding(2) var<storage, read> srgb: array<f32, 256>;
@@ -341,7 +345,7 @@ fn fs_main(in: VertexOut) -> FragmentOut {
     let px = duv_dx * size0;
     let py = duv_dy * size0;
     let lod = lod_of(max(length(px), length(py)));
-    let mode = params.mode.x;
+    let mode = MODE;
     var c: vec4<f32>;
     if mode >= 20u {
         // The device's own sampler (the hardware rows): sRGB is decoded by the texture format.

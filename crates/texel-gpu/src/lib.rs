@@ -216,7 +216,7 @@ pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
     info: AdapterSummary,
-    pipeline: wgpu::RenderPipeline,
+    module: wgpu::ShaderModule,
     srgb: wgpu::Buffer,
     ewa_lut: wgpu::Buffer,
     /// The device writes timestamps around render passes (`Features::TIMESTAMP_QUERY`).
@@ -284,7 +284,7 @@ impl Gpu {
             label: Some("filters.wgsl"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
         });
-        let pipeline = create_pipeline(&device, &module);
+
         let table: Vec<u8> = texel_texture::color::srgb_table()
             .iter()
             .flat_map(|x| x.to_le_bytes())
@@ -299,7 +299,7 @@ impl Gpu {
             device,
             queue,
             info,
-            pipeline,
+            module,
             srgb,
             ewa_lut,
             timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
@@ -323,8 +323,14 @@ const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// position (3), uv (2), colour (4) as `f32`.
 const VERTEX_FLOATS: usize = 9;
 
-fn create_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule) -> wgpu::RenderPipeline {
+/// The pipeline of one shader mode (`MODE`, a pipeline constant).
+fn create_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    mode: u32,
+) -> wgpu::RenderPipeline {
     let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x2, 2 => Float32x4];
+    let constants = [("MODE", f64::from(mode))];
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("texel filters"),
         layout: None,
@@ -353,7 +359,10 @@ fn create_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule) -> wgpu::
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &constants,
+                ..Default::default()
+            },
             targets: &[Some(COLOR.into()), Some(COVERAGE.into())],
         }),
         multiview_mask: None,
@@ -515,6 +524,7 @@ pub fn render(
 /// vertices, indices and bind groups, ready to render frames of any size.
 pub struct GpuDraws<'g> {
     gpu: &'g Gpu,
+    pipeline: wgpu::RenderPipeline,
     /// Per draw: bind group, vertex buffer, index buffer, index count.
     draws: Vec<(wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32)>,
 }
@@ -528,21 +538,24 @@ impl Gpu {
     pub fn prepare(&self, draws: &[DrawCall], filter: GpuFilter) -> Result<GpuDraws<'_>, GpuError> {
         let device = &self.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let pipeline = create_pipeline(device, &self.module, filter.mode().0);
         let mut prepared = Vec::new();
         for draw in draws {
-            prepared.push(self.prepare_draw(draw, filter)?);
+            prepared.push(self.prepare_draw(&pipeline, draw, filter)?);
         }
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Failed(e.to_string()));
         }
         Ok(GpuDraws {
             gpu: self,
+            pipeline,
             draws: prepared,
         })
     }
 
     fn prepare_draw(
         &self,
+        pipeline: &wgpu::RenderPipeline,
         draw: &DrawCall,
         filter: GpuFilter,
     ) -> Result<(wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32), GpuError> {
@@ -586,7 +599,7 @@ impl Gpu {
         });
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
-            layout: &self.pipeline.get_bind_group_layout(0),
+            layout: &pipeline.get_bind_group_layout(0),
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -723,7 +736,7 @@ impl GpuDraws<'_> {
                 }),
                 ..Default::default()
             });
-            pass.set_pipeline(&gpu.pipeline);
+            pass.set_pipeline(&self.pipeline);
             for (bind, vb, ib, count) in &self.draws {
                 pass.set_bind_group(0, bind, &[]);
                 pass.set_vertex_buffer(0, vb.slice(..));
