@@ -107,7 +107,7 @@ fn time_gpu(
     let gpu = texel_gpu::Gpu::new(args.adapter.as_deref())?;
     let mut out = Vec::new();
     for filter in filters {
-        let Some(gpu_filter) = texel_gpu::GpuFilter::from_name(filter.name()) else {
+        let Some(gpu_filter) = texel_gpu::GpuFilter::of(*filter) else {
             anyhow::bail!("--gpu has no {} filter", filter.name());
         };
         let samplers = scene.samplers(*filter)?;

@@ -155,9 +155,7 @@ fn gpu_rows(
     settings.derivatives = texel_raster::Derivatives::Quad;
     let mut jobs: Vec<(String, Filter, GpuFilter)> = filters
         .iter()
-        .filter_map(|&f| {
-            GpuFilter::from_name(f.name()).map(|g| (format!("gpu-{}", f.name()), f, g))
-        })
+        .filter_map(|&f| GpuFilter::of(f).map(|g| (format!("gpu-{}", f.name()), f, g)))
         .collect();
     jobs.push((
         "hw-trilinear".into(),

@@ -42,11 +42,13 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     };
     let draws = scene.draws(&samplers);
     let frame = if args.gpu {
-        let name = filter.unwrap_or(Filter::Trilinear).name();
-        let Some(gpu_filter) = GpuFilter::from_name(name) else {
+        let filter = filter.unwrap_or(Filter::Trilinear);
+        let Some(gpu_filter) = GpuFilter::of(filter) else {
+            let names: Vec<&str> = GpuFilter::filters().map(Filter::name).collect();
             bail!(
-                "--gpu has no {name} filter; it renders {}",
-                GpuFilter::NAMES[..10].join(", ")
+                "--gpu has no {} filter; it renders {}",
+                filter.name(),
+                names.join(", ")
             );
         };
         settings.derivatives = Derivatives::Quad;

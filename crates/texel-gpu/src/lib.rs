@@ -24,6 +24,7 @@
 use std::fmt;
 use std::sync::mpsc;
 
+use texel::Filter;
 use texel_raster::{DrawCall, Frame, RenderSettings, View};
 use texel_texture::{AddressMode, Format, LevelTexels, Texture};
 
@@ -96,41 +97,23 @@ pub enum GpuFilter {
 }
 
 impl GpuFilter {
-    /// The filter for a texel filter name (`trilinear`, `aniso16`, `hw-trilinear`, ...), if the
-    /// GPU path has it.
-    pub fn from_name(name: &str) -> Option<GpuFilter> {
-        Some(match name {
-            "nearest" => GpuFilter::Lab(1),
-            "bilinear" => GpuFilter::Lab(2),
-            "mip-nearest" => GpuFilter::Lab(3),
-            "trilinear" => GpuFilter::Lab(4),
-            "aniso2" => GpuFilter::Lab(5),
-            "aniso4" => GpuFilter::Lab(6),
-            "aniso8" => GpuFilter::Lab(7),
-            "aniso16" => GpuFilter::Lab(8),
-            "bicubic" => GpuFilter::Bicubic,
-            "ewa" => GpuFilter::Ewa,
-            "hw-trilinear" => GpuFilter::HwTrilinear,
-            "hw-aniso16" => GpuFilter::HwAniso16,
-            _ => return None,
+    /// The GPU path's version of texel's `filter`, if it has one (every filter but the ripmap and
+    /// the summed-area table).
+    pub fn of(filter: Filter) -> Option<GpuFilter> {
+        Some(match filter {
+            Filter::Bicubic => GpuFilter::Bicubic,
+            Filter::Ewa => GpuFilter::Ewa,
+            Filter::Ripmap | Filter::Sat => return None,
+            lab => GpuFilter::Lab(lab.lab_mode()?),
         })
     }
 
-    /// Every name [`GpuFilter::from_name`] accepts.
-    pub const NAMES: [&'static str; 12] = [
-        "nearest",
-        "bilinear",
-        "mip-nearest",
-        "trilinear",
-        "aniso2",
-        "aniso4",
-        "aniso8",
-        "aniso16",
-        "bicubic",
-        "ewa",
-        "hw-trilinear",
-        "hw-aniso16",
-    ];
+    /// Every texel filter the GPU path has, in [`Filter::ALL`]'s order.
+    pub fn filters() -> impl Iterator<Item = Filter> {
+        Filter::ALL
+            .into_iter()
+            .filter(|&f| GpuFilter::of(f).is_some())
+    }
 
     /// The shader's mode number and anisotropy clamp.
     fn mode(self) -> (u32, u32) {
@@ -311,6 +294,21 @@ impl Gpu {
         &self.info
     }
 
+    /// `Err(TooLarge)` with both figures if `what` (`width x height`) exceeds the device's 2D
+    /// texture limit.
+    fn check_size(&self, what: &'static str, width: u32, height: u32) -> Result<(), GpuError> {
+        let max = self.device.limits().max_texture_dimension_2d;
+        if width > max || height > max {
+            return Err(GpuError::TooLarge {
+                what,
+                width,
+                height,
+                max,
+            });
+        }
+        Ok(())
+    }
+
     /// Whether [`GpuDraws::render_timed`] can measure device time (timestamp queries).
     pub fn has_timestamps(&self) -> bool {
         self.timestamps
@@ -412,16 +410,8 @@ fn wgpu_address(mode: AddressMode) -> wgpu::AddressMode {
 /// Upload `texture`'s pyramid, level by level, in its own format (`hardware`: an sRGB format for
 /// 8-bit sRGB textures, so that the device's sampler decodes).
 fn upload(gpu: &Gpu, texture: &Texture, hardware: bool) -> Result<wgpu::Texture, GpuError> {
-    let max = gpu.device.limits().max_texture_dimension_2d;
     let (w, h) = (texture.width(), texture.height());
-    if w > max || h > max {
-        return Err(GpuError::TooLarge {
-            what: "a texture",
-            width: w,
-            height: h,
-            max,
-        });
-    }
+    gpu.check_size("a texture", w, h)?;
     let format = match texture.format() {
         Format::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
         Format::Rgba8Srgb if hardware => wgpu::TextureFormat::Rgba8UnormSrgb,
@@ -660,15 +650,7 @@ impl GpuDraws<'_> {
         }
         let gpu = self.gpu;
         let (w, h) = (settings.width, settings.height);
-        let max = gpu.device.limits().max_texture_dimension_2d;
-        if w > max || h > max {
-            return Err(GpuError::TooLarge {
-                what: "the frame",
-                width: w,
-                height: h,
-                max,
-            });
-        }
+        gpu.check_size("the frame", w, h)?;
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let target = |format, usage| {

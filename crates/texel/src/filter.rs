@@ -67,6 +67,12 @@ impl Filter {
         "sat",
     ];
 
+    /// The lab's mode number of this filter (1-8), `None` for bicubic, EWA, ripmap and
+    /// summed-area table (the inverse of [`Filter::from_lab_mode`]).
+    pub fn lab_mode(self) -> Option<u8> {
+        (1..=8).find(|&m| Filter::from_lab_mode(m).ok() == Some(self))
+    }
+
     /// The name (`mip-nearest`).
     pub fn name(self) -> &'static str {
         Self::NAMES[self as usize]
@@ -193,6 +199,7 @@ mod tests {
         assert!(Filter::parse_list(" , ").is_err());
         for m in 1..=8 {
             let f = Filter::from_lab_mode(m).unwrap();
+            assert_eq!(f.lab_mode(), Some(m));
             let d = f.descriptor(AddressMode::Repeat, AddressMode::Repeat);
             assert_eq!(
                 d,
@@ -202,5 +209,7 @@ mod tests {
             );
         }
         assert!(Filter::from_lab_mode(9).is_err());
+        let modes = Filter::ALL.iter().filter_map(|f| f.lab_mode()).count();
+        assert_eq!(modes, 8, "bicubic, EWA, ripmap and SAT have no lab mode");
     }
 }
