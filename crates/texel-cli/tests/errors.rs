@@ -209,11 +209,7 @@ fn error_unwritable_output_path() {
         1,
         &["/proc/texel-test.png"],
     );
-    let src = d.join("src.png");
-    Image8::filled(8, 8, [9, 9, 9, 255])
-        .unwrap()
-        .write_png(&src)
-        .unwrap();
+    let src = grey_png(&d, "src.png");
     fails(
         &[
             "warp",
@@ -316,19 +312,7 @@ fn error_corrupt_png_for_warp_and_mips() {
     );
     // A corrupt --extra image.
     fails(
-        &[
-            "compare",
-            "--size",
-            "32x18",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--extra",
-            &format!("gpu={p}"),
-            "--out",
-            &d.arg("c"),
-        ],
+        &compare_extra(&format!("gpu={p}"), &d.arg("c")),
         1,
         &["--extra", &p],
     );
@@ -359,19 +343,7 @@ fn error_bad_size() {
         .write_png(&extra)
         .unwrap();
     fails(
-        &[
-            "compare",
-            "--size",
-            "32x18",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--extra",
-            &format!("gpu={}", extra.display()),
-            "--out",
-            &d.arg("c"),
-        ],
+        &compare_extra(&format!("gpu={}", extra.display()), &d.arg("c")),
         1,
         &["10x10", "32x18"],
     );
@@ -406,11 +378,7 @@ fn mips_of_a_wide_texture() {
 #[test]
 fn error_warp_too_large() {
     let d = Dir::new("err-warp-size");
-    let src = d.join("src.png");
-    Image8::filled(8, 8, [9, 9, 9, 255])
-        .unwrap()
-        .write_png(&src)
-        .unwrap();
+    let src = grey_png(&d, "src.png");
     fails(
         &[
             "warp",
@@ -431,11 +399,7 @@ fn error_warp_too_large() {
 #[test]
 fn error_bad_corners() {
     let d = Dir::new("err-corners");
-    let src = d.join("src.png");
-    Image8::filled(8, 8, [9, 9, 9, 255])
-        .unwrap()
-        .write_png(&src)
-        .unwrap();
+    let src = grey_png(&d, "src.png");
     let s = src.to_string_lossy().into_owned();
     let out = d.arg("x.png");
     // A bow tie (top-right and bottom-right swapped) and all four points on one line.

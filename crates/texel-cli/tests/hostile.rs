@@ -497,6 +497,8 @@ fn fifos_where_files_belong_are_refused_at_once() {
         d.arg("gltf.toml"),
     );
     let (mips, cmp, extra) = (d.arg("m"), d.arg("c"), format!("x={f}"));
+    let compare = compare_extra(&extra, &cmp);
+    let compare: Vec<&str> = compare.iter().map(String::as_str).collect();
     let cases: [&[&str]; 7] = [
         &["render", &f, "-o", &png],
         &["render", &tex, "-o", &png],
@@ -504,19 +506,7 @@ fn fifos_where_files_belong_are_refused_at_once() {
         &["render", &gltf, "-o", &png],
         &["mips", &f, "--out", &mips],
         &["warp", &f, "--corners", "0,0,1,0,1,1,0,1", "-o", &png],
-        &[
-            "compare",
-            "--size",
-            "32x18",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--extra",
-            &extra,
-            "--out",
-            &cmp,
-        ],
+        &compare,
     ];
     for args in cases {
         let out = texel_within(args, limit);
@@ -749,19 +739,7 @@ fn errors_name_the_real_cause() {
     );
     // An --extra image of another size is refused from its header, before it is decoded.
     fails(
-        &[
-            "compare",
-            "--size",
-            "32x18",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--extra",
-            &format!("gpu={img}"),
-            "--out",
-            &d.arg("c2"),
-        ],
+        &compare_extra(&format!("gpu={img}"), &d.arg("c2")),
         1,
         &["is 16x9 but the comparison is 32x18"],
     );

@@ -10,17 +10,7 @@ fn mips_writes_every_level_and_the_chain() {
     // 16 x 8 of uniform 2x2 blocks: level 1 is exactly the block colours (raw bytes).
     let block = |x: u32, y: u32| [(x / 2 * 30) as u8, (y / 2 * 60) as u8, 200, 255];
     let src = Image8::from_fn(16, 8, block).unwrap();
-    let input = d.join("tex.png");
-    src.write_png(&input).unwrap();
-    let out = d.join("mips");
-    ok(&[
-        "mips",
-        &input.to_string_lossy(),
-        "--color",
-        "raw",
-        "--out",
-        &out.to_string_lossy(),
-    ]);
+    let out = raw_mips(&d, &src, "tex.png", "mips");
     let sizes = [(16, 8), (8, 4), (4, 2), (2, 1), (1, 1)];
     let mut files: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
@@ -58,17 +48,7 @@ fn mips_writes_every_level_and_the_chain() {
         [(x * 12) as u8, (y * 20) as u8, ((x + y) * 7) as u8, 255]
     })
     .unwrap();
-    let input = d.join("odd.png");
-    odd.write_png(&input).unwrap();
-    let out = d.join("odd");
-    ok(&[
-        "mips",
-        &input.to_string_lossy(),
-        "--color",
-        "raw",
-        "--out",
-        &out.to_string_lossy(),
-    ]);
+    let out = raw_mips(&d, &odd, "odd.png", "odd");
     for (k, (w, h)) in [(20, 12), (10, 6), (5, 3), (2, 1), (1, 1)]
         .into_iter()
         .enumerate()
@@ -88,4 +68,21 @@ fn mips_writes_every_level_and_the_chain() {
             last[c]
         );
     }
+}
+
+/// Write `image` to `d/file` and run `texel mips` on it with `--color raw` into `d/out`; returns
+/// the output directory.
+fn raw_mips(d: &Dir, image: &Image8, file: &str, out: &str) -> std::path::PathBuf {
+    let input = d.join(file);
+    image.write_png(&input).unwrap();
+    let dir = d.join(out);
+    ok(&[
+        "mips",
+        &input.to_string_lossy(),
+        "--color",
+        "raw",
+        "--out",
+        &dir.to_string_lossy(),
+    ]);
+    dir
 }

@@ -1,7 +1,5 @@
 //! Atomic outputs: failed writes leave nothing behind.
 
-use texel_quality::Image8;
-
 use crate::util::*;
 
 #[test]
@@ -22,11 +20,7 @@ fn failed_writes_leave_no_temporary_files() {
         1,
         &["cannot write", &x],
     );
-    let src = d.join("src.png");
-    Image8::filled(8, 8, [9, 9, 9, 255])
-        .unwrap()
-        .write_png(&src)
-        .unwrap();
+    let src = grey_png(&d, "src.png");
     fails(
         &[
             "warp",
@@ -47,19 +41,7 @@ fn failed_writes_leave_no_temporary_files() {
     // compare failing after its filters' images were written (the --extra image is missing): the
     // report directory is never published, and its staging directory is gone.
     fails(
-        &[
-            "compare",
-            "--size",
-            "32x18",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--extra",
-            &format!("gpu={}", d.arg("missing.png")),
-            "--out",
-            &d.arg("cmp"),
-        ],
+        &compare_extra(&format!("gpu={}", d.arg("missing.png")), &d.arg("cmp")),
         1,
         &["missing.png"],
     );

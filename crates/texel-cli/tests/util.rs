@@ -256,3 +256,33 @@ pub(crate) fn base64(bytes: &[u8]) -> String {
     }
     s
 }
+
+/// An 8x8 opaque grey PNG at `d/name`: a small valid source image.
+pub(crate) fn grey_png(d: &Dir, name: &str) -> PathBuf {
+    let path = d.join(name);
+    Image8::filled(8, 8, [9, 9, 9, 255])
+        .unwrap()
+        .write_png(&path)
+        .unwrap();
+    path
+}
+
+/// The smallest comparison that scores an `--extra` image (`extra` is `LABEL=PATH`): nearest on
+/// the default scene at 32x18 with one reference sample, written to `out`.
+pub(crate) fn compare_extra(extra: &str, out: &str) -> Vec<String> {
+    [
+        "compare",
+        "--size",
+        "32x18",
+        "--spp",
+        "1",
+        "--filters",
+        "nearest",
+        "--extra",
+        extra,
+        "--out",
+        out,
+    ]
+    .map(String::from)
+    .to_vec()
+}
