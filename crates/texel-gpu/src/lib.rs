@@ -21,6 +21,7 @@
 //! # Ok(()) }
 //! ```
 
+use std::cell::RefCell;
 use std::fmt;
 use std::sync::mpsc;
 
@@ -515,6 +516,8 @@ pub fn render(
 pub struct GpuDraws<'g> {
     gpu: &'g Gpu,
     pipeline: wgpu::RenderPipeline,
+    /// The render targets of the last frame, reused while the size stays.
+    targets: RefCell<Option<Targets>>,
     /// Per draw: bind group, vertex buffer, index buffer, index count.
     draws: Vec<(wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32)>,
 }
@@ -539,6 +542,7 @@ impl Gpu {
         Ok(GpuDraws {
             gpu: self,
             pipeline,
+            targets: RefCell::new(None),
             draws: prepared,
         })
     }
@@ -653,26 +657,12 @@ impl GpuDraws<'_> {
         gpu.check_size("the frame", w, h)?;
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let target = |format, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: None,
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
+        let mut cached = self.targets.borrow_mut();
+        let targets = match cached.take() {
+            Some(t) if t.size == (w, h) => t,
+            _ => Targets::new(device, w, h),
         };
-        let copy = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-        let color = target(COLOR, copy);
-        let coverage = target(COVERAGE, copy);
-        let depth = target(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let (color, coverage, depth) = (&targets.color, &targets.coverage, &targets.depth);
         let mut encoder = device.create_command_encoder(&Default::default());
         let queries = gpu.timestamps.then(|| {
             device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -726,8 +716,8 @@ impl GpuDraws<'_> {
                 pass.draw_indexed(0..*count, 0, 0..1);
             }
         }
-        let color_bytes = read_back(gpu, &mut encoder, &color, 16);
-        let coverage_bytes = read_back(gpu, &mut encoder, &coverage, 1);
+        let color_bytes = read_back(gpu, &mut encoder, color, 16);
+        let coverage_bytes = read_back(gpu, &mut encoder, coverage, 1);
         let time_bytes = queries.as_ref().map(|q| {
             let resolve = device.create_buffer(&wgpu::BufferDescriptor {
                 label: None,
@@ -751,6 +741,8 @@ impl GpuDraws<'_> {
             }
         });
         gpu.queue.submit([encoder.finish()]);
+        *cached = Some(targets);
+        drop(cached);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Failed(e.to_string()));
         }
@@ -776,6 +768,42 @@ impl GpuDraws<'_> {
             None => None,
         };
         Ok((frame, ms))
+    }
+}
+
+/// A frame's render targets: linear colour, coverage and depth, `size` pixels.
+struct Targets {
+    size: (u32, u32),
+    color: wgpu::Texture,
+    coverage: wgpu::Texture,
+    depth: wgpu::Texture,
+}
+
+impl Targets {
+    fn new(device: &wgpu::Device, w: u32, h: u32) -> Targets {
+        let target = |format, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let copy = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        Targets {
+            size: (w, h),
+            color: target(COLOR, copy),
+            coverage: target(COVERAGE, copy),
+            depth: target(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT),
+        }
     }
 }
 
