@@ -73,6 +73,9 @@ pub enum GpuError {
         /// The device's `max_texture_dimension_2d`.
         max: u32,
     },
+    /// The render settings are invalid ([`texel_raster::RenderSettings::validate`]).
+    #[error(transparent)]
+    Settings(#[from] texel_raster::RasterError),
     /// What the GPU path does not render (lighting, debug views, counting texels).
     #[error("the GPU path does not support {0}")]
     Unsupported(&'static str),
@@ -520,6 +523,8 @@ pub struct GpuDraws<'g> {
     targets: RefCell<Option<Targets>>,
     /// Per draw: bind group, vertex buffer, index buffer, index count.
     draws: Vec<(wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32)>,
+    /// Per draw: the uniform buffer, whose first 64 bytes are `clip_from_world`.
+    uniforms: Vec<wgpu::Buffer>,
 }
 
 impl Gpu {
@@ -533,8 +538,11 @@ impl Gpu {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let pipeline = create_pipeline(device, &self.module, filter.mode().0);
         let mut prepared = Vec::new();
+        let mut uniforms = Vec::new();
         for draw in draws {
-            prepared.push(self.prepare_draw(&pipeline, draw, filter)?);
+            let (draw, u) = self.prepare_draw(&pipeline, draw, filter)?;
+            prepared.push(draw);
+            uniforms.push(u);
         }
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Failed(e.to_string()));
@@ -544,6 +552,7 @@ impl Gpu {
             pipeline,
             targets: RefCell::new(None),
             draws: prepared,
+            uniforms,
         })
     }
 
@@ -552,7 +561,7 @@ impl Gpu {
         pipeline: &wgpu::RenderPipeline,
         draw: &DrawCall,
         filter: GpuFilter,
-    ) -> Result<(wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32), GpuError> {
+    ) -> Result<((wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32), wgpu::Buffer), GpuError> {
         let device = &self.device;
         let texture = upload(self, draw.texture, filter.is_hardware())?;
         let view = texture.create_view(&Default::default());
@@ -619,15 +628,30 @@ impl Gpu {
         });
         let vb = buffer(device, &self.queue, &vertices, wgpu::BufferUsages::VERTEX);
         let ib = buffer(device, &self.queue, &indices, wgpu::BufferUsages::INDEX);
-        Ok((bind, vb, ib, draw.triangles.len() as u32 * 3))
+        Ok(((bind, vb, ib, draw.triangles.len() as u32 * 3), uniforms))
     }
 }
 
 impl GpuDraws<'_> {
-    /// Render one frame and read it back.
+    /// Move the camera: every draw's `clip_from_world` becomes `clip_from_world` for the frames
+    /// rendered after this call (a viewer's fly camera, without uploading the draws again).
+    pub fn set_clip_from_world(&self, clip_from_world: glam::Mat4) {
+        let bytes: Vec<u8> = clip_from_world
+            .to_cols_array()
+            .iter()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        for u in &self.uniforms {
+            self.gpu.queue.write_buffer(u, 0, &bytes);
+        }
+    }
+
+    /// Render one frame and read it back. A scissor rectangle ([`RenderSettings::scissor`]) limits
+    /// the pixels drawn; the rest keep the background.
     ///
     /// # Errors
-    /// [`GpuError::Unsupported`] for lighting, debug views or texel counting;
+    /// [`GpuError::Settings`] for invalid settings; [`GpuError::Unsupported`] for lighting, debug
+    /// views or texel counting;
     /// [`GpuError::TooLarge`] for a frame over the device's limits; [`GpuError::Failed`] when the
     /// device reports an error or is lost.
     pub fn render(&self, settings: &RenderSettings) -> Result<Frame, GpuError> {
@@ -643,6 +667,7 @@ impl GpuDraws<'_> {
         &self,
         settings: &RenderSettings,
     ) -> Result<(Frame, Option<f64>), GpuError> {
+        settings.validate()?;
         if settings.light.is_some() {
             return Err(GpuError::Unsupported("lighting"));
         }
@@ -709,7 +734,14 @@ impl GpuDraws<'_> {
                 ..Default::default()
             });
             pass.set_pipeline(&self.pipeline);
-            for (bind, vb, ib, count) in &self.draws {
+            let [x0, y0, x1, y1] = settings.scissor_rect();
+            let draws = if x0 < x1 && y0 < y1 {
+                pass.set_scissor_rect(x0, y0, x1 - x0, y1 - y0);
+                &self.draws[..]
+            } else {
+                &[]
+            };
+            for (bind, vb, ib, count) in draws {
                 pass.set_bind_group(0, bind, &[]);
                 pass.set_vertex_buffer(0, vb.slice(..));
                 pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);

@@ -122,3 +122,53 @@ fn device_time_is_measured_when_the_device_can() {
         None => assert!(!gpu.has_timestamps()),
     }
 }
+
+/// `set_clip_from_world` moves the camera of prepared draws: the frame equals the one prepared
+/// with the new camera, bit for bit. A scissor keeps the pixels inside (bit for bit the whole
+/// frame's) and leaves the background outside.
+#[test]
+fn a_moved_camera_and_a_scissor_match_fresh_draws() {
+    let Some(gpu) = gpu() else { return };
+    let scene = Scene::load("builtin:ground").unwrap();
+    let options = SceneOptions {
+        size: Some((160, 96)),
+        ..SceneOptions::default()
+    };
+    let prepared =
+        PreparedScene::new(scene, &options, &mut MemoryBudget::half_of_machine()).unwrap();
+    let samplers = prepared.samplers(Filter::Aniso8).unwrap();
+    let mut draws = prepared.draws(&samplers);
+    let settings = prepared.settings();
+    let first = gpu.prepare(&draws, GpuFilter::Lab(8)).unwrap();
+    let mut camera = prepared.scene.camera;
+    camera.eye.y += 0.7;
+    camera.target.x += 1.5;
+    let moved = camera.clip_from_world(160.0 / 96.0);
+    first.set_clip_from_world(moved);
+    let via_update = first.render(&settings).unwrap();
+    for d in &mut draws {
+        d.clip_from_world = moved;
+    }
+    let fresh = texel_gpu::render(&gpu, &settings, &draws, GpuFilter::Lab(8)).unwrap();
+    assert_eq!(via_update.color, fresh.color);
+    assert!(fresh.coverage.iter().filter(|&&c| c).count() > 1000);
+
+    let scissor = [30, 20, 111, 77];
+    let part = first
+        .render(&texel::raster::RenderSettings {
+            scissor: Some(scissor),
+            ..settings
+        })
+        .unwrap();
+    for j in 0..96 {
+        for i in 0..160 {
+            let k = fresh.index(i, j);
+            if (30..111).contains(&i) && (20..77).contains(&j) {
+                assert_eq!(part.color[k], fresh.color[k], "pixel ({i}, {j})");
+            } else {
+                assert_eq!(part.color[k], settings.background, "pixel ({i}, {j})");
+                assert!(!part.coverage[k]);
+            }
+        }
+    }
+}

@@ -65,6 +65,16 @@ pub enum RasterError {
     /// The background colour has a NaN or infinite channel.
     #[error("background colour {0:?} is not finite")]
     NonFiniteBackground([f32; 4]),
+    /// The scissor rectangle is reversed or reaches outside the frame.
+    #[error("scissor rectangle {scissor:?} ([x0, y0, x1, y1]) does not lie in the {width}x{height} frame")]
+    InvalidScissor {
+        /// The rectangle `[x0, y0, x1, y1]`.
+        scissor: [u32; 4],
+        /// Frame width in pixels.
+        width: u32,
+        /// Frame height in pixels.
+        height: u32,
+    },
     /// The light's direction, colour or ambient term is not finite.
     #[error("directional light is not finite: direction {direction:?}, color {color:?}, ambient {ambient:?}")]
     NonFiniteLight {

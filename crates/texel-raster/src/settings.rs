@@ -98,6 +98,13 @@ pub struct RenderSettings {
     pub count_texels: bool,
     /// Record each pixel's footprint (uv and derivatives) in [`crate::Frame::footprints`].
     pub capture_footprints: bool,
+    /// Draw only the pixels `x0 <= i < x1, y0 <= j < y1` of `[x0, y0, x1, y1]`, as Vulkan's
+    /// scissor rectangle: pixels outside are left as they are (background after a clear). Inside,
+    /// every pixel is bit for bit what the whole frame gives it, derivatives included (quad
+    /// derivatives evaluate helper pixels from the plane equations, so a quad cut by the scissor
+    /// keeps its differences). `None` draws the whole frame; the rectangle must lie in the frame
+    /// and may be empty.
+    pub scissor: Option<[u32; 4]>,
 }
 
 impl RenderSettings {
@@ -116,7 +123,13 @@ impl RenderSettings {
             threads: None,
             count_texels: false,
             capture_footprints: false,
+            scissor: None,
         }
+    }
+
+    /// The scissor rectangle `[x0, y0, x1, y1]` (the whole frame when there is none).
+    pub fn scissor_rect(&self) -> [u32; 4] {
+        self.scissor.unwrap_or([0, 0, self.width, self.height])
     }
 
     /// Whether texels are counted (`count_texels` or the fetches view).
@@ -129,7 +142,7 @@ impl RenderSettings {
     /// # Errors
     /// [`RasterError::InvalidSize`], [`RasterError::TooManyPixels`],
     /// [`RasterError::InvalidThreadCount`], [`RasterError::NonFiniteBackground`],
-    /// [`RasterError::NonFiniteLight`].
+    /// [`RasterError::NonFiniteLight`], [`RasterError::InvalidScissor`].
     pub fn validate(&self) -> Result<(), RasterError> {
         let (width, height) = (self.width, self.height);
         if width == 0 || height == 0 || width > MAX_DIMENSION || height > MAX_DIMENSION {
@@ -153,6 +166,15 @@ impl RenderSettings {
         }
         if !self.background.iter().all(|c| c.is_finite()) {
             return Err(RasterError::NonFiniteBackground(self.background));
+        }
+        if let Some(r @ [x0, y0, x1, y1]) = self.scissor {
+            if x0 > x1 || y0 > y1 || x1 > width || y1 > height {
+                return Err(RasterError::InvalidScissor {
+                    scissor: r,
+                    width,
+                    height,
+                });
+            }
         }
         if let Some(l) = self.light {
             if !(l.direction.is_finite() && l.color.is_finite() && l.ambient.is_finite()) {

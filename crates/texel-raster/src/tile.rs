@@ -179,14 +179,21 @@ pub(crate) fn draw_frame(
 }
 
 fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
+    // The tile's pixels inside the scissor, inclusive: [i0, j0, i1, j1].
+    let [sx0, sy0, sx1, sy1] = ctx.settings.scissor_rect();
+    let (ti0, tj0) = (tile.x0.max(sx0), tile.y0.max(sy0));
+    let (ti1, tj1) = ((tile.x0 + tile.w).min(sx1), (tile.y0 + tile.h).min(sy1));
+    if ti0 >= ti1 || tj0 >= tj1 {
+        return;
+    }
     let batched = ctx.settings.view == View::Color && !ctx.counting;
     let mut span = if batched { Some(Span::new()) } else { None };
     for &t in bin {
         let Some([bi0, bj0, bi1, bj1]) = t.bbox else {
             continue;
         };
-        let (i_lo, i_hi) = (bi0.max(tile.x0), bi1.min(tile.x0 + tile.w - 1));
-        let (j_lo, j_hi) = (bj0.max(tile.y0), bj1.min(tile.y0 + tile.h - 1));
+        let (i_lo, i_hi) = (bi0.max(ti0), bi1.min(ti1 - 1));
+        let (j_lo, j_hi) = (bj0.max(tj0), bj1.min(tj1 - 1));
         if i_lo > i_hi || j_lo > j_hi {
             continue;
         }
