@@ -61,6 +61,14 @@ pub enum Command {
     ///
     /// Example: texel bench ../shared/scenes/ground.toml --frames 10 --threads 2 --json
     Bench(BenchArgs),
+    /// An interactive window: the lab's keys 1-8 switch the filter while you fly over the scene;
+    /// split screen compares two filters on one frame; 0 accumulates the reference.
+    ///
+    /// Example: texel view builtin:ground --size 1280x720
+    ///
+    /// Example (scripted, as the tests run it): texel view --keys 5 --frames 3 --no-hud --screenshot s.png
+    #[command(after_help = crate::view::controls::key_table())]
+    View(ViewArgs),
     /// List the Vulkan and GL adapters the GPU path (`render --gpu`) can use.
     ///
     /// Example: texel gpu-info
@@ -157,6 +165,39 @@ pub struct RenderArgs {
     /// Output PNG (`-` writes it to standard output).
     #[arg(short, long)]
     pub output: PathBuf,
+}
+
+/// `texel view`.
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Worker threads for rendering, 1 to 1024 (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Render the filters texel-gpu has (nearest to aniso16, bicubic, EWA; colour view) on a
+    /// Vulkan or GL device; the reference, ripmaps, summed-area tables and debug views stay on
+    /// the CPU. The HUD says which ran where.
+    #[arg(long)]
+    pub gpu: bool,
+    /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
+    #[arg(long, value_name = "NAME", requires = "gpu")]
+    pub adapter: Option<String>,
+    /// Key presses applied before the first frame, comma-separated: 0-9, a-z, tab, esc, f12,
+    /// [, ], left, right, up, down, pageup, pagedown, each optionally shift+KEY (e.g. 1,5,v,tab).
+    /// A movement key moves the camera by a quarter second's travel.
+    #[arg(long, value_name = "KEYS")]
+    pub keys: Option<String>,
+    /// Exit after this many frames were shown at full resolution, 1 to 1000000.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub frames: Option<u32>,
+    /// Write the last frame shown (overlays included unless --no-hud) to this PNG at exit.
+    #[arg(long, value_name = "PATH")]
+    pub screenshot: Option<PathBuf>,
+    /// Hide the heads-up display and the split-screen divider line, so the window (and a
+    /// screenshot) shows exactly the rendered frame; H still shows the key table.
+    #[arg(long = "no-hud", action = clap::ArgAction::SetFalse)]
+    pub hud: bool,
 }
 
 /// `texel reference`.

@@ -18,6 +18,7 @@ mod input;
 mod output;
 mod progress;
 mod threads;
+mod view;
 
 use std::process::ExitCode;
 
@@ -54,6 +55,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => cmd_demo::run(&args, &mut input),
         Command::Warp(args) => cmd_warp::run(&args, &mut input),
         Command::Mips(args) => cmd_mips::run(&args, &mut input),
+        Command::View(args) => view::run(&args, input),
         Command::GpuInfo => cmd_render::gpu_info(),
     };
     match result {

@@ -13,4 +13,5 @@ mod outputs;
 mod reference;
 mod render;
 mod util;
+mod view;
 mod warp;

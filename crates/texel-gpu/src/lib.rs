@@ -522,10 +522,13 @@ pub struct GpuDraws<'g> {
     /// The render targets of the last frame, reused while the size stays.
     targets: RefCell<Option<Targets>>,
     /// Per draw: bind group, vertex buffer, index buffer, index count.
-    draws: Vec<(wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32)>,
+    draws: Vec<UploadedDraw>,
     /// Per draw: the uniform buffer, whose first 64 bytes are `clip_from_world`.
     uniforms: Vec<wgpu::Buffer>,
 }
+
+/// One uploaded draw: bind group, vertex buffer, index buffer, index count.
+type UploadedDraw = (wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32);
 
 impl Gpu {
     /// Upload `draws` for rendering with `filter`.
@@ -561,7 +564,7 @@ impl Gpu {
         pipeline: &wgpu::RenderPipeline,
         draw: &DrawCall,
         filter: GpuFilter,
-    ) -> Result<((wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, u32), wgpu::Buffer), GpuError> {
+    ) -> Result<(UploadedDraw, wgpu::Buffer), GpuError> {
         let device = &self.device;
         let texture = upload(self, draw.texture, filter.is_hardware())?;
         let view = texture.create_view(&Default::default());

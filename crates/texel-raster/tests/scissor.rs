@@ -19,7 +19,11 @@ fn check(whole: &Frame, part: &Frame, [x0, y0, x1, y1]: [u32; 4], background: [f
         for i in 0..whole.width {
             let k = whole.index(i, j);
             if (x0..x1).contains(&i) && (y0..y1).contains(&j) {
-                assert_eq!(bits(part.color[k]), bits(whole.color[k]), "pixel ({i}, {j})");
+                assert_eq!(
+                    bits(part.color[k]),
+                    bits(whole.color[k]),
+                    "pixel ({i}, {j})"
+                );
                 assert_eq!(part.coverage[k], whole.coverage[k], "pixel ({i}, {j})");
                 inside_covered += usize::from(whole.coverage[k]);
             } else {
@@ -84,11 +88,18 @@ fn two_scissored_draws_make_a_split_screen() {
         for i in 0..w {
             let k = frame.index(i, j);
             let want = if i < 150 { &whole_left } else { &whole_right };
-            assert_eq!(bits(frame.color[k]), bits(want.color[k]), "pixel ({i}, {j})");
+            assert_eq!(
+                bits(frame.color[k]),
+                bits(want.color[k]),
+                "pixel ({i}, {j})"
+            );
             differ += usize::from(whole_left.color[k] != whole_right.color[k]);
         }
     }
-    assert!(differ > 1000, "the two filters should differ near the horizon");
+    assert!(
+        differ > 1000,
+        "the two filters should differ near the horizon"
+    );
 }
 
 #[test]

@@ -1,0 +1,120 @@
+//! `texel view`: an interactive window rendering continuously with texel's own renderer — the
+//! lab's keys 1-8, a fly camera, split-screen comparison and a progressive reference.
+//!
+//! Three parts, so that everything but the window is tested without one:
+//! - [`controls`]: keys, the state they change and the key table (`--help` and the overlay);
+//! - [`worker`]: the render thread (scissored halves, reduced resolution while moving, bands,
+//!   the accumulating reference, HUD statistics);
+//! - [`window`]: winit's event loop and softbuffer's surface.
+
+pub mod controls;
+pub mod fly;
+pub mod hud;
+pub mod window;
+pub mod worker;
+
+use std::sync::Arc;
+
+use anyhow::{anyhow, Context, Result};
+use texel_gpu::Gpu;
+use winit::event_loop::EventLoop;
+
+use crate::cli::ViewArgs;
+use crate::input::{load_scene, Input};
+use controls::{parse_keys, Mode, ViewState};
+use fly::Fly;
+use window::{App, Options};
+use worker::{Rendered, Shared, Worker};
+
+/// Run `texel view`.
+pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
+    let presses =
+        parse_keys(args.keys.as_deref().unwrap_or("")).map_err(|e| anyhow!("--keys: {e}"))?;
+    let mut input = input;
+    let scene = load_scene(
+        &args.scene.scene,
+        args.scene.color,
+        args.scene.size,
+        &mut input,
+    )?;
+    let gpu = if args.gpu {
+        Some(Gpu::new(args.adapter.as_deref())?)
+    } else {
+        None
+    };
+    let size = (scene.width, scene.height);
+    let fly = Fly::new(scene.scene.camera, movement_speed(&scene));
+    let state = ViewState::new(Mode::Filter(texel::Filter::Trilinear), args.scene.color);
+    // The window first: without a display, say so before any thread starts.
+    let event_loop = EventLoop::<Rendered>::with_user_event()
+        .build()
+        .map_err(|e| {
+            anyhow!(
+                "cannot open a window ({e}); texel view needs an X11 or Wayland display (DISPLAY or \
+                 WAYLAND_DISPLAY); for a headless machine run it under Xvfb (xvfb-run texel view)"
+            )
+        })?;
+    let proxy = event_loop.create_proxy();
+    let mut scenes = [None, None];
+    scenes[args.scene.color as usize] = Some(scene);
+    let worker = Worker {
+        scene_spec: args.scene.scene.clone(),
+        size: args.scene.size,
+        scenes,
+        input,
+        threads: args.threads,
+        gpu,
+    };
+    let shared = Arc::new(Shared::default());
+    let thread = {
+        let shared = shared.clone();
+        std::thread::Builder::new()
+            .name("texel-view-render".into())
+            .spawn(move || worker::run(worker, shared, move |r| proxy.send_event(r).is_ok()))
+            .context("cannot start the render thread")?
+    };
+    let mut app = App::new(
+        Options {
+            title: format!("texel view - {}", args.scene.scene),
+            size,
+            max_frames: args.frames.map(u64::from),
+            screenshot: args.screenshot.clone(),
+        },
+        state,
+        fly,
+        shared.clone(),
+    );
+    app.script(&presses);
+    if !args.hud {
+        app.hide_hud();
+    }
+    let ran = event_loop.run_app(&mut app);
+    shared.quit();
+    let _ = thread.join();
+    ran.context("the window's event loop failed")?;
+    match app.failure {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Movement speed of the fly camera: an eighth of the scene's bounding-box diagonal per second
+/// (at least 0.1 world units), so every scene crosses in seconds.
+fn movement_speed(scene: &texel::PreparedScene) -> f32 {
+    let mut lo = glam::Vec3::splat(f32::INFINITY);
+    let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
+    for m in &scene.scene.meshes {
+        for &p in &m.positions {
+            if p.is_finite() {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+    }
+    let d = (hi - lo).length();
+    if d.is_finite() {
+        (d / 8.0).max(0.1)
+    } else {
+        1.0
+    }
+}

@@ -1,0 +1,755 @@
+//! The viewer's render thread: it renders the newest request continuously, away from the window's
+//! event loop, so input is handled every frame however slow the filter.
+//!
+//! - **One frame** renders each half (or the whole screen) through a scissor rectangle
+//!   ([`texel_raster::RenderSettings::scissor`]), so a split screen costs one frame, and each half
+//!   is bit for bit what `texel render` gives that filter.
+//! - **Never freeze**: while the camera moves, a frame whose measured cost (ms per pixel, per
+//!   mode) would exceed [`BUDGET_MS`] is rendered at 1/s resolution (`s` up to 8) and shown
+//!   enlarged; when the camera stops, it is rendered at full resolution in bands of rows of
+//!   about [`BUDGET_MS`] each, abandoned between bands as soon as a newer request arrives.
+//! - **The reference** (mode 0) accumulates passes of 2 x 2 stratified jittered level-0 samples
+//!   per pixel (`render_reference_strata` with a new seed per pass) while nothing changes, up to
+//!   [`MAX_REFERENCE_SAMPLES`], then stops; any change restarts it. While moving it shows one
+//!   sample per pixel.
+//! - **Statistics** for the HUD (mean texels per covered pixel, lod range) come from one extra
+//!   full-resolution pass with texel counting and footprints, once the camera is still, so they
+//!   never slow the frames timed.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use texel::scene::Camera;
+use texel::{Filter, PreparedScene, Sampler, SamplerDescriptor};
+use texel_gpu::{Gpu, GpuDraws, GpuFilter};
+use texel_quality::Encoding;
+use texel_raster::{draw_into, render_reference_strata, DrawCall, Frame, RenderSettings, View};
+
+use super::controls::{Mode, ViewState};
+use crate::cli::ColorArg;
+use crate::input::{load_scene, Input};
+use crate::output::encoding;
+
+/// Time one frame (or one band of rows) should take, milliseconds.
+pub const BUDGET_MS: f64 = 40.0;
+
+/// Samples per pixel at which the reference stops refining.
+pub const MAX_REFERENCE_SAMPLES: u32 = 512;
+
+/// Largest reduction of resolution while moving.
+const MAX_SCALE: u32 = 8;
+
+/// What the window asks the render thread for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Request {
+    /// Increases with every request.
+    pub generation: u64,
+    /// Filters, view and modes.
+    pub state: ViewState,
+    /// The camera.
+    pub camera: Camera,
+    /// The window's size in pixels.
+    pub width: u32,
+    /// The window's size in pixels.
+    pub height: u32,
+    /// The camera is moving: keep frames within the budget, do not accumulate.
+    pub moving: bool,
+}
+
+impl Request {
+    /// Whether two requests give the same image (the HUD, help and the moving flag aside).
+    fn same_image(&self, other: &Request) -> bool {
+        let strip = |s: &ViewState| ViewState {
+            hud: false,
+            help: false,
+            ..s.clone()
+        };
+        strip(&self.state) == strip(&other.state)
+            && self.camera == other.camera
+            && (self.width, self.height) == (other.width, other.height)
+    }
+}
+
+/// The mailbox between the window and the render thread: the newest request wins.
+#[derive(Default)]
+pub struct Shared {
+    slot: Mutex<Slot>,
+    wake: Condvar,
+}
+
+#[derive(Default)]
+struct Slot {
+    request: Option<Request>,
+    newest: u64,
+    quit: bool,
+}
+
+impl Shared {
+    /// Hand the render thread a new request (replacing one it has not started).
+    pub fn submit(&self, request: Request) {
+        let mut slot = self.slot.lock().unwrap_or_else(|e| e.into_inner());
+        slot.newest = request.generation;
+        slot.request = Some(request);
+        self.wake.notify_all();
+    }
+
+    /// Ask the render thread to stop.
+    pub fn quit(&self) {
+        self.slot.lock().unwrap_or_else(|e| e.into_inner()).quit = true;
+        self.wake.notify_all();
+    }
+
+    /// Whether a request newer than `generation` (or quitting) is waiting.
+    fn superseded(&self, generation: u64) -> bool {
+        let slot = self.slot.lock().unwrap_or_else(|e| e.into_inner());
+        slot.quit || slot.newest > generation
+    }
+
+    /// The next request: a new one if there is one, else `current` again unless `idle`, else
+    /// wait. `None` when quitting.
+    fn next(&self, current: Option<Request>, idle: bool) -> Option<Request> {
+        let mut slot = self.slot.lock().unwrap_or_else(|e| e.into_inner());
+        loop {
+            if slot.quit {
+                return None;
+            }
+            if let Some(r) = slot.request.take() {
+                return Some(r);
+            }
+            if let (Some(c), false) = (&current, idle) {
+                return Some(c.clone());
+            }
+            slot = self.wake.wait(slot).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+}
+
+/// What the HUD says about one half of the screen.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartInfo {
+    /// The mode shown.
+    pub mode: Mode,
+    /// `"gpu"` when texel-gpu rendered it, `"cpu"` otherwise.
+    pub backend: &'static str,
+    /// Reference samples per pixel accumulated so far.
+    pub samples: Option<u32>,
+    /// Mean texels read per covered pixel and the lod range (min, max) over covered pixels,
+    /// once measured for this image.
+    pub stats: Option<Stats>,
+}
+
+/// Measured texel reads and lods of one half.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stats {
+    /// Mean texels read per covered pixel.
+    pub texels_mean: f64,
+    /// Smallest and largest lod over covered pixels (see [`lod_range`]).
+    pub lod: Option<(f32, f32)>,
+}
+
+/// One frame for the window.
+pub struct Rendered {
+    /// The request's generation.
+    pub generation: u64,
+    /// Window-sized `0x00RRGGBB` pixels.
+    pub pixels: Vec<u32>,
+    /// Width of `pixels`.
+    pub width: u32,
+    /// Height of `pixels`.
+    pub height: u32,
+    /// Milliseconds the frame took to render (not counting encoding for display).
+    pub ms: f64,
+    /// Resolution divisor (1: full resolution).
+    pub scale: u32,
+    /// Per half.
+    pub parts: Vec<PartInfo>,
+    /// An error to show instead of a new image (the pixels are then empty).
+    pub error: Option<String>,
+}
+
+/// What the render thread owns.
+pub struct Worker {
+    /// The scene argument (a path or `builtin:NAME`), reloaded for the other colour handling.
+    pub scene_spec: String,
+    /// `--size`, passed on to reloads.
+    pub size: Option<crate::cli::Size>,
+    /// The scene as loaded for each colour handling (index: `ColorArg as usize`).
+    pub scenes: [Option<PreparedScene>; 2],
+    /// Memory account and input policy.
+    pub input: Input,
+    /// `--threads`.
+    pub threads: Option<u32>,
+    /// `--gpu`: the device.
+    pub gpu: Option<Gpu>,
+}
+
+/// Per-image state kept between frames.
+#[derive(Default)]
+struct Progress {
+    /// The request the accumulation and statistics belong to.
+    image: Option<Request>,
+    /// Reference sums (linear RGBA) and samples per pixel.
+    sum: Vec<[f32; 4]>,
+    samples: u32,
+    passes: u64,
+    stats: Option<Vec<Option<Stats>>>,
+    /// One full-resolution frame of this image was shown (statistics wait for the second).
+    first_done: bool,
+}
+
+type SamplerKey = (Filter, u32, usize);
+
+/// Run the render thread until [`Shared::quit`] or until `send` reports the window gone.
+pub fn run(mut worker: Worker, shared: Arc<Shared>, send: impl Fn(Rendered) -> bool) {
+    let pool = match worker.threads {
+        Some(n) => match rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build()
+        {
+            Ok(p) => Some(p),
+            Err(e) => {
+                send(error_frame(0, &format!("cannot start worker threads: {e}")));
+                return;
+            }
+        },
+        None => None,
+    };
+    let gpu = worker.gpu.take();
+    let mut gpu_draws: HashMap<SamplerKey, GpuDraws<'_>> = HashMap::new();
+    let mut samplers: HashMap<SamplerKey, Vec<Sampler>> = HashMap::new();
+    let mut costs: HashMap<(Mode, View, bool), f64> = HashMap::new();
+    let mut progress = Progress::default();
+    let mut frame: Option<Frame> = None;
+    let mut current: Option<Request> = None;
+    let mut idle = false;
+    while let Some(req) = shared.next(current.take(), idle) {
+        let mut ctx = FrameContext {
+            worker: &mut worker,
+            gpu: gpu.as_ref(),
+            gpu_draws: &mut gpu_draws,
+            samplers: &mut samplers,
+            costs: &mut costs,
+            progress: &mut progress,
+            frame: &mut frame,
+            shared: &shared,
+        };
+        let result = match &pool {
+            Some(p) => p.install(|| ctx.render(&req)),
+            None => ctx.render(&req),
+        };
+        idle = false;
+        let out = match result {
+            Ok(Some(r)) => {
+                let refining = r.scale > 1
+                    || r.parts.iter().any(|p| {
+                        p.stats.is_none() && p.mode != Mode::Reference
+                            || p.samples.is_some_and(|s| s < MAX_REFERENCE_SAMPLES)
+                    });
+                // A finished reference stops; every other image is rendered again and again.
+                idle = !refining && r.parts.iter().all(|p| p.mode == Mode::Reference);
+                r
+            }
+            Ok(None) => {
+                current = Some(req);
+                continue;
+            }
+            Err(e) => {
+                idle = true;
+                error_frame(req.generation, &crate::chain_line(&e))
+            }
+        };
+        if !send(out) {
+            break;
+        }
+        current = Some(req);
+    }
+}
+
+fn error_frame(generation: u64, message: &str) -> Rendered {
+    Rendered {
+        generation,
+        pixels: Vec::new(),
+        width: 0,
+        height: 0,
+        ms: 0.0,
+        scale: 1,
+        parts: Vec::new(),
+        error: Some(message.to_string()),
+    }
+}
+
+struct FrameContext<'a, 'g> {
+    worker: &'a mut Worker,
+    gpu: Option<&'g Gpu>,
+    gpu_draws: &'a mut HashMap<SamplerKey, GpuDraws<'g>>,
+    samplers: &'a mut HashMap<SamplerKey, Vec<Sampler>>,
+    costs: &'a mut HashMap<(Mode, View, bool), f64>,
+    progress: &'a mut Progress,
+    frame: &'a mut Option<Frame>,
+    shared: &'a Shared,
+}
+
+/// The pixel rectangles `[x0, y0, x1, y1]` of the modes on screen at `w x h`.
+pub fn part_rects(state: &ViewState, w: u32, h: u32) -> Vec<[u32; 4]> {
+    if state.split && w >= 2 {
+        let d = ((state.divider * w as f32).round() as u32).clamp(1, w - 1);
+        vec![[0, 0, d, h], [d, 0, w, h]]
+    } else {
+        vec![[0, 0, w, h]]
+    }
+}
+
+impl FrameContext<'_, '_> {
+    fn scene(&mut self, color: ColorArg) -> Result<&PreparedScene> {
+        let w = &mut *self.worker;
+        let slot = color as usize;
+        if w.scenes[slot].is_none() {
+            let s = load_scene(&w.scene_spec, color, w.size, &mut w.input)
+                .context("cannot load the scene for the other colour handling")?;
+            w.scenes[slot] = Some(s);
+        }
+        Ok(w.scenes[slot].as_ref().expect("loaded above"))
+    }
+
+    /// Samplers of `filter` with the lod bias, built (and their structures) once.
+    fn samplers(&mut self, filter: Filter, state: &ViewState) -> Result<SamplerKey> {
+        let key = (filter, state.lod_bias.to_bits(), state.color as usize);
+        if !self.samplers.contains_key(&key) {
+            let scene = self.scene(state.color)?;
+            let list = scene
+                .samplers(filter)?
+                .iter()
+                .map(|s| {
+                    Sampler::new(SamplerDescriptor {
+                        lod_bias: state.lod_bias,
+                        ..*s.descriptor()
+                    })
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let w = &mut *self.worker;
+            let scene = w.scenes[state.color as usize].as_ref().expect("loaded");
+            scene.build_structures_within(&list, &mut w.input.budget)?;
+            self.samplers.insert(key, list);
+        }
+        Ok(key)
+    }
+
+    /// Render one frame of `req`; `None` when a newer request superseded it mid-way.
+    fn render(&mut self, req: &Request) -> Result<Option<Rendered>> {
+        let state = &req.state;
+        let same = self
+            .progress
+            .image
+            .as_ref()
+            .is_some_and(|r| r.same_image(req));
+        if !same || req.moving {
+            *self.progress = Progress {
+                image: (!req.moving).then(|| req.clone()),
+                ..Progress::default()
+            };
+        }
+        let modes = state.modes();
+        let has_gpu = self.gpu.is_some();
+        let use_gpu = |m: Mode| {
+            has_gpu
+                && state.view == View::Color
+                && matches!(m, Mode::Filter(f) if GpuFilter::of(f).is_some())
+        };
+        // Resolution: full unless moving over budget.
+        let full_rects = part_rects(state, req.width, req.height);
+        let predicted: f64 = modes
+            .iter()
+            .zip(&full_rects)
+            .map(|(&m, r)| {
+                let px = f64::from(r[2] - r[0]) * f64::from(r[3] - r[1]);
+                self.cost(m, state.view, use_gpu(m)) * px
+            })
+            .sum();
+        let scale = if req.moving {
+            ((predicted / BUDGET_MS).sqrt().ceil() as u32).clamp(1, MAX_SCALE)
+        } else {
+            1
+        };
+        let (w, h) = (req.width.div_ceil(scale), req.height.div_ceil(scale));
+        let rects = part_rects(state, w, h);
+        let scene = self.scene(state.color)?;
+        let mut settings = scene.settings();
+        settings.width = w;
+        settings.height = h;
+        settings.view = state.view;
+        settings.perspective = state.perspective;
+        settings.derivatives = state.derivatives;
+        settings.threads = None;
+        let clip = req.camera.clip_from_world(w as f32 / h as f32);
+        let frame = match self.frame.take() {
+            Some(mut f) if f.width == w && f.height == h => {
+                f.reset(&settings);
+                f
+            }
+            _ => Frame::new(&settings),
+        };
+        let mut frame = frame;
+        if self.progress.sum.len() != frame.color.len() {
+            self.progress.sum = vec![[0.0; 4]; frame.color.len()];
+        }
+        let t0 = Instant::now();
+        let mut parts = Vec::new();
+        let spp = if req.moving { [1, 1] } else { [2, 2] };
+        for (&mode, &rect) in modes.iter().zip(&rects) {
+            let started = Instant::now();
+            let gpu = use_gpu(mode);
+            let filter = match mode {
+                Mode::Filter(f) => f,
+                Mode::Reference => Filter::Trilinear,
+            };
+            let key = self.samplers(filter, state)?;
+            let scene = self.worker.scenes[state.color as usize]
+                .as_ref()
+                .expect("loaded");
+            let mut draws = scene.draws(&self.samplers[&key]);
+            for d in &mut draws {
+                d.clip_from_world = clip;
+            }
+            match mode {
+                Mode::Filter(f) if gpu => {
+                    let gpu_dev = self.gpu.expect("use_gpu checked");
+                    let g = match self.gpu_draws.entry(key) {
+                        std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                        std::collections::hash_map::Entry::Vacant(e) => {
+                            e.insert(gpu_dev.prepare(&draws, GpuFilter::of(f).expect("checked"))?)
+                        }
+                    };
+                    g.set_clip_from_world(clip);
+                    let out = g.render(&RenderSettings {
+                        scissor: Some(rect),
+                        derivatives: texel_raster::Derivatives::Quad,
+                        ..settings
+                    })?;
+                    copy_rect(&out.color, &mut frame.color, w, rect);
+                }
+                Mode::Filter(_) => {
+                    for band in bands(rect, self.cost(mode, state.view, false), req.moving) {
+                        if self.shared.superseded(req.generation) {
+                            *self.frame = Some(frame);
+                            return Ok(None);
+                        }
+                        let s = RenderSettings {
+                            scissor: Some(band),
+                            ..settings
+                        };
+                        draw_into(&s, &draws, &mut frame)?;
+                    }
+                }
+                Mode::Reference => {
+                    self.progress.passes += 1;
+                    let seed = self.progress.passes;
+                    for band in bands(rect, self.cost(mode, state.view, false), req.moving) {
+                        if self.shared.superseded(req.generation) {
+                            *self.frame = Some(frame);
+                            return Ok(None);
+                        }
+                        let s = RenderSettings {
+                            scissor: Some(band),
+                            view: View::Color,
+                            ..settings
+                        };
+                        let pass = render_reference_strata(&s, &draws, spp, seed, None)?;
+                        // The pass holds means of spp[0] x spp[1] samples: add their sums.
+                        let n = (spp[0] * spp[1]) as f32;
+                        for_rect(band, w, |k| {
+                            let (a, b) = (&mut self.progress.sum[k], pass.color[k]);
+                            for c in 0..4 {
+                                a[c] += b[c] * n;
+                            }
+                        });
+                    }
+                }
+            }
+            let px = f64::from(rect[2] - rect[0]) * f64::from(rect[3] - rect[1]);
+            let ms = started.elapsed().as_secs_f64() * 1e3;
+            let c = self.costs.entry((mode, state.view, gpu)).or_insert(ms / px);
+            *c = 0.5 * *c + 0.5 * ms / px.max(1.0);
+            parts.push(PartInfo {
+                mode,
+                backend: if gpu { "gpu" } else { "cpu" },
+                samples: None,
+                stats: None,
+            });
+        }
+        // The reference halves show the mean so far.
+        let per_pass = spp[0] * spp[1];
+        let has_reference = modes.contains(&Mode::Reference);
+        if has_reference {
+            self.progress.samples += per_pass;
+        }
+        let samples = self.progress.samples;
+        for (part, &rect) in parts.iter_mut().zip(&rects) {
+            if part.mode == Mode::Reference {
+                part.samples = Some(samples);
+                let inv = 1.0 / samples as f32;
+                for_rect(rect, w, |k| {
+                    frame.color[k] = self.progress.sum[k].map(|c| c * inv);
+                });
+            }
+        }
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        // Statistics once per still image, after its first frame.
+        if !req.moving && scale == 1 {
+            if let Some(stats) = &self.progress.stats {
+                for (p, s) in parts.iter_mut().zip(stats) {
+                    p.stats = *s;
+                }
+            } else if self.progress.image.is_some() && self.progress.first_done {
+                let stats = self.measure(req, &rects, &settings, clip)?;
+                if let Some(stats) = stats {
+                    for (p, s) in parts.iter_mut().zip(&stats) {
+                        p.stats = *s;
+                    }
+                    self.progress.stats = Some(stats);
+                }
+            } else {
+                self.progress.first_done = true;
+            }
+        }
+        let pixels = display(&frame, &rects, &modes, state, scale, req.width, req.height);
+        *self.frame = Some(frame);
+        Ok(Some(Rendered {
+            generation: req.generation,
+            pixels,
+            width: req.width,
+            height: req.height,
+            ms,
+            scale,
+            parts,
+            error: None,
+        }))
+    }
+
+    /// Milliseconds per pixel measured for `mode` (a guess of 20 ns before the first frame).
+    fn cost(&self, mode: Mode, view: View, gpu: bool) -> f64 {
+        self.costs.get(&(mode, view, gpu)).copied().unwrap_or(2e-5)
+    }
+
+    /// The HUD's statistics for each filter half: one counting pass at full resolution
+    /// ([`lod_range`] for the lods). `None` if superseded.
+    fn measure(
+        &mut self,
+        req: &Request,
+        rects: &[[u32; 4]],
+        settings: &RenderSettings,
+        clip: glam::Mat4,
+    ) -> Result<Option<Vec<Option<Stats>>>> {
+        let state = &req.state;
+        let mut out = Vec::new();
+        for (&mode, &rect) in state.modes().iter().zip(rects) {
+            let Mode::Filter(filter) = mode else {
+                out.push(None);
+                continue;
+            };
+            if self.shared.superseded(req.generation) {
+                return Ok(None);
+            }
+            let key = self.samplers(filter, state)?;
+            let scene = self.worker.scenes[state.color as usize]
+                .as_ref()
+                .expect("loaded");
+            let mut draws = scene.draws(&self.samplers[&key]);
+            for d in &mut draws {
+                d.clip_from_world = clip;
+            }
+            let s = RenderSettings {
+                scissor: Some(rect),
+                view: View::Color,
+                count_texels: true,
+                capture_footprints: true,
+                ..*settings
+            };
+            let counted = texel_raster::render(&s, &draws)?;
+            let (mut texels, mut covered) = (0u64, 0u64);
+            for_rect(rect, s.width, |k| {
+                if counted.coverage[k] {
+                    texels += u64::from(counted.texels_read[k]);
+                    covered += 1;
+                }
+            });
+            let lod = lod_range(&s, &draws, &counted, rect)?;
+            out.push(Some(Stats {
+                texels_mean: texels as f64 / covered.max(1) as f64,
+                lod,
+            }));
+        }
+        Ok(Some(out))
+    }
+}
+
+/// The smallest and largest lod of the covered pixels of `rect` in `frame` (rendered with
+/// footprints). A pixel's lod depends on its mesh's texture size and sampler; when every draw
+/// has the same texture size and lod settings the answer is exact from `frame`; otherwise each
+/// group of draws that share them is rendered alone and its own covered pixels counted (pixels
+/// hidden behind another group then count too).
+pub fn lod_range(
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+    frame: &Frame,
+    rect: [u32; 4],
+) -> Result<Option<(f32, f32)>> {
+    let group_of = |d: &DrawCall| {
+        let s = d.sampler.descriptor();
+        (
+            d.texture.width(),
+            d.texture.height(),
+            s.lod_bias.to_bits(),
+            s.lod_min_clamp.to_bits(),
+            s.lod_max_clamp.to_bits(),
+        )
+    };
+    let mut groups: Vec<_> = draws.iter().map(group_of).collect();
+    groups.sort_unstable();
+    groups.dedup();
+    let mut range: Option<(f32, f32)> = None;
+    let mut add = |lod: f32| {
+        if lod.is_finite() {
+            range = Some(range.map_or((lod, lod), |(a, b)| (a.min(lod), b.max(lod))));
+        }
+    };
+    for g in &groups {
+        let members: Vec<DrawCall> = draws
+            .iter()
+            .filter(|d| group_of(d) == *g)
+            .copied()
+            .collect();
+        let alone;
+        let f = if groups.len() == 1 {
+            frame
+        } else {
+            alone = texel_raster::render(settings, &members)?;
+            &alone
+        };
+        let d = &members[0];
+        for_rect(rect, settings.width, |k| {
+            if f.coverage[k] {
+                add(d.sampler.lod(d.texture, &f.footprints[k]));
+            }
+        });
+    }
+    Ok(range)
+}
+
+/// Row bands of `rect`, each about [`BUDGET_MS`] at `cost` ms per pixel (multiples of the 64-row
+/// tile; the whole rectangle while moving, where the resolution already keeps it short).
+fn bands(rect: [u32; 4], cost: f64, moving: bool) -> Vec<[u32; 4]> {
+    let [x0, y0, x1, y1] = rect;
+    let w = f64::from((x1 - x0).max(1));
+    let rows = if moving {
+        y1 - y0
+    } else {
+        let r = (BUDGET_MS / (cost * w)).max(1.0);
+        ((r / 64.0).round().max(1.0) as u32).saturating_mul(64)
+    };
+    let mut out = Vec::new();
+    let mut y = y0;
+    while y < y1 {
+        let e = y.saturating_add(rows.max(1)).min(y1);
+        out.push([x0, y, x1, e]);
+        y = e;
+    }
+    out
+}
+
+/// Call `f` with the index of every pixel of `rect` in a frame `width` wide.
+fn for_rect(rect: [u32; 4], width: u32, mut f: impl FnMut(usize)) {
+    let [x0, y0, x1, y1] = rect;
+    for y in y0..y1 {
+        let row = y as usize * width as usize;
+        for x in x0..x1 {
+            f(row + x as usize);
+        }
+    }
+}
+
+fn copy_rect(from: &[[f32; 4]], to: &mut [[f32; 4]], width: u32, rect: [u32; 4]) {
+    for_rect(rect, width, |k| to[k] = from[k]);
+}
+
+/// The frame as window pixels: each half encoded for display (colour as `--color` says, debug
+/// views as sRGB, as `texel render` writes them), enlarged `scale` times.
+fn display(
+    frame: &Frame,
+    rects: &[[u32; 4]],
+    modes: &[Mode],
+    state: &ViewState,
+    scale: u32,
+    width: u32,
+    height: u32,
+) -> Vec<u32> {
+    let enc_for = |m: Mode| -> Encoding {
+        if state.view == View::Color || m == Mode::Reference {
+            encoding(state.color)
+        } else {
+            Encoding::Srgb
+        }
+    };
+    let mut small = vec![0u32; frame.color.len()];
+    for (&m, &rect) in modes.iter().zip(rects) {
+        let enc = enc_for(m);
+        for_rect(rect, frame.width, |k| {
+            let [r, g, b, _] = enc.encode(frame.color[k]);
+            small[k] = u32::from(r) << 16 | u32::from(g) << 8 | u32::from(b);
+        });
+    }
+    if scale == 1 {
+        return small;
+    }
+    let mut out = vec![0u32; width as usize * height as usize];
+    for y in 0..height {
+        let src = (y / scale) as usize * frame.width as usize;
+        for x in 0..width {
+            out[y as usize * width as usize + x as usize] = small[src + (x / scale) as usize];
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bands_cover_the_rectangle_once_in_tile_rows() {
+        for (rect, cost) in [
+            ([0, 0, 1280, 720], 1e-5),
+            ([5, 3, 700, 719], 1e-3),
+            ([0, 0, 1, 1], 1.0),
+        ] {
+            let b = bands(rect, cost, false);
+            assert_eq!(b.first().unwrap()[1], rect[1]);
+            assert_eq!(b.last().unwrap()[3], rect[3]);
+            for w in b.windows(2) {
+                assert_eq!(w[0][3], w[1][1]);
+            }
+            for band in &b[..b.len() - 1] {
+                assert_eq!((band[3] - band[1]) % 64, 0);
+            }
+        }
+        // Cheap filters: one band; slow ones: 64-row bands.
+        assert_eq!(bands([0, 0, 1280, 720], 1e-6, false).len(), 1);
+        assert_eq!(bands([0, 0, 1280, 720], 1e-3, false).len(), 12);
+        assert_eq!(bands([0, 0, 1280, 720], 1e-3, true).len(), 1);
+    }
+
+    #[test]
+    fn halves_meet_at_the_divider() {
+        let mut s = ViewState::new(Mode::Reference, ColorArg::Srgb);
+        assert_eq!(part_rects(&s, 100, 50), vec![[0, 0, 100, 50]]);
+        s.split = true;
+        s.divider = 0.3;
+        assert_eq!(
+            part_rects(&s, 100, 50),
+            vec![[0, 0, 30, 50], [30, 0, 100, 50]]
+        );
+        s.divider = 0.0;
+        assert_eq!(part_rects(&s, 100, 50)[0], [0, 0, 1, 50]);
+    }
+}
