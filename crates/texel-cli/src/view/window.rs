@@ -69,6 +69,10 @@ pub struct App {
     last_tick: Instant,
     last_motion: Option<Instant>,
     status: Option<(String, Instant)>,
+    /// Render milliseconds of every full-resolution frame shown, and when the first and last
+    /// frames were shown.
+    full_ms: Vec<f64>,
+    shown: Option<(Instant, Instant)>,
     /// The first error that ends the viewer.
     pub failure: Option<anyhow::Error>,
 }
@@ -106,6 +110,8 @@ impl App {
             last_tick: Instant::now(),
             last_motion: None,
             status: None,
+            full_ms: Vec::new(),
+            shown: None,
             failure: None,
         }
     }
@@ -127,6 +133,25 @@ impl App {
                 Effect::None => {}
             }
         }
+    }
+
+    /// One line on what was shown: frames, the median render time of the full-resolution ones
+    /// and frames per second of wall time between the first and the last frame shown.
+    pub fn summary(&self) -> String {
+        let mut ms = self.full_ms.clone();
+        ms.sort_by(f64::total_cmp);
+        let median = ms.get(ms.len() / 2).copied().unwrap_or(f64::NAN);
+        let fps = match self.shown {
+            Some((a, b)) if self.presented > 1 && b > a => {
+                (self.presented - 1) as f64 / (b - a).as_secs_f64()
+            }
+            _ => f64::NAN,
+        };
+        format!(
+            "texel view: {} frames shown ({} at full resolution), median {median:.2} ms to render, {fps:.1} frames per second",
+            self.presented,
+            ms.len()
+        )
     }
 
     /// Start with the HUD and the divider line hidden (`--no-hud`).
@@ -584,7 +609,11 @@ impl ApplicationHandler<Rendered> for App {
                     self.frame_times.push(now);
                     self.frame_times
                         .retain(|t| now - *t < Duration::from_secs(1));
+                    self.shown = Some((self.shown.map_or(now, |s| s.0), now));
                     let full = self.latest.as_ref().is_some_and(|r| r.scale == 1);
+                    if let (true, Some(r)) = (full, &self.latest) {
+                        self.full_ms.push(r.ms);
+                    }
                     if full && self.options.max_frames.is_some_and(|m| self.presented >= m) {
                         event_loop.exit();
                     }
