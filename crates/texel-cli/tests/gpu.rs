@@ -6,7 +6,7 @@ use texel_quality::Image8;
 use crate::util::*;
 
 /// Whether the machine has an adapter; panics under `CI=true` when it has none.
-fn have_adapter() -> bool {
+pub(crate) fn have_adapter() -> bool {
     if !texel_gpu::adapters().is_empty() {
         return true;
     }
