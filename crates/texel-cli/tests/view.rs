@@ -270,12 +270,22 @@ fn with_gpu_the_viewer_shows_what_render_gpu_writes() {
     let Some(x) = Xvfb::start() else { return };
     let d = Dir::new("view-gpu");
     // Mode 4 on the device; the ripmap (M) stays on the CPU, as the HUD says.
-    let shot = view(&x, &d, "gpu.png", &["--gpu", "--keys", "4", "--frames", "2"]);
+    let shot = view(
+        &x,
+        &d,
+        "gpu.png",
+        &["--gpu", "--keys", "4", "--frames", "2"],
+    );
     let want = render(&d, "gpu-render.png", &["--gpu", "--lab-mode", "4"]);
     let db = psnr(&shot, &want, None).unwrap();
     eprintln!("--gpu --keys 4: {db:.1} dB against texel render --gpu --lab-mode 4");
     assert!(db >= 50.0, "{db:.1} dB");
-    let shot = view(&x, &d, "ripmap.png", &["--gpu", "--keys", "m", "--frames", "1"]);
+    let shot = view(
+        &x,
+        &d,
+        "ripmap.png",
+        &["--gpu", "--keys", "m", "--frames", "1"],
+    );
     let want = render(&d, "ripmap-render.png", &["--filter", "ripmap"]);
     assert!(psnr(&shot, &want, None).unwrap() >= 50.0);
 }

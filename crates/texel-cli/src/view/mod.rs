@@ -99,8 +99,10 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     }
 }
 
-/// Movement speed of the fly camera: an eighth of the scene's bounding-box diagonal per second
-/// (at least 0.1 world units), so every scene crosses in seconds.
+/// Movement speed of the fly camera: half the distance from the eye to the point looked at per
+/// second (the scene's scale where the camera is: the ground plane's camera stands 1 unit high and
+/// looks 10 units ahead, so it moves 5 units a second), at most the scene's bounding-box diagonal
+/// and at least 0.001 world units.
 fn movement_speed(scene: &texel::PreparedScene) -> f32 {
     let mut lo = glam::Vec3::splat(f32::INFINITY);
     let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
@@ -112,9 +114,16 @@ fn movement_speed(scene: &texel::PreparedScene) -> f32 {
             }
         }
     }
-    let d = (hi - lo).length();
-    if d.is_finite() {
-        (d / 8.0).max(0.1)
+    let diagonal = (hi - lo).length();
+    let c = &scene.scene.camera;
+    let reach = (c.target - c.eye).length() / 2.0;
+    let speed = if diagonal.is_finite() {
+        reach.min(diagonal)
+    } else {
+        reach
+    };
+    if speed.is_finite() {
+        speed.max(1e-3)
     } else {
         1.0
     }
