@@ -81,6 +81,7 @@ fuzz_target!(|input: Input| {
             texture: &tex,
             sampler: &sampler,
             clip_from_world,
+            material: None,
         };
         render(&settings, &[call]).expect("valid draw").coverage
     };

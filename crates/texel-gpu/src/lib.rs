@@ -534,9 +534,13 @@ impl Gpu {
     /// Upload `draws` for rendering with `filter`.
     ///
     /// # Errors
+    /// [`GpuError::Unsupported`] for draws with a material;
     /// [`GpuError::TooLarge`] for a texture over the device's limit; [`GpuError::Failed`] when
     /// the device reports an error.
     pub fn prepare(&self, draws: &[DrawCall], filter: GpuFilter) -> Result<GpuDraws<'_>, GpuError> {
+        if draws.iter().any(|d| d.material.is_some()) {
+            return Err(GpuError::Unsupported("materials"));
+        }
         let device = &self.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let pipeline = create_pipeline(device, &self.module, filter.mode().0);
@@ -671,7 +675,7 @@ impl GpuDraws<'_> {
         settings: &RenderSettings,
     ) -> Result<(Frame, Option<f64>), GpuError> {
         settings.validate()?;
-        if settings.light.is_some() {
+        if settings.is_lit() {
             return Err(GpuError::Unsupported("lighting"));
         }
         if settings.view != View::Color {

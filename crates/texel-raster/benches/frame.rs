@@ -64,6 +64,7 @@ fn mesh(c: &mut Criterion) {
         texture: &texture,
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
+        material: None,
     };
     let mut group = c.benchmark_group("mesh_100k_64x64_trilinear");
     group

@@ -76,6 +76,7 @@ fn main() {
         texture: &texture,
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
+        material: None,
     };
     let cells: Vec<String> = per_thread_count(runs, w, h, draw)
         .iter()

@@ -3,6 +3,8 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use texel_texture::{Sampler, Texture};
 
+use crate::material::Material;
+
 /// One vertex of a mesh, in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vertex {
@@ -13,9 +15,12 @@ pub struct Vertex {
     pub uv: Vec2,
     /// Linear RGBA colour multiplied into the texture colour (white for a plain textured mesh).
     pub color: Vec4,
-    /// World-space normal, used by the optional Lambert light; need not be normalised (the
-    /// interpolated normal is normalised per pixel).
+    /// World-space normal, used by lighting; need not be normalised (the interpolated normal is
+    /// normalised per pixel).
     pub normal: Vec3,
+    /// World-space tangent (`xyz`, along increasing u) and handedness (`w = +-1`) for normal
+    /// maps, as glTF's `TANGENT`: the bitangent is `w * cross(normal, tangent)`. Zero when none.
+    pub tangent: Vec4,
 }
 
 impl Vertex {
@@ -26,6 +31,7 @@ impl Vertex {
             uv,
             color: Vec4::ONE,
             normal: Vec3::Y,
+            tangent: Vec4::ZERO,
         }
     }
 }
@@ -42,10 +48,15 @@ pub struct DrawCall<'a> {
     /// Triangles as three vertex indices. Front faces are counter-clockwise in NDC (OpenGL's default,
     /// which appears counter-clockwise on screen too).
     pub triangles: &'a [[u32; 3]],
-    /// The texture sampled for the diffuse colour.
+    /// The texture sampled for the base (diffuse) colour.
     pub texture: &'a Texture,
     /// How the texture is sampled (filter, address modes, lod clamps).
     pub sampler: &'a Sampler,
     /// World to clip space: `perspective * look_at * world_from_model` (see [`crate::camera`]).
+    /// Lighting takes the eye's position from it (the point it maps to the clip-space direction
+    /// `(0, 0, 1, 0)`, the centre of projection).
     pub clip_from_world: Mat4,
+    /// Shading parameters and maps when the frame has lights ([`crate::RenderSettings::lights`]);
+    /// `None` is Lambertian (see [`crate::material`]).
+    pub material: Option<&'a Material<'a>>,
 }

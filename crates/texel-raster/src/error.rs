@@ -75,15 +75,14 @@ pub enum RasterError {
         /// Frame height in pixels.
         height: u32,
     },
-    /// The light's direction, colour or ambient term is not finite.
-    #[error("directional light is not finite: direction {direction:?}, color {color:?}, ambient {ambient:?}")]
-    NonFiniteLight {
-        /// The light's direction.
-        direction: [f32; 3],
-        /// The light's colour.
-        color: [f32; 3],
-        /// The ambient term.
-        ambient: [f32; 3],
+    /// A light has a non-finite number.
+    #[error("light is not finite: {0}")]
+    NonFiniteLight(String),
+    /// A draw's material has a factor out of range or not finite.
+    #[error("draw {draw}: material factors out of range (roughness and metallic in [0, 1], finite colour and normal scale, channels 0-3)")]
+    InvalidMaterial {
+        /// Index of the draw call.
+        draw: usize,
     },
     /// The reference renderer's samples per pixel side is outside `1..=MAX_SPP_SIDE`.
     #[error("reference samples per pixel side {spp_side} is invalid: it must be in 1..={max}")]

@@ -29,6 +29,7 @@
 //!     texture: &tex,
 //!     sampler: &sampler,
 //!     clip_from_world: Mat4::IDENTITY,
+//!     material: None,
 //! };
 //! let frame = render(&RenderSettings::new(8, 8), &[draw])?;
 //! // The lower-left half is white. The 8 diagonal pixel centres lie exactly on the hypotenuse, a
@@ -45,6 +46,7 @@ mod draw;
 mod error;
 mod frame;
 pub mod interp;
+pub mod material;
 pub mod reference;
 mod settings;
 pub mod setup;
@@ -56,8 +58,9 @@ pub use draw::{DrawCall, Vertex};
 pub use error::RasterError;
 pub use frame::Frame;
 pub use reference::{render_reference, render_reference_strata};
+pub use material::{ChannelInput, Light, Material, SpecularAa, TextureInput, MAX_LIGHTS};
 pub use settings::{
-    Derivatives, DirectionalLight, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS,
+    Derivatives, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS,
 };
 
 /// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].

@@ -9,7 +9,9 @@
 //! 1/256 pixel, as the rasterizer snaps), then interpolates `uv` perspective-correctly *at its exact
 //! sub-pixel position* from the same homogeneous plane equations, samples the texture bilinearly at
 //! level 0 (a sampler with Linear mag/min filters, no mipmapping, and the draw's address modes and
-//! border colour), and shades as [`crate::View::Color`] does (vertex colour, optional light).
+//! border colour), and shades as [`crate::View::Color`] does (vertex colour; under lights the same
+//! material model, its maps read bilinearly at level 0 too and the normals used exactly, without
+//! specular antialiasing).
 //! Samples that hit nothing take the background colour. The pixel is the plain mean (box filter) in
 //! linear light.
 //!
@@ -34,6 +36,7 @@ use texel_texture::{FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor};
 use crate::draw::DrawCall;
 use crate::error::RasterError;
 use crate::frame::Frame;
+use crate::material::{ChannelInput, Material, SpecularAa, TextureInput};
 use crate::settings::{Perspective, RenderSettings};
 use crate::setup::{setup_draws, validate_draws, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
@@ -92,29 +95,77 @@ pub fn render_reference_strata(
     validate_draws(draws)?;
     let samplers = draws
         .iter()
-        .map(|d| {
-            Sampler::new(SamplerDescriptor {
-                mag_filter: FilterMode::Linear,
-                min_filter: FilterMode::Linear,
-                mipmap_filter: MipmapFilterMode::None,
-                anisotropy_clamp: 1,
-                lod_min_clamp: 0.0,
-                lod_max_clamp: 32.0,
-                lod_bias: 0.0,
-                ..*d.sampler.descriptor()
-            })
+        .map(|d| level0(d.sampler))
+        .collect::<Result<Vec<_>, _>>()?;
+    // The materials' maps are read at level 0 too, and the normals exactly (no specular
+    // antialiasing: the sub-samples resolve the variation it approximates).
+    let map_samplers = draws
+        .iter()
+        .map(|d| -> Result<[Option<Sampler>; 3], RasterError> {
+            let Some(m) = d.material else {
+                return Ok([None, None, None]);
+            };
+            Ok([
+                m.roughness_map.map(|c| level0(c.input.sampler)).transpose()?,
+                m.metallic_map.map(|c| level0(c.input.sampler)).transpose()?,
+                m.normal_map.map(|t| level0(t.sampler)).transpose()?,
+            ])
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let materials: Vec<Option<Material>> = draws
+        .iter()
+        .zip(&map_samplers)
+        .map(|(d, [r, m, n])| {
+            d.material.map(|mat| {
+                Material {
+                    roughness_map: channel(mat.roughness_map, r),
+                    metallic_map: channel(mat.metallic_map, m),
+                    normal_map: mat
+                        .normal_map
+                        .zip(n.as_ref())
+                        .map(|(t, s)| TextureInput { sampler: s, ..t }),
+                    specular_aa: SpecularAa::None,
+                    ..*mat
+                }
+            })
+        })
+        .collect();
     crate::with_threads(settings.threads, || {
-        reference_frame(settings, draws, &samplers, strata, seed, progress)
+        reference_frame(settings, draws, (&samplers, &materials), strata, seed, progress)
     })
+}
+
+/// `c` read through sampler `s` instead of its own.
+fn channel<'a>(c: Option<ChannelInput<'a>>, s: &'a Option<Sampler>) -> Option<ChannelInput<'a>> {
+    c.zip(s.as_ref()).map(|(c, s)| ChannelInput {
+        input: TextureInput {
+            sampler: s,
+            ..c.input
+        },
+        ..c
+    })
+}
+
+/// `sampler` reading level 0 bilinearly (no mipmaps, no anisotropy), with its address modes and
+/// border colour.
+fn level0(sampler: &Sampler) -> Result<Sampler, RasterError> {
+    Ok(Sampler::new(SamplerDescriptor {
+        mag_filter: FilterMode::Linear,
+        min_filter: FilterMode::Linear,
+        mipmap_filter: MipmapFilterMode::None,
+        anisotropy_clamp: 1,
+        lod_min_clamp: 0.0,
+        lod_max_clamp: 32.0,
+        lod_bias: 0.0,
+        ..*sampler.descriptor()
+    })?)
 }
 
 struct Context<'a> {
     settings: &'a RenderSettings,
     setups: &'a [TriangleSetup],
     draws: Vec<DrawContext<'a>>,
-    light: Option<Lighting>,
+    lighting: Option<Lighting>,
     strata: [u32; 2],
     seed: u64,
 }
@@ -122,7 +173,7 @@ struct Context<'a> {
 fn reference_frame(
     settings: &RenderSettings,
     draws: &[DrawCall],
-    samplers: &[Sampler],
+    (samplers, materials): (&[Sampler], &[Option<Material>]),
     strata: [u32; 2],
     seed: u64,
     progress: Option<Progress>,
@@ -151,13 +202,18 @@ fn reference_frame(
     let ref_draws: Vec<DrawCall> = draws
         .iter()
         .zip(samplers)
-        .map(|(d, s)| DrawCall { sampler: s, ..*d })
+        .zip(materials)
+        .map(|((d, s), m)| DrawCall {
+            sampler: s,
+            material: m.as_ref(),
+            ..*d
+        })
         .collect();
     let ctx = Context {
         settings,
         setups: &setups,
         draws: ref_draws.iter().map(DrawContext::new).collect(),
-        light: settings.light.as_ref().map(Lighting::new),
+        lighting: Lighting::of(settings),
         strata,
         seed,
     };
@@ -284,7 +340,9 @@ fn reference_row(
             let uv = uvs[0] * lambda.x + uvs[1] * lambda.y + uvs[2] * lambda.z;
             let fp = dc.footprint(uv, DVec2::ZERO, DVec2::ZERO);
             let tex = dc.sampler.sample(dc.texture, &fp);
-            sum += Vec4::from_array(shade(dc, dc.vertices(t), lambda, tex, ctx.light.as_ref()));
+            let lit = ctx.lighting.as_ref();
+            let (c, _) = shade(dc, dc.vertices(t), lambda, tex, &fp, lit, false);
+            sum += Vec4::from_array(c);
         }
         *out = (sum * inv_spp).to_array();
         *cov = hit;

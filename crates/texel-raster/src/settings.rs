@@ -1,9 +1,9 @@
 //! How a frame is rendered: size, background, derivative and interpolation modes, debug view, light,
 //! threads.
 
-use glam::Vec3;
 
 use crate::error::RasterError;
+use crate::material::{Light, MAX_LIGHTS};
 
 /// The largest frame side in pixels (keeps fixed-point edge functions far from `i64` overflow,
 /// see [`crate::setup`]).
@@ -59,18 +59,6 @@ pub enum View {
     Barycentric,
 }
 
-/// One directional light for Lambert shading: `colour = texture * vertex_colour * (ambient + color *
-/// max(0, n . l))`, with `n` the interpolated normal and `l` the normalised `direction`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DirectionalLight {
-    /// World-space direction *towards* the light (need not be normalised; zero gives no diffuse term).
-    pub direction: Vec3,
-    /// Linear RGB intensity of the light.
-    pub color: Vec3,
-    /// Linear RGB ambient term added to the diffuse term.
-    pub ambient: Vec3,
-}
-
 /// Everything that configures one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -88,8 +76,10 @@ pub struct RenderSettings {
     pub view: View,
     /// Skip triangles that are clockwise in NDC (back faces, OpenGL's default front face is CCW).
     pub cull_backfaces: bool,
-    /// Optional Lambert light; `None` shades unlit (texture times vertex colour).
-    pub light: Option<DirectionalLight>,
+    /// Up to [`MAX_LIGHTS`] lights (`None` slots are skipped). With none the frame is unlit
+    /// (texture times vertex colour); with any, every colour pixel is shaded by
+    /// [`crate::material`]'s model with its draw's material.
+    pub lights: [Option<Light>; MAX_LIGHTS],
     /// Worker threads: `None` uses rayon's global pool, `Some(n)` a local pool of `n >= 1` threads.
     /// The image is identical for every thread count.
     pub threads: Option<usize>,
@@ -109,7 +99,7 @@ pub struct RenderSettings {
 
 impl RenderSettings {
     /// Defaults for a `width x height` frame: opaque black background, analytic derivatives,
-    /// perspective-correct colour view, no culling, no light, rayon's global pool, no counting.
+    /// perspective-correct colour view, no culling, no lights, rayon's global pool, no counting.
     pub fn new(width: u32, height: u32) -> Self {
         RenderSettings {
             width,
@@ -119,7 +109,7 @@ impl RenderSettings {
             perspective: Perspective::Correct,
             view: View::Color,
             cull_backfaces: false,
-            light: None,
+            lights: [None; MAX_LIGHTS],
             threads: None,
             count_texels: false,
             capture_footprints: false,
@@ -130,6 +120,16 @@ impl RenderSettings {
     /// The scissor rectangle `[x0, y0, x1, y1]` (the whole frame when there is none).
     pub fn scissor_rect(&self) -> [u32; 4] {
         self.scissor.unwrap_or([0, 0, self.width, self.height])
+    }
+
+    /// Whether any light is set (the frame is shaded).
+    pub fn is_lit(&self) -> bool {
+        self.lights.iter().any(Option::is_some)
+    }
+
+    /// The lights that are set.
+    pub fn active_lights(&self) -> impl Iterator<Item = &Light> {
+        self.lights.iter().flatten()
     }
 
     /// Whether texels are counted (`count_texels` or the fetches view).
@@ -176,14 +176,8 @@ impl RenderSettings {
                 });
             }
         }
-        if let Some(l) = self.light {
-            if !(l.direction.is_finite() && l.color.is_finite() && l.ambient.is_finite()) {
-                return Err(RasterError::NonFiniteLight {
-                    direction: l.direction.to_array(),
-                    color: l.color.to_array(),
-                    ambient: l.ambient.to_array(),
-                });
-            }
+        if let Some(l) = self.active_lights().find(|l| !l.is_finite()) {
+            return Err(RasterError::NonFiniteLight(format!("{l:?}")));
         }
         Ok(())
     }

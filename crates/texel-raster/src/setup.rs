@@ -171,6 +171,9 @@ impl TriangleSetup {
 /// [`RasterError::IndexOutOfRange`] for the first offending index.
 pub fn validate_draws(draws: &[DrawCall]) -> Result<(), RasterError> {
     for (d, draw) in draws.iter().enumerate() {
+        if draw.material.is_some_and(|m| !m.is_valid()) {
+            return Err(RasterError::InvalidMaterial { draw: d });
+        }
         let n = draw.vertices.len();
         for (t, tri) in draw.triangles.iter().enumerate() {
             if let Some(&index) = tri.iter().find(|&&k| k as usize >= n) {

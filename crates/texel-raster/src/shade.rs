@@ -1,9 +1,10 @@
-//! Colour shading: the texture's colour as the diffuse colour, times the interpolated vertex colour,
-//! optionally lit by one directional light (Lambert), and the footprint handed to the sampler.
+//! Colour shading: the texture's colour as the base colour, times the material's factor and the
+//! interpolated vertex colour; under lights, [`crate::material`]'s model with the material's maps
+//! read through the same footprint; and the footprint handed to the sampler.
 //!
-//! `colour = texture * vertex_colour * (ambient + light_colour * max(0, n . l))` in linear light, with
-//! `n` the perspective-correct interpolated normal, normalised. Alpha is `texture.a * vertex.a`;
-//! there is no blending (the nearest fragment replaces the pixel).
+//! Attributes (normal, tangent, position) are the perspective-correct barycentric combinations of
+//! the original triangle's vertices. Alpha is `texture.a * base_color.a * vertex.a`; there is no
+//! blending (the nearest fragment replaces the pixel).
 //!
 //! Footprints: `uv` is interpolated in `f64`. For periodic address modes the sampler's result does
 //! not change when a whole period is subtracted, so `u` (`v`) is reduced modulo 1 (Repeat) or 2
@@ -11,12 +12,13 @@
 //! reaches `|u| = 250`, 256 000 texels) this keeps the texel position exact to `f32` precision
 //! instead of losing 1/64 texel.
 
-use glam::{DVec2, DVec3, Vec3, Vec4};
+use glam::{DMat4, DVec2, DVec3, DVec4, Vec3, Vec4};
 use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};
 use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
 use crate::draw::{DrawCall, Vertex};
-use crate::settings::DirectionalLight;
+use crate::material::{self, Light, Material, SpecularAa, Surface, MIN_ROUGHNESS};
+use crate::settings::RenderSettings;
 use crate::setup::TriangleSetup;
 
 /// Per-draw state resolved once per frame.
@@ -31,6 +33,10 @@ pub(crate) struct DrawContext<'a> {
     inv_period: DVec2,
     /// Whether any vertex colour differs from opaque white (skips the multiply when not).
     colored: bool,
+    /// The draw's material.
+    pub material: Option<&'a Material<'a>>,
+    /// The eye's world position (the centre of projection of `clip_from_world`).
+    pub eye: Vec3,
 }
 
 fn period(mode: AddressMode) -> f64 {
@@ -71,6 +77,26 @@ fn reduce(x: f64, p: f64, inv_p: f64) -> f64 {
     }
 }
 
+/// The centre of projection of `clip_from_world`: the world point that maps to clip-space
+/// `(0, 0, z, 0)`, `M^-1 (0, 0, 1, 0)` divided by its `w` (in `f64`). The origin for a matrix
+/// without one (not invertible, or orthographic).
+fn eye_of(draw: &DrawCall) -> Vec3 {
+    let m = DMat4::from_cols_array(&draw.clip_from_world.to_cols_array().map(f64::from));
+    if m.determinant() == 0.0 {
+        return Vec3::ZERO;
+    }
+    let h = m.inverse() * DVec4::new(0.0, 0.0, 1.0, 0.0);
+    if h.w.abs() < 1e-300 {
+        return Vec3::ZERO;
+    }
+    let p = (h.truncate() / h.w).as_vec3();
+    if p.is_finite() {
+        p
+    } else {
+        Vec3::ZERO
+    }
+}
+
 impl<'a> DrawContext<'a> {
     pub fn new(draw: &DrawCall<'a>) -> Self {
         let d = draw.sampler.descriptor();
@@ -81,6 +107,8 @@ impl<'a> DrawContext<'a> {
             period: DVec2::new(period(d.address_mode_u), period(d.address_mode_v)),
             inv_period: DVec2::new(inv_period(d.address_mode_u), inv_period(d.address_mode_v)),
             colored: draw.vertices.iter().any(|v| v.color != Vec4::ONE),
+            material: draw.material,
+            eye: eye_of(draw),
         }
     }
 
@@ -110,45 +138,105 @@ impl<'a> DrawContext<'a> {
     }
 }
 
-/// A [`DirectionalLight`] with its direction normalised once.
-#[derive(Clone, Copy, Debug)]
+/// The frame's lights, gathered once.
+#[derive(Clone, Debug)]
 pub(crate) struct Lighting {
-    to_light: Vec3,
-    color: Vec3,
-    ambient: Vec3,
+    lights: Vec<Light>,
 }
 
 impl Lighting {
-    pub fn new(light: &DirectionalLight) -> Self {
-        Lighting {
-            to_light: light.direction.normalize_or_zero(),
-            color: light.color,
-            ambient: light.ambient,
-        }
+    /// The lights of `settings`, or `None` for an unlit frame.
+    pub fn of(settings: &RenderSettings) -> Option<Self> {
+        settings.is_lit().then(|| Lighting {
+            lights: settings.active_lights().copied().collect(),
+        })
     }
 }
 
-/// The shaded colour of a fragment with texture colour `tex` (linear RGBA) and barycentrics `lambda`.
+/// How far an 8-bit normal map's decoded vector may fall short of unit length by quantisation
+/// alone (each of three components off by up to 1/255): Toksvig counts lengths within it as 1.
+const UNORM8_NORMAL_SLACK: f32 = 0.006_8;
+
+/// The shaded colour of a fragment with base texture colour `tex` (linear RGBA), barycentrics
+/// `lambda` and footprint `fp` (for the material's maps), and the texels the maps read when
+/// `count`. Unlit frames show `tex * base_color * vertex colour`; lit frames
+/// [`crate::material::radiance`].
 #[inline(always)]
 pub(crate) fn shade(
     ctx: &DrawContext,
     verts: [&Vertex; 3],
     lambda: DVec3,
     tex: [f32; 4],
-    light: Option<&Lighting>,
-) -> [f32; 4] {
+    fp: &Footprint,
+    lighting: Option<&Lighting>,
+    count: bool,
+) -> ([f32; 4], u32) {
     let l = lambda.as_vec3();
     let mut c = Vec4::from_array(tex);
     if ctx.colored {
         c *= verts[0].color * l.x + verts[1].color * l.y + verts[2].color * l.z;
     }
-    if let Some(light) = light {
-        let n = (verts[0].normal * l.x + verts[1].normal * l.y + verts[2].normal * l.z)
-            .normalize_or_zero();
-        let k = light.ambient + light.color * n.dot(light.to_light).max(0.0);
-        c = (c.truncate() * k).extend(c.w);
+    if let Some(m) = ctx.material {
+        c *= m.base_color;
     }
-    c.to_array()
+    let Some(lighting) = lighting else {
+        return (c.to_array(), 0);
+    };
+    let mut texels = 0;
+    let position = verts[0].position * l.x + verts[1].position * l.y + verts[2].position * l.z;
+    let mut normal = (verts[0].normal * l.x + verts[1].normal * l.y + verts[2].normal * l.z)
+        .normalize_or_zero();
+    if normal == Vec3::ZERO {
+        normal = (verts[1].position - verts[0].position)
+            .cross(verts[2].position - verts[0].position)
+            .normalize_or(Vec3::Y);
+    }
+    let (mut roughness, mut metallic) = (1.0, 0.0);
+    if let Some(m) = ctx.material {
+        roughness = m.roughness;
+        metallic = m.metallic;
+        if let Some(map) = &m.roughness_map {
+            let (t, n) = material::sample(&map.input, fp, count);
+            roughness *= t[map.channel];
+            texels += n;
+        }
+        if let Some(map) = &m.metallic_map {
+            let (t, n) = material::sample(&map.input, fp, count);
+            metallic *= t[map.channel];
+            texels += n;
+        }
+        if let Some(map) = &m.normal_map {
+            let tangent = verts[0].tangent * l.x + verts[1].tangent * l.y + verts[2].tangent * l.z;
+            let t = tangent.truncate() - normal * normal.dot(tangent.truncate());
+            if let Some(t) = t.try_normalize() {
+                let (nt, n) = material::sample(map, fp, count);
+                texels += n;
+                let raw = Vec3::new(nt[0], nt[1], nt[2]) * 2.0 - Vec3::ONE;
+                if m.specular_aa == SpecularAa::Toksvig {
+                    let slack = if map.texture.format() == texel_texture::Format::Rgba32Float {
+                        0.0
+                    } else {
+                        UNORM8_NORMAL_SLACK
+                    };
+                    let len = (raw.length() + slack).min(1.0);
+                    roughness = material::toksvig_roughness(roughness, len);
+                }
+                let sign = if tangent.w < 0.0 { -1.0 } else { 1.0 };
+                let b = normal.cross(t) * sign;
+                let scaled = raw * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
+                normal = (t * scaled.x + b * scaled.y + normal * scaled.z).normalize_or(normal);
+            }
+        }
+    }
+    let surface = Surface {
+        base: c.truncate(),
+        roughness: roughness.clamp(MIN_ROUGHNESS, 1.0),
+        metallic: metallic.clamp(0.0, 1.0),
+        normal,
+        position,
+    };
+    let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, ctx.material.is_none());
+    (rgb.extend(c.w).to_array(), texels)
 }
 
 #[cfg(test)]

@@ -116,7 +116,7 @@ struct TileTarget<'f> {
 struct Context<'a> {
     settings: &'a RenderSettings,
     draws: Vec<DrawContext<'a>>,
-    light: Option<Lighting>,
+    lighting: Option<Lighting>,
     counting: bool,
     capture: bool,
 }
@@ -145,7 +145,7 @@ pub(crate) fn draw_frame(
     let ctx = Context {
         settings,
         draws: draws.iter().map(DrawContext::new).collect(),
-        light: settings.light.as_ref().map(Lighting::new),
+        lighting: Lighting::of(settings),
         counting,
         capture,
     };
@@ -435,8 +435,9 @@ fn flush_span(
     if n == 0 {
         return;
     }
-    // Nearest or bilinear without mipmaps ignore the derivatives: skip them unless captured.
-    let deriv = ctx.capture || dc.sampler.uses_derivatives();
+    // Nearest or bilinear without mipmaps ignore the derivatives: skip them unless captured or a
+    // material's maps may need them.
+    let deriv = ctx.capture || dc.sampler.uses_derivatives() || dc.material.is_some();
     span.barycentrics(t, ctx.settings.perspective, deriv);
     span.footprints(dc, dc.uvs(t), deriv);
     dc.sampler
@@ -455,7 +456,8 @@ fn flush_span(
         while k < n && span.lj[k] == lj {
             let li = span.li[k] as usize;
             let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
-            color[li] = shade(dc, verts, lambda, span.texs[k], ctx.light.as_ref());
+            let lit = ctx.lighting.as_ref();
+            color[li] = shade(dc, verts, lambda, span.texs[k], &span.fps[k], lit, false).0;
             depth[li] = span.z[k];
             coverage[li] = true;
             k += 1;
@@ -541,8 +543,17 @@ fn write_fragment(
     } else {
         ([0.0; 4], 0)
     };
+    let lit = ctx.lighting.as_ref();
+    // The texels a material's maps read count too (in every view, so the fetches view agrees
+    // with the counts of the colour view).
+    let (shaded, map_texels) = if ctx.settings.view == View::Color || (ctx.counting && lit.is_some()) {
+        shade(dc, dc.vertices(t), f.lambda, tex, &fp, lit, ctx.counting)
+    } else {
+        ([0.0; 4], 0)
+    };
+    let count = count + map_texels;
     let color = match ctx.settings.view {
-        View::Color => shade(dc, dc.vertices(t), f.lambda, tex, ctx.light.as_ref()),
+        View::Color => shaded,
         View::Uv => views::uv_color(f.uv.x, f.uv.y),
         View::Mip => views::mip_color(dc.sampler, dc.texture, &fp),
         View::Lod => views::lod_color(dc.sampler, dc.texture, &fp),

@@ -18,6 +18,7 @@ fn draw<'a>(
         texture: &tex.0,
         sampler: &tex.1,
         clip_from_world: m,
+        material: None,
     }
 }
 

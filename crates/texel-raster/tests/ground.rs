@@ -7,7 +7,7 @@ use common::{lab_sampler, white, Ground};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use texel_raster::views::MIP_PALETTE;
 use texel_raster::{
-    render, render_reference, DirectionalLight, DrawCall, Frame, RenderSettings, Vertex, View,
+    render, render_reference, DrawCall, Light, Frame, RenderSettings, Vertex, View,
 };
 
 const W: u32 = 320;
@@ -202,6 +202,7 @@ fn vertex_colours_barycentrics_and_lambert() {
         texture: &tex,
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
+        material: None,
     };
     let color = render(&RenderSettings::new(w, h), &[draw]).unwrap();
     let bary = render(
@@ -222,13 +223,18 @@ fn vertex_colours_barycentrics_and_lambert() {
     for k in 0..3 {
         assert!((f32::from(b[k]) - expect[k] * 255.0).abs() <= 1.0, "{b:?}");
     }
-    // Lambert: normal +z, light from +z at 60 degrees: ambient 0.1 + 0.8 * cos 60 = 0.5.
+    // Lambert (no material): normal +z, light at 60 degrees from +z with illuminance 0.8 pi:
+    // 0.8 pi / pi * cos 60 + ambient 0.1 = 0.5.
+    let mut lights = [None; texel_raster::MAX_LIGHTS];
+    lights[0] = Some(Light::Directional {
+        direction: Vec3::new(0.0, 3f32.sqrt(), 1.0),
+        intensity: Vec3::splat(0.8 * std::f32::consts::PI),
+    });
+    lights[3] = Some(Light::Ambient {
+        intensity: Vec3::splat(0.1),
+    });
     let lit = RenderSettings {
-        light: Some(DirectionalLight {
-            direction: Vec3::new(0.0, 3f32.sqrt(), 1.0),
-            color: Vec3::splat(0.8),
-            ambient: Vec3::splat(0.1),
-        }),
+        lights,
         ..RenderSettings::new(w, h)
     };
     let mut lit_vertices = vertices.clone();

@@ -161,6 +161,7 @@ fn reference_covers_tile_seams_and_subpixel_triangles() {
         texture: &tex,
         sampler: &sampler,
         clip_from_world: glam::Mat4::IDENTITY,
+        material: None,
     };
     let s = RenderSettings::new(w, h);
     let f = render_reference(&s, &[draw], 4, 7, None).unwrap();
@@ -177,6 +178,7 @@ fn reference_covers_tile_seams_and_subpixel_triangles() {
         texture: &tex,
         sampler: &sampler,
         clip_from_world: glam::Mat4::IDENTITY,
+        material: None,
     };
     assert_eq!(render(&s, &[draw]).unwrap().covered_pixels(), 0);
     let f = render_reference(&s, &[draw], 8, 7, None).unwrap();

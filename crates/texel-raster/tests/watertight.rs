@@ -16,6 +16,7 @@ fn coverage_counts(vertices: &[Vertex], triangles: &[[u32; 3]], w: u32, h: u32) 
         texture: &tex,
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
+        material: None,
     };
     let settings = RenderSettings::new(w, h);
     let setups = setup_draws(&settings, &[draw]).unwrap();

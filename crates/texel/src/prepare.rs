@@ -239,6 +239,7 @@ impl PreparedScene {
                 texture: &self.textures[&mesh.texture],
                 sampler,
                 clip_from_world,
+                material: None,
             })
             .collect()
     }

@@ -87,6 +87,7 @@ impl Ground {
             texture: &self.texture,
             sampler,
             clip_from_world: self.clip_from_world,
+            material: None,
         }
     }
 

@@ -1,0 +1,401 @@
+//! Lights, materials and the shading model: Lambert diffuse plus GGX specular with Smith masking,
+//! as glTF 2.0's metallic-roughness model (glTF 2.0 specification, Appendix B "BRDF
+//! Implementation"), with normal maps in glTF's tangent space and specular antialiasing.
+//!
+//! For a fragment with base colour `c` (the draw's texture times the material's factor times the
+//! vertex colour), perceptual roughness `r` and metalness `m`, unit normal `n`, unit view direction
+//! `v` (towards the eye) and a light from unit direction `l` giving illuminance `E` on a surface
+//! facing it:
+//!
+//! - `alpha = r^2` (Burley 2012; `r` clamped to at least [`MIN_ROUGHNESS`]);
+//! - `h = normalize(l + v)`, `F0 = mix(0.04, c, m)`, `F = F0 + (1 - F0)(1 - v.h)^5` (Schlick 1994);
+//! - `D = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2)` (GGX, Walter et al. 2007);
+//! - `Vis = 0.5 / (n.l sqrt((n.v)^2 (1 - alpha^2) + alpha^2) + n.v sqrt((n.l)^2 (1 - alpha^2) +
+//!   alpha^2))`, the height-correlated Smith masking-shadowing term divided by `4 n.l n.v` (Heitz
+//!   2014, eq. 99);
+//! - `f = (1 - F) c_diff / pi + F D Vis` with `c_diff = c (1 - m)`;
+//! - outgoing radiance `L = sum over lights of f E (n.l)` for `n.l > 0`, plus `A (c_diff + F0)` for
+//!   ambient light `A`.
+//!
+//! Units follow glTF's `KHR_lights_punctual`: a directional light's `intensity` is the illuminance
+//! on a surface facing it; a point light's is its luminous intensity, giving `intensity / d^2` at
+//! distance `d`. A white Lambertian surface facing a directional light of intensity `pi` therefore
+//! shows radiance 1.
+//!
+//! Draws without a [`Material`] under lights are Lambertian: `L = c/pi sum E (n.l) + A c`, with the
+//! interpolated vertex normal.
+
+use glam::{Vec3, Vec4};
+use texel_texture::{Footprint, Sampler, Texture};
+
+/// The most lights a frame has (as fixed-function GPUs had 8).
+pub const MAX_LIGHTS: usize = 8;
+
+/// The smallest perceptual roughness used (`alpha = 0.045^2 = 0.002`): a perfect mirror's
+/// highlight under a point light would be a Dirac pulse no pixel samples.
+pub const MIN_ROUGHNESS: f32 = 0.045;
+
+/// One light, in world space, linear RGB.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Parallel light from `direction` (pointing *towards* the light; need not be normalised):
+    /// illuminance `intensity` on a surface facing it.
+    Directional {
+        /// Direction towards the light.
+        direction: Vec3,
+        /// Illuminance on a surface facing the light, linear RGB.
+        intensity: Vec3,
+    },
+    /// A point light at `position`: illuminance `intensity / d^2` at distance `d` on a surface
+    /// facing it.
+    Point {
+        /// World-space position.
+        position: Vec3,
+        /// Luminous intensity, linear RGB.
+        intensity: Vec3,
+    },
+    /// Light from every direction, unoccluded: adds `intensity * (c_diff + F0)`.
+    Ambient {
+        /// Ambient radiance, linear RGB.
+        intensity: Vec3,
+    },
+}
+
+impl Light {
+    /// Whether every number is finite.
+    pub fn is_finite(&self) -> bool {
+        match *self {
+            Light::Directional {
+                direction,
+                intensity,
+            } => direction.is_finite() && intensity.is_finite(),
+            Light::Point {
+                position,
+                intensity,
+            } => position.is_finite() && intensity.is_finite(),
+            Light::Ambient { intensity } => intensity.is_finite(),
+        }
+    }
+}
+
+/// How the specular lobe is widened where the normal varies within a pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SpecularAa {
+    /// None: the filtered normal is normalised and used as if it were exact (sparkles and aliases
+    /// at a distance).
+    #[default]
+    None,
+    /// Toksvig (2005): the filtered (averaged) tangent-space normal is shorter than 1 where the
+    /// normals under the footprint disagree. With `|n|` its length and the Blinn-Phong exponent
+    /// `s = 2 / alpha^2 - 2` equivalent to GGX's `alpha` (Walter et al. 2007), the exponent becomes
+    /// `s' = s |n| / (|n| + s (1 - |n|))`, i.e. `alpha'^2 = 2 / (s' + 2)`.
+    Toksvig,
+}
+
+/// A texture read through a sampler (a material's map).
+#[derive(Clone, Copy, Debug)]
+pub struct TextureInput<'a> {
+    /// The texture.
+    pub texture: &'a Texture,
+    /// How it is filtered (normally the same filter as the draw's colour texture).
+    pub sampler: &'a Sampler,
+}
+
+/// One channel of a texture read through a sampler (`0` red ... `3` alpha), multiplying a factor.
+#[derive(Clone, Copy, Debug)]
+pub struct ChannelInput<'a> {
+    /// The texture and its sampler.
+    pub input: TextureInput<'a>,
+    /// The channel read, `0..=3`.
+    pub channel: usize,
+}
+
+/// A draw's material. The base colour texture is the draw call's own texture; everything here
+/// multiplies or perturbs it.
+#[derive(Clone, Copy, Debug)]
+pub struct Material<'a> {
+    /// Linear RGBA factor multiplying the base colour texture.
+    pub base_color: Vec4,
+    /// Perceptual roughness factor in `[0, 1]` (multiplies `roughness_map`).
+    pub roughness: f32,
+    /// Metalness factor in `[0, 1]` (multiplies `metallic_map`).
+    pub metallic: f32,
+    /// Roughness from a texture channel (glTF: green of `metallicRoughnessTexture`).
+    pub roughness_map: Option<ChannelInput<'a>>,
+    /// Metalness from a texture channel (glTF: blue of `metallicRoughnessTexture`).
+    pub metallic_map: Option<ChannelInput<'a>>,
+    /// Tangent-space normal map (glTF: `normalTexture`, linear RGB, `+Y` up, `n = 2 rgb - 1`).
+    pub normal_map: Option<TextureInput<'a>>,
+    /// Scales the normal map's x and y (glTF `normalTexture.scale`).
+    pub normal_scale: f32,
+    /// Specular antialiasing.
+    pub specular_aa: SpecularAa,
+}
+
+impl Default for Material<'_> {
+    /// A white dielectric of roughness 0.5 without maps.
+    fn default() -> Self {
+        Material {
+            base_color: Vec4::ONE,
+            roughness: 0.5,
+            metallic: 0.0,
+            roughness_map: None,
+            metallic_map: None,
+            normal_map: None,
+            normal_scale: 1.0,
+            specular_aa: SpecularAa::None,
+        }
+    }
+}
+
+impl Material<'_> {
+    /// Whether every factor is finite and in range (`roughness` and `metallic` in `[0, 1]`,
+    /// channels `0..=3`).
+    pub fn is_valid(&self) -> bool {
+        let channel_ok = |c: &Option<ChannelInput>| c.is_none_or(|c| c.channel < 4);
+        self.base_color.is_finite()
+            && (0.0..=1.0).contains(&self.roughness)
+            && (0.0..=1.0).contains(&self.metallic)
+            && self.normal_scale.is_finite()
+            && channel_ok(&self.roughness_map)
+            && channel_ok(&self.metallic_map)
+    }
+}
+
+/// Everything the BRDF needs at one fragment.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface {
+    /// Base colour, linear RGB.
+    pub base: Vec3,
+    /// Perceptual roughness after maps and antialiasing, `[MIN_ROUGHNESS, 1]`.
+    pub roughness: f32,
+    /// Metalness, `[0, 1]`.
+    pub metallic: f32,
+    /// Unit shading normal.
+    pub normal: Vec3,
+    /// World-space position.
+    pub position: Vec3,
+}
+
+/// GGX's normal distribution `D(n.h)` for `alpha` (see the module docs).
+pub fn ggx_d(n_dot_h: f32, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let t = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    a2 / (std::f32::consts::PI * t * t)
+}
+
+/// The height-correlated Smith term divided by `4 n.l n.v` (Heitz 2014).
+pub fn smith_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let gv = n_dot_l * (n_dot_v * n_dot_v * (1.0 - a2) + a2).sqrt();
+    let gl = n_dot_v * (n_dot_l * n_dot_l * (1.0 - a2) + a2).sqrt();
+    0.5 / (gv + gl).max(1e-12)
+}
+
+/// Schlick's Fresnel approximation for reflectance `f0` at normal incidence.
+pub fn fresnel(f0: Vec3, v_dot_h: f32) -> Vec3 {
+    let k = (1.0 - v_dot_h.clamp(0.0, 1.0)).powi(5);
+    f0 + (Vec3::ONE - f0) * k
+}
+
+/// The roughness that Toksvig's rule gives for `roughness` and a filtered normal of length
+/// `length` (`(0, 1]`; 1 leaves it unchanged). See [`SpecularAa::Toksvig`].
+pub fn toksvig_roughness(roughness: f32, length: f32) -> f32 {
+    let r = roughness.max(MIN_ROUGHNESS);
+    let len = length.clamp(1e-4, 1.0);
+    let a2 = r.powi(4);
+    let s = 2.0 / a2 - 2.0;
+    let s2 = s * len / (len + s * (1.0 - len));
+    let a2_new = 2.0 / (s2 + 2.0);
+    a2_new.sqrt().sqrt().clamp(r, 1.0)
+}
+
+/// Outgoing radiance (linear RGB) of `surface` seen from `eye` under `lights`; `lambert` drops
+/// the specular lobe (draws without a material). See the module docs.
+pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -> Vec3 {
+    let n = surface.normal;
+    let v = (eye - surface.position).normalize_or_zero();
+    let n_dot_v = n.dot(v).max(1e-4);
+    let alpha = surface.roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
+    let c_diff = surface.base * (1.0 - surface.metallic);
+    let f0 = if lambert {
+        Vec3::ZERO
+    } else {
+        Vec3::splat(0.04).lerp(surface.base, surface.metallic)
+    };
+    let mut out = Vec3::ZERO;
+    for light in lights {
+        let (l, e) = match *light {
+            Light::Directional {
+                direction,
+                intensity,
+            } => (direction.normalize_or_zero(), intensity),
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let d = position - surface.position;
+                let d2 = d.length_squared();
+                if d2 <= 0.0 {
+                    continue;
+                }
+                (d / d2.sqrt(), intensity / d2)
+            }
+            Light::Ambient { intensity } => {
+                out += intensity * (c_diff + f0);
+                continue;
+            }
+        };
+        let n_dot_l = n.dot(l);
+        if n_dot_l <= 0.0 {
+            continue;
+        }
+        let diffuse = c_diff * std::f32::consts::FRAC_1_PI;
+        let f = if lambert {
+            diffuse
+        } else {
+            let h = (l + v).normalize_or_zero();
+            let fr = fresnel(f0, v.dot(h));
+            let spec = fr * (ggx_d(n.dot(h).max(0.0), alpha) * smith_visibility(n_dot_l, n_dot_v, alpha));
+            (Vec3::ONE - fr) * diffuse + spec
+        };
+        out += f * e * n_dot_l;
+    }
+    out
+}
+
+/// Read `input` at `footprint`; also returns the texels read.
+pub(crate) fn sample(input: &TextureInput, fp: &Footprint, count: bool) -> ([f32; 4], u32) {
+    if count {
+        input.sampler.sample_counted(input.texture, fp)
+    } else {
+        (input.sampler.sample(input.texture, fp), 0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f32::consts::PI;
+
+    /// `integral over the hemisphere of D(n.h) (n.h) dw = 1`, by the midpoint rule in theta.
+    #[test]
+    fn ggx_is_normalised() {
+        for alpha in [0.05f32, 0.2, 0.5, 1.0] {
+            let n = 200_000;
+            let mut sum = 0.0f64;
+            for k in 0..n {
+                let theta = (k as f64 + 0.5) / n as f64 * std::f64::consts::FRAC_PI_2;
+                let c = theta.cos() as f32;
+                sum += f64::from(ggx_d(c, alpha)) * f64::from(c) * theta.sin()
+                    * 2.0
+                    * std::f64::consts::PI
+                    * (std::f64::consts::FRAC_PI_2 / n as f64);
+            }
+            assert!((sum - 1.0).abs() < 2e-3, "alpha {alpha}: {sum}");
+        }
+    }
+
+    #[test]
+    fn smith_and_fresnel_limits() {
+        // alpha = 1, n.l = n.v = 1: V = 0.5 / (1 + 1) = 0.25 (G = 1 over 4).
+        assert!((smith_visibility(1.0, 1.0, 1.0) - 0.25).abs() < 1e-6);
+        // Symmetric in l and v.
+        assert_eq!(smith_visibility(0.3, 0.8, 0.4), smith_visibility(0.8, 0.3, 0.4));
+        let f0 = Vec3::new(0.04, 0.5, 1.0);
+        assert!((fresnel(f0, 1.0) - f0).length() < 1e-6);
+        assert!((fresnel(f0, 0.0) - Vec3::ONE).length() < 1e-6);
+    }
+
+    #[test]
+    fn lambert_white_under_pi_is_one_and_point_lights_fall_off() {
+        let s = Surface {
+            base: Vec3::ONE,
+            roughness: 1.0,
+            metallic: 0.0,
+            normal: Vec3::Y,
+            position: Vec3::ZERO,
+        };
+        let sun = [Light::Directional {
+            direction: Vec3::Y,
+            intensity: Vec3::splat(PI),
+        }];
+        let l = radiance(&s, Vec3::new(0.0, 5.0, 5.0), &sun, true);
+        assert!((l - Vec3::ONE).length() < 1e-5, "{l}");
+        // 60 degrees: half. Ambient adds c.
+        let tilted = [
+            Light::Directional {
+                direction: Vec3::new(3f32.sqrt(), 1.0, 0.0),
+                intensity: Vec3::splat(PI),
+            },
+            Light::Ambient {
+                intensity: Vec3::splat(0.25),
+            },
+        ];
+        let l = radiance(&s, Vec3::Y, &tilted, true);
+        assert!((l - Vec3::splat(0.75)).length() < 1e-5, "{l}");
+        // A point light at distance 2 gives a quarter of its intensity.
+        let point = [Light::Point {
+            position: Vec3::new(0.0, 2.0, 0.0),
+            intensity: Vec3::splat(4.0 * PI),
+        }];
+        let l = radiance(&s, Vec3::Y, &point, true);
+        assert!((l - Vec3::ONE).length() < 1e-5, "{l}");
+        // Lights behind the surface give nothing.
+        let below = [Light::Directional {
+            direction: -Vec3::Y,
+            intensity: Vec3::splat(PI),
+        }];
+        assert_eq!(radiance(&s, Vec3::Y, &below, false), Vec3::ZERO);
+    }
+
+    /// The full model's energy stays below the incoming light's (white furnace, one direction):
+    /// directional-hemispherical reflectance of a white rough dielectric under uniform light is at
+    /// most 1, estimated by integrating over light directions.
+    #[test]
+    fn a_white_surface_reflects_at_most_what_arrives() {
+        for (roughness, metallic) in [(0.1f32, 0.0f32), (0.5, 0.0), (1.0, 0.0), (0.3, 1.0)] {
+            let s = Surface {
+                base: Vec3::ONE,
+                roughness,
+                metallic,
+                normal: Vec3::Z,
+                position: Vec3::ZERO,
+            };
+            let eye = Vec3::new(0.5, 0.0, 1.0) * 10.0;
+            let (nt, np) = (400, 400);
+            let mut sum = 0.0f64;
+            for i in 0..nt {
+                let theta = (i as f32 + 0.5) / nt as f32 * PI / 2.0;
+                for j in 0..np {
+                    let phi = (j as f32 + 0.5) / np as f32 * 2.0 * PI;
+                    let l = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                    // Radiance 1 from direction l over solid angle dw: E = dw.
+                    let dw = theta.sin() * (PI / 2.0 / nt as f32) * (2.0 * PI / np as f32);
+                    let light = [Light::Directional {
+                        direction: l,
+                        intensity: Vec3::splat(dw),
+                    }];
+                    sum += f64::from(radiance(&s, eye, &light, false).x);
+                }
+            }
+            assert!(sum <= 1.0 + 1e-3 && sum > 0.5, "r {roughness} m {metallic}: {sum}");
+        }
+    }
+
+    #[test]
+    fn toksvig_widens_only_short_normals() {
+        assert!((toksvig_roughness(0.3, 1.0) - 0.3).abs() < 1e-4);
+        let mut last = 0.3;
+        for len in [0.99f32, 0.95, 0.8, 0.5] {
+            let r = toksvig_roughness(0.3, len);
+            assert!(r > last && r <= 1.0, "{len}: {r}");
+            last = r;
+        }
+        // Check one value against the formula by hand: r = 0.5, |n| = 0.9.
+        let s = 2.0 / 0.5f32.powi(4) - 2.0; // 30
+        let s2 = s * 0.9 / (0.9 + s * 0.1); // 6.75
+        let want = (2.0 / (s2 + 2.0)).powf(0.25);
+        assert!((toksvig_roughness(0.5, 0.9) - want).abs() < 1e-5);
+    }
+}
