@@ -119,7 +119,7 @@ pub enum ViewArg {
 #[derive(Debug, Args)]
 pub struct SceneArgs {
     /// Scene file (TOML) or built-in scene (builtin:ground, builtin:ground-rotated, builtin:zoneplate,
-    /// builtin:cube, builtin:sphere, builtin:triangle).
+    /// builtin:cube, builtin:sphere, builtin:triangle, builtin:glossy).
     #[arg(default_value = "builtin:ground")]
     pub scene: String,
     /// Colour handling.
@@ -128,6 +128,29 @@ pub struct SceneArgs {
     /// Output size WIDTHxHEIGHT, each side 1 to 16384, overriding the scene's (e.g. 640x360).
     #[arg(long)]
     pub size: Option<Size>,
+    /// Specular antialiasing for every material, overriding the scene's `specular_aa` (scenes
+    /// with lights and materials, e.g. builtin:glossy). The reference ignores it: its normals
+    /// are exact.
+    #[arg(long, value_enum)]
+    pub specular_aa: Option<SpecularAaArg>,
+}
+
+/// Specular antialiasing (see texel-raster's `material` module).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SpecularAaArg {
+    /// None: the filtered normal is normalised and used as if exact.
+    None,
+    /// Toksvig (2005): roughness widened by how much the filtered normal shortened.
+    Toksvig,
+}
+
+impl From<SpecularAaArg> for texel_raster::SpecularAa {
+    fn from(a: SpecularAaArg) -> Self {
+        match a {
+            SpecularAaArg::None => texel_raster::SpecularAa::None,
+            SpecularAaArg::Toksvig => texel_raster::SpecularAa::Toksvig,
+        }
+    }
 }
 
 /// `texel render`.

@@ -151,7 +151,7 @@ fn time_gpu(
 }
 
 pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
-    let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let scene = load_scene(&args.scene, input)?;
     let filters = parse_list(&args.filters)?;
     let budget = &mut input.budget;
     let timings = if args.gpu {

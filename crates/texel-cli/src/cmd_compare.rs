@@ -314,7 +314,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         .map(|e| parse_extra(e))
         .collect::<Result<Vec<_>>>()?;
     check_extras(&extras, &filters)?;
-    let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let scene = load_scene(&args.scene, input)?;
     let frames = if args.gpu {
         gpu_rows(&scene, &filters, args.adapter.as_deref(), &mut input.budget)?
     } else {

@@ -13,7 +13,7 @@ use texel_quality::{publish_dir, write_atomic, Report};
 use crate::cli::{ColorArg, DemoArgs};
 use crate::cmd_compare::{compare, Extras, COMPARE_BYTES_PER_PIXEL};
 use crate::filters::Filter;
-use crate::input::{load_scene, Input};
+use crate::input::{load_scene_with, Input};
 
 /// Run `texel demo`: every scene's report is written into one staging directory, published as a
 /// whole at `--out` when all are done.
@@ -29,7 +29,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
                 budget: input.budget.clone(),
                 sanitize: input.sanitize,
             };
-            let scene = load_scene(&label, ColorArg::Srgb, args.size, &mut scene_input)?;
+            let scene = load_scene_with(&label, ColorArg::Srgb, args.size, None, &mut scene_input)?;
             scene_input.budget.take(
                 "the comparison's reference and images",
                 u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,

@@ -17,7 +17,7 @@ pub const SEED: u64 = 0x7e_7e1;
 /// (256 -> 16 x 16, 512 -> 16 x 32, 7 -> 1 x 7).
 pub fn strata(spp: u32) -> (u32, u32) {
     let mut n = (f64::from(spp).sqrt().floor() as u32).max(1);
-    while spp % n != 0 {
+    while !spp.is_multiple_of(n) {
         n -= 1;
     }
     (n, spp / n)
@@ -45,7 +45,7 @@ pub fn reference_frame(scene: &PreparedScene, spp: u32) -> Result<texel_raster::
 
 /// Run `texel reference`.
 pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
-    let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let scene = load_scene(&args.scene, input)?;
     let frame = reference_frame(&scene, args.spp)?;
     write_png(
         &args.output,

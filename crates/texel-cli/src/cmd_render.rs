@@ -16,7 +16,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         Some(m) => Some(Filter::from_lab_mode(m)?),
         None => args.filter,
     };
-    let scene = load_scene(&args.scene.scene, args.scene.color, args.scene.size, input)?;
+    let scene = load_scene(&args.scene, input)?;
     let samplers = match filter {
         Some(f) => scene.samplers(f)?,
         None => scene.default_samplers()?,

@@ -6,7 +6,9 @@ use texel::memory::{TRIANGLE_BYTES, VERTEX_BYTES};
 use texel::{MemoryBudget, PreparedScene, Scene, SceneLimits, SceneOptions};
 use texel_texture::{ColorSpace, Limits, LoadOptions, TextureError};
 
-use crate::cli::{ColorArg, Size};
+use texel_raster::SpecularAa;
+
+use crate::cli::{ColorArg, SceneArgs, Size, SpecularAaArg};
 
 /// How a command reads its inputs: the memory account and the non-finite-texel policy.
 pub struct Input {
@@ -87,11 +89,24 @@ pub fn scene_limits(remaining: u64) -> SceneLimits {
     }
 }
 
-/// Load `scene` (a path or `builtin:NAME`) and its textures within `input`'s account.
-pub fn load_scene(
+/// Load the scene of a command's [`SceneArgs`] within `input`'s account.
+pub fn load_scene(args: &SceneArgs, input: &mut Input) -> Result<PreparedScene> {
+    load_scene_with(
+        &args.scene,
+        args.color,
+        args.size,
+        args.specular_aa.map(SpecularAaArg::into),
+        input,
+    )
+}
+
+/// Load `scene` (a path or `builtin:NAME`) and its textures within `input`'s account, with
+/// `color` handling, an output `size` and a `specular_aa` override.
+pub fn load_scene_with(
     scene: &str,
     color: ColorArg,
     size: Option<Size>,
+    specular_aa: Option<SpecularAa>,
     input: &mut Input,
 ) -> Result<PreparedScene> {
     let limits = scene_limits(input.budget.remaining());
@@ -112,6 +127,7 @@ pub fn load_scene(
         size: size.map(|s| (s.width, s.height)),
         color: color.into(),
         replace_non_finite: input.sanitize,
+        specular_aa,
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;

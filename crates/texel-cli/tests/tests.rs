@@ -12,6 +12,7 @@ mod mips;
 mod outputs;
 mod reference;
 mod render;
+mod shading;
 mod util;
 mod view;
 mod warp;

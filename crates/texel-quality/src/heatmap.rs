@@ -103,7 +103,7 @@ pub fn heat_map(
         .iter()
         .enumerate()
         .map(|(i, &e)| {
-            if mask.map_or(true, |m| m.bits()[i]) {
+            if mask.is_none_or(|m| m.bits()[i]) {
                 let [r, g, b] = viridis(e / max_error);
                 [r, g, b, 255]
             } else {

@@ -21,7 +21,7 @@ fn sse(a: &Image8, b: &Image8, mask: Option<&Mask>) -> Result<(u64, usize), Qual
     let mut sum = 0u64;
     let mut n = 0usize;
     for (i, (pa, pb)) in a.pixels().iter().zip(b.pixels()).enumerate() {
-        if mask.map_or(true, |m| m.bits()[i]) {
+        if mask.is_none_or(|m| m.bits()[i]) {
             n += 1;
             for c in 0..3 {
                 let d = i64::from(pa[c]) - i64::from(pb[c]);

@@ -101,7 +101,7 @@ impl SsimMap {
         let mut n = 0usize;
         for y in HALF as u32..self.height.saturating_sub(HALF as u32) {
             for x in HALF as u32..self.width.saturating_sub(HALF as u32) {
-                if mask.map_or(true, |m| m.get(x, y)) {
+                if mask.is_none_or(|m| m.get(x, y)) {
                     sum += self.get(x, y).expect("interior");
                     n += 1;
                 }

@@ -58,5 +58,5 @@ pub struct DrawCall<'a> {
     pub clip_from_world: Mat4,
     /// Shading parameters and maps when the frame has lights ([`crate::RenderSettings::lights`]);
     /// `None` is Lambertian (see [`crate::material`]).
-    pub material: Option<&'a Material<'a>>,
+    pub material: Option<Material<'a>>,
 }

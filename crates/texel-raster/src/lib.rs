@@ -57,11 +57,9 @@ pub mod views;
 pub use draw::{DrawCall, Vertex};
 pub use error::RasterError;
 pub use frame::Frame;
-pub use reference::{render_reference, render_reference_strata};
 pub use material::{ChannelInput, Light, Material, SpecularAa, TextureInput, MAX_LIGHTS};
-pub use settings::{
-    Derivatives, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS,
-};
+pub use reference::{render_reference, render_reference_strata};
+pub use settings::{Derivatives, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS};
 
 /// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].
 ///

@@ -256,7 +256,8 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
         } else {
             let h = (l + v).normalize_or_zero();
             let fr = fresnel(f0, v.dot(h));
-            let spec = fr * (ggx_d(n.dot(h).max(0.0), alpha) * smith_visibility(n_dot_l, n_dot_v, alpha));
+            let spec =
+                fr * (ggx_d(n.dot(h).max(0.0), alpha) * smith_visibility(n_dot_l, n_dot_v, alpha));
             (Vec3::ONE - fr) * diffuse + spec
         };
         out += f * e * n_dot_l;
@@ -287,7 +288,9 @@ mod tests {
             for k in 0..n {
                 let theta = (k as f64 + 0.5) / n as f64 * std::f64::consts::FRAC_PI_2;
                 let c = theta.cos() as f32;
-                sum += f64::from(ggx_d(c, alpha)) * f64::from(c) * theta.sin()
+                sum += f64::from(ggx_d(c, alpha))
+                    * f64::from(c)
+                    * theta.sin()
                     * 2.0
                     * std::f64::consts::PI
                     * (std::f64::consts::FRAC_PI_2 / n as f64);
@@ -301,7 +304,10 @@ mod tests {
         // alpha = 1, n.l = n.v = 1: V = 0.5 / (1 + 1) = 0.25 (G = 1 over 4).
         assert!((smith_visibility(1.0, 1.0, 1.0) - 0.25).abs() < 1e-6);
         // Symmetric in l and v.
-        assert_eq!(smith_visibility(0.3, 0.8, 0.4), smith_visibility(0.8, 0.3, 0.4));
+        assert_eq!(
+            smith_visibility(0.3, 0.8, 0.4),
+            smith_visibility(0.8, 0.3, 0.4)
+        );
         let f0 = Vec3::new(0.04, 0.5, 1.0);
         assert!((fresnel(f0, 1.0) - f0).length() < 1e-6);
         assert!((fresnel(f0, 0.0) - Vec3::ONE).length() < 1e-6);
@@ -369,7 +375,11 @@ mod tests {
                 let theta = (i as f32 + 0.5) / nt as f32 * PI / 2.0;
                 for j in 0..np {
                     let phi = (j as f32 + 0.5) / np as f32 * 2.0 * PI;
-                    let l = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                    let l = Vec3::new(
+                        theta.sin() * phi.cos(),
+                        theta.sin() * phi.sin(),
+                        theta.cos(),
+                    );
                     // Radiance 1 from direction l over solid angle dw: E = dw.
                     let dw = theta.sin() * (PI / 2.0 / nt as f32) * (2.0 * PI / np as f32);
                     let light = [Light::Directional {
@@ -379,7 +389,10 @@ mod tests {
                     sum += f64::from(radiance(&s, eye, &light, false).x);
                 }
             }
-            assert!(sum <= 1.0 + 1e-3 && sum > 0.5, "r {roughness} m {metallic}: {sum}");
+            assert!(
+                sum <= 1.0 + 1e-3 && sum > 0.5,
+                "r {roughness} m {metallic}: {sum}"
+            );
         }
     }
 

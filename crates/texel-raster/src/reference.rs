@@ -106,8 +106,12 @@ pub fn render_reference_strata(
                 return Ok([None, None, None]);
             };
             Ok([
-                m.roughness_map.map(|c| level0(c.input.sampler)).transpose()?,
-                m.metallic_map.map(|c| level0(c.input.sampler)).transpose()?,
+                m.roughness_map
+                    .map(|c| level0(c.input.sampler))
+                    .transpose()?,
+                m.metallic_map
+                    .map(|c| level0(c.input.sampler))
+                    .transpose()?,
                 m.normal_map.map(|t| level0(t.sampler)).transpose()?,
             ])
         })
@@ -116,22 +120,27 @@ pub fn render_reference_strata(
         .iter()
         .zip(&map_samplers)
         .map(|(d, [r, m, n])| {
-            d.material.map(|mat| {
-                Material {
-                    roughness_map: channel(mat.roughness_map, r),
-                    metallic_map: channel(mat.metallic_map, m),
-                    normal_map: mat
-                        .normal_map
-                        .zip(n.as_ref())
-                        .map(|(t, s)| TextureInput { sampler: s, ..t }),
-                    specular_aa: SpecularAa::None,
-                    ..*mat
-                }
+            d.material.map(|mat| Material {
+                roughness_map: channel(mat.roughness_map, r),
+                metallic_map: channel(mat.metallic_map, m),
+                normal_map: mat
+                    .normal_map
+                    .zip(n.as_ref())
+                    .map(|(t, s)| TextureInput { sampler: s, ..t }),
+                specular_aa: SpecularAa::None,
+                ..mat
             })
         })
         .collect();
     crate::with_threads(settings.threads, || {
-        reference_frame(settings, draws, (&samplers, &materials), strata, seed, progress)
+        reference_frame(
+            settings,
+            draws,
+            (&samplers, &materials),
+            strata,
+            seed,
+            progress,
+        )
     })
 }
 
@@ -205,7 +214,7 @@ fn reference_frame(
         .zip(materials)
         .map(|((d, s), m)| DrawCall {
             sampler: s,
-            material: m.as_ref(),
+            material: *m,
             ..*d
         })
         .collect();

@@ -1,7 +1,6 @@
 //! How a frame is rendered: size, background, derivative and interpolation modes, debug view, light,
 //! threads.
 
-
 use crate::error::RasterError;
 use crate::material::{Light, MAX_LIGHTS};
 

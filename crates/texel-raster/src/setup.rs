@@ -171,7 +171,7 @@ impl TriangleSetup {
 /// [`RasterError::IndexOutOfRange`] for the first offending index.
 pub fn validate_draws(draws: &[DrawCall]) -> Result<(), RasterError> {
     for (d, draw) in draws.iter().enumerate() {
-        if draw.material.is_some_and(|m| !m.is_valid()) {
+        if draw.material.as_ref().is_some_and(|m| !m.is_valid()) {
             return Err(RasterError::InvalidMaterial { draw: d });
         }
         let n = draw.vertices.len();

@@ -34,7 +34,7 @@ pub(crate) struct DrawContext<'a> {
     /// Whether any vertex colour differs from opaque white (skips the multiply when not).
     colored: bool,
     /// The draw's material.
-    pub material: Option<&'a Material<'a>>,
+    pub material: Option<Material<'a>>,
     /// The eye's world position (the centre of projection of `clip_from_world`).
     pub eye: Vec3,
 }
@@ -176,7 +176,7 @@ pub(crate) fn shade(
     if ctx.colored {
         c *= verts[0].color * l.x + verts[1].color * l.y + verts[2].color * l.z;
     }
-    if let Some(m) = ctx.material {
+    if let Some(m) = &ctx.material {
         c *= m.base_color;
     }
     let Some(lighting) = lighting else {
@@ -184,15 +184,15 @@ pub(crate) fn shade(
     };
     let mut texels = 0;
     let position = verts[0].position * l.x + verts[1].position * l.y + verts[2].position * l.z;
-    let mut normal = (verts[0].normal * l.x + verts[1].normal * l.y + verts[2].normal * l.z)
-        .normalize_or_zero();
+    let mut normal =
+        (verts[0].normal * l.x + verts[1].normal * l.y + verts[2].normal * l.z).normalize_or_zero();
     if normal == Vec3::ZERO {
         normal = (verts[1].position - verts[0].position)
             .cross(verts[2].position - verts[0].position)
             .normalize_or(Vec3::Y);
     }
     let (mut roughness, mut metallic) = (1.0, 0.0);
-    if let Some(m) = ctx.material {
+    if let Some(m) = &ctx.material {
         roughness = m.roughness;
         metallic = m.metallic;
         if let Some(map) = &m.roughness_map {

@@ -546,11 +546,12 @@ fn write_fragment(
     let lit = ctx.lighting.as_ref();
     // The texels a material's maps read count too (in every view, so the fetches view agrees
     // with the counts of the colour view).
-    let (shaded, map_texels) = if ctx.settings.view == View::Color || (ctx.counting && lit.is_some()) {
-        shade(dc, dc.vertices(t), f.lambda, tex, &fp, lit, ctx.counting)
-    } else {
-        ([0.0; 4], 0)
-    };
+    let (shaded, map_texels) =
+        if ctx.settings.view == View::Color || (ctx.counting && lit.is_some()) {
+            shade(dc, dc.vertices(t), f.lambda, tex, &fp, lit, ctx.counting)
+        } else {
+            ([0.0; 4], 0)
+        };
     let count = count + map_texels;
     let color = match ctx.settings.view {
         View::Color => shaded,

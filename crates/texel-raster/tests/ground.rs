@@ -7,7 +7,7 @@ use common::{lab_sampler, white, Ground};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use texel_raster::views::MIP_PALETTE;
 use texel_raster::{
-    render, render_reference, DrawCall, Light, Frame, RenderSettings, Vertex, View,
+    render, render_reference, DrawCall, Frame, Light, RenderSettings, Vertex, View,
 };
 
 const W: u32 = 320;

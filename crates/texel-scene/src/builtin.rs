@@ -21,6 +21,8 @@ pub const GROUND_TOML: &str = include_str!("builtin/ground.toml");
 pub const ZONEPLATE_TOML: &str = include_str!("builtin/zoneplate.toml");
 /// The barycentric triangle scene's TOML.
 pub const TRIANGLE_TOML: &str = include_str!("builtin/triangle.toml");
+/// The glossy normal-mapped plane's TOML.
+pub const GLOSSY_TOML: &str = include_str!("builtin/glossy.toml");
 
 /// Angle by which `ground-rotated` turns the ground's uvs, in degrees.
 pub const GROUND_ROTATION_DEG: f32 = 30.0;
@@ -42,6 +44,13 @@ pub fn builtin_names() -> &'static [&'static str] {
         "sphere",
         "triangle",
     ]
+}
+
+/// Built-in scenes lit by lights and shaded with materials (`builtin:NAME` accepts them too):
+/// - `glossy`: a glossy plane, normal-mapped with bumps, receding to the horizon under a low
+///   light from the far side (specular aliasing).
+pub fn shaded_builtin_names() -> &'static [&'static str] {
+    &["glossy"]
 }
 
 fn from_toml(name: &str, text: &str) -> Result<Scene, SceneError> {
@@ -67,6 +76,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         }
         "zoneplate" => from_toml(name, ZONEPLATE_TOML),
         "triangle" => from_toml(name, TRIANGLE_TOML),
+        "glossy" => from_toml(name, GLOSSY_TOML),
         "cube" => Ok(cube()),
         "sphere" => Ok(sphere()),
         _ => Err(SceneError::UnknownBuiltin {
@@ -108,6 +118,8 @@ fn cube() -> Scene {
         address_mode_u: AddressMode::ClampToEdge,
         address_mode_v: AddressMode::ClampToEdge,
         filters: None,
+        material: None,
+        tangents: None,
     };
     for (n, r, u) in faces {
         let base = mesh.positions.len() as u32;
@@ -151,6 +163,8 @@ fn cube() -> Scene {
             },
         ),
         meshes: vec![mesh],
+        lights: Vec::new(),
+        materials: Default::default(),
     }
 }
 
@@ -229,7 +243,11 @@ fn sphere() -> Scene {
             address_mode_u: AddressMode::Repeat,
             address_mode_v: AddressMode::ClampToEdge,
             filters: None,
+            material: None,
+            tangents: None,
         }],
+        lights: Vec::new(),
+        materials: Default::default(),
     }
 }
 
@@ -239,7 +257,7 @@ mod tests {
 
     #[test]
     fn every_builtin_loads_and_validates() {
-        for name in builtin_names() {
+        for name in builtin_names().iter().chain(shaded_builtin_names()) {
             let s = Scene::load(&format!("builtin:{name}")).unwrap();
             s.validate().unwrap();
             assert!(!s.meshes.is_empty(), "{name}");

@@ -30,7 +30,7 @@ pub enum SceneError {
         message: String,
     },
     /// `builtin:NAME` with a name that does not exist.
-    #[error("unknown built-in scene {name:?}: available are {}", crate::builtin_names().join(", "))]
+    #[error("unknown built-in scene {name:?}: available are {}, {}", crate::builtin_names().join(", "), crate::shaded_builtin_names().join(", "))]
     UnknownBuiltin {
         /// The name after `builtin:`.
         name: String,
@@ -92,6 +92,25 @@ pub enum SceneError {
         /// What is wrong.
         reason: &'static str,
     },
+    /// A mesh's texture or material is missing or contradicts itself.
+    #[error("meshes[{mesh}]: {reason}")]
+    MeshMaterial {
+        /// Mesh index.
+        mesh: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A material is invalid.
+    #[error("materials.{name}: {reason}")]
+    Material {
+        /// The material's name.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A light is invalid, or there are too many.
+    #[error("lights: {0}")]
+    Light(String),
     /// A per-vertex attribute has a different length from `positions`.
     #[error("meshes[{mesh}]: {attribute} has {got} entries but positions has {expected}")]
     MeshLength {

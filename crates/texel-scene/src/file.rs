@@ -11,7 +11,7 @@
 //! near = 0.05
 //! far = 2000.0
 //! [textures.checker]            # path = "file.png" (relative to the scene file) or
-//! procedural = "checker"        # procedural = checker | zoneplate | grid | uv | solid;
+//! procedural = "checker"        # procedural = checker | zoneplate | grid | uv | solid | bumps;
 //! size = 1024                   # color = "srgb" (default) | "linear"; see `Procedural` for each
 //! checks = 8                    # kind's parameters (size or width + height, checks, cells,
 //! color = "srgb"                # line_width, rgba)
@@ -22,6 +22,18 @@
 //! uvs = [[0.0, 1.0], [1.0, 1.0], [0.5, 0.0]]
 //! triangles = [[0, 1, 2]]       # optional: normals = [[x, y, z], ...], colors = [[r, g, b, a], ...]
 //! # or: obj = "file.obj"  /  gltf = "file.gltf" or "file.glb" (relative to the scene file)
+//! # material = "NAME" (optional; `texture` may then be left out if the material's base_color
+//! # is a texture)
+//! [[lights]]                    # type = "directional" (direction towards the light) |
+//! type = "directional"          #   "point" (position) | "ambient"; intensity = [r, g, b]
+//! direction = [0.0, 0.25, -1.0] #   linear (glTF KHR_lights_punctual units); at most 8 lights
+//! intensity = [5.0, 5.0, 5.0]
+//! [materials.glossy]            # base_color = "TEXTURE" or [r, g, b] (linear, default white);
+//! base_color = "checker"        # roughness, metallic = number in [0, 1] or "TEXTURE" (red);
+//! roughness = 0.25              # normal = "TEXTURE" (color = "linear"), normal_scale;
+//! normal = "bumps"              # specular_aa = "none" | "toksvig" (| "lean" | "projected":
+//! specular_aa = "toksvig"       # not built yet); height, height_scale, displacement, layers:
+//!                               # parsed, refused until built
 //! ```
 //!
 //! Every table denies unknown keys; a syntax or type error is reported with its line and column.
@@ -37,7 +49,10 @@ use texel_texture::{AddressMode, ColorSpace};
 use crate::camera::Camera;
 use crate::error::SceneError;
 use crate::limits::SceneLimits;
-use crate::model::{Mesh, Output, Scene, TextureSource, TextureSpec};
+use crate::model::{
+    ColorInput, Displacement, LightSpec, MaterialSpec, Mesh, Output, ScalarInput, Scene,
+    SpecularAaSpec, TextureSource, TextureSpec,
+};
 use crate::procedural::Procedural;
 
 #[derive(Deserialize)]
@@ -49,6 +64,131 @@ struct RawScene {
     textures: BTreeMap<String, RawTexture>,
     #[serde(default)]
     meshes: Vec<RawMesh>,
+    #[serde(default)]
+    lights: Vec<RawLight>,
+    #[serde(default)]
+    materials: BTreeMap<String, RawMaterial>,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum RawLight {
+    Directional {
+        direction: [f32; 3],
+        intensity: [f32; 3],
+    },
+    Point {
+        position: [f32; 3],
+        intensity: [f32; 3],
+    },
+    Ambient {
+        intensity: [f32; 3],
+    },
+}
+
+/// A texture name or a constant.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawColor {
+    Texture(String),
+    Rgb([f32; 3]),
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawScalar {
+    Texture(String),
+    Value(f32),
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum RawDisplacement {
+    None,
+    Bump,
+    Pom,
+    Tessellate,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum RawSpecularAa {
+    None,
+    Toksvig,
+    Lean,
+    Projected,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMaterial {
+    base_color: Option<RawColor>,
+    roughness: Option<RawScalar>,
+    metallic: Option<RawScalar>,
+    normal: Option<String>,
+    normal_scale: Option<f32>,
+    height: Option<String>,
+    height_scale: Option<f32>,
+    displacement: Option<RawDisplacement>,
+    specular_aa: Option<RawSpecularAa>,
+    layers: Option<Vec<toml::Table>>,
+}
+
+fn light_spec(l: RawLight) -> LightSpec {
+    match l {
+        RawLight::Directional {
+            direction,
+            intensity,
+        } => LightSpec::Directional {
+            direction: direction.into(),
+            intensity: intensity.into(),
+        },
+        RawLight::Point {
+            position,
+            intensity,
+        } => LightSpec::Point {
+            position: position.into(),
+            intensity: intensity.into(),
+        },
+        RawLight::Ambient { intensity } => LightSpec::Ambient {
+            intensity: intensity.into(),
+        },
+    }
+}
+
+fn material_spec(m: RawMaterial) -> MaterialSpec {
+    let d = MaterialSpec::default();
+    let scalar = |s: Option<RawScalar>, default: ScalarInput| match s {
+        Some(RawScalar::Texture(t)) => ScalarInput::Texture(t),
+        Some(RawScalar::Value(v)) => ScalarInput::Value(v),
+        None => default,
+    };
+    MaterialSpec {
+        base_color: match m.base_color {
+            Some(RawColor::Texture(t)) => ColorInput::Texture(t),
+            Some(RawColor::Rgb(c)) => ColorInput::Rgb(c.into()),
+            None => d.base_color,
+        },
+        roughness: scalar(m.roughness, d.roughness),
+        metallic: scalar(m.metallic, d.metallic),
+        normal: m.normal,
+        normal_scale: m.normal_scale.unwrap_or(d.normal_scale),
+        height: m.height,
+        height_scale: m.height_scale.unwrap_or(d.height_scale),
+        displacement: match m.displacement {
+            None | Some(RawDisplacement::None) => Displacement::None,
+            Some(RawDisplacement::Bump) => Displacement::Bump,
+            Some(RawDisplacement::Pom) => Displacement::Pom,
+            Some(RawDisplacement::Tessellate) => Displacement::Tessellate,
+        },
+        specular_aa: match m.specular_aa {
+            None | Some(RawSpecularAa::None) => SpecularAaSpec::None,
+            Some(RawSpecularAa::Toksvig) => SpecularAaSpec::Toksvig,
+            Some(RawSpecularAa::Lean) => SpecularAaSpec::Lean,
+            Some(RawSpecularAa::Projected) => SpecularAaSpec::Projected,
+        },
+        layers: m.layers.map_or(0, |l| l.len()),
+    }
 }
 
 #[derive(Deserialize)]
@@ -88,6 +228,7 @@ enum Kind {
     Grid,
     Uv,
     Solid,
+    Bumps,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -110,6 +251,7 @@ struct RawTexture {
     cells: Option<u32>,
     line_width: Option<f32>,
     rgba: Option<[u8; 4]>,
+    slope: Option<f32>,
 }
 
 /// Address mode names in scene files (kebab-case WebGPU names).
@@ -138,7 +280,8 @@ impl From<ModeName> for AddressMode {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawMesh {
-    texture: String,
+    texture: Option<String>,
+    material: Option<String>,
     address_mode: Option<ModeName>,
     address_mode_u: Option<ModeName>,
     address_mode_v: Option<ModeName>,
@@ -177,6 +320,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
         ("cells", t.cells.is_some()),
         ("line_width", t.line_width.is_some()),
         ("rgba", t.rgba.is_some()),
+        ("slope", t.slope.is_some()),
     ]
     .iter()
     .filter(|p| p.1)
@@ -200,6 +344,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Grid => &["size", "width", "height", "cells", "line_width"],
                 Kind::Uv => &["size", "width", "height"],
                 Kind::Solid => &["size", "width", "height", "rgba"],
+                Kind::Bumps => &["size", "cells", "slope"],
             };
             if let Some(k) = given.iter().find(|k| !allowed.contains(k)) {
                 return Err(bad(format!(
@@ -212,6 +357,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Checker | Kind::Zoneplate | Kind::Grid => 1024,
                 Kind::Uv => 256,
                 Kind::Solid => 1,
+                Kind::Bumps => 512,
             };
             let (width, height) = match (t.size, t.width, t.height) {
                 (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
@@ -249,6 +395,17 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                     }
                 }
                 Kind::Uv => Procedural::Uv { width, height },
+                Kind::Bumps => {
+                    let slope = t.slope.unwrap_or(0.5);
+                    if !(slope.is_finite() && slope >= 0.0) {
+                        return Err(bad(format!("slope = {slope} must be finite and >= 0")));
+                    }
+                    Procedural::Bumps {
+                        size: width,
+                        cells: positive(t.cells, "cells", 32)?,
+                        slope,
+                    }
+                }
                 Kind::Solid => Procedural::Solid {
                     width,
                     height,
@@ -260,16 +417,48 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
     Ok(TextureSpec { source, color })
 }
 
+/// The texture a mesh is drawn with: its own `texture`, or its material's `base_color` texture
+/// (they must agree when both are given).
+fn mesh_texture(
+    index: usize,
+    m: &RawMesh,
+    materials: &BTreeMap<String, MaterialSpec>,
+) -> Result<String, SceneError> {
+    let src = |reason: String| SceneError::MeshMaterial {
+        mesh: index,
+        reason,
+    };
+    let from_material = match m.material.as_ref().and_then(|n| materials.get(n)) {
+        Some(MaterialSpec {
+            base_color: ColorInput::Texture(t),
+            ..
+        }) => Some(t.clone()),
+        _ => None,
+    };
+    match (&m.texture, from_material) {
+        (Some(a), Some(b)) if *a != b => Err(src(format!(
+            "texture = {a:?} differs from its material's base_color = {b:?}; give one"
+        ))),
+        (Some(a), _) => Ok(a.clone()),
+        (None, Some(b)) => Ok(b),
+        (None, None) => Err(src(
+            "give texture = NAME, or a material whose base_color is a texture".to_string(),
+        )),
+    }
+}
+
 fn meshes(
     index: usize,
     m: RawMesh,
     base: &Path,
     limits: &SceneLimits,
+    materials: &BTreeMap<String, MaterialSpec>,
 ) -> Result<Vec<Mesh>, SceneError> {
     let src = |reason| SceneError::MeshSource {
         mesh: index,
         reason,
     };
+    let texture = mesh_texture(index, &m, materials)?;
     let sources = [m.positions.is_some(), m.obj.is_some(), m.gltf.is_some()]
         .iter()
         .filter(|&&b| b)
@@ -292,10 +481,12 @@ fn meshes(
             normals: m.normals.map(|v| v.into_iter().map(Vec3::from).collect()),
             colors: m.colors.map(|v| v.into_iter().map(Vec4::from).collect()),
             triangles,
-            texture: m.texture.clone(),
+            texture: texture.clone(),
             address_mode_u: AddressMode::Repeat,
             address_mode_v: AddressMode::Repeat,
             filters: None,
+            material: None,
+            tangents: None,
         }]
     } else {
         if m.uvs.is_some() || m.triangles.is_some() || m.normals.is_some() || m.colors.is_some() {
@@ -306,15 +497,16 @@ fn meshes(
         if let Some(obj) = m.obj {
             vec![crate::obj::load_obj_with(
                 &base.join(obj),
-                &m.texture,
+                &texture,
                 limits,
             )?]
         } else {
             let path = base.join(m.gltf.expect("one source"));
-            crate::gltf_import::load_gltf_with(&path, &m.texture, limits)?
+            crate::gltf_import::load_gltf_with(&path, &texture, limits)?
         }
     };
     for mesh in &mut out {
+        mesh.material.clone_from(&m.material);
         if let Some(u) = mode_u {
             mesh.address_mode_u = u;
         }
@@ -362,6 +554,11 @@ impl Scene {
             .into_iter()
             .map(|(name, t)| texture_spec(&name, t, &base).map(|s| (name, s)))
             .collect::<Result<_, _>>()?;
+        let materials: BTreeMap<String, MaterialSpec> = raw
+            .materials
+            .into_iter()
+            .map(|(name, m)| (name, material_spec(m)))
+            .collect();
         let mut all = Vec::new();
         for (i, m) in raw.meshes.into_iter().enumerate() {
             // Each mesh file gets what the meshes before it left of the scene's limits.
@@ -373,7 +570,7 @@ impl Scene {
                 max_vertices: limits.max_vertices.saturating_sub(verts),
                 ..*limits
             };
-            all.extend(meshes(i, m, &base, &left)?);
+            all.extend(meshes(i, m, &base, &left, &materials)?);
         }
         let tris: u64 = all.iter().map(|m| m.triangles.len() as u64).sum();
         let verts: u64 = all.iter().map(|m| m.positions.len() as u64).sum();
@@ -399,6 +596,8 @@ impl Scene {
             },
             textures,
             meshes: all,
+            lights: raw.lights.into_iter().map(light_spec).collect(),
+            materials,
         };
         scene.validate()?;
         Ok(scene)

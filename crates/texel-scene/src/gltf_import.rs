@@ -184,6 +184,8 @@ impl Ctx<'_> {
                 address_mode_u,
                 address_mode_v,
                 filters,
+                material: None,
+                tangents: None,
             });
         }
         Ok(())

@@ -39,16 +39,21 @@ mod limits;
 mod model;
 mod obj;
 mod procedural;
+mod tangents;
 mod texture;
 mod validate;
 
 pub use builtin::{
-    builtin, builtin_names, GROUND_ROTATION_DEG, GROUND_TOML, TRIANGLE_TOML, ZONEPLATE_TOML,
+    builtin, builtin_names, shaded_builtin_names, GLOSSY_TOML, GROUND_ROTATION_DEG, GROUND_TOML,
+    TRIANGLE_TOML, ZONEPLATE_TOML,
 };
 pub use camera::Camera;
 pub use error::SceneError;
 pub use gltf_import::{load_gltf, load_gltf_slice, load_gltf_with};
 pub use limits::SceneLimits;
-pub use model::{Mesh, MeshFilters, Output, Scene, TextureSource, TextureSpec, MAX_OUTPUT_SIDE};
+pub use model::{
+    ColorInput, Displacement, LightSpec, MaterialSpec, Mesh, MeshFilters, Output, ScalarInput,
+    Scene, SpecularAaSpec, TextureSource, TextureSpec, MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
+};
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::Procedural;

@@ -23,6 +23,145 @@ pub struct Scene {
     pub textures: BTreeMap<String, TextureSpec>,
     /// The meshes, drawn in order (depth-tested).
     pub meshes: Vec<Mesh>,
+    /// Lights (`[[lights]]`); none renders unlit, as before materials existed.
+    pub lights: Vec<LightSpec>,
+    /// Materials by name (`[materials.NAME]`; meshes refer to them by name).
+    pub materials: BTreeMap<String, MaterialSpec>,
+}
+
+/// The most lights a scene has.
+pub const MAX_SCENE_LIGHTS: usize = 8;
+
+/// A light of a scene file (`[[lights]]`), linear RGB; units as glTF's `KHR_lights_punctual`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightSpec {
+    /// `type = "directional"`: `direction` towards the light, `intensity` the illuminance on a
+    /// surface facing it.
+    Directional {
+        /// Direction towards the light (not zero).
+        direction: Vec3,
+        /// Illuminance, linear RGB.
+        intensity: Vec3,
+    },
+    /// `type = "point"`: `position`, `intensity` (illuminance `intensity / d^2` at distance `d`).
+    Point {
+        /// World-space position.
+        position: Vec3,
+        /// Luminous intensity, linear RGB.
+        intensity: Vec3,
+    },
+    /// `type = "ambient"`: light from every direction, `intensity` the radiance.
+    Ambient {
+        /// Radiance, linear RGB.
+        intensity: Vec3,
+    },
+}
+
+/// A colour input: a texture (by name) or a constant linear RGB colour.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ColorInput {
+    /// The texture of this name.
+    Texture(String),
+    /// A constant linear RGB colour.
+    Rgb(Vec3),
+}
+
+/// A scalar input: a constant, or a texture's red channel (linear) by name.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ScalarInput {
+    /// A constant in `[0, 1]`.
+    Value(f32),
+    /// The red channel of the texture of this name.
+    Texture(String),
+}
+
+/// How a material's height map displaces the surface (`displacement = ...`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Displacement {
+    /// `"none"`.
+    #[default]
+    None,
+    /// `"bump"`: normals from the height map.
+    Bump,
+    /// `"pom"`: parallax occlusion mapping.
+    Pom,
+    /// `"tessellate"`: true displacement of tessellated geometry.
+    Tessellate,
+}
+
+/// Specular antialiasing of a material (`specular_aa = ...`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SpecularAaSpec {
+    /// `"none"`.
+    #[default]
+    None,
+    /// `"toksvig"`.
+    Toksvig,
+    /// `"lean"`.
+    Lean,
+    /// `"projected"`.
+    Projected,
+}
+
+/// A material (`[materials.NAME]`): glTF-style metallic-roughness parameters and maps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialSpec {
+    /// `base_color`: a texture name (replacing the mesh's texture) or `[r, g, b]` (linear,
+    /// multiplying the mesh's texture). Default white.
+    pub base_color: ColorInput,
+    /// `roughness`: perceptual roughness, number in `[0, 1]` or texture name (red). Default 0.5.
+    pub roughness: ScalarInput,
+    /// `metallic`: number in `[0, 1]` or texture name (red). Default 0.
+    pub metallic: ScalarInput,
+    /// `normal`: tangent-space normal map (texture name, must be `color = "linear"`).
+    pub normal: Option<String>,
+    /// `normal_scale`: scales the normal map's x and y. Default 1.
+    pub normal_scale: f32,
+    /// `height`: height map (texture name).
+    pub height: Option<String>,
+    /// `height_scale`: world units of height per unit of the map. Default 0.05.
+    pub height_scale: f32,
+    /// `displacement`.
+    pub displacement: Displacement,
+    /// `specular_aa`.
+    pub specular_aa: SpecularAaSpec,
+    /// Number of `[[materials.NAME.layers]]` tables given.
+    pub layers: usize,
+}
+
+impl Default for MaterialSpec {
+    fn default() -> Self {
+        MaterialSpec {
+            base_color: ColorInput::Rgb(Vec3::ONE),
+            roughness: ScalarInput::Value(0.5),
+            metallic: ScalarInput::Value(0.0),
+            normal: None,
+            normal_scale: 1.0,
+            height: None,
+            height_scale: 0.05,
+            displacement: Displacement::None,
+            specular_aa: SpecularAaSpec::None,
+            layers: 0,
+        }
+    }
+}
+
+impl MaterialSpec {
+    /// Every texture name the material reads.
+    pub fn textures(&self) -> Vec<&str> {
+        let mut out = Vec::new();
+        if let ColorInput::Texture(t) = &self.base_color {
+            out.push(t.as_str());
+        }
+        for s in [&self.roughness, &self.metallic] {
+            if let ScalarInput::Texture(t) = s {
+                out.push(t.as_str());
+            }
+        }
+        out.extend(self.normal.as_deref());
+        out.extend(self.height.as_deref());
+        out
+    }
 }
 
 /// Output image settings.
@@ -80,6 +219,11 @@ pub struct Mesh {
     pub address_mode_v: AddressMode,
     /// Filters requested by a glTF sampler, if any (the CLI's `--filter` may override them).
     pub filters: Option<MeshFilters>,
+    /// Name of the material in [`Scene::materials`], if any.
+    pub material: Option<String>,
+    /// Tangents (`xyz` along increasing u, `w = +-1` handedness as glTF's `TANGENT`), one per
+    /// position, if given or generated ([`Mesh::generate_tangents`]).
+    pub tangents: Option<Vec<Vec4>>,
 }
 
 /// Texture filters a glTF sampler asks for (glTF 2.0 spec, 5.26 "Sampler"); `None` = not specified.

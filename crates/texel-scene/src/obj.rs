@@ -205,6 +205,8 @@ pub fn load_obj_bytes(
         address_mode_u: AddressMode::Repeat,
         address_mode_v: AddressMode::Repeat,
         filters: None,
+        material: None,
+        tangents: None,
     };
     for model in &models {
         let m = &model.mesh;

@@ -53,6 +53,20 @@ pub enum Procedural {
         /// Height in texels.
         height: u32,
     },
+    /// A tangent-space normal map (use with `color = "linear"`) of the egg-crate height field
+    /// `h(x, y) = A sin(2 pi c x / W) sin(2 pi c y / H)` in texels, `x = i + 0.5`, `y = j + 0.5`,
+    /// `c = cells` bumps along each side, `A` chosen so the steepest slope is `slope`
+    /// (`A = slope W / (2 pi c)` for a square map). With `y` up the image (glTF's `+Y`), the normal
+    /// is `normalize(-dh/dx, dh/dj, 1)` and the code `round(255 (n + 1) / 2)`. Square;
+    /// `size = 512`, `cells = 32`, `slope = 0.5` by default.
+    Bumps {
+        /// Side in texels.
+        size: u32,
+        /// Bumps along each side (`>= 1`).
+        cells: u32,
+        /// Steepest slope (rise over run, `>= 0`, finite).
+        slope: f32,
+    },
     /// One colour everywhere (8-bit codes, `rgba = [255, 255, 255, 255]` and `size = 1` by default).
     Solid {
         /// Width in texels.
@@ -72,7 +86,7 @@ impl Procedural {
             | Procedural::Grid { width, height, .. }
             | Procedural::Uv { width, height }
             | Procedural::Solid { width, height, .. } => (width, height),
-            Procedural::ZonePlate { size } => (size, size),
+            Procedural::ZonePlate { size } | Procedural::Bumps { size, .. } => (size, size),
         }
     }
 
@@ -83,7 +97,7 @@ impl Procedural {
             Procedural::Checker { width, checks, .. } => {
                 let s = f64::from(width) / f64::from(checks);
                 let a = (f64::from(i) / s).floor() as u64 + (f64::from(j) / s).floor() as u64;
-                grey(if a % 2 == 0 { 0 } else { 255 })
+                grey(if a.is_multiple_of(2) { 0 } else { 255 })
             }
             Procedural::ZonePlate { size } => {
                 let c = f64::from(size) / 2.0;
@@ -108,8 +122,26 @@ impl Procedural {
                 let g = (255.0 * (f64::from(j) + 0.5) / f64::from(height)).round() as u8;
                 [r, g, 0, 255]
             }
+            Procedural::Bumps { size, cells, slope } => {
+                let n = Self::bump_normal(size, cells, slope, i, j);
+                let enc = |c: f64| (255.0 * (c + 1.0) / 2.0).round().clamp(0.0, 255.0) as u8;
+                [enc(n[0]), enc(n[1]), enc(n[2]), 255]
+            }
             Procedural::Solid { rgba, .. } => rgba,
         }
+    }
+
+    /// The unit tangent-space normal of [`Procedural::Bumps`] at texel `(i, j)` (`+y` up the image).
+    pub fn bump_normal(size: u32, cells: u32, slope: f32, i: u32, j: u32) -> [f64; 3] {
+        use std::f64::consts::PI;
+        let k = 2.0 * PI * f64::from(cells) / f64::from(size);
+        let a = f64::from(slope) / k;
+        let (x, y) = (f64::from(i) + 0.5, f64::from(j) + 0.5);
+        let hx = a * k * (k * x).cos() * (k * y).sin();
+        let hj = a * k * (k * x).sin() * (k * y).cos();
+        let v = [-hx, hj, 1.0];
+        let len = (v[0] * v[0] + v[1] * v[1] + 1.0).sqrt();
+        v.map(|c| c / len)
     }
 
     /// Generate the texture (with its mip pyramid) in colour space `color`. The size is checked

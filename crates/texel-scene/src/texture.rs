@@ -70,7 +70,9 @@ impl TextureSpec {
 }
 
 impl Scene {
-    /// Load every texture the meshes use (unused ones are skipped), by name.
+    /// Load every texture the meshes and their materials use (unused ones are skipped), by name.
+    /// `color_override` applies to colour textures; material maps other than `base_color`
+    /// (normals, roughness, metalness) hold data and keep their own colour space.
     ///
     /// # Errors
     /// As [`TextureSpec::load`].
@@ -81,21 +83,28 @@ impl Scene {
     ) -> Result<BTreeMap<String, Texture>, SceneError> {
         let mut out = BTreeMap::new();
         for (mi, m) in self.meshes.iter().enumerate() {
-            if out.contains_key(&m.texture) {
-                continue;
+            let mut wanted = vec![(m.texture.as_str(), color_override)];
+            if let Some(mat) = m.material.as_ref().and_then(|n| self.materials.get(n)) {
+                for t in mat.textures() {
+                    if t != m.texture {
+                        wanted.push((t, None));
+                    }
+                }
             }
-            let spec = self
-                .textures
-                .get(&m.texture)
-                .ok_or_else(|| SceneError::UnknownTexture {
-                    mesh: mi,
-                    name: m.texture.clone(),
-                    defined: self.textures.keys().cloned().collect::<Vec<_>>().join(", "),
-                })?;
-            out.insert(
-                m.texture.clone(),
-                spec.load(&m.texture, color_override, limits)?,
-            );
+            for (name, color) in wanted {
+                if out.contains_key(name) {
+                    continue;
+                }
+                let spec = self
+                    .textures
+                    .get(name)
+                    .ok_or_else(|| SceneError::UnknownTexture {
+                        mesh: mi,
+                        name: name.to_string(),
+                        defined: self.textures.keys().cloned().collect::<Vec<_>>().join(", "),
+                    })?;
+                out.insert(name.to_string(), spec.load(name, color, limits)?);
+            }
         }
         Ok(out)
     }

@@ -519,7 +519,7 @@ fn gltf_with_external_buffer_and_glb() {
 
     // The same as GLB: header, JSON chunk (space-padded), BIN chunk.
     let mut json = triangle_json(None).into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let total = 12 + 8 + json.len() + 8 + buf.len();

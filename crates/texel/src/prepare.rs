@@ -5,8 +5,10 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Mutex;
 
-use texel_raster::{DrawCall, RenderSettings, Vertex};
-use texel_scene::Scene;
+use texel_raster::{
+    ChannelInput, DrawCall, Light, Material, RenderSettings, SpecularAa, TextureInput, Vertex,
+};
+use texel_scene::{ColorInput, LightSpec, ScalarInput, Scene, SpecularAaSpec};
 use texel_texture::color::srgb_to_linear;
 use texel_texture::{ColorSpace, Limits, Sampler, Texture};
 
@@ -33,6 +35,9 @@ pub struct SceneOptions {
     /// Replace NaN and infinite float texels ([`texel_texture::replace_non_finite`]) instead of
     /// refusing the texture; [`PreparedScene::replaced`] reports how many.
     pub replace_non_finite: bool,
+    /// Specular antialiasing for every material, overriding each one's `specular_aa` (the
+    /// CLI's `--specular-aa`).
+    pub specular_aa: Option<SpecularAa>,
 }
 
 /// A loaded scene, ready to render with any filter.
@@ -55,6 +60,8 @@ pub struct PreparedScene {
     pub replaced: Vec<(String, u64)>,
     /// The (texture, structure) pairs [`PreparedScene::build_structures_within`] has charged.
     charged: Mutex<BTreeSet<(String, &'static str)>>,
+    /// [`SceneOptions::specular_aa`].
+    specular_aa: Option<SpecularAa>,
 }
 
 impl PreparedScene {
@@ -91,14 +98,23 @@ impl PreparedScene {
         };
         let mut textures = BTreeMap::new();
         let mut replaced = Vec::new();
+        // Each mesh's colour texture (with --color's override), then its material's maps, which
+        // hold data and keep their own colour space.
+        let mut wanted: Vec<(String, Option<ColorSpace>)> = Vec::new();
         for m in &scene.meshes {
-            if textures.contains_key(&m.texture) {
+            wanted.push((m.texture.clone(), override_space));
+            if let Some(mat) = m.material.as_ref().and_then(|n| scene.materials.get(n)) {
+                wanted.extend(mat.textures().into_iter().map(|t| (t.to_string(), None)));
+            }
+        }
+        for (name, space) in wanted {
+            if textures.contains_key(&name) {
                 continue;
             }
-            let spec = scene.textures.get(&m.texture).ok_or_else(|| {
+            let spec = scene.textures.get(&name).ok_or_else(|| {
                 texel_scene::SceneError::UnknownTexture {
                     mesh: 0,
-                    name: m.texture.clone(),
+                    name: name.clone(),
                     defined: scene
                         .textures
                         .keys()
@@ -111,20 +127,24 @@ impl PreparedScene {
                 max_bytes: budget.remaining(),
                 ..Limits::default()
             };
-            let loaded = spec.load_with(
-                &m.texture,
-                override_space,
-                &limits,
-                options.replace_non_finite,
-            )?;
+            let loaded = spec.load_with(&name, space, &limits, options.replace_non_finite)?;
             if loaded.replaced > 0 {
-                replaced.push((m.texture.clone(), loaded.replaced));
+                replaced.push((name.clone(), loaded.replaced));
             }
-            budget.take(
-                &format!("texture {:?}", m.texture),
-                loaded.texture.pyramid_bytes(),
-            )?;
-            textures.insert(m.texture.clone(), loaded.texture);
+            budget.take(&format!("texture {name:?}"), loaded.texture.pyramid_bytes())?;
+            textures.insert(name, loaded.texture);
+        }
+        // Normal maps need tangents: MikkTSpace where the mesh brings none.
+        let mut scene = scene;
+        for m in &mut scene.meshes {
+            let mapped = m
+                .material
+                .as_ref()
+                .and_then(|n| scene.materials.get(n))
+                .is_some_and(|mat| mat.normal.is_some());
+            if mapped && m.tangents.is_none() {
+                m.generate_tangents();
+            }
         }
         let vertices = scene.meshes.iter().map(texel_vertices).collect();
         Ok(PreparedScene {
@@ -136,6 +156,7 @@ impl PreparedScene {
             color: options.color,
             replaced,
             charged: Mutex::new(BTreeSet::new()),
+            specular_aa: options.specular_aa,
         })
     }
 
@@ -239,15 +260,78 @@ impl PreparedScene {
                 texture: &self.textures[&mesh.texture],
                 sampler,
                 clip_from_world,
-                material: None,
+                material: self.material(mesh, sampler),
             })
             .collect()
     }
 
-    /// Render settings for this scene's size and background (the background decoded as the
-    /// colour handling says).
+    /// The rasterizer's material of `mesh`, its maps read through `sampler`.
+    fn material<'a>(
+        &'a self,
+        mesh: &texel_scene::Mesh,
+        sampler: &'a Sampler,
+    ) -> Option<Material<'a>> {
+        let spec = self.scene.materials.get(mesh.material.as_ref()?)?;
+        let input = |name: &str| TextureInput {
+            texture: &self.textures[name],
+            sampler,
+        };
+        let scalar = |s: &ScalarInput| match s {
+            ScalarInput::Value(v) => (*v, None),
+            ScalarInput::Texture(t) => (
+                1.0,
+                Some(ChannelInput {
+                    input: input(t),
+                    channel: 0,
+                }),
+            ),
+        };
+        let (roughness, roughness_map) = scalar(&spec.roughness);
+        let (metallic, metallic_map) = scalar(&spec.metallic);
+        let base_color = match spec.base_color {
+            ColorInput::Rgb(c) => c.extend(1.0),
+            ColorInput::Texture(_) => glam::Vec4::ONE,
+        };
+        let specular_aa = self.specular_aa.unwrap_or(match spec.specular_aa {
+            SpecularAaSpec::Toksvig => SpecularAa::Toksvig,
+            // Validation refuses the methods not built yet.
+            _ => SpecularAa::None,
+        });
+        Some(Material {
+            base_color,
+            roughness,
+            metallic,
+            roughness_map,
+            metallic_map,
+            normal_map: spec.normal.as_deref().map(input),
+            normal_scale: spec.normal_scale,
+            specular_aa,
+        })
+    }
+
+    /// Render settings for this scene's size, background (decoded as the colour handling says)
+    /// and lights.
     pub fn settings(&self) -> RenderSettings {
         let mut s = RenderSettings::new(self.width, self.height);
+        for (slot, light) in s.lights.iter_mut().zip(&self.scene.lights) {
+            *slot = Some(match *light {
+                LightSpec::Directional {
+                    direction,
+                    intensity,
+                } => Light::Directional {
+                    direction,
+                    intensity,
+                },
+                LightSpec::Point {
+                    position,
+                    intensity,
+                } => Light::Point {
+                    position,
+                    intensity,
+                },
+                LightSpec::Ambient { intensity } => Light::Ambient { intensity },
+            });
+        }
         let bg = self.scene.output.background;
         let decode = |b: u8| match self.color {
             ColorHandling::Srgb => srgb_to_linear(f32::from(b) / 255.0),
@@ -272,6 +356,9 @@ fn texel_vertices(mesh: &texel_scene::Mesh) -> Vec<Vertex> {
             }
             if let Some(n) = &mesh.normals {
                 v.normal = n[k];
+            }
+            if let Some(t) = &mesh.tangents {
+                v.tangent = t[k];
             }
             v
         })

@@ -31,12 +31,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     let presses =
         parse_keys(args.keys.as_deref().unwrap_or("")).map_err(|e| anyhow!("--keys: {e}"))?;
     let mut input = input;
-    let scene = load_scene(
-        &args.scene.scene,
-        args.scene.color,
-        args.scene.size,
-        &mut input,
-    )?;
+    let scene = load_scene(&args.scene, &mut input)?;
     let gpu = if args.gpu {
         Some(Gpu::new(args.adapter.as_deref())?)
     } else {
@@ -60,6 +55,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     let worker = Worker {
         scene_spec: args.scene.scene.clone(),
         size: args.scene.size,
+        specular_aa: args.scene.specular_aa.map(Into::into),
         scenes,
         input,
         threads: args.threads,

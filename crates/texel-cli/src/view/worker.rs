@@ -30,7 +30,7 @@ use texel_raster::{draw_into, render_reference_strata, DrawCall, Frame, RenderSe
 
 use super::controls::{Mode, ViewState};
 use crate::cli::ColorArg;
-use crate::input::{load_scene, Input};
+use crate::input::{load_scene_with, Input};
 use crate::output::encoding;
 
 /// Time one frame (or one band of rows) should take, milliseconds.
@@ -176,6 +176,8 @@ pub struct Worker {
     pub scene_spec: String,
     /// `--size`, passed on to reloads.
     pub size: Option<crate::cli::Size>,
+    /// `--specular-aa`, passed on to reloads.
+    pub specular_aa: Option<texel_raster::SpecularAa>,
     /// The scene as loaded for each colour handling (index: `ColorArg as usize`).
     pub scenes: [Option<PreparedScene>; 2],
     /// Memory account and input policy.
@@ -307,7 +309,7 @@ impl FrameContext<'_, '_> {
         let w = &mut *self.worker;
         let slot = color as usize;
         if w.scenes[slot].is_none() {
-            let s = load_scene(&w.scene_spec, color, w.size, &mut w.input)
+            let s = load_scene_with(&w.scene_spec, color, w.size, w.specular_aa, &mut w.input)
                 .context("cannot load the scene for the other colour handling")?;
             w.scenes[slot] = Some(s);
         }
@@ -352,7 +354,12 @@ impl FrameContext<'_, '_> {
             };
         }
         let modes = state.modes();
-        let has_gpu = self.gpu.is_some();
+        // The GPU path has no lighting or materials: lit scenes stay on the CPU.
+        let lit = self.worker.scenes[state.color as usize]
+            .as_ref()
+            .or(self.worker.scenes.iter().flatten().next())
+            .is_some_and(|s| !s.scene.lights.is_empty() || !s.scene.materials.is_empty());
+        let has_gpu = self.gpu.is_some() && !lit;
         let use_gpu = |m: Mode| {
             has_gpu
                 && state.view == View::Color
@@ -750,12 +757,14 @@ mod tests {
                 width: w,
                 height: h,
             });
-            let scene = load_scene("builtin:ground", ColorArg::Srgb, size, &mut input).unwrap();
+            let scene =
+                load_scene_with("builtin:ground", ColorArg::Srgb, size, None, &mut input).unwrap();
             let camera = scene.scene.camera;
             Harness {
                 worker: Worker {
                     scene_spec: "builtin:ground".into(),
                     size,
+                    specular_aa: None,
                     scenes: [Some(scene), None],
                     input,
                     threads: None,

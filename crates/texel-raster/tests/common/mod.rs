@@ -15,7 +15,7 @@ pub fn checker(size: u32, checks: u32) -> Texture {
     let texels = (0..size * size)
         .map(|k| {
             let (i, j) = (k % size, k / size);
-            if (i / cell + j / cell) % 2 == 0 {
+            if (i / cell + j / cell).is_multiple_of(2) {
                 [0, 0, 0, 255]
             } else {
                 [255, 255, 255, 255]

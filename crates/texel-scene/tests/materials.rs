@@ -1,0 +1,225 @@
+//! Lights, materials and tangents in scene files.
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+use texel_scene::{
+    ColorInput, LightSpec, Mesh, Procedural, ScalarInput, Scene, SceneError, SpecularAaSpec,
+};
+
+const BASE: &str = r#"
+[output]
+width = 64
+height = 32
+[camera]
+eye = [0.0, 1.0, 3.0]
+target = [0.0, 0.0, 0.0]
+fovy_deg = 50.0
+near = 0.1
+far = 100.0
+[textures.grey]
+procedural = "solid"
+[textures.bumps]
+procedural = "bumps"
+size = 64
+cells = 4
+color = "linear"
+[textures.rough]
+procedural = "checker"
+size = 8
+color = "linear"
+"#;
+
+const MESH: &str = r#"
+[[meshes]]
+material = "m"
+positions = [[-1.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 0.0, -1.0]]
+uvs = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]
+triangles = [[0, 1, 2], [0, 2, 3]]
+"#;
+
+fn parse(extra: &str) -> Result<Scene, SceneError> {
+    Scene::from_toml_str(&format!("{BASE}{extra}{MESH}"), Path::new("test.toml"))
+}
+
+#[test]
+fn lights_and_materials_parse_with_their_defaults() {
+    let s = parse(
+        r#"
+[[lights]]
+type = "directional"
+direction = [0.0, 1.0, 0.5]
+intensity = [3.0, 3.0, 3.0]
+[[lights]]
+type = "point"
+position = [0.0, 2.0, 0.0]
+intensity = [10.0, 9.0, 8.0]
+[[lights]]
+type = "ambient"
+intensity = [0.1, 0.1, 0.1]
+[materials.m]
+base_color = "grey"
+roughness = "rough"
+metallic = 0.25
+normal = "bumps"
+normal_scale = 0.5
+specular_aa = "toksvig"
+"#,
+    )
+    .unwrap();
+    assert_eq!(s.lights.len(), 3);
+    assert_eq!(
+        s.lights[1],
+        LightSpec::Point {
+            position: Vec3::new(0.0, 2.0, 0.0),
+            intensity: Vec3::new(10.0, 9.0, 8.0)
+        }
+    );
+    let m = &s.materials["m"];
+    assert_eq!(m.base_color, ColorInput::Texture("grey".into()));
+    assert_eq!(m.roughness, ScalarInput::Texture("rough".into()));
+    assert_eq!(m.metallic, ScalarInput::Value(0.25));
+    assert_eq!(m.normal.as_deref(), Some("bumps"));
+    assert_eq!(m.specular_aa, SpecularAaSpec::Toksvig);
+    // The mesh takes its texture from the material's base colour.
+    assert_eq!(s.meshes[0].texture, "grey");
+    assert_eq!(s.meshes[0].material.as_deref(), Some("m"));
+    // Defaults: white, roughness 0.5, metallic 0, no maps.
+    let d = parse("[materials.m]\n").err();
+    assert!(
+        d.is_some(),
+        "a mesh without a texture and a material without one is refused"
+    );
+    let s = parse("[materials.m]\nbase_color = [0.5, 0.25, 1.0]\n");
+    assert!(s.is_err());
+}
+
+#[test]
+fn bad_lights_and_materials_are_refused_with_the_reason() {
+    let cases: [(&str, &str); 9] = [
+        (
+            "[materials.m]\nbase_color = \"grey\"\nshininess = 3.0\n",
+            "unknown field `shininess`",
+        ),
+        ("[materials.m]\nbase_color = \"nope\"\n", "texture \"nope\", which is not defined"),
+        (
+            "[materials.m]\nbase_color = \"grey\"\nroughness = 1.5\n",
+            "roughness = 1.5 must be in [0, 1]",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\nnormal = \"grey\"\n",
+            "give it color = \"linear\"",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\ndisplacement = \"pom\"\nheight = \"rough\"\n",
+            "not implemented yet",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\nspecular_aa = \"lean\"\n",
+            "not implemented yet",
+        ),
+        (
+            "[[lights]]\ntype = \"directional\"\ndirection = [0.0, 0.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n[materials.m]\nbase_color = \"grey\"\n",
+            "direction is zero",
+        ),
+        (
+            "[[lights]]\ntype = \"spot\"\nintensity = [1.0, 1.0, 1.0]\n[materials.m]\nbase_color = \"grey\"\n",
+            "spot",
+        ),
+        (
+            "[[lights]]\ntype = \"ambient\"\nintensity = [-1.0, 1.0, 1.0]\n[materials.m]\nbase_color = \"grey\"\n",
+            "negative",
+        ),
+    ];
+    for (extra, needle) in cases {
+        let e = parse(extra).unwrap_err().to_string();
+        assert!(e.contains(needle), "{extra}: {e}");
+    }
+    let nine: String = (0..9)
+        .map(|_| "[[lights]]\ntype = \"ambient\"\nintensity = [0.1, 0.1, 0.1]\n")
+        .collect();
+    let e = parse(&format!("{nine}[materials.m]\nbase_color = \"grey\"\n"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("more than the 8"), "{e}");
+    let e = Scene::from_toml_str(
+        &format!(
+            "{BASE}{}",
+            MESH.replace("material = \"m\"", "material = \"q\"\ntexture = \"grey\"")
+        ),
+        Path::new("t.toml"),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("material \"q\" is not defined"), "{e}");
+}
+
+/// MikkTSpace tangents follow glTF: `w * cross(n, t)` points up the image (towards decreasing v).
+#[test]
+fn generated_tangents_point_along_u_and_up_the_image() {
+    // A plane in y = 0 facing +y with u along +x: with v along +z up the image is -z, with v
+    // along -z it is +z (the two handednesses). Triangles are counter-clockwise seen from +y.
+    for (v_dir, want_up, triangles) in [
+        (1.0f32, -Vec3::Z, vec![[0, 2, 1], [0, 3, 2]]),
+        (-1.0, Vec3::Z, vec![[0, 1, 2], [0, 2, 3]]),
+    ] {
+        let positions = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, v_dir),
+            Vec3::new(0.0, 0.0, v_dir),
+        ];
+        let uvs = vec![Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
+        let mut mesh = Mesh {
+            positions,
+            uvs,
+            normals: Some(vec![Vec3::Y; 4]),
+            colors: None,
+            triangles,
+            texture: "t".into(),
+            address_mode_u: texel_texture::AddressMode::Repeat,
+            address_mode_v: texel_texture::AddressMode::Repeat,
+            filters: None,
+            material: None,
+            tangents: None,
+        };
+        mesh.generate_tangents();
+        for t in mesh.tangents.as_ref().unwrap() {
+            assert!((t.truncate() - Vec3::X).length() < 1e-5, "{t}");
+            let up = Vec3::Y.cross(t.truncate()) * t.w;
+            assert!(
+                (up - want_up).length() < 1e-5,
+                "v along {v_dir}: up {up}, tangent {t}"
+            );
+            assert_eq!(t.w.abs(), 1.0);
+        }
+    }
+}
+
+#[test]
+fn bump_normals_are_unit_and_slope_limited() {
+    let (size, cells, slope) = (64, 4, 0.6f32);
+    let mut steepest = 0.0f64;
+    for j in 0..size {
+        for i in 0..size {
+            let n = Procedural::bump_normal(size, cells, slope, i, j);
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            assert!((len - 1.0).abs() < 1e-12);
+            steepest = steepest.max((n[0] * n[0] + n[1] * n[1]).sqrt() / n[2]);
+        }
+    }
+    // The gradient's largest magnitude is the slope (reached where both sines peak together,
+    // within the sampling of the texel centres).
+    assert!(
+        steepest <= f64::from(slope) + 1e-9 && steepest > f64::from(slope) * 0.9,
+        "{steepest}"
+    );
+    // Encoded codes decode back within half a code.
+    let p = Procedural::Bumps { size, cells, slope };
+    let c = p.code(5, 9);
+    let n = Procedural::bump_normal(size, cells, slope, 5, 9);
+    for k in 0..3 {
+        let back = f64::from(c[k]) / 255.0 * 2.0 - 1.0;
+        assert!((back - n[k]).abs() <= 1.0 / 255.0 + 1e-12);
+    }
+}
