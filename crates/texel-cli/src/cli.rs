@@ -142,6 +142,9 @@ pub enum SpecularAaArg {
     None,
     /// Toksvig (2005): roughness widened by how much the filtered normal shortened.
     Toksvig,
+    /// LEAN mapping (Olano & Baker 2010): slope moments filtered with the normals; roughness
+    /// widened by their variance.
+    Lean,
 }
 
 impl From<SpecularAaArg> for texel_raster::SpecularAa {
@@ -149,6 +152,7 @@ impl From<SpecularAaArg> for texel_raster::SpecularAa {
         match a {
             SpecularAaArg::None => texel_raster::SpecularAa::None,
             SpecularAaArg::Toksvig => texel_raster::SpecularAa::Toksvig,
+            SpecularAaArg::Lean => texel_raster::SpecularAa::Lean,
         }
     }
 }

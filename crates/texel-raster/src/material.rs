@@ -90,6 +90,15 @@ pub enum SpecularAa {
     /// `s = 2 / alpha^2 - 2` equivalent to GGX's `alpha` (Walter et al. 2007), the exponent becomes
     /// `s' = s |n| / (|n| + s (1 - |n|))`, i.e. `alpha'^2 = 2 / (s' + 2)`.
     Toksvig,
+    /// LEAN mapping (Olano & Baker 2010): the map's slopes `b = (n_x, n_y) / n_z` and their second
+    /// moments `(b_x^2, b_y^2)` are stored in a float texture ([`lean_map`]) and filtered by the
+    /// same filter, which is exact for them because they are linear. The mean slope gives the
+    /// normal `normalize(b_x, b_y, 1)`; `E[b^2] - E[b]^2` per axis is the slope variance under the
+    /// footprint. Its mean over both axes `sigma^2` widens the isotropic lobe as a Beckmann lobe of
+    /// that variance would (`alpha^2 = 2 sigma^2` for Beckmann): `alpha'^2 = alpha^2 + 2 sigma^2`.
+    /// (LEAN's cross moment `b_x b_y` would orient an anisotropic lobe; the lobe here is
+    /// isotropic, so it is not stored.) Needs [`Material::lean`].
+    Lean,
 }
 
 /// A texture read through a sampler (a material's map).
@@ -130,6 +139,9 @@ pub struct Material<'a> {
     pub normal_scale: f32,
     /// Specular antialiasing.
     pub specular_aa: SpecularAa,
+    /// The LEAN moment map of `normal_map` ([`lean_map`]), read through the normal map's
+    /// sampler; required by [`SpecularAa::Lean`].
+    pub lean: Option<&'a Texture>,
 }
 
 impl Default for Material<'_> {
@@ -144,16 +156,20 @@ impl Default for Material<'_> {
             normal_map: None,
             normal_scale: 1.0,
             specular_aa: SpecularAa::None,
+            lean: None,
         }
     }
 }
 
 impl Material<'_> {
     /// Whether every factor is finite and in range (`roughness` and `metallic` in `[0, 1]`,
-    /// channels `0..=3`).
+    /// channels `0..=3`), and LEAN has its maps and a normal map.
     pub fn is_valid(&self) -> bool {
         let channel_ok = |c: &Option<ChannelInput>| c.is_none_or(|c| c.channel < 4);
-        self.base_color.is_finite()
+        let lean_ok = self.specular_aa != SpecularAa::Lean
+            || (self.lean.is_some() && self.normal_map.is_some());
+        lean_ok
+            && self.base_color.is_finite()
             && (0.0..=1.0).contains(&self.roughness)
             && (0.0..=1.0).contains(&self.metallic)
             && self.normal_scale.is_finite()
@@ -263,6 +279,49 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
         out += f * e * n_dot_l;
     }
     out
+}
+
+/// The steepest slope LEAN stores (`n_z` at least `1 / sqrt(1 + 16^2)`, 86 degrees from the
+/// surface normal): grazing map normals would make the moments explode.
+pub const LEAN_MAX_SLOPE: f32 = 16.0;
+
+/// The LEAN moment map of a tangent-space normal map (Olano & Baker 2010), `Rgba32Float` with its
+/// own pyramid: `[b_x, b_y, b_x^2, b_y^2]`, where `b = (n_x, n_y) / n_z` for each level-0 texel's
+/// normal `n = normalize(2 rgb - 1)` (slopes clamped to [`LEAN_MAX_SLOPE`]). Averaging it over any
+/// footprint gives the mean slope and the second moments of the normals under it.
+///
+/// # Errors
+/// The size errors of `Texture::from_fn` for a float texture of the map's size.
+pub fn lean_map(
+    normal_map: &Texture,
+    limits: &texel_texture::Limits,
+) -> Result<Texture, texel_texture::TextureError> {
+    let (w, h) = (normal_map.width(), normal_map.height());
+    let slope = |i: u32, j: u32| {
+        let c = normal_map.texel(0, i, j).unwrap_or([0.5, 0.5, 1.0, 1.0]);
+        let n = (Vec3::new(c[0], c[1], c[2]) * 2.0 - Vec3::ONE).normalize_or(Vec3::Z);
+        let z =
+            n.z.max(1.0 / (1.0 + LEAN_MAX_SLOPE * LEAN_MAX_SLOPE).sqrt());
+        (n.truncate() / z).clamp_length_max(LEAN_MAX_SLOPE)
+    };
+    Texture::from_fn(w, h, texel_texture::Format::Rgba32Float, limits, |i, j| {
+        let b = slope(i, j);
+        [b.x, b.y, b.x * b.x, b.y * b.y]
+    })
+}
+
+/// LEAN's tangent-space normal (unit) and widened roughness from the filtered moments
+/// `[b_x, b_y, b_x^2, b_y^2]`, for a normal map scaled by `scale` and base `roughness`. See
+/// [`SpecularAa::Lean`].
+pub fn lean_normal_roughness(moments: [f32; 4], scale: f32, roughness: f32) -> (Vec3, f32) {
+    let b = glam::Vec2::new(moments[0], moments[1]) * scale;
+    let s2 = scale * scale;
+    let var_x = moments[2] * s2 - b.x * b.x;
+    let var_y = moments[3] * s2 - b.y * b.y;
+    let sigma2 = (0.5 * (var_x + var_y)).max(0.0);
+    let alpha = roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
+    let alpha2 = (alpha * alpha + 2.0 * sigma2).min(1.0);
+    (b.extend(1.0).normalize(), alpha2.sqrt().sqrt())
 }
 
 /// Read `input` at `footprint`; also returns the texels read.
@@ -394,6 +453,50 @@ mod tests {
                 "r {roughness} m {metallic}: {sum}"
             );
         }
+    }
+
+    #[test]
+    fn lean_moments_give_the_mean_normal_and_the_slope_variance() {
+        // One flat texel: the normal is z and nothing widens.
+        let flat = lean_normal_roughness([0.0, 0.0, 0.0, 0.0], 1.0, 0.3);
+        assert!((flat.0 - Vec3::Z).length() < 1e-6 && (flat.1 - 0.3).abs() < 1e-6);
+        // Two slopes (+0.5, 0) and (-0.5, 0) averaged: mean 0, variance 0.25 along x, 0 along y:
+        // sigma^2 = 0.125, alpha'^2 = alpha^2 + 0.25.
+        let (n, r) = lean_normal_roughness([0.0, 0.0, 0.25, 0.0], 1.0, 0.3);
+        assert!((n - Vec3::Z).length() < 1e-6);
+        let want = (0.3f32.powi(4) + 0.25).sqrt().sqrt();
+        assert!((r - want).abs() < 1e-6, "{r} vs {want}");
+        // A constant slope (0.5, 0.25): the normal tilts, no variance. Scale 2 doubles the slope.
+        let (n, r) = lean_normal_roughness([0.5, 0.25, 0.25, 0.0625], 2.0, 0.3);
+        assert!(
+            (n - Vec3::new(1.0, 0.5, 1.0).normalize()).length() < 1e-6,
+            "{n}"
+        );
+        assert!((r - 0.3).abs() < 1e-5, "{r}");
+    }
+
+    #[test]
+    fn the_lean_map_holds_slopes_and_their_squares() {
+        let n = Vec3::new(0.3, -0.2, 0.9).normalize();
+        let code = |c: f32| ((c + 1.0) / 2.0 * 255.0).round() as u8;
+        let t = Texture::from_rgba8(
+            2,
+            2,
+            vec![[code(n.x), code(n.y), code(n.z), 255]; 4],
+            texel_texture::ColorSpace::Linear,
+            &texel_texture::Limits::default(),
+        )
+        .unwrap();
+        let a = lean_map(&t, &texel_texture::Limits::default()).unwrap();
+        let c = t.texel(0, 0, 0).unwrap();
+        let d = (Vec3::new(c[0], c[1], c[2]) * 2.0 - Vec3::ONE).normalize();
+        let (bx, by) = (d.x / d.z, d.y / d.z);
+        let got = a.texel(0, 1, 1).unwrap();
+        for (g, w) in got.iter().zip([bx, by, bx * bx, by * by]) {
+            assert!((g - w).abs() < 1e-6, "{got:?}");
+        }
+        // The coarsest level averages them (a constant map: the same values).
+        assert!((a.texel(1, 0, 0).unwrap()[2] - bx * bx).abs() < 1e-6);
     }
 
     #[test]

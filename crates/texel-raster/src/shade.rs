@@ -17,7 +17,7 @@ use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};
 use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
 use crate::draw::{DrawCall, Vertex};
-use crate::material::{self, Light, Material, SpecularAa, Surface, MIN_ROUGHNESS};
+use crate::material::{self, Light, Material, SpecularAa, Surface, TextureInput, MIN_ROUGHNESS};
 use crate::settings::RenderSettings;
 use crate::setup::TriangleSetup;
 
@@ -205,7 +205,23 @@ pub(crate) fn shade(
             metallic *= t[map.channel];
             texels += n;
         }
-        if let Some(map) = &m.normal_map {
+        if let (SpecularAa::Lean, Some(map), Some(lean)) = (m.specular_aa, &m.normal_map, m.lean) {
+            let tangent = verts[0].tangent * l.x + verts[1].tangent * l.y + verts[2].tangent * l.z;
+            let t = tangent.truncate() - normal * normal.dot(tangent.truncate());
+            if let Some(t) = t.try_normalize() {
+                let moments = TextureInput {
+                    texture: lean,
+                    sampler: map.sampler,
+                };
+                let (a, n) = material::sample(&moments, fp, count);
+                texels += n;
+                let (nt, r) = material::lean_normal_roughness(a, m.normal_scale, roughness);
+                roughness = r;
+                let sign = if tangent.w < 0.0 { -1.0 } else { 1.0 };
+                let bt = normal.cross(t) * sign;
+                normal = (t * nt.x + bt * nt.y + normal * nt.z).normalize_or(normal);
+            }
+        } else if let Some(map) = &m.normal_map {
             let tangent = verts[0].tangent * l.x + verts[1].tangent * l.y + verts[2].tangent * l.z;
             let t = tangent.truncate() - normal * normal.dot(tangent.truncate());
             if let Some(t) = t.try_normalize() {

@@ -115,7 +115,7 @@ fn bad_lights_and_materials_are_refused_with_the_reason() {
             "not implemented yet",
         ),
         (
-            "[materials.m]\nbase_color = \"grey\"\nspecular_aa = \"lean\"\n",
+            "[materials.m]\nbase_color = \"grey\"\nspecular_aa = \"projected\"\n",
             "not implemented yet",
         ),
         (

@@ -62,6 +62,9 @@ pub struct PreparedScene {
     charged: Mutex<BTreeSet<(String, &'static str)>>,
     /// [`SceneOptions::specular_aa`].
     specular_aa: Option<SpecularAa>,
+    /// LEAN moment maps ([`texel_raster::material::lean_map`]) of the normal maps of materials
+    /// that use LEAN, by the normal map's texture name.
+    lean_maps: BTreeMap<String, Texture>,
 }
 
 impl PreparedScene {
@@ -134,6 +137,40 @@ impl PreparedScene {
             budget.take(&format!("texture {name:?}"), loaded.texture.pyramid_bytes())?;
             textures.insert(name, loaded.texture);
         }
+        // LEAN reads moment maps made from the normal maps (float, charged like any texture).
+        let mut lean_maps = BTreeMap::new();
+        for mat in scene.materials.values() {
+            let lean = options
+                .specular_aa
+                .map_or(mat.specular_aa == SpecularAaSpec::Lean, |o| {
+                    o == SpecularAa::Lean
+                });
+            let Some(normal) = mat.normal.as_ref().filter(|_| lean) else {
+                continue;
+            };
+            let Some(map) = textures.get(normal) else {
+                continue;
+            };
+            if lean_maps.contains_key(normal) {
+                continue;
+            }
+            let limits = Limits {
+                max_bytes: budget.remaining(),
+                ..Limits::default()
+            };
+            let moments = texel_raster::material::lean_map(map, &limits).map_err(|source| {
+                texel_scene::SceneError::Texture {
+                    name: format!("{normal} (LEAN moments)"),
+                    path: None,
+                    source,
+                }
+            })?;
+            budget.take(
+                &format!("the LEAN moments of {normal:?}"),
+                moments.pyramid_bytes(),
+            )?;
+            lean_maps.insert(normal.clone(), moments);
+        }
         // Normal maps need tangents: MikkTSpace where the mesh brings none.
         let mut scene = scene;
         for m in &mut scene.meshes {
@@ -157,6 +194,7 @@ impl PreparedScene {
             replaced,
             charged: Mutex::new(BTreeSet::new()),
             specular_aa: options.specular_aa,
+            lean_maps,
         })
     }
 
@@ -292,11 +330,17 @@ impl PreparedScene {
             ColorInput::Rgb(c) => c.extend(1.0),
             ColorInput::Texture(_) => glam::Vec4::ONE,
         };
-        let specular_aa = self.specular_aa.unwrap_or(match spec.specular_aa {
+        let mut specular_aa = self.specular_aa.unwrap_or(match spec.specular_aa {
             SpecularAaSpec::Toksvig => SpecularAa::Toksvig,
+            SpecularAaSpec::Lean => SpecularAa::Lean,
             // Validation refuses the methods not built yet.
             _ => SpecularAa::None,
         });
+        let lean = spec.normal.as_ref().and_then(|n| self.lean_maps.get(n));
+        if specular_aa == SpecularAa::Lean && lean.is_none() {
+            // No normal map: nothing varies within a pixel to antialias.
+            specular_aa = SpecularAa::None;
+        }
         Some(Material {
             base_color,
             roughness,
@@ -306,6 +350,7 @@ impl PreparedScene {
             normal_map: spec.normal.as_deref().map(input),
             normal_scale: spec.normal_scale,
             specular_aa,
+            lean,
         })
     }
 
