@@ -15,7 +15,8 @@
 //!   2014, eq. 99);
 //! - `f = (1 - F) c_diff / pi + F D Vis` with `c_diff = c (1 - m)`;
 //! - outgoing radiance `L = sum over lights of f E (n.l)` for `n.l > 0`, plus `A (c_diff + F0)` for
-//!   ambient light `A`.
+//!   ambient light `A`. The diffuse part's `n.l` uses [`Surface::diffuse_normal`] (the mean normal
+//!   under the pixel where specular antialiasing keeps it; the shading normal otherwise).
 //!
 //! Units follow glTF's `KHR_lights_punctual`: a directional light's `intensity` is the illuminance
 //! on a surface facing it; a point light's is its luminous intensity, giving `intensity / d^2` at
@@ -189,6 +190,10 @@ pub struct Surface {
     pub metallic: f32,
     /// Unit shading normal.
     pub normal: Vec3,
+    /// The normal the diffuse term uses, length at most 1: the mean of the normals under the
+    /// pixel where a filter averaged them (`E[max(0, n.l)] = E[n].l` while no normal under it
+    /// faces away from the light), else `normal`.
+    pub diffuse_normal: Vec3,
     /// World-space position.
     pub position: Vec3,
 }
@@ -263,20 +268,20 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
             }
         };
         let n_dot_l = n.dot(l);
-        if n_dot_l <= 0.0 {
+        let diffuse = c_diff * std::f32::consts::FRAC_1_PI * surface.diffuse_normal.dot(l).max(0.0);
+        if lambert {
+            out += diffuse * e;
             continue;
         }
-        let diffuse = c_diff * std::f32::consts::FRAC_1_PI;
-        let f = if lambert {
-            diffuse
-        } else {
-            let h = (l + v).normalize_or_zero();
-            let fr = fresnel(f0, v.dot(h));
-            let spec =
-                fr * (ggx_d(n.dot(h).max(0.0), alpha) * smith_visibility(n_dot_l, n_dot_v, alpha));
-            (Vec3::ONE - fr) * diffuse + spec
-        };
-        out += f * e * n_dot_l;
+        if n_dot_l <= 0.0 {
+            out += diffuse * e;
+            continue;
+        }
+        let h = (l + v).normalize_or_zero();
+        let fr = fresnel(f0, v.dot(h));
+        let spec =
+            fr * (ggx_d(n.dot(h).max(0.0), alpha) * smith_visibility(n_dot_l, n_dot_v, alpha));
+        out += ((Vec3::ONE - fr) * diffuse + spec * n_dot_l) * e;
     }
     out
 }
@@ -379,6 +384,7 @@ mod tests {
             roughness: 1.0,
             metallic: 0.0,
             normal: Vec3::Y,
+            diffuse_normal: Vec3::Y,
             position: Vec3::ZERO,
         };
         let sun = [Light::Directional {
@@ -425,6 +431,7 @@ mod tests {
                 roughness,
                 metallic,
                 normal: Vec3::Z,
+                diffuse_normal: Vec3::Z,
                 position: Vec3::ZERO,
             };
             let eye = Vec3::new(0.5, 0.0, 1.0) * 10.0;

@@ -153,6 +153,13 @@ impl Lighting {
     }
 }
 
+/// A filtered tangent-space normal `mean` in world space, no longer than 1: the mean of the unit
+/// normals under the footprint (its length is how much they agree; scaling by `normal_scale` can
+/// lengthen it, hence the cap).
+fn mean_world(t: Vec3, b: Vec3, n: Vec3, mean: Vec3) -> Vec3 {
+    (t * mean.x + b * mean.y + n * mean.z).clamp_length_max(1.0)
+}
+
 /// How far an 8-bit normal map's decoded vector may fall short of unit length by quantisation
 /// alone (each of three components off by up to 1/255): Toksvig counts lengths within it as 1.
 const UNORM8_NORMAL_SLACK: f32 = 0.006_8;
@@ -192,6 +199,8 @@ pub(crate) fn shade(
             .normalize_or(Vec3::Y);
     }
     let (mut roughness, mut metallic) = (1.0, 0.0);
+    // The mean normal for the diffuse term: set by the antialiasing methods that keep it.
+    let mut diffuse_normal = None;
     if let Some(m) = &ctx.material {
         roughness = m.roughness;
         metallic = m.metallic;
@@ -219,6 +228,12 @@ pub(crate) fn shade(
                 roughness = r;
                 let sign = if tangent.w < 0.0 { -1.0 } else { 1.0 };
                 let bt = normal.cross(t) * sign;
+                // The filtered normal map is the mean normal.
+                let (raw, n) = material::sample(map, fp, count);
+                texels += n;
+                let mean = Vec3::new(raw[0], raw[1], raw[2]) * 2.0 - Vec3::ONE;
+                let mean = mean * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
+                diffuse_normal = Some(mean_world(t, bt, normal, mean));
                 normal = (t * nt.x + bt * nt.y + normal * nt.z).normalize_or(normal);
             }
         } else if let Some(map) = &m.normal_map {
@@ -240,6 +255,9 @@ pub(crate) fn shade(
                 let sign = if tangent.w < 0.0 { -1.0 } else { 1.0 };
                 let b = normal.cross(t) * sign;
                 let scaled = raw * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
+                if m.specular_aa == SpecularAa::Toksvig {
+                    diffuse_normal = Some(mean_world(t, b, normal, scaled));
+                }
                 normal = (t * scaled.x + b * scaled.y + normal * scaled.z).normalize_or(normal);
             }
         }
@@ -249,6 +267,7 @@ pub(crate) fn shade(
         roughness: roughness.clamp(MIN_ROUGHNESS, 1.0),
         metallic: metallic.clamp(0.0, 1.0),
         normal,
+        diffuse_normal: diffuse_normal.unwrap_or(normal),
         position,
     };
     let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, ctx.material.is_none());

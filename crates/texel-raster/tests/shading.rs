@@ -111,6 +111,7 @@ fn a_normal_map_tilts_the_shading_normal_in_gltf_tangent_space() {
                 roughness,
                 metallic: 0.0,
                 normal: world,
+                diffuse_normal: world,
                 position: hit(m, eye, i, j),
             };
             let want = radiance(&surface, eye, &[light], false);
