@@ -153,11 +153,15 @@ impl Lighting {
     }
 }
 
-/// A filtered tangent-space normal `mean` in world space, no longer than 1: the mean of the unit
-/// normals under the footprint (its length is how much they agree; scaling by `normal_scale` can
-/// lengthen it, hence the cap).
-fn mean_world(t: Vec3, b: Vec3, n: Vec3, mean: Vec3) -> Vec3 {
-    (t * mean.x + b * mean.y + n * mean.z).clamp_length_max(1.0)
+/// The unit tangent and bitangent at barycentrics `l` for the unit shading `normal`: the
+/// interpolated tangent made orthogonal to `normal` (Gram-Schmidt), and glTF's bitangent
+/// `w cross(normal, tangent)`. `None` where the vertices carry no tangent (or it is parallel to
+/// the normal): the normal map cannot be oriented.
+fn tangent_frame(verts: [&Vertex; 3], l: Vec3, normal: Vec3) -> Option<(Vec3, Vec3)> {
+    let tangent = verts[0].tangent * l.x + verts[1].tangent * l.y + verts[2].tangent * l.z;
+    let t = (tangent.truncate() - normal * normal.dot(tangent.truncate())).try_normalize()?;
+    let sign = if tangent.w < 0.0 { -1.0 } else { 1.0 };
+    Some((t, normal.cross(t) * sign))
 }
 
 /// How far an 8-bit normal map's decoded vector may fall short of unit length by quantisation
@@ -214,51 +218,44 @@ pub(crate) fn shade(
             metallic *= t[map.channel];
             texels += n;
         }
-        if let (SpecularAa::Lean, Some(map), Some(lean)) = (m.specular_aa, &m.normal_map, m.lean) {
-            let tangent = verts[0].tangent * l.x + verts[1].tangent * l.y + verts[2].tangent * l.z;
-            let t = tangent.truncate() - normal * normal.dot(tangent.truncate());
-            if let Some(t) = t.try_normalize() {
-                let moments = TextureInput {
-                    texture: lean,
-                    sampler: map.sampler,
+        if let Some(map) = &m.normal_map {
+            if let Some((t, b)) = tangent_frame(verts, l, normal) {
+                let to_world = |v: Vec3| t * v.x + b * v.y + normal * v.z;
+                let (texel, n) = material::sample(map, fp, count);
+                texels += n;
+                // The filtered map normal: the mean of the normals under the footprint.
+                let raw = Vec3::new(texel[0], texel[1], texel[2]) * 2.0 - Vec3::ONE;
+                let mean = raw * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
+                let shading = match (m.specular_aa, m.lean) {
+                    (SpecularAa::Lean, Some(lean)) => {
+                        let moments = TextureInput {
+                            texture: lean,
+                            sampler: map.sampler,
+                        };
+                        let (a, n) = material::sample(&moments, fp, count);
+                        texels += n;
+                        let (nt, r) = material::lean_normal_roughness(a, m.normal_scale, roughness);
+                        roughness = r;
+                        Some(nt)
+                    }
+                    (SpecularAa::Toksvig, _) => {
+                        let slack = if map.texture.format() == texel_texture::Format::Rgba32Float {
+                            0.0
+                        } else {
+                            UNORM8_NORMAL_SLACK
+                        };
+                        let len = (raw.length() + slack).min(1.0);
+                        roughness = material::toksvig_roughness(roughness, len);
+                        Some(mean)
+                    }
+                    _ => None,
                 };
-                let (a, n) = material::sample(&moments, fp, count);
-                texels += n;
-                let (nt, r) = material::lean_normal_roughness(a, m.normal_scale, roughness);
-                roughness = r;
-                let sign = if tangent.w < 0.0 { -1.0 } else { 1.0 };
-                let bt = normal.cross(t) * sign;
-                // The filtered normal map is the mean normal.
-                let (raw, n) = material::sample(map, fp, count);
-                texels += n;
-                let mean = Vec3::new(raw[0], raw[1], raw[2]) * 2.0 - Vec3::ONE;
-                let mean = mean * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
-                diffuse_normal = Some(mean_world(t, bt, normal, mean));
-                normal = (t * nt.x + bt * nt.y + normal * nt.z).normalize_or(normal);
-            }
-        } else if let Some(map) = &m.normal_map {
-            let tangent = verts[0].tangent * l.x + verts[1].tangent * l.y + verts[2].tangent * l.z;
-            let t = tangent.truncate() - normal * normal.dot(tangent.truncate());
-            if let Some(t) = t.try_normalize() {
-                let (nt, n) = material::sample(map, fp, count);
-                texels += n;
-                let raw = Vec3::new(nt[0], nt[1], nt[2]) * 2.0 - Vec3::ONE;
-                if m.specular_aa == SpecularAa::Toksvig {
-                    let slack = if map.texture.format() == texel_texture::Format::Rgba32Float {
-                        0.0
-                    } else {
-                        UNORM8_NORMAL_SLACK
-                    };
-                    let len = (raw.length() + slack).min(1.0);
-                    roughness = material::toksvig_roughness(roughness, len);
+                // Antialiased methods light the diffuse term with the mean normal (no longer
+                // than 1: scaling by `normal_scale` can lengthen it).
+                if shading.is_some() {
+                    diffuse_normal = Some(to_world(mean).clamp_length_max(1.0));
                 }
-                let sign = if tangent.w < 0.0 { -1.0 } else { 1.0 };
-                let b = normal.cross(t) * sign;
-                let scaled = raw * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
-                if m.specular_aa == SpecularAa::Toksvig {
-                    diffuse_normal = Some(mean_world(t, b, normal, scaled));
-                }
-                normal = (t * scaled.x + b * scaled.y + normal * scaled.z).normalize_or(normal);
+                normal = to_world(shading.unwrap_or(mean)).normalize_or(normal);
             }
         }
     }
