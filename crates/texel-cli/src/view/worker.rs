@@ -245,13 +245,12 @@ pub fn run(mut worker: Worker, shared: Arc<Shared>, send: impl Fn(Rendered) -> b
         idle = false;
         let out = match result {
             Ok(Some(r)) => {
-                let refining = r.scale > 1
-                    || r.parts.iter().any(|p| {
-                        p.stats.is_none() && p.mode != Mode::Reference
-                            || p.samples.is_some_and(|s| s < MAX_REFERENCE_SAMPLES)
-                    });
-                // A finished reference stops; every other image is rendered again and again.
-                idle = !refining && r.parts.iter().all(|p| p.mode == Mode::Reference);
+                // A finished reference (every half one, at full resolution) stops; every other
+                // image is rendered again and again.
+                idle = r.scale == 1
+                    && r.parts
+                        .iter()
+                        .all(|p| p.samples.is_some_and(|s| s >= MAX_REFERENCE_SAMPLES));
                 r
             }
             Ok(None) => {
@@ -292,6 +291,22 @@ struct FrameContext<'a, 'g> {
     progress: &'a mut Progress,
     frame: &'a mut Option<Frame>,
     shared: &'a Shared,
+}
+
+/// The draws of the scene loaded for `key`'s colour handling with `key`'s samplers (built by
+/// `FrameContext::samplers`), seen through `clip` (the fly camera).
+fn camera_draws<'a>(
+    scenes: &'a [Option<PreparedScene>; 2],
+    samplers: &'a HashMap<SamplerKey, Vec<Sampler>>,
+    key: SamplerKey,
+    clip: glam::Mat4,
+) -> Vec<DrawCall<'a>> {
+    let scene = scenes[key.2].as_ref().expect("loaded with its samplers");
+    let mut draws = scene.draws(&samplers[&key]);
+    for d in &mut draws {
+        d.clip_from_world = clip;
+    }
+    draws
 }
 
 /// The pixel rectangles `[x0, y0, x1, y1]` of the modes on screen at `w x h`.
@@ -391,14 +406,13 @@ impl FrameContext<'_, '_> {
         settings.derivatives = state.derivatives;
         settings.threads = None;
         let clip = req.camera.clip_from_world(w as f32 / h as f32);
-        let frame = match self.frame.take() {
+        let mut frame = match self.frame.take() {
             Some(mut f) if f.width == w && f.height == h => {
                 f.reset(&settings);
                 f
             }
             _ => Frame::new(&settings),
         };
-        let mut frame = frame;
         if self.progress.sum.len() != frame.color.len() {
             self.progress.sum = vec![[0.0; 4]; frame.color.len()];
         }
@@ -413,13 +427,7 @@ impl FrameContext<'_, '_> {
                 Mode::Reference => Filter::Trilinear,
             };
             let key = self.samplers(filter, state)?;
-            let scene = self.worker.scenes[state.color as usize]
-                .as_ref()
-                .expect("loaded");
-            let mut draws = scene.draws(&self.samplers[&key]);
-            for d in &mut draws {
-                d.clip_from_world = clip;
-            }
+            let draws = camera_draws(&self.worker.scenes, self.samplers, key, clip);
             match mode {
                 Mode::Filter(f) if gpu => {
                     let gpu_dev = self.gpu.expect("use_gpu checked");
@@ -440,8 +448,7 @@ impl FrameContext<'_, '_> {
                 Mode::Filter(_) => {
                     for band in bands(rect, self.cost(mode, state.view, false), req.moving) {
                         if self.shared.superseded(req.generation) {
-                            *self.frame = Some(frame);
-                            return Ok(None);
+                            return Ok(self.abandon(frame));
                         }
                         let s = RenderSettings {
                             scissor: Some(band),
@@ -455,8 +462,7 @@ impl FrameContext<'_, '_> {
                     let seed = self.progress.passes;
                     for band in bands(rect, self.cost(mode, state.view, false), req.moving) {
                         if self.shared.superseded(req.generation) {
-                            *self.frame = Some(frame);
-                            return Ok(None);
+                            return Ok(self.abandon(frame));
                         }
                         let s = RenderSettings {
                             scissor: Some(band),
@@ -535,6 +541,14 @@ impl FrameContext<'_, '_> {
         }))
     }
 
+    /// Give up the frame for a newer request: keep its buffers, and forget the reference's
+    /// accumulation, which may now hold part of a pass.
+    fn abandon(&mut self, frame: Frame) -> Option<Rendered> {
+        *self.frame = Some(frame);
+        self.progress.image = None;
+        None
+    }
+
     /// Milliseconds per pixel measured for `mode` (a guess of 20 ns before the first frame).
     fn cost(&self, mode: Mode, view: View, gpu: bool) -> f64 {
         self.costs.get(&(mode, view, gpu)).copied().unwrap_or(2e-5)
@@ -560,13 +574,7 @@ impl FrameContext<'_, '_> {
                 return Ok(None);
             }
             let key = self.samplers(filter, state)?;
-            let scene = self.worker.scenes[state.color as usize]
-                .as_ref()
-                .expect("loaded");
-            let mut draws = scene.draws(&self.samplers[&key]);
-            for d in &mut draws {
-                d.clip_from_world = clip;
-            }
+            let draws = camera_draws(&self.worker.scenes, self.samplers, key, clip);
             let s = RenderSettings {
                 scissor: Some(rect),
                 view: View::Color,
@@ -942,6 +950,28 @@ mod tests {
             ..req.clone()
         });
         assert!(h.render(&req).is_none());
+    }
+
+    #[test]
+    fn an_abandoned_reference_pass_restarts_the_accumulation() {
+        let mut h = Harness::new(160, 200);
+        let req = h.request("0", false);
+        for k in 1..=2u32 {
+            assert_eq!(h.render(&req).unwrap().parts[0].samples, Some(4 * k));
+        }
+        // Now slow enough for 64-row bands, and superseded before the pass ends: part of the
+        // pass may be summed, so the next frame of the same image starts again.
+        h.costs.insert(
+            (Mode::Reference, View::Color, false),
+            BUDGET_MS / (160.0 * 64.0),
+        );
+        let newer = Request {
+            generation: 2,
+            ..req.clone()
+        };
+        h.shared.submit(newer.clone());
+        assert!(h.render(&req).is_none());
+        assert_eq!(h.render(&newer).unwrap().parts[0].samples, Some(4));
     }
 
     #[test]
