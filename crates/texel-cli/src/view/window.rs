@@ -181,23 +181,9 @@ impl App {
             moving,
         };
         if let Some(s) = &self.submitted {
-            let same = Request {
-                generation: s.generation,
-                ..request.clone()
-            };
-            if &same == s {
-                return;
-            }
-            // HUD-only changes need no new frame.
-            let strip = |s: &ViewState| ViewState {
-                hud: false,
-                help: false,
-                ..s.clone()
-            };
-            if strip(&s.state) == strip(&request.state)
-                && s.camera == request.camera
-                && (s.width, s.height, s.moving) == (width, height, moving)
-            {
+            if s.same_image(&request) && s.moving == moving {
+                // Nothing the render thread draws changed (at most the HUD): keep its request,
+                // show the overlay again.
                 self.submitted = Some(Request {
                     generation: s.generation,
                     ..request
@@ -277,16 +263,28 @@ impl App {
                 self.composed[(y * w) as usize..][..src.len()].copy_from_slice(src);
             }
         }
+        // Overlays: the HUD and the divider line (not with --no-hud), then the key table below.
+        let lines = if self.state.hud {
+            self.hud_lines()
+        } else {
+            Vec::new()
+        };
+        let scale = scale_for(h);
+        let mut canvas = Canvas {
+            pixels: &mut self.composed,
+            width: w,
+            height: h,
+        };
+        let mut top = 0;
         if self.state.hud {
-            self.overlay(w, h);
-        } else if self.state.help {
+            if self.state.split {
+                canvas.vline(part_rects(&self.state, w, h)[1][0], 0x00ff_ffff);
+            }
+            top = canvas.panel(0, 0, &lines, scale) + 4;
+        }
+        if self.state.help {
             let table: Vec<String> = key_table().lines().map(str::to_string).collect();
-            let mut canvas = Canvas {
-                pixels: &mut self.composed,
-                width: w,
-                height: h,
-            };
-            canvas.panel(0, 0, &table, scale_for(h));
+            canvas.panel(0, top, &table, scale);
         }
         let (Some(surface), Some(nw), Some(nh)) = (
             self.surface.as_mut(),
@@ -308,8 +306,8 @@ impl App {
         Ok(())
     }
 
-    fn overlay(&mut self, w: u32, h: u32) {
-        let scale = scale_for(h);
+    /// The HUD's lines: each half's mode and statistics, timing, settings, messages.
+    fn hud_lines(&self) -> Vec<String> {
         let mut lines = Vec::new();
         let (ms, frame_scale, parts) = match &self.latest {
             Some(r) => (r.ms, r.scale, r.parts.clone()),
@@ -375,20 +373,7 @@ impl App {
             }
         }
         lines.push("H: keys".to_string());
-        let mut canvas = Canvas {
-            pixels: &mut self.composed,
-            width: w,
-            height: h,
-        };
-        if self.state.split {
-            let rects = part_rects(&self.state, w, h);
-            canvas.vline(rects[1][0], 0x00ff_ffff);
-        }
-        let top = canvas.panel(0, 0, &lines, scale);
-        if self.state.help {
-            let table: Vec<String> = key_table().lines().map(str::to_string).collect();
-            canvas.panel(0, top + 4, &table, scale);
-        }
+        lines
     }
 
     fn tick(&mut self) {

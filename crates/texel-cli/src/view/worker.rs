@@ -61,7 +61,7 @@ pub struct Request {
 
 impl Request {
     /// Whether two requests give the same image (the HUD, help and the moving flag aside).
-    fn same_image(&self, other: &Request) -> bool {
+    pub fn same_image(&self, other: &Request) -> bool {
         let strip = |s: &ViewState| ViewState {
             hud: false,
             help: false,
