@@ -57,3 +57,4 @@ pub use model::{
 };
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::Procedural;
+pub use texture::TextureUse;

@@ -69,10 +69,58 @@ impl TextureSpec {
     }
 }
 
+/// One texture a scene draws with ([`Scene::used_textures`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TextureUse<'a> {
+    /// The first mesh that uses it.
+    pub mesh: usize,
+    /// Its name in [`Scene::textures`].
+    pub name: &'a str,
+    /// Whether it holds colour (a mesh's base colour texture), which a colour-space override
+    /// such as the CLI's `--color raw` applies to; material maps (normals, roughness,
+    /// metalness) hold data and keep their own colour space.
+    pub color: bool,
+}
+
 impl Scene {
-    /// Load every texture the meshes and their materials use (unused ones are skipped), by name.
-    /// `color_override` applies to colour textures; material maps other than `base_color`
-    /// (normals, roughness, metalness) hold data and keep their own colour space.
+    /// Every texture the meshes and their materials use, once each, in first-use order: each
+    /// mesh's colour texture, then its material's maps.
+    pub fn used_textures(&self) -> Vec<TextureUse<'_>> {
+        let mut out: Vec<TextureUse> = Vec::new();
+        for (mesh, m) in self.meshes.iter().enumerate() {
+            let maps = m
+                .material
+                .as_ref()
+                .and_then(|n| self.materials.get(n))
+                .map(|mat| mat.textures())
+                .unwrap_or_default();
+            let uses = std::iter::once((m.texture.as_str(), true))
+                .chain(maps.into_iter().map(|t| (t, false)));
+            for (name, color) in uses {
+                if !out.iter().any(|u| u.name == name) {
+                    out.push(TextureUse { mesh, name, color });
+                }
+            }
+        }
+        out
+    }
+
+    /// The spec of a used texture, or [`SceneError::UnknownTexture`] naming the mesh.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownTexture`] (validation already refuses such scenes).
+    pub fn texture_spec(&self, u: &TextureUse) -> Result<&TextureSpec, SceneError> {
+        self.textures
+            .get(u.name)
+            .ok_or_else(|| SceneError::UnknownTexture {
+                mesh: u.mesh,
+                name: u.name.to_string(),
+                defined: self.textures.keys().cloned().collect::<Vec<_>>().join(", "),
+            })
+    }
+
+    /// Load every texture of [`Scene::used_textures`] (unused ones are skipped), by name.
+    /// `color_override` applies to colour textures only.
     ///
     /// # Errors
     /// As [`TextureSpec::load`].
@@ -82,29 +130,10 @@ impl Scene {
         limits: &Limits,
     ) -> Result<BTreeMap<String, Texture>, SceneError> {
         let mut out = BTreeMap::new();
-        for (mi, m) in self.meshes.iter().enumerate() {
-            let mut wanted = vec![(m.texture.as_str(), color_override)];
-            if let Some(mat) = m.material.as_ref().and_then(|n| self.materials.get(n)) {
-                for t in mat.textures() {
-                    if t != m.texture {
-                        wanted.push((t, None));
-                    }
-                }
-            }
-            for (name, color) in wanted {
-                if out.contains_key(name) {
-                    continue;
-                }
-                let spec = self
-                    .textures
-                    .get(name)
-                    .ok_or_else(|| SceneError::UnknownTexture {
-                        mesh: mi,
-                        name: name.to_string(),
-                        defined: self.textures.keys().cloned().collect::<Vec<_>>().join(", "),
-                    })?;
-                out.insert(name.to_string(), spec.load(name, color, limits)?);
-            }
+        for u in self.used_textures() {
+            let space = if u.color { color_override } else { None };
+            let texture = self.texture_spec(&u)?.load(u.name, space, limits)?;
+            out.insert(u.name.to_string(), texture);
         }
         Ok(out)
     }

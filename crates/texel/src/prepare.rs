@@ -101,41 +101,22 @@ impl PreparedScene {
         };
         let mut textures = BTreeMap::new();
         let mut replaced = Vec::new();
-        // Each mesh's colour texture (with --color's override), then its material's maps, which
-        // hold data and keep their own colour space.
-        let mut wanted: Vec<(String, Option<ColorSpace>)> = Vec::new();
-        for m in &scene.meshes {
-            wanted.push((m.texture.clone(), override_space));
-            if let Some(mat) = m.material.as_ref().and_then(|n| scene.materials.get(n)) {
-                wanted.extend(mat.textures().into_iter().map(|t| (t.to_string(), None)));
-            }
-        }
-        for (name, space) in wanted {
-            if textures.contains_key(&name) {
-                continue;
-            }
-            let spec = scene.textures.get(&name).ok_or_else(|| {
-                texel_scene::SceneError::UnknownTexture {
-                    mesh: 0,
-                    name: name.clone(),
-                    defined: scene
-                        .textures
-                        .keys()
-                        .cloned()
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                }
-            })?;
+        for u in scene.used_textures() {
+            let spec = scene.texture_spec(&u)?;
             let limits = Limits {
                 max_bytes: budget.remaining(),
                 ..Limits::default()
             };
-            let loaded = spec.load_with(&name, space, &limits, options.replace_non_finite)?;
+            let space = if u.color { override_space } else { None };
+            let loaded = spec.load_with(u.name, space, &limits, options.replace_non_finite)?;
             if loaded.replaced > 0 {
-                replaced.push((name.clone(), loaded.replaced));
+                replaced.push((u.name.to_string(), loaded.replaced));
             }
-            budget.take(&format!("texture {name:?}"), loaded.texture.pyramid_bytes())?;
-            textures.insert(name, loaded.texture);
+            budget.take(
+                &format!("texture {:?}", u.name),
+                loaded.texture.pyramid_bytes(),
+            )?;
+            textures.insert(u.name.to_string(), loaded.texture);
         }
         // LEAN reads moment maps made from the normal maps (float, charged like any texture).
         let mut lean_maps = BTreeMap::new();
