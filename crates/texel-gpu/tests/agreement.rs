@@ -51,16 +51,20 @@ fn psnr(a: &texel::Frame, b: &texel::Frame) -> (f64, u8, usize) {
     (db, worst, n / 3)
 }
 
-/// Every filter the GPU path has against the CPU path on `scene`.
-fn agree(scene: &str) {
-    let Some(gpu) = gpu() else { return };
-    let scene = Scene::load(scene).unwrap();
+/// `scene` prepared at the tests' reduced size, 160 x 96.
+fn small(scene: &str) -> PreparedScene {
     let options = SceneOptions {
         size: Some((160, 96)),
         ..SceneOptions::default()
     };
-    let prepared =
-        PreparedScene::new(scene, &options, &mut MemoryBudget::half_of_machine()).unwrap();
+    let scene = Scene::load(scene).unwrap();
+    PreparedScene::new(scene, &options, &mut MemoryBudget::half_of_machine()).unwrap()
+}
+
+/// Every filter the GPU path has against the CPU path on `scene`.
+fn agree(scene: &str) {
+    let Some(gpu) = gpu() else { return };
+    let prepared = small(scene);
     let mut settings = prepared.settings();
     settings.derivatives = Derivatives::Quad;
     for filter in GpuFilter::filters() {
@@ -100,13 +104,7 @@ fn cube_agrees_with_the_cpu() {
 #[test]
 fn device_time_is_measured_when_the_device_can() {
     let Some(gpu) = gpu() else { return };
-    let scene = Scene::load("builtin:ground").unwrap();
-    let options = SceneOptions {
-        size: Some((160, 96)),
-        ..SceneOptions::default()
-    };
-    let prepared =
-        PreparedScene::new(scene, &options, &mut MemoryBudget::half_of_machine()).unwrap();
+    let prepared = small("builtin:ground");
     let samplers = prepared.samplers(Filter::Trilinear).unwrap();
     let draws = prepared.draws(&samplers);
     let gpu_draws = gpu.prepare(&draws, GpuFilter::Lab(4)).unwrap();
@@ -129,13 +127,7 @@ fn device_time_is_measured_when_the_device_can() {
 #[test]
 fn a_moved_camera_and_a_scissor_match_fresh_draws() {
     let Some(gpu) = gpu() else { return };
-    let scene = Scene::load("builtin:ground").unwrap();
-    let options = SceneOptions {
-        size: Some((160, 96)),
-        ..SceneOptions::default()
-    };
-    let prepared =
-        PreparedScene::new(scene, &options, &mut MemoryBudget::half_of_machine()).unwrap();
+    let prepared = small("builtin:ground");
     let samplers = prepared.samplers(Filter::Aniso8).unwrap();
     let mut draws = prepared.draws(&samplers);
     let settings = prepared.settings();
