@@ -27,6 +27,14 @@ fn plane() -> Vec<Vertex> {
         .collect()
 }
 
+/// The two counter-clockwise triangles of [`plane`].
+const PLANE_TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+
+/// A 1x1 RGBA8 (linear) texture of grey level `v` (stored as its 8-bit code).
+fn grey(v: f32) -> Texture {
+    Texture::from_fn(1, 1, Format::Rgba8Unorm, &Limits::default(), |_, _| [v; 4]).unwrap()
+}
+
 fn view() -> (Mat4, Vec3) {
     let eye = Vec3::new(0.4, 0.3, 3.0);
     let m = camera::perspective(50f32.to_radians(), W as f32 / H as f32, 0.1, 10.0)
@@ -64,10 +72,7 @@ fn a_normal_map_tilts_the_shading_normal_in_gltf_tangent_space() {
         &Limits::default(),
     )
     .unwrap();
-    let white = Texture::from_fn(1, 1, Format::Rgba8Unorm, &Limits::default(), |_, _| {
-        [1.0; 4]
-    })
-    .unwrap();
+    let white = grey(1.0);
     let sampler = Sampler::new(SamplerDescriptor::default()).unwrap();
     let vertices = plane();
     let (m, eye) = view();
@@ -93,7 +98,7 @@ fn a_normal_map_tilts_the_shading_normal_in_gltf_tangent_space() {
         };
         let draw = DrawCall {
             vertices: &vertices,
-            triangles: &[[0, 1, 2], [0, 2, 3]],
+            triangles: &PLANE_TRIANGLES,
             texture: &white,
             sampler: &sampler,
             clip_from_world: m,
@@ -102,7 +107,6 @@ fn a_normal_map_tilts_the_shading_normal_in_gltf_tangent_space() {
         let frame = render(&settings, &[draw]).unwrap();
         // Tangent +x, bitangent +y, normal +z: the world normal is the scaled map normal.
         let world = (decoded * Vec3::new(scale, scale, 1.0)).normalize();
-        let mut checked = 0;
         for (i, j) in [(48, 32), (30, 20), (70, 45), (40, 50)] {
             let k = frame.index(i, j);
             assert!(frame.coverage[k], "({i}, {j}) not covered");
@@ -120,24 +124,19 @@ fn a_normal_map_tilts_the_shading_normal_in_gltf_tangent_space() {
                 (got - want).abs().max_element() < 2e-4 * want.max_element().max(1.0),
                 "scale {scale}, ({i}, {j}): got {got}, want {want}"
             );
-            checked += 1;
         }
-        assert_eq!(checked, 4);
     }
 }
 
 #[test]
 fn lights_without_a_material_are_lambertian_and_unlit_frames_ignore_normals() {
-    let white = Texture::from_fn(1, 1, Format::Rgba8Unorm, &Limits::default(), |_, _| {
-        [0.5; 4]
-    })
-    .unwrap();
+    let white = grey(0.5);
     let sampler = Sampler::new(SamplerDescriptor::default()).unwrap();
     let vertices = plane();
     let (m, eye) = view();
     let draw = DrawCall {
         vertices: &vertices,
-        triangles: &[[0, 1, 2], [0, 2, 3]],
+        triangles: &PLANE_TRIANGLES,
         texture: &white,
         sampler: &sampler,
         clip_from_world: m,

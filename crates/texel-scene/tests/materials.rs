@@ -4,7 +4,8 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use texel_scene::{
-    ColorInput, LightSpec, Mesh, Procedural, ScalarInput, Scene, SceneError, SpecularAaSpec,
+    ColorInput, LightSpec, MaterialSpec, Mesh, Procedural, ScalarInput, Scene, SceneError,
+    SpecularAaSpec,
 };
 
 const BASE: &str = r#"
@@ -84,14 +85,39 @@ specular_aa = "toksvig"
     // The mesh takes its texture from the material's base colour.
     assert_eq!(s.meshes[0].texture, "grey");
     assert_eq!(s.meshes[0].material.as_deref(), Some("m"));
-    // Defaults: white, roughness 0.5, metallic 0, no maps.
-    let d = parse("[materials.m]\n").err();
-    assert!(
-        d.is_some(),
-        "a mesh without a texture and a material without one is refused"
+    // Defaults: white, roughness 0.5, metallic 0, no maps, no antialiasing.
+    let with_texture = |material: &str| {
+        Scene::from_toml_str(
+            &format!(
+                "{BASE}{material}{}",
+                MESH.replace("material = \"m\"", "material = \"m\"\ntexture = \"grey\"")
+            ),
+            Path::new("test.toml"),
+        )
+    };
+    let s = with_texture("[materials.m]\n").unwrap();
+    assert_eq!(s.materials["m"], MaterialSpec::default());
+    let d = MaterialSpec::default();
+    assert_eq!(d.base_color, ColorInput::Rgb(Vec3::ONE));
+    assert_eq!(d.roughness, ScalarInput::Value(0.5));
+    assert_eq!(d.metallic, ScalarInput::Value(0.0));
+    assert_eq!(
+        (d.normal.as_deref(), d.specular_aa),
+        (None, SpecularAaSpec::None)
     );
-    let s = parse("[materials.m]\nbase_color = [0.5, 0.25, 1.0]\n");
-    assert!(s.is_err());
+    // A constant base colour multiplies the mesh's texture, which must then be given.
+    let s = with_texture("[materials.m]\nbase_color = [0.5, 0.25, 1.0]\n").unwrap();
+    assert_eq!(
+        s.materials["m"].base_color,
+        ColorInput::Rgb(Vec3::new(0.5, 0.25, 1.0))
+    );
+    for material in [
+        "[materials.m]\n",
+        "[materials.m]\nbase_color = [0.5, 0.25, 1.0]\n",
+    ] {
+        let e = parse(material).unwrap_err().to_string();
+        assert!(e.contains("give texture = NAME"), "{e}");
+    }
 }
 
 #[test]

@@ -129,7 +129,24 @@ mod tests {
             height: h,
         };
         c.text(15, 5, "HH", 0xff, 3);
-        c.panel(10, 2, &["a long line".into()], 2);
+        // 'H' at scale 3 from column 15: glyph column 1 (bit 1 of row 0) covers pixels 18-20,
+        // rows 5-7; the rest of the glyph falls outside the 20x10 canvas.
+        assert_eq!(glyph[0] & 0b10, 0b10);
+        assert_eq!(px[(5 * w + 18) as usize], 0xff);
+        panel_clips_at_the_edge(&mut px, w, h);
+    }
+
+    fn panel_clips_at_the_edge(px: &mut [u32], w: u32, h: u32) {
+        // A panel wider than the canvas shades and writes up to its edge.
+        let before = px[(9 * w + 19) as usize];
+        let mut c = Canvas {
+            pixels: px,
+            width: w,
+            height: h,
+        };
+        let height = c.panel(10, 2, &["a long line".into()], 2);
+        assert_eq!(height, 2 * (GLYPH + 2) + 2 * 8);
+        assert_eq!(px[(9 * w + 19) as usize], (before >> 2) & 0x003f_3f3f);
     }
 
     #[test]
