@@ -121,11 +121,7 @@ impl PreparedScene {
         // LEAN reads moment maps made from the normal maps (float, charged like any texture).
         let mut lean_maps = BTreeMap::new();
         for mat in scene.materials.values() {
-            let lean = options
-                .specular_aa
-                .map_or(mat.specular_aa == SpecularAaSpec::Lean, |o| {
-                    o == SpecularAa::Lean
-                });
+            let lean = specular_aa(mat, options.specular_aa) == SpecularAa::Lean;
             let Some(normal) = mat.normal.as_ref().filter(|_| lean) else {
                 continue;
             };
@@ -311,12 +307,7 @@ impl PreparedScene {
             ColorInput::Rgb(c) => c.extend(1.0),
             ColorInput::Texture(_) => glam::Vec4::ONE,
         };
-        let mut specular_aa = self.specular_aa.unwrap_or(match spec.specular_aa {
-            SpecularAaSpec::Toksvig => SpecularAa::Toksvig,
-            SpecularAaSpec::Lean => SpecularAa::Lean,
-            // Validation refuses the methods not built yet.
-            _ => SpecularAa::None,
-        });
+        let mut specular_aa = specular_aa(spec, self.specular_aa);
         let lean = spec.normal.as_ref().and_then(|n| self.lean_maps.get(n));
         if specular_aa == SpecularAa::Lean && lean.is_none() {
             // No normal map: nothing varies within a pixel to antialias.
@@ -371,6 +362,16 @@ impl PreparedScene {
         ];
         s
     }
+}
+
+/// The specular antialiasing a material gets: `overridden` (the CLI's `--specular-aa`) or its own.
+fn specular_aa(spec: &texel_scene::MaterialSpec, overridden: Option<SpecularAa>) -> SpecularAa {
+    overridden.unwrap_or(match spec.specular_aa {
+        SpecularAaSpec::Toksvig => SpecularAa::Toksvig,
+        SpecularAaSpec::Lean => SpecularAa::Lean,
+        // Validation refuses the methods not built yet.
+        SpecularAaSpec::None | SpecularAaSpec::Projected => SpecularAa::None,
+    })
 }
 
 fn texel_vertices(mesh: &texel_scene::Mesh) -> Vec<Vertex> {
