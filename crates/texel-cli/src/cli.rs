@@ -133,6 +133,31 @@ pub struct SceneArgs {
     /// are exact.
     #[arg(long, value_enum)]
     pub specular_aa: Option<SpecularAaArg>,
+    /// What every material's height map does, overriding the scene's `displacement` (materials
+    /// without a height map are unaffected).
+    #[arg(long, value_enum)]
+    pub displacement: Option<DisplacementArg>,
+}
+
+/// How height maps shape the surface (see texel-raster's `Displacement`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum DisplacementArg {
+    /// The height map is not used.
+    None,
+    /// Bump mapping: normals from the height map, flat geometry.
+    Bump,
+    /// Parallax occlusion mapping (Tatarchuk 2006): the view ray marched through the heights.
+    Pom,
+}
+
+impl From<DisplacementArg> for texel_scene::Displacement {
+    fn from(a: DisplacementArg) -> Self {
+        match a {
+            DisplacementArg::None => texel_scene::Displacement::None,
+            DisplacementArg::Bump => texel_scene::Displacement::Bump,
+            DisplacementArg::Pom => texel_scene::Displacement::Pom,
+        }
+    }
 }
 
 /// Specular antialiasing (see texel-raster's `material` module).
@@ -145,6 +170,9 @@ pub enum SpecularAaArg {
     /// LEAN mapping (Olano & Baker 2010): slope moments filtered with the normals; roughness
     /// widened by their variance.
     Lean,
+    /// Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021): roughness widened by the
+    /// normal's change to the neighbouring pixels, as GPUs ship it.
+    Projected,
 }
 
 impl From<SpecularAaArg> for texel_raster::SpecularAa {
@@ -153,6 +181,7 @@ impl From<SpecularAaArg> for texel_raster::SpecularAa {
             SpecularAaArg::None => texel_raster::SpecularAa::None,
             SpecularAaArg::Toksvig => texel_raster::SpecularAa::Toksvig,
             SpecularAaArg::Lean => texel_raster::SpecularAa::Lean,
+            SpecularAaArg::Projected => texel_raster::SpecularAa::Projected,
         }
     }
 }

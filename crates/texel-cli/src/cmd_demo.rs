@@ -29,7 +29,13 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
                 budget: input.budget.clone(),
                 sanitize: input.sanitize,
             };
-            let scene = load_scene_with(&label, ColorArg::Srgb, args.size, None, &mut scene_input)?;
+            let scene = load_scene_with(
+                &label,
+                ColorArg::Srgb,
+                args.size,
+                Default::default(),
+                &mut scene_input,
+            )?;
             scene_input.budget.take(
                 "the comparison's reference and images",
                 u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,

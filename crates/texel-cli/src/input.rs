@@ -95,18 +95,37 @@ pub fn load_scene(args: &SceneArgs, input: &mut Input) -> Result<PreparedScene> 
         &args.scene,
         args.color,
         args.size,
-        args.specular_aa.map(SpecularAaArg::into),
+        MaterialOverrides::of(args),
         input,
     )
 }
 
+/// What the CLI overrides in every material (`--specular-aa`, `--displacement`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MaterialOverrides {
+    /// `--specular-aa`.
+    pub specular_aa: Option<SpecularAa>,
+    /// `--displacement`.
+    pub displacement: Option<texel_scene::Displacement>,
+}
+
+impl MaterialOverrides {
+    /// The overrides a command's [`SceneArgs`] give.
+    pub fn of(args: &SceneArgs) -> Self {
+        MaterialOverrides {
+            specular_aa: args.specular_aa.map(SpecularAaArg::into),
+            displacement: args.displacement.map(Into::into),
+        }
+    }
+}
+
 /// Load `scene` (a path or `builtin:NAME`) and its textures within `input`'s account, with
-/// `color` handling, an output `size` and a `specular_aa` override.
+/// `color` handling, an output `size` and the material `overrides`.
 pub fn load_scene_with(
     scene: &str,
     color: ColorArg,
     size: Option<Size>,
-    specular_aa: Option<SpecularAa>,
+    overrides: MaterialOverrides,
     input: &mut Input,
 ) -> Result<PreparedScene> {
     let limits = scene_limits(input.budget.remaining());
@@ -127,7 +146,8 @@ pub fn load_scene_with(
         size: size.map(|s| (s.width, s.height)),
         color: color.into(),
         replace_non_finite: input.sanitize,
-        specular_aa,
+        specular_aa: overrides.specular_aa,
+        displacement: overrides.displacement,
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;

@@ -48,6 +48,7 @@ mod frame;
 pub mod interp;
 pub mod material;
 pub mod reference;
+mod relief;
 mod settings;
 pub mod setup;
 mod shade;
@@ -57,7 +58,9 @@ pub mod views;
 pub use draw::{DrawCall, Vertex};
 pub use error::RasterError;
 pub use frame::Frame;
-pub use material::{ChannelInput, Light, Material, SpecularAa, TextureInput, MAX_LIGHTS};
+pub use material::{
+    ChannelInput, Displacement, Light, Material, SpecularAa, TextureInput, MAX_LIGHTS,
+};
 pub use reference::{render_reference, render_reference_strata};
 pub use settings::{Derivatives, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS};
 

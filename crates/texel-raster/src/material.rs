@@ -98,8 +98,37 @@ pub enum SpecularAa {
     /// footprint. Its mean over both axes `sigma^2` widens the isotropic lobe as a Beckmann lobe of
     /// that variance would (`alpha^2 = 2 sigma^2` for Beckmann): `alpha'^2 = alpha^2 + 2 sigma^2`.
     /// (LEAN's cross moment `b_x b_y` would orient an anisotropic lobe; the lobe here is
-    /// isotropic, so it is not stored.) Needs [`Material::lean`].
+    /// isotropic, so it is not stored.) Needs [`Material::lean`] for a normal map, or
+    /// [`Material::height_moments`] for a height map (whose slopes are the height's gradient).
     Lean,
+    /// Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021, "Stable Geometric Specular
+    /// Antialiasing with Projected-Space NDF Filtering", JCGT 10(2), eq. 14 and listing 5), what
+    /// GPUs ship: the shading normal is also evaluated one pixel to the right and one below (the
+    /// difference a fragment quad's `ddx`/`ddy` takes), and the lobe widens by the screen-space
+    /// variance of the normal under a Gaussian pixel filter of variance `sigma^2 = 1 / (2 pi)`:
+    /// `alpha'^2 = min(1, alpha^2 + min(sigma^2 (|dn/dx|^2 + |dn/dy|^2), kappa))` with the paper's
+    /// clamp `kappa = 0.18`. Covers normal maps, bump maps and curved geometry alike, at the price
+    /// of two more normal evaluations.
+    Projected,
+}
+
+/// How a material's height map shapes the surface ([`Material::height_map`]). The mesh is the
+/// top of the relief: height 1 lies on it and height 0 lies `height_scale` below it, along the
+/// normal (so a displaced point is `p + height_scale (h - 1) n`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Displacement {
+    /// The height map is not used.
+    #[default]
+    None,
+    /// Bump mapping (Blinn 1978), as pbrt-v4's `BumpMap`: the normal of the displaced surface from
+    /// forward differences of the filtered height, with a step that follows the pixel footprint
+    /// (`du = (|du/dx| + |du/dy|) / 2`, likewise `dv`); the geometry stays flat.
+    Bump,
+    /// Parallax occlusion mapping (Tatarchuk 2006): the view ray is marched through the height
+    /// field below the polygon (8 to 64 linear steps, more at grazing angles, then a secant step)
+    /// and every map is read where it meets the relief; the normal is bump mapping's at that
+    /// point. Silhouettes and self-shadowing are not modelled.
+    Pom,
 }
 
 /// A texture read through a sampler (a material's map).
@@ -141,8 +170,19 @@ pub struct Material<'a> {
     /// Specular antialiasing.
     pub specular_aa: SpecularAa,
     /// The LEAN moment map of `normal_map` ([`lean_map`]), read through the normal map's
-    /// sampler; required by [`SpecularAa::Lean`].
+    /// sampler; required by [`SpecularAa::Lean`] on a normal map.
     pub lean: Option<&'a Texture>,
+    /// Height map, one channel in `[0, 1]` (see [`Displacement`]); used when `displacement` is
+    /// not [`Displacement::None`]. A normal map, when there is one, still gives the normal.
+    pub height_map: Option<ChannelInput<'a>>,
+    /// World units between heights 0 and 1; finite and at least 0.
+    pub height_scale: f32,
+    /// What the height map does.
+    pub displacement: Displacement,
+    /// The slope moment map of `height_map` ([`height_moments`]), read through the height map's
+    /// sampler; used by [`SpecularAa::Lean`] and [`SpecularAa::Toksvig`] on bump-mapped
+    /// surfaces without a normal map.
+    pub height_moments: Option<&'a Texture>,
 }
 
 impl Default for Material<'_> {
@@ -158,24 +198,45 @@ impl Default for Material<'_> {
             normal_scale: 1.0,
             specular_aa: SpecularAa::None,
             lean: None,
+            height_map: None,
+            height_scale: 0.05,
+            displacement: Displacement::None,
+            height_moments: None,
         }
     }
 }
 
 impl Material<'_> {
     /// Whether every factor is finite and in range (`roughness` and `metallic` in `[0, 1]`,
-    /// channels `0..=3`), and LEAN has its maps and a normal map.
+    /// channels `0..=3`, `height_scale >= 0`), LEAN has its moment map for the map that gives
+    /// the normal, and a displacement has a height map.
     pub fn is_valid(&self) -> bool {
         let channel_ok = |c: &Option<ChannelInput>| c.is_none_or(|c| c.channel < 4);
         let lean_ok = self.specular_aa != SpecularAa::Lean
-            || (self.lean.is_some() && self.normal_map.is_some());
+            || match (self.normal_map, self.bumped()) {
+                (Some(_), _) => self.lean.is_some(),
+                (None, true) => self.height_moments.is_some(),
+                (None, false) => true,
+            };
+        let height_ok = self.displacement == Displacement::None || self.height_map.is_some();
         lean_ok
+            && height_ok
+            && self.height_scale.is_finite()
+            && self.height_scale >= 0.0
+            && channel_ok(&self.height_map)
             && self.base_color.is_finite()
             && (0.0..=1.0).contains(&self.roughness)
             && (0.0..=1.0).contains(&self.metallic)
             && self.normal_scale.is_finite()
             && channel_ok(&self.roughness_map)
             && channel_ok(&self.metallic_map)
+    }
+}
+
+impl Material<'_> {
+    /// Whether the height map gives the normal (a displacement is set and there is a height map).
+    pub fn bumped(&self) -> bool {
+        self.displacement != Displacement::None && self.height_map.is_some()
     }
 }
 
@@ -323,10 +384,63 @@ pub fn lean_normal_roughness(moments: [f32; 4], scale: f32, roughness: f32) -> (
     let s2 = scale * scale;
     let var_x = moments[2] * s2 - b.x * b.x;
     let var_y = moments[3] * s2 - b.y * b.y;
+    (
+        b.extend(1.0).normalize(),
+        slope_variance_roughness(roughness, var_x, var_y),
+    )
+}
+
+/// The perceptual roughness whose lobe also covers normals with slope variances `var_x` and
+/// `var_y` along two orthogonal directions: `alpha'^2 = alpha^2 + 2 sigma^2` with `sigma^2` their
+/// mean (negative variances, from rounding, count as 0). See [`SpecularAa::Lean`].
+pub fn slope_variance_roughness(roughness: f32, var_x: f32, var_y: f32) -> f32 {
     let sigma2 = (0.5 * (var_x + var_y)).max(0.0);
     let alpha = roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
     let alpha2 = (alpha * alpha + 2.0 * sigma2).min(1.0);
-    (b.extend(1.0).normalize(), alpha2.sqrt().sqrt())
+    alpha2.sqrt().sqrt()
+}
+
+/// The variance of the pixel filter in projected-space NDF filtering, `1 / (2 pi)`.
+pub const PROJECTED_SIGMA2: f32 = 0.159_154_94;
+
+/// The clamp of the kernel's `alpha^2` in projected-space NDF filtering (the paper's `kappa`).
+pub const PROJECTED_KAPPA: f32 = 0.18;
+
+/// Projected-space NDF filtering's roughness for `roughness` and the screen-space differences
+/// `dn_dx`, `dn_dy` of the unit shading normal (see [`SpecularAa::Projected`]).
+pub fn projected_roughness(roughness: f32, dn_dx: Vec3, dn_dy: Vec3) -> f32 {
+    let kernel = PROJECTED_SIGMA2 * (dn_dx.length_squared() + dn_dy.length_squared());
+    let alpha = roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
+    let alpha2 = (alpha * alpha + kernel.min(PROJECTED_KAPPA)).min(1.0);
+    alpha2.sqrt().sqrt()
+}
+
+/// The slope moment map of a height map (one channel, `channel`): `Rgba32Float` with its own
+/// pyramid holding `[g_u, g_v, g_u^2, g_v^2]`, where `g` is the height's gradient per unit of `u`
+/// and `v` from forward differences between level-0 texels (wrapping at the edges, as height maps
+/// tile): `g_u = (h(i + 1, j) - h(i, j)) w`, `g_v = (h(i, j + 1) - h(i, j)) h_px`. Averaged over a
+/// footprint it gives the variance of the gradient under it, which [`SpecularAa::Lean`] turns into
+/// roughness after scaling by `height_scale` and the surface's size per unit of `u` and `v`.
+///
+/// # Errors
+/// The size errors of `Texture::from_fn` for a float texture of the map's size.
+pub fn height_moments(
+    height_map: &Texture,
+    channel: usize,
+    limits: &texel_texture::Limits,
+) -> Result<Texture, texel_texture::TextureError> {
+    let (w, h) = (height_map.width(), height_map.height());
+    let at = |i: u32, j: u32| {
+        height_map
+            .texel(0, i % w, j % h)
+            .map_or(0.0, |t| t[channel.min(3)])
+    };
+    Texture::from_fn(w, h, texel_texture::Format::Rgba32Float, limits, |i, j| {
+        let h0 = at(i, j);
+        let gu = (at(i + 1, j) - h0) * w as f32;
+        let gv = (at(i, j + 1) - h0) * h as f32;
+        [gu, gv, gu * gu, gv * gv]
+    })
 }
 
 /// Read `input` at `footprint`; also returns the texels read.
@@ -520,5 +634,37 @@ mod tests {
         let s2 = s * 0.9 / (0.9 + s * 0.1); // 6.75
         let want = (2.0 / (s2 + 2.0)).powf(0.25);
         assert!((toksvig_roughness(0.5, 0.9) - want).abs() < 1e-5);
+    }
+
+    #[test]
+    fn projected_filtering_follows_eq_14() {
+        // No change across the pixel: unchanged.
+        assert!((projected_roughness(0.3, Vec3::ZERO, Vec3::ZERO) - 0.3).abs() < 1e-6);
+        // |dn/dx|^2 + |dn/dy|^2 = 0.5: kernel alpha^2 = 0.5 / (2 pi).
+        let (dx, dy) = (Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.5, 0.0));
+        let want = (0.3f32.powi(4) + 0.5 / (2.0 * PI)).powf(0.25);
+        assert!((projected_roughness(0.3, dx, dy) - want).abs() < 1e-6);
+        // Large changes clamp at kappa.
+        let big = Vec3::new(2.0, 0.0, 0.0);
+        let want = (0.3f32.powi(4) + PROJECTED_KAPPA).powf(0.25);
+        assert!((projected_roughness(0.3, big, big) - want).abs() < 1e-6);
+    }
+
+    #[test]
+    fn height_moments_hold_forward_differences_and_their_squares() {
+        let limits = texel_texture::Limits::default();
+        // h = (i^2) / 64 along u over 8 texels, constant along v.
+        let t = Texture::from_fn(8, 4, texel_texture::Format::Rgba32Float, &limits, |i, _| {
+            let h = (i * i) as f32 / 64.0;
+            [h, 0.0, 0.0, 1.0]
+        })
+        .unwrap();
+        let m = height_moments(&t, 0, &limits).unwrap();
+        let got = m.texel(0, 2, 1).unwrap();
+        let gu = (9.0 - 4.0) / 64.0 * 8.0;
+        assert_eq!(got, [gu, 0.0, gu * gu, 0.0]);
+        // The last column wraps to the first.
+        let got = m.texel(0, 7, 0).unwrap();
+        assert_eq!(got[0], (0.0 - 49.0 / 64.0) * 8.0);
     }
 }

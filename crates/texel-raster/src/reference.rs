@@ -29,7 +29,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::{DVec2, Vec4};
+use glam::{DVec2, DVec3, Vec4};
 use rayon::prelude::*;
 use texel_texture::{FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor};
 
@@ -101,9 +101,9 @@ pub fn render_reference_strata(
     // antialiasing: the sub-samples resolve the variation it approximates).
     let map_samplers = draws
         .iter()
-        .map(|d| -> Result<[Option<Sampler>; 3], RasterError> {
+        .map(|d| -> Result<[Option<Sampler>; 4], RasterError> {
             let Some(m) = d.material else {
-                return Ok([None, None, None]);
+                return Ok([None, None, None, None]);
             };
             Ok([
                 m.roughness_map
@@ -113,16 +113,18 @@ pub fn render_reference_strata(
                     .map(|c| level0(c.input.sampler))
                     .transpose()?,
                 m.normal_map.map(|t| level0(t.sampler)).transpose()?,
+                m.height_map.map(|c| level0(c.input.sampler)).transpose()?,
             ])
         })
         .collect::<Result<Vec<_>, _>>()?;
     let materials: Vec<Option<Material>> = draws
         .iter()
         .zip(&map_samplers)
-        .map(|(d, [r, m, n])| {
+        .map(|(d, [r, m, n, h])| {
             d.material.map(|mat| Material {
                 roughness_map: channel(mat.roughness_map, r),
                 metallic_map: channel(mat.metallic_map, m),
+                height_map: channel(mat.height_map, h),
                 normal_map: mat
                     .normal_map
                     .zip(n.as_ref())
@@ -350,7 +352,16 @@ fn reference_row(
             let fp = dc.footprint(uv, DVec2::ZERO, DVec2::ZERO);
             let tex = dc.sampler.sample(dc.texture, &fp);
             let lit = ctx.lighting.as_ref();
-            let (c, _) = shade(dc, dc.vertices(t), lambda, tex, &fp, lit, false);
+            let (c, _) = shade(
+                dc,
+                dc.vertices(t),
+                lambda,
+                [DVec3::ZERO; 2],
+                tex,
+                &fp,
+                lit,
+                false,
+            );
             sum += Vec4::from_array(c);
         }
         *out = (sum * inv_spp).to_array();

@@ -17,7 +17,10 @@ use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};
 use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
 use crate::draw::{DrawCall, Vertex};
-use crate::material::{self, Light, Material, SpecularAa, Surface, TextureInput, MIN_ROUGHNESS};
+use crate::material::{
+    self, Displacement, Light, Material, SpecularAa, Surface, TextureInput, MIN_ROUGHNESS,
+};
+use crate::relief;
 use crate::settings::RenderSettings;
 use crate::setup::TriangleSetup;
 
@@ -153,36 +156,130 @@ impl Lighting {
     }
 }
 
-/// The unit tangent and bitangent at barycentrics `l` for the unit shading `normal`: the
-/// interpolated tangent made orthogonal to `normal` (Gram-Schmidt), and glTF's bitangent
-/// `w cross(normal, tangent)`. `None` where the vertices carry no tangent (or it is parallel to
-/// the normal): the normal map cannot be oriented.
-fn tangent_frame(verts: [&Vertex; 3], l: Vec3, normal: Vec3) -> Option<(Vec3, Vec3)> {
-    let tangent = verts[0].tangent * l.x + verts[1].tangent * l.y + verts[2].tangent * l.z;
-    let t = (tangent.truncate() - normal * normal.dot(tangent.truncate())).try_normalize()?;
-    let sign = if tangent.w < 0.0 { -1.0 } else { 1.0 };
-    Some((t, normal.cross(t) * sign))
-}
-
-/// How far an 8-bit normal map's decoded vector may fall short of unit length by quantisation
-/// alone (each of three components off by up to 1/255): Toksvig counts lengths within it as 1.
-const UNORM8_NORMAL_SLACK: f32 = 0.006_8;
-
 /// The shaded colour of a fragment with base texture colour `tex` (linear RGBA), barycentrics
-/// `lambda` and footprint `fp` (for the material's maps), and the texels the maps read when
-/// `count`. Unlit frames show `tex * base_color * vertex colour`; lit frames
-/// [`crate::material::radiance`].
+/// `lambda` and their screen derivatives `dlambda` (per pixel right and down; zero where not
+/// known, as for the reference's sub-samples), and footprint `fp` (for the material's maps); also
+/// the texels the maps read when `count`. Unlit frames show `tex * base_color * vertex colour`;
+/// lit frames [`crate::material::radiance`] with the normal and roughness of [`crate::relief`].
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn shade(
     ctx: &DrawContext,
     verts: [&Vertex; 3],
     lambda: DVec3,
+    dlambda: [DVec3; 2],
     tex: [f32; 4],
     fp: &Footprint,
     lighting: Option<&Lighting>,
     count: bool,
 ) -> ([f32; 4], u32) {
     let l = lambda.as_vec3();
+    let Some(lighting) = lighting else {
+        return (base_color(ctx, verts, l, tex).to_array(), 0);
+    };
+    let mut texels = 0;
+    let mut position = relief::interpolate(verts, l, |v| v.position);
+    let normal = relief::geometric_normal(verts, l);
+    let Some(m) = &ctx.material else {
+        let c = base_color(ctx, verts, l, tex);
+        let surface = Surface {
+            base: c.truncate(),
+            roughness: 1.0,
+            metallic: 0.0,
+            normal,
+            diffuse_normal: normal,
+            position,
+        };
+        let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, true);
+        return (rgb.extend(c.w).to_array(), 0);
+    };
+    // Parallax occlusion mapping moves every read to where the view ray meets the relief.
+    let mut fp = *fp;
+    let mut tex = tex;
+    if let (Displacement::Pom, Some(height)) = (m.displacement, &m.height_map) {
+        let hit = relief::parallax(
+            m,
+            height,
+            verts,
+            normal,
+            position,
+            ctx.eye,
+            &fp,
+            count,
+            &mut texels,
+        );
+        if let Some(hit) = hit {
+            fp = hit.footprint;
+            position = hit.position;
+            let (t, n) = material::sample(
+                &TextureInput {
+                    texture: ctx.texture,
+                    sampler: ctx.sampler,
+                },
+                &fp,
+                count,
+            );
+            tex = t;
+            texels += n;
+        }
+    }
+    let c = base_color(ctx, verts, l, tex);
+    let mut roughness = m.roughness;
+    let mut metallic = m.metallic;
+    if let Some(map) = &m.roughness_map {
+        let (t, n) = material::sample(&map.input, &fp, count);
+        roughness *= t[map.channel];
+        texels += n;
+    }
+    if let Some(map) = &m.metallic_map {
+        let (t, n) = material::sample(&map.input, &fp, count);
+        metallic *= t[map.channel];
+        texels += n;
+    }
+    let mut shading = relief::shading_normal(
+        m,
+        verts,
+        l,
+        normal,
+        &fp,
+        m.specular_aa,
+        roughness,
+        count,
+        &mut texels,
+    );
+    if m.specular_aa == SpecularAa::Projected {
+        // The normals one pixel right and one down, as a fragment quad's ddx and ddy see them.
+        let neighbour = |dl: DVec3, duv: [f32; 2], texels: &mut u32| {
+            let l = relief::shifted(lambda, dl);
+            let n = relief::geometric_normal(verts, l);
+            let fp = Footprint {
+                u: fp.u + duv[0],
+                v: fp.v + duv[1],
+                ..fp
+            };
+            let aa = SpecularAa::None;
+            relief::shading_normal(m, verts, l, n, &fp, aa, roughness, count, texels).normal
+        };
+        let nx = neighbour(dlambda[0], [fp.dudx, fp.dvdx], &mut texels);
+        let ny = neighbour(dlambda[1], [fp.dudy, fp.dvdy], &mut texels);
+        shading.roughness =
+            material::projected_roughness(roughness, nx - shading.normal, ny - shading.normal);
+    }
+    let surface = Surface {
+        base: c.truncate(),
+        roughness: shading.roughness.clamp(MIN_ROUGHNESS, 1.0),
+        metallic: metallic.clamp(0.0, 1.0),
+        normal: shading.normal,
+        diffuse_normal: shading.diffuse_normal.unwrap_or(shading.normal),
+        position,
+    };
+    let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, false);
+    (rgb.extend(c.w).to_array(), texels)
+}
+
+/// The unlit colour: texture times vertex colour times the material's factor.
+#[inline(always)]
+fn base_color(ctx: &DrawContext, verts: [&Vertex; 3], l: Vec3, tex: [f32; 4]) -> Vec4 {
     let mut c = Vec4::from_array(tex);
     if ctx.colored {
         c *= verts[0].color * l.x + verts[1].color * l.y + verts[2].color * l.z;
@@ -190,85 +287,7 @@ pub(crate) fn shade(
     if let Some(m) = &ctx.material {
         c *= m.base_color;
     }
-    let Some(lighting) = lighting else {
-        return (c.to_array(), 0);
-    };
-    let mut texels = 0;
-    let position = verts[0].position * l.x + verts[1].position * l.y + verts[2].position * l.z;
-    let mut normal =
-        (verts[0].normal * l.x + verts[1].normal * l.y + verts[2].normal * l.z).normalize_or_zero();
-    if normal == Vec3::ZERO {
-        normal = (verts[1].position - verts[0].position)
-            .cross(verts[2].position - verts[0].position)
-            .normalize_or(Vec3::Y);
-    }
-    let (mut roughness, mut metallic) = (1.0, 0.0);
-    // The mean normal for the diffuse term: set by the antialiasing methods that keep it.
-    let mut diffuse_normal = None;
-    if let Some(m) = &ctx.material {
-        roughness = m.roughness;
-        metallic = m.metallic;
-        if let Some(map) = &m.roughness_map {
-            let (t, n) = material::sample(&map.input, fp, count);
-            roughness *= t[map.channel];
-            texels += n;
-        }
-        if let Some(map) = &m.metallic_map {
-            let (t, n) = material::sample(&map.input, fp, count);
-            metallic *= t[map.channel];
-            texels += n;
-        }
-        if let Some(map) = &m.normal_map {
-            if let Some((t, b)) = tangent_frame(verts, l, normal) {
-                let to_world = |v: Vec3| t * v.x + b * v.y + normal * v.z;
-                let (texel, n) = material::sample(map, fp, count);
-                texels += n;
-                // The filtered map normal: the mean of the normals under the footprint.
-                let raw = Vec3::new(texel[0], texel[1], texel[2]) * 2.0 - Vec3::ONE;
-                let mean = raw * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
-                let shading = match (m.specular_aa, m.lean) {
-                    (SpecularAa::Lean, Some(lean)) => {
-                        let moments = TextureInput {
-                            texture: lean,
-                            sampler: map.sampler,
-                        };
-                        let (a, n) = material::sample(&moments, fp, count);
-                        texels += n;
-                        let (nt, r) = material::lean_normal_roughness(a, m.normal_scale, roughness);
-                        roughness = r;
-                        Some(nt)
-                    }
-                    (SpecularAa::Toksvig, _) => {
-                        let slack = if map.texture.format() == texel_texture::Format::Rgba32Float {
-                            0.0
-                        } else {
-                            UNORM8_NORMAL_SLACK
-                        };
-                        let len = (raw.length() + slack).min(1.0);
-                        roughness = material::toksvig_roughness(roughness, len);
-                        Some(mean)
-                    }
-                    _ => None,
-                };
-                // Antialiased methods light the diffuse term with the mean normal (no longer
-                // than 1: scaling by `normal_scale` can lengthen it).
-                if shading.is_some() {
-                    diffuse_normal = Some(to_world(mean).clamp_length_max(1.0));
-                }
-                normal = to_world(shading.unwrap_or(mean)).normalize_or(normal);
-            }
-        }
-    }
-    let surface = Surface {
-        base: c.truncate(),
-        roughness: roughness.clamp(MIN_ROUGHNESS, 1.0),
-        metallic: metallic.clamp(0.0, 1.0),
-        normal,
-        diffuse_normal: diffuse_normal.unwrap_or(normal),
-        position,
-    };
-    let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, ctx.material.is_none());
-    (rgb.extend(c.w).to_array(), texels)
+    c
 }
 
 #[cfg(test)]

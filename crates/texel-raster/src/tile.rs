@@ -124,6 +124,8 @@ struct Context<'a> {
 /// What the fragment stage needs besides the pixel: barycentrics and the footprint's inputs.
 struct Fragment {
     lambda: DVec3,
+    /// `lambda`'s derivatives per pixel right and down.
+    dlambda: [DVec3; 2],
     uv: DVec2,
     duv_dx: DVec2,
     duv_dy: DVec2,
@@ -229,6 +231,7 @@ fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range:
                     let (duv_dx, duv_dy) = b.derivatives2(uvs);
                     let f = Fragment {
                         lambda: b.lambda,
+                        dlambda: [b.dx, b.dy],
                         uv: b.interpolate2(uvs),
                         duv_dx,
                         duv_dy,
@@ -456,8 +459,13 @@ fn flush_span(
         while k < n && span.lj[k] == lj {
             let li = span.li[k] as usize;
             let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
+            let dlambda = [
+                DVec3::new(span.ldx[0][k], span.ldx[1][k], span.ldx[2][k]),
+                DVec3::new(span.ldy[0][k], span.ldy[1][k], span.ldy[2][k]),
+            ];
             let lit = ctx.lighting.as_ref();
-            color[li] = shade(dc, verts, lambda, span.texs[k], &span.fps[k], lit, false).0;
+            let (tex, fp) = (span.texs[k], &span.fps[k]);
+            color[li] = shade(dc, verts, lambda, dlambda, tex, fp, lit, false).0;
             depth[li] = span.z[k];
             coverage[li] = true;
             k += 1;
@@ -506,11 +514,17 @@ fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: 
             });
             let uv = lambda.map(|l| uvs[0] * l.x + uvs[1] * l.y + uvs[2] * l.z);
             let d = quad_differences(uv);
+            // The barycentrics' differences across the quad, as the uv's.
+            let dl = quad_differences(lambda.map(|l| l.truncate())).map(|(dx, dy)| {
+                let third = |d: DVec2| DVec3::new(d.x, d.y, -d.x - d.y);
+                [third(dx), third(dy)]
+            });
             for k in 0..4usize {
                 if mask & (1 << k) != 0 {
                     let (i, j) = (qi + (k as u32 & 1), qj + (k as u32 >> 1));
                     let f = Fragment {
                         lambda: lambda[k],
+                        dlambda: dl[k],
                         uv: uv[k],
                         duv_dx: d[k].0,
                         duv_dy: d[k].1,
@@ -548,7 +562,16 @@ fn write_fragment(
     // with the counts of the colour view).
     let (shaded, map_texels) =
         if ctx.settings.view == View::Color || (ctx.counting && lit.is_some()) {
-            shade(dc, dc.vertices(t), f.lambda, tex, &fp, lit, ctx.counting)
+            shade(
+                dc,
+                dc.vertices(t),
+                f.lambda,
+                f.dlambda,
+                tex,
+                &fp,
+                lit,
+                ctx.counting,
+            )
         } else {
             ([0.0; 4], 0)
         };

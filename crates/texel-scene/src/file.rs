@@ -31,9 +31,10 @@
 //! [materials.glossy]            # base_color = "TEXTURE" or [r, g, b] (linear, default white);
 //! base_color = "checker"        # roughness, metallic = number in [0, 1] or "TEXTURE" (red);
 //! roughness = 0.25              # normal = "TEXTURE" (color = "linear"), normal_scale;
-//! normal = "bumps"              # specular_aa = "none" | "toksvig" (| "lean" | "projected":
-//! specular_aa = "toksvig"       # not built yet); height, height_scale, displacement, layers:
-//!                               # parsed, refused until built
+//! normal = "bumps"              # specular_aa = "none" | "toksvig" | "lean" | "projected";
+//! specular_aa = "toksvig"       # height = "TEXTURE" (red, color = "linear"), height_scale
+//!                               # (world units, default 0.05), displacement = "none" | "bump" |
+//!                               # "pom" (| "tessellate" and layers: parsed, refused until built)
 //! ```
 //!
 //! Every table denies unknown keys; a syntax or type error is reported with its line and column.

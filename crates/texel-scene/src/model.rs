@@ -89,6 +89,18 @@ pub enum Displacement {
     Tessellate,
 }
 
+impl Displacement {
+    /// The name scene files use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Displacement::None => "none",
+            Displacement::Bump => "bump",
+            Displacement::Pom => "pom",
+            Displacement::Tessellate => "tessellate",
+        }
+    }
+}
+
 /// Specular antialiasing of a material (`specular_aa = ...`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SpecularAaSpec {

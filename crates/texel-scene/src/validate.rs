@@ -4,8 +4,8 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::SceneError;
 use crate::model::{
-    ColorInput, Displacement, LightSpec, MaterialSpec, ScalarInput, Scene, SpecularAaSpec,
-    MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
+    ColorInput, Displacement, LightSpec, MaterialSpec, ScalarInput, Scene, MAX_OUTPUT_SIDE,
+    MAX_SCENE_LIGHTS,
 };
 
 fn finite3(what: impl Fn() -> String, v: Vec3) -> Result<(), SceneError> {
@@ -258,21 +258,35 @@ impl Scene {
                 )));
             }
         }
+        if let Some(h) = &m.height {
+            if self.textures[h].color != texel_texture::ColorSpace::Linear {
+                return Err(bad(format!(
+                    "height map {h:?} holds heights, not colours: give it color = \"linear\""
+                )));
+            }
+        }
+        if m.height_scale < 0.0 {
+            return Err(bad(format!(
+                "height_scale = {} must be at least 0",
+                m.height_scale
+            )));
+        }
+        if m.displacement != Displacement::None && m.height.is_none() {
+            return Err(bad(format!(
+                "displacement = \"{}\" needs a height map: give it height = \"TEXTURE\"",
+                m.displacement.name()
+            )));
+        }
         // Parsed so that scene files written for the full schema are read, refused until built.
-        let missing = if m.displacement != Displacement::None || m.height.is_some() {
-            Some("height maps and displacement (bump, pom, tessellate)")
-        } else if matches!(
-            m.specular_aa,
-            SpecularAaSpec::Lean | SpecularAaSpec::Projected
-        ) {
-            Some("specular_aa = \"lean\" and \"projected\" (toksvig and none are)")
+        let missing = if m.displacement == Displacement::Tessellate {
+            Some("displacement = \"tessellate\"")
         } else if m.layers > 0 {
             Some("layered materials")
         } else {
             None
         };
         if let Some(what) = missing {
-            return Err(bad(format!("{what} are not implemented yet")));
+            return Err(bad(format!("{what} is not implemented yet")));
         }
         Ok(())
     }

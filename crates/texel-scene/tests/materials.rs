@@ -4,8 +4,8 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use texel_scene::{
-    ColorInput, LightSpec, MaterialSpec, Mesh, Procedural, ScalarInput, Scene, SceneError,
-    SpecularAaSpec,
+    ColorInput, Displacement, LightSpec, MaterialSpec, Mesh, Procedural, ScalarInput, Scene,
+    SceneError, SpecularAaSpec,
 };
 
 const BASE: &str = r#"
@@ -121,8 +121,40 @@ specular_aa = "toksvig"
 }
 
 #[test]
+fn every_specular_aa_method_and_height_maps_parse() {
+    for (name, want) in [
+        ("none", SpecularAaSpec::None),
+        ("toksvig", SpecularAaSpec::Toksvig),
+        ("lean", SpecularAaSpec::Lean),
+        ("projected", SpecularAaSpec::Projected),
+    ] {
+        let s = parse(&format!(
+            "[materials.m]\nbase_color = \"grey\"\nnormal = \"bumps\"\nspecular_aa = \"{name}\"\n"
+        ))
+        .unwrap();
+        assert_eq!(s.materials["m"].specular_aa, want);
+    }
+    for (name, want) in [
+        ("none", Displacement::None),
+        ("bump", Displacement::Bump),
+        ("pom", Displacement::Pom),
+    ] {
+        let s = parse(&format!(
+            "[materials.m]\nbase_color = \"grey\"\nheight = \"rough\"\nheight_scale = 0.2\ndisplacement = \"{name}\"\n"
+        ))
+        .unwrap();
+        let m = &s.materials["m"];
+        assert_eq!(
+            (m.displacement, m.height.as_deref(), m.height_scale),
+            (want, Some("rough"), 0.2)
+        );
+        assert_eq!(want.name(), name);
+    }
+}
+
+#[test]
 fn bad_lights_and_materials_are_refused_with_the_reason() {
-    let cases: [(&str, &str); 9] = [
+    let cases: [(&str, &str); 12] = [
         (
             "[materials.m]\nbase_color = \"grey\"\nshininess = 3.0\n",
             "unknown field `shininess`",
@@ -137,12 +169,24 @@ fn bad_lights_and_materials_are_refused_with_the_reason() {
             "give it color = \"linear\"",
         ),
         (
-            "[materials.m]\nbase_color = \"grey\"\ndisplacement = \"pom\"\nheight = \"rough\"\n",
+            "[materials.m]\nbase_color = \"grey\"\ndisplacement = \"pom\"\n",
+            "displacement = \"pom\" needs a height map",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\ndisplacement = \"bump\"\nheight = \"grey\"\n",
+            "height map \"grey\" holds heights, not colours",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\nheight = \"rough\"\nheight_scale = -0.1\n",
+            "height_scale = -0.1 must be at least 0",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\ndisplacement = \"tessellate\"\nheight = \"rough\"\n",
             "not implemented yet",
         ),
         (
-            "[materials.m]\nbase_color = \"grey\"\nspecular_aa = \"projected\"\n",
-            "not implemented yet",
+            "[materials.m]\nbase_color = \"grey\"\nspecular_aa = \"sharpen\"\n",
+            "unknown variant `sharpen`",
         ),
         (
             "[[lights]]\ntype = \"directional\"\ndirection = [0.0, 0.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n[materials.m]\nbase_color = \"grey\"\n",

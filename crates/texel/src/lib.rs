@@ -78,7 +78,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Err
             size: options.size,
             color: options.color,
             replace_non_finite: false,
-            specular_aa: None,
+            ..SceneOptions::default()
         },
         &mut budget,
     )?;

@@ -6,7 +6,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Mutex;
 
 use texel_raster::{
-    ChannelInput, DrawCall, Light, Material, RenderSettings, SpecularAa, TextureInput, Vertex,
+    ChannelInput, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
+    TextureInput, Vertex,
 };
 use texel_scene::{ColorInput, LightSpec, ScalarInput, Scene, SpecularAaSpec};
 use texel_texture::color::srgb_to_linear;
@@ -38,6 +39,9 @@ pub struct SceneOptions {
     /// Specular antialiasing for every material, overriding each one's `specular_aa` (the
     /// CLI's `--specular-aa`).
     pub specular_aa: Option<SpecularAa>,
+    /// What every material's height map does, overriding each one's `displacement` (the CLI's
+    /// `--displacement`; materials without a height map are unaffected).
+    pub displacement: Option<texel_scene::Displacement>,
 }
 
 /// A loaded scene, ready to render with any filter.
@@ -62,9 +66,14 @@ pub struct PreparedScene {
     charged: Mutex<BTreeSet<(String, &'static str)>>,
     /// [`SceneOptions::specular_aa`].
     specular_aa: Option<SpecularAa>,
+    /// [`SceneOptions::displacement`].
+    displacement: Option<texel_scene::Displacement>,
     /// LEAN moment maps ([`texel_raster::material::lean_map`]) of the normal maps of materials
     /// that use LEAN, by the normal map's texture name.
     lean_maps: BTreeMap<String, Texture>,
+    /// Slope moment maps ([`texel_raster::material::height_moments`]) of the height maps of
+    /// bump-mapped materials without a normal map that use LEAN or Toksvig, by texture name.
+    height_moments: BTreeMap<String, Texture>,
 }
 
 impl PreparedScene {
@@ -118,35 +127,46 @@ impl PreparedScene {
             )?;
             textures.insert(u.name.to_string(), loaded.texture);
         }
-        // LEAN reads moment maps made from the normal maps (float, charged like any texture).
+        // LEAN reads moment maps made from the normal maps, and LEAN and Toksvig on bump maps
+        // moment maps made from the height maps (float, charged like any texture).
         let mut lean_maps = BTreeMap::new();
+        let mut height_moments = BTreeMap::new();
         for mat in scene.materials.values() {
-            let lean = specular_aa(mat, options.specular_aa) == SpecularAa::Lean;
-            let Some(normal) = mat.normal.as_ref().filter(|_| lean) else {
+            let aa = specular_aa(mat, options.specular_aa);
+            let bumped = displacement(mat, options.displacement) != texel_scene::Displacement::None
+                && mat.height.is_some()
+                && mat.normal.is_none();
+            let (name, kind, out) = match (&mat.normal, &mat.height) {
+                (Some(n), _) if aa == SpecularAa::Lean => (n, "LEAN moments", &mut lean_maps),
+                (None, Some(h))
+                    if bumped && matches!(aa, SpecularAa::Lean | SpecularAa::Toksvig) =>
+                {
+                    (h, "slope moments", &mut height_moments)
+                }
+                _ => continue,
+            };
+            let Some(map) = textures.get(name) else {
                 continue;
             };
-            let Some(map) = textures.get(normal) else {
-                continue;
-            };
-            if lean_maps.contains_key(normal) {
+            if out.contains_key(name) {
                 continue;
             }
             let limits = Limits {
                 max_bytes: budget.remaining(),
                 ..Limits::default()
             };
-            let moments = texel_raster::material::lean_map(map, &limits).map_err(|source| {
-                texel_scene::SceneError::Texture {
-                    name: format!("{normal} (LEAN moments)"),
-                    path: None,
-                    source,
-                }
+            let built = if kind == "LEAN moments" {
+                texel_raster::material::lean_map(map, &limits)
+            } else {
+                texel_raster::material::height_moments(map, 0, &limits)
+            };
+            let moments = built.map_err(|source| texel_scene::SceneError::Texture {
+                name: format!("{name} ({kind})"),
+                path: None,
+                source,
             })?;
-            budget.take(
-                &format!("the LEAN moments of {normal:?}"),
-                moments.pyramid_bytes(),
-            )?;
-            lean_maps.insert(normal.clone(), moments);
+            budget.take(&format!("the {kind} of {name:?}"), moments.pyramid_bytes())?;
+            out.insert(name.clone(), moments);
         }
         // Normal maps need tangents: MikkTSpace where the mesh brings none.
         let mut scene = scene;
@@ -171,7 +191,9 @@ impl PreparedScene {
             replaced,
             charged: Mutex::new(BTreeSet::new()),
             specular_aa: options.specular_aa,
+            displacement: options.displacement,
             lean_maps,
+            height_moments,
         })
     }
 
@@ -309,8 +331,19 @@ impl PreparedScene {
         };
         let mut specular_aa = specular_aa(spec, self.specular_aa);
         let lean = spec.normal.as_ref().and_then(|n| self.lean_maps.get(n));
-        if specular_aa == SpecularAa::Lean && lean.is_none() {
-            // No normal map: nothing varies within a pixel to antialias.
+        let height_moments = spec
+            .height
+            .as_ref()
+            .and_then(|h| self.height_moments.get(h));
+        let shape = match displacement(spec, self.displacement) {
+            texel_scene::Displacement::None => Displacement::None,
+            texel_scene::Displacement::Bump => Displacement::Bump,
+            texel_scene::Displacement::Pom => Displacement::Pom,
+            // Tessellated geometry is displaced before drawing; its normal is the bump map's.
+            texel_scene::Displacement::Tessellate => Displacement::Bump,
+        };
+        if specular_aa == SpecularAa::Lean && lean.is_none() && height_moments.is_none() {
+            // No normal or bump map: nothing varies within a pixel to antialias.
             specular_aa = SpecularAa::None;
         }
         Some(Material {
@@ -323,6 +356,17 @@ impl PreparedScene {
             normal_scale: spec.normal_scale,
             specular_aa,
             lean,
+            height_map: spec.height.as_deref().map(|h| ChannelInput {
+                input: input(h),
+                channel: 0,
+            }),
+            height_scale: spec.height_scale,
+            displacement: if spec.height.is_some() {
+                shape
+            } else {
+                Displacement::None
+            },
+            height_moments,
         })
     }
 
@@ -369,9 +413,17 @@ fn specular_aa(spec: &texel_scene::MaterialSpec, overridden: Option<SpecularAa>)
     overridden.unwrap_or(match spec.specular_aa {
         SpecularAaSpec::Toksvig => SpecularAa::Toksvig,
         SpecularAaSpec::Lean => SpecularAa::Lean,
-        // Validation refuses the methods not built yet.
-        SpecularAaSpec::None | SpecularAaSpec::Projected => SpecularAa::None,
+        SpecularAaSpec::Projected => SpecularAa::Projected,
+        SpecularAaSpec::None => SpecularAa::None,
     })
+}
+
+/// The displacement a material gets: `overridden` (the CLI's `--displacement`) or its own.
+fn displacement(
+    spec: &texel_scene::MaterialSpec,
+    overridden: Option<texel_scene::Displacement>,
+) -> texel_scene::Displacement {
+    overridden.unwrap_or(spec.displacement)
 }
 
 fn texel_vertices(mesh: &texel_scene::Mesh) -> Vec<Vertex> {

@@ -55,7 +55,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     let worker = Worker {
         scene_spec: args.scene.scene.clone(),
         size: args.scene.size,
-        specular_aa: args.scene.specular_aa.map(Into::into),
+        overrides: crate::input::MaterialOverrides::of(&args.scene),
         scenes,
         input,
         threads: args.threads,

@@ -176,8 +176,8 @@ pub struct Worker {
     pub scene_spec: String,
     /// `--size`, passed on to reloads.
     pub size: Option<crate::cli::Size>,
-    /// `--specular-aa`, passed on to reloads.
-    pub specular_aa: Option<texel_raster::SpecularAa>,
+    /// `--specular-aa` and `--displacement`, passed on to reloads.
+    pub overrides: crate::input::MaterialOverrides,
     /// The scene as loaded for each colour handling (index: `ColorArg as usize`).
     pub scenes: [Option<PreparedScene>; 2],
     /// Memory account and input policy.
@@ -324,7 +324,7 @@ impl FrameContext<'_, '_> {
         let w = &mut *self.worker;
         let slot = color as usize;
         if w.scenes[slot].is_none() {
-            let s = load_scene_with(&w.scene_spec, color, w.size, w.specular_aa, &mut w.input)
+            let s = load_scene_with(&w.scene_spec, color, w.size, w.overrides, &mut w.input)
                 .context("cannot load the scene for the other colour handling")?;
             w.scenes[slot] = Some(s);
         }
@@ -765,14 +765,20 @@ mod tests {
                 width: w,
                 height: h,
             });
-            let scene =
-                load_scene_with("builtin:ground", ColorArg::Srgb, size, None, &mut input).unwrap();
+            let scene = load_scene_with(
+                "builtin:ground",
+                ColorArg::Srgb,
+                size,
+                Default::default(),
+                &mut input,
+            )
+            .unwrap();
             let camera = scene.scene.camera;
             Harness {
                 worker: Worker {
                     scene_spec: "builtin:ground".into(),
                     size,
-                    specular_aa: None,
+                    overrides: Default::default(),
                     scenes: [Some(scene), None],
                     input,
                     threads: None,

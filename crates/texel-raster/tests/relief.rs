@@ -1,0 +1,262 @@
+//! Height maps: bump mapping and parallax occlusion mapping against the analytic surfaces they
+//! stand for, and projected-space NDF filtering on a surface whose normal does not vary.
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use texel_raster::material::{radiance, Surface};
+use texel_raster::{
+    camera, render, ChannelInput, Displacement, DrawCall, Light, Material, RenderSettings,
+    SpecularAa, TextureInput, Vertex, MAX_LIGHTS,
+};
+use texel_texture::{AddressMode, Format, Limits, Sampler, SamplerDescriptor, Texture};
+
+const W: u32 = 96;
+const H: u32 = 64;
+
+/// The square `[-1, 1]^2` in z = 0 facing +z, u along +x, v down (-y): 2 world units per unit
+/// of u and of v.
+fn plane() -> Vec<Vertex> {
+    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .iter()
+        .map(|&(x, y)| {
+            let mut v = Vertex::new(
+                Vec3::new(x, y, 0.0),
+                Vec2::new((x + 1.0) / 2.0, (1.0 - y) / 2.0),
+            );
+            v.normal = Vec3::Z;
+            v.tangent = Vec4::new(1.0, 0.0, 0.0, 1.0);
+            v
+        })
+        .collect()
+}
+
+const PLANE_TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+
+fn view() -> (Mat4, Vec3) {
+    let eye = Vec3::new(0.4, 0.3, 3.0);
+    let m = camera::perspective(50f32.to_radians(), W as f32 / H as f32, 0.1, 10.0)
+        * camera::look_at(eye, Vec3::ZERO, Vec3::Y);
+    (m, eye)
+}
+
+/// The ray from `eye` through pixel `(i, j)`'s centre (unit direction).
+fn ray(m: Mat4, eye: Vec3, i: u32, j: u32) -> Vec3 {
+    let x = (i as f32 + 0.5) / W as f32 * 2.0 - 1.0;
+    let y = 1.0 - (j as f32 + 0.5) / H as f32 * 2.0;
+    (m.inverse().project_point3(Vec3::new(x, y, 1.0)) - eye).normalize()
+}
+
+/// A 64x64 float texture holding `f(u, v)` at texel centres, in every channel.
+fn float_map(f: impl Fn(f32, f32) -> f32) -> Texture {
+    Texture::from_fn(64, 64, Format::Rgba32Float, &Limits::default(), |i, j| {
+        let v = f((i as f32 + 0.5) / 64.0, (j as f32 + 0.5) / 64.0);
+        [v, v, v, 1.0]
+    })
+    .unwrap()
+}
+
+fn trilinear_clamped() -> Sampler {
+    let d = SamplerDescriptor::lab_mode(4).unwrap();
+    Sampler::new(d.with_address_mode(AddressMode::ClampToEdge)).unwrap()
+}
+
+fn lit(light: Light) -> RenderSettings {
+    let mut lights = [None; MAX_LIGHTS];
+    lights[0] = Some(light);
+    RenderSettings {
+        lights,
+        ..RenderSettings::new(W, H)
+    }
+}
+
+/// Heights rising linearly along u, `h = u`: the bumped surface is the plane `z = s (u - 1)`,
+/// whose normal is `(-s / 2, 0, 1)` (2 world units per unit of u). Every pixel inside the square
+/// shades with that normal, for every footprint-following step.
+#[test]
+fn bump_mapping_a_ramp_gives_the_tilted_planes_normal() {
+    let heights = float_map(|u, _| u);
+    let white = float_map(|_, _| 1.0);
+    let sampler = trilinear_clamped();
+    let vertices = plane();
+    let (m, eye) = view();
+    let light = Light::Directional {
+        direction: Vec3::new(0.6, 0.3, 1.0),
+        intensity: Vec3::splat(3.0),
+    };
+    for s in [0.2f32, 1.0] {
+        let material = Material {
+            roughness: 0.4,
+            height_map: Some(ChannelInput {
+                input: TextureInput {
+                    texture: &heights,
+                    sampler: &sampler,
+                },
+                channel: 0,
+            }),
+            height_scale: s,
+            displacement: Displacement::Bump,
+            ..Material::default()
+        };
+        let draw = DrawCall {
+            vertices: &vertices,
+            triangles: &PLANE_TRIANGLES,
+            texture: &white,
+            sampler: &sampler,
+            clip_from_world: m,
+            material: Some(material),
+        };
+        let frame = render(&lit(light), &[draw]).unwrap();
+        let normal = Vec3::new(-s / 2.0, 0.0, 1.0).normalize();
+        for (i, j) in [(48, 32), (35, 25), (60, 40)] {
+            let k = frame.index(i, j);
+            assert!(frame.coverage[k]);
+            let d = ray(m, eye, i, j);
+            let surface = Surface {
+                base: Vec3::ONE,
+                roughness: 0.4,
+                metallic: 0.0,
+                normal,
+                diffuse_normal: normal,
+                position: eye + d * (-eye.z / d.z),
+            };
+            let want = radiance(&surface, eye, &[light], false);
+            let got = Vec3::from_slice(&frame.color[k][..3]);
+            assert!(
+                (got - want).abs().max_element() < 2e-3 * want.max_element(),
+                "s {s} ({i}, {j}): got {got}, want {want}"
+            );
+        }
+    }
+}
+
+/// Constant heights `h = 0.5` put the relief flat, `s / 2` below the polygon: parallax occlusion
+/// mapping must read the colour where the view ray meets that plane. The colour is `u` and only
+/// ambient light shines, so a pixel shows `A (u + 0.04)` at the hit's `u`.
+#[test]
+fn parallax_reads_where_the_ray_meets_the_relief() {
+    let heights = float_map(|_, _| 0.5);
+    let ramp = float_map(|u, _| u);
+    let sampler = trilinear_clamped();
+    let vertices = plane();
+    let (m, eye) = view();
+    let s = 0.4f32;
+    let material = Material {
+        roughness: 0.4,
+        height_map: Some(ChannelInput {
+            input: TextureInput {
+                texture: &heights,
+                sampler: &sampler,
+            },
+            channel: 0,
+        }),
+        height_scale: s,
+        displacement: Displacement::Pom,
+        ..Material::default()
+    };
+    let draw = DrawCall {
+        vertices: &vertices,
+        triangles: &PLANE_TRIANGLES,
+        texture: &ramp,
+        sampler: &sampler,
+        clip_from_world: m,
+        material: Some(material),
+    };
+    let ambient = Light::Ambient {
+        intensity: Vec3::ONE,
+    };
+    let frame = render(&lit(ambient), &[draw]).unwrap();
+    let flat = render(
+        &lit(ambient),
+        &[DrawCall {
+            material: Some(Material {
+                displacement: Displacement::None,
+                ..material
+            }),
+            ..draw
+        }],
+    )
+    .unwrap();
+    let mut moved = 0;
+    for (i, j) in [(48, 32), (35, 25), (60, 40), (30, 40)] {
+        let k = frame.index(i, j);
+        assert!(frame.coverage[k]);
+        let d = ray(m, eye, i, j);
+        let q = eye + d * ((-s / 2.0 - eye.z) / d.z);
+        let u = (q.x + 1.0) / 2.0;
+        let got = frame.color[k][0];
+        let want = u + 0.04;
+        assert!(
+            (got - want).abs() < 2e-3,
+            "({i}, {j}): got {got}, want {want}"
+        );
+        // Without parallax the polygon's own u shows.
+        let p = eye + d * (-eye.z / d.z);
+        assert!((flat.color[k][0] - ((p.x + 1.0) / 2.0 + 0.04)).abs() < 2e-3);
+        moved += usize::from((got - flat.color[k][0]).abs() > 0.01);
+    }
+    assert!(moved >= 3, "parallax moved only {moved} of 4 pixels");
+}
+
+/// Projected-space NDF filtering widens the lobe only where the normal changes from pixel to
+/// pixel: on a flat plane without maps it is the unfiltered image bit for bit; over a bumpy height
+/// map it changes the highlight.
+#[test]
+fn projected_filtering_widens_only_where_the_normal_varies() {
+    let white = float_map(|_, _| 1.0);
+    let bumps = float_map(|u, v| {
+        0.5 + 0.5
+            * (u * 40.0 * std::f32::consts::TAU).sin()
+            * (v * 40.0 * std::f32::consts::TAU).sin()
+    });
+    let sampler = trilinear_clamped();
+    let vertices = plane();
+    let (m, _) = view();
+    let light = Light::Directional {
+        direction: Vec3::new(-0.4, -0.3, 3.0),
+        intensity: Vec3::splat(3.0),
+    };
+    let frame = |aa: SpecularAa, height: Option<&Texture>| {
+        let material = Material {
+            roughness: 0.2,
+            height_map: height.map(|t| ChannelInput {
+                input: TextureInput {
+                    texture: t,
+                    sampler: &sampler,
+                },
+                channel: 0,
+            }),
+            height_scale: 0.02,
+            displacement: if height.is_some() {
+                Displacement::Bump
+            } else {
+                Displacement::None
+            },
+            specular_aa: aa,
+            ..Material::default()
+        };
+        let draw = DrawCall {
+            vertices: &vertices,
+            triangles: &PLANE_TRIANGLES,
+            texture: &white,
+            sampler: &sampler,
+            clip_from_world: m,
+            material: Some(material),
+        };
+        render(&lit(light), &[draw]).unwrap()
+    };
+    assert_eq!(
+        frame(SpecularAa::Projected, None).color,
+        frame(SpecularAa::None, None).color
+    );
+    let (plain, filtered) = (
+        frame(SpecularAa::None, Some(&bumps)),
+        frame(SpecularAa::Projected, Some(&bumps)),
+    );
+    let peak = |f: &texel_raster::Frame| f.color.iter().map(|c| c[0]).fold(0.0f32, f32::max);
+    // A wider lobe has a lower peak.
+    assert!(
+        peak(&filtered) < 0.9 * peak(&plain),
+        "{} vs {}",
+        peak(&filtered),
+        peak(&plain)
+    );
+}
