@@ -294,9 +294,33 @@ pub struct CompareArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
+    /// Also render a slow camera orbit of N frames (2 to 1000; the scene's own view first) and
+    /// report per filter its PSNR averaged over the frames and its flicker: its change between
+    /// consecutive frames less the reference's, per pixel, as a mean absolute value in 8-bit
+    /// units (sparkle shows in motion; motion itself cancels). Renders
+    /// N references.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=1000))]
+    pub orbit: Option<u32>,
+    /// With --orbit: degrees the camera turns per frame about its up axis through the target
+    /// (finite, 0 to 10).
+    #[arg(long, value_name = "DEG", default_value_t = 0.1, requires = "orbit", value_parser = parse_orbit_step)]
+    pub orbit_step: f32,
     /// Output directory: created, or replaced as a whole if texel wrote it before.
     #[arg(long)]
     pub out: PathBuf,
+}
+
+/// `--orbit-step`: a finite number of degrees in `[0, 10]`.
+fn parse_orbit_step(s: &str) -> Result<f32, String> {
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number of degrees"))?;
+    if v.is_finite() && (0.0..=10.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{s} degrees per frame is outside 0 to 10"))
+    }
 }
 
 /// `texel demo`.

@@ -10,14 +10,14 @@ use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 use texel_quality::{
-    crop_enlarge, default_band_rows, heat_map, horizon_crop_rect, publish_dir, FilterRow, Image8,
-    Mask, Report, Scores,
+    crop_enlarge, default_band_rows, excess_change, heat_map, horizon_crop_rect, mean_abs_change,
+    psnr, publish_dir, FilterRow, Image8, Mask, Orbit, Report, Scores,
 };
 use texel_raster::{render, Frame};
 
 use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
-use crate::cmd_reference::reference_frame;
+use crate::cmd_reference::{reference_frame, reference_frame_from};
 use crate::filters::{parse_list, Filter};
 use crate::input::{load_scene, Input};
 use crate::output::encoding;
@@ -184,15 +184,27 @@ fn gpu_rows(
     Ok(rows)
 }
 
+/// A camera orbit to measure flicker over (`--orbit`, `--orbit-step`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitSpec {
+    /// Frames, the scene's own view first (at least 2).
+    pub frames: u32,
+    /// Degrees per frame.
+    pub step_deg: f32,
+}
+
 /// Compare `filters` on a prepared scene against a `spp` reference, write everything into `dir`
 /// (which must exist: the caller publishes it, see [`texel_quality::publish_dir`]) and return the
-/// report. `label` names the scene in the report.
+/// report. `label` names the scene in the report. With an `orbit`, the filters' rows also get
+/// their flicker and orbit PSNR ([`orbit_scores`]).
+#[allow(clippy::too_many_arguments)]
 pub fn compare(
     scene: &PreparedScene,
     label: &str,
     filters: &[Filter],
     spp: u32,
     extras: &Extras,
+    orbit: Option<OrbitSpec>,
     dir: &Path,
     budget: &mut MemoryBudget,
 ) -> Result<Report> {
@@ -223,6 +235,7 @@ pub fn compare(
     };
 
     let mut rows = Vec::new();
+    let mut images = Vec::new();
     let pb = progress::bar(filters.len() as u64, "filters");
     for &filter in filters {
         pb.set_message(filter.name());
@@ -242,9 +255,23 @@ pub fn compare(
         row.ms_per_frame = Some(median(&mut times.draw_ms));
         row.texture_bytes = Some(bytes);
         rows.push(row);
+        if orbit.is_some() {
+            images.push(image);
+        }
         pb.inc(1);
     }
     pb.finish_and_clear();
+    let orbit = match orbit {
+        Some(spec) => Some(orbit_scores(
+            scene,
+            filters,
+            spp,
+            spec,
+            (&scoring, images),
+            &mut rows,
+        )?),
+        None => None,
+    };
 
     for (label, frame, ms) in &extras.frames {
         let image = Image8::from_linear(w, h, &frame.color, enc)?;
@@ -285,9 +312,66 @@ pub fn compare(
         band_rows: scoring.band_rows,
         heat_map_max: HEAT_MAP_MAX,
         rows,
+        orbit,
     };
     report.write(dir)?;
     Ok(report)
+}
+
+/// Render the rest of an orbit (frames 1 to `frames - 1`; frame 0 is the comparison's own, its
+/// reference in `scoring` and its images in `images`, one per filter) and set each filter row's
+/// [`FilterRow::flicker`] ([`excess_change`] averaged over consecutive pairs) and
+/// [`FilterRow::psnr_orbit`]. Change is measured over the pixels the reference covers in both
+/// frames of a pair.
+fn orbit_scores(
+    scene: &PreparedScene,
+    filters: &[Filter],
+    spp: u32,
+    spec: OrbitSpec,
+    (scoring, images): (&Scoring, Vec<Image8>),
+    rows: &mut [FilterRow],
+) -> Result<Orbit> {
+    let enc = encoding(scene.color);
+    let settings = scene.settings();
+    let (w, h) = (settings.width, settings.height);
+    let mut prev_ref = scoring.reference.clone();
+    let mut prev_cov = scoring.coverage.clone();
+    let mut prev = images;
+    let mut ref_change = 0.0;
+    let mut change = vec![0.0; filters.len()];
+    let mut psnr_sum: Vec<f64> = rows.iter().map(|r| r.psnr_all).collect();
+    for k in 1..spec.frames {
+        eprintln!("orbit frame {k} of {}", spec.frames - 1);
+        let camera = scene.scene.camera.orbited(spec.step_deg * k as f32);
+        let reference = reference_frame_from(scene, spp, &camera)?;
+        let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
+        let coverage = Mask::new(w, h, reference.coverage)?;
+        ref_change += mean_abs_change(&prev_ref, &ref_image, &prev_cov, &coverage)?;
+        for (i, &filter) in filters.iter().enumerate() {
+            let samplers = scene.samplers(filter)?;
+            let frame = render(&settings, &scene.draws_from(&samplers, &camera))?;
+            let image = Image8::from_linear(w, h, &frame.color, enc)?;
+            change[i] += excess_change(
+                [&prev[i], &image],
+                [&prev_ref, &ref_image],
+                [&prev_cov, &coverage],
+            )?;
+            psnr_sum[i] += psnr(&ref_image, &image, Some(&coverage))?;
+            prev[i] = image;
+        }
+        (prev_ref, prev_cov) = (ref_image, coverage);
+    }
+    let pairs = f64::from(spec.frames - 1);
+    let reference_flicker = ref_change / pairs;
+    for (i, row) in rows.iter_mut().take(filters.len()).enumerate() {
+        row.flicker = Some(change[i] / pairs);
+        row.psnr_orbit = Some(psnr_sum[i] / f64::from(spec.frames));
+    }
+    Ok(Orbit {
+        frames: spec.frames,
+        step_deg: spec.step_deg,
+        reference_flicker,
+    })
 }
 
 /// Mean texels read over covered pixels, and the maximum.
@@ -334,6 +418,17 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         "the comparison's reference and images",
         u64::from(scene.width) * u64::from(scene.height) * per_pixel,
     )?;
+    let orbit = args.orbit.map(|frames| OrbitSpec {
+        frames,
+        step_deg: args.orbit_step,
+    });
+    if orbit.is_some() {
+        // The previous frame's 8-bit images (reference and one per filter) and coverage.
+        input.budget.take(
+            "the orbit's previous frames",
+            u64::from(scene.width) * u64::from(scene.height) * (4 * filters.len() as u64 + 5),
+        )?;
+    }
     let report = publish_dir(&args.out, |dir| {
         compare(
             &scene,
@@ -341,6 +436,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
             &filters,
             args.spp,
             &extras,
+            orbit,
             dir,
             &mut input.budget,
         )

@@ -49,6 +49,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
                 &Filter::ALL,
                 args.spp,
                 &Extras::default(),
+                None,
                 &sub,
                 &mut scene_input.budget,
             )?;

@@ -25,10 +25,19 @@ pub fn strata(spp: u32) -> (u32, u32) {
 
 /// Render the reference of a prepared scene, with a progress bar on a terminal.
 pub fn reference_frame(scene: &PreparedScene, spp: u32) -> Result<texel_raster::Frame> {
+    reference_frame_from(scene, spp, &scene.scene.camera)
+}
+
+/// [`reference_frame`] seen by `camera` instead of the scene's.
+pub fn reference_frame_from(
+    scene: &PreparedScene,
+    spp: u32,
+    camera: &texel_scene::Camera,
+) -> Result<texel_raster::Frame> {
     // The reference samples level 0 bilinearly with each mesh's address modes; the filter only
     // supplies those.
     let samplers = scene.samplers(Filter::Bilinear)?;
-    let draws = scene.draws(&samplers);
+    let draws = scene.draws_from(&samplers, camera);
     let settings = scene.settings();
     let (n, m) = strata(spp);
     let pb = progress::bar(1000, "reference");

@@ -11,7 +11,7 @@
 //! Rows with infinite PSNR (identical to the reference) cannot be placed and are listed under it.
 
 use crate::heatmap::legend_svg;
-use crate::report::{fmt_psnr, row_cells, Report, TABLE_HEADER};
+use crate::report::{fmt_psnr, row_cells, table_header, Report};
 
 /// Escape text for HTML/SVG text and attribute values: `& < > " '`.
 pub fn escape(s: &str) -> String {
@@ -257,13 +257,14 @@ impl Report {
             self.band_rows
         );
         s += "<table>\n<tr>";
-        for h in TABLE_HEADER {
+        let orbit = self.orbit.is_some();
+        for h in table_header(orbit) {
             s += &format!("<th>{}</th>", escape(h));
         }
         s += "</tr>\n";
         for r in &self.rows {
             s += "<tr>";
-            for c in row_cells(r) {
+            for c in row_cells(r, orbit) {
                 s += &format!("<td>{}</td>", escape(&c));
             }
             s += "</tr>\n";

@@ -38,6 +38,24 @@ pub struct Report {
     pub heat_map_max: f32,
     /// One row per filter, then the external images.
     pub rows: Vec<FilterRow>,
+    /// The camera orbit the rows' flicker and orbit PSNR were measured over (`--orbit`).
+    #[serde(default)]
+    pub orbit: Option<Orbit>,
+}
+
+/// A slow camera orbit (`texel compare --orbit N`): the scene's camera turned about its up axis
+/// through the target by `step_deg` per frame, `frames` frames from the scene's own view.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Orbit {
+    /// Frames, the scene's own view first.
+    pub frames: u32,
+    /// Degrees turned per frame.
+    pub step_deg: f32,
+    /// The reference's own frame-to-frame change ([`crate::mean_abs_change`] between consecutive
+    /// frames, averaged): the change that motion causes, which the rows' flicker figures exclude
+    /// pixel by pixel.
+    pub reference_flicker: f64,
 }
 
 /// One filter's (or one external image's) results.
@@ -74,6 +92,14 @@ pub struct FilterRow {
     /// The enlarged horizon crop's file name.
     #[serde(default)]
     pub horizon_crop: Option<String>,
+    /// With an orbit: the frame-to-frame change less the reference's, per pixel, as a mean
+    /// absolute value in 8-bit units ([`crate::excess_change`]), averaged over the orbit's
+    /// consecutive pairs ([`Orbit`]). 0: it changes exactly as the reference does.
+    #[serde(default)]
+    pub flicker: Option<f64>,
+    /// With an orbit: PSNR over the covered pixels averaged over the orbit's frames.
+    #[serde(default)]
+    pub psnr_orbit: Option<f64>,
 }
 
 impl FilterRow {
@@ -93,6 +119,8 @@ impl FilterRow {
             image: image.into(),
             heat_map: None,
             horizon_crop: None,
+            flicker: None,
+            psnr_orbit: None,
         }
     }
 }
@@ -144,9 +172,10 @@ pub(crate) fn fmt_opt<T>(v: Option<T>, f: impl Fn(T) -> String) -> String {
     v.map_or_else(|| "-".to_string(), f)
 }
 
-/// The table's cells for one row, in [`TABLE_HEADER`] order.
-pub(crate) fn row_cells(r: &FilterRow) -> [String; 8] {
-    [
+/// The table's cells for one row, in [`table_header`] order (with the orbit's columns when
+/// `orbit`).
+pub(crate) fn row_cells(r: &FilterRow, orbit: bool) -> Vec<String> {
+    let mut cells = vec![
         if r.extra {
             format!("{} (extra)", r.name)
         } else {
@@ -159,11 +188,25 @@ pub(crate) fn row_cells(r: &FilterRow) -> [String; 8] {
         fmt_opt(r.texels_per_pixel_max, |v| v.to_string()),
         fmt_opt(r.ms_per_frame, |v| format!("{v:.2}")),
         fmt_opt(r.texture_bytes, |v| v.to_string()),
-    ]
+    ];
+    if orbit {
+        cells.push(fmt_opt(r.psnr_orbit, fmt_psnr));
+        cells.push(fmt_opt(r.flicker, |v| format!("{v:.2}")));
+    }
+    cells
 }
 
-/// Column headers of the report table.
-pub(crate) const TABLE_HEADER: [&str; 8] = [
+/// Column headers of the report table, with the orbit's when `orbit`.
+pub(crate) fn table_header(orbit: bool) -> Vec<&'static str> {
+    let mut h = TABLE_HEADER.to_vec();
+    if orbit {
+        h.extend(["PSNR orbit (dB)", "flicker"]);
+    }
+    h
+}
+
+/// Column headers of the report table without an orbit.
+const TABLE_HEADER: [&str; 8] = [
     "filter",
     "PSNR all (dB)",
     "PSNR band (dB)",
@@ -210,10 +253,21 @@ impl Report {
             md_cell(&self.color),
             self.band_rows
         );
-        s += &format!("| {} |\n", TABLE_HEADER.join(" | "));
-        s += "|---|--:|--:|--:|--:|--:|--:|--:|\n";
+        let orbit = self.orbit.is_some();
+        if let Some(o) = &self.orbit {
+            s += &format!(
+                "Orbit: {} frames, {} degrees per frame about the camera's up axis through its \
+                 target. PSNR orbit is the mean over the frames; flicker is the change between \
+                 consecutive frames less the reference's change, pixel by pixel, as a mean absolute \
+                 value (8-bit units; the reference's own change is {:.2}).\n\n",
+                o.frames, o.step_deg, o.reference_flicker
+            );
+        }
+        let header = table_header(orbit);
+        s += &format!("| {} |\n", header.join(" | "));
+        s += &format!("|---{}|\n", "|--:".repeat(header.len() - 1));
         for r in &self.rows {
-            let cells = row_cells(r).map(|c| md_cell(&c));
+            let cells: Vec<String> = row_cells(r, orbit).iter().map(|c| md_cell(c)).collect();
             s += &format!("| {} |\n", cells.join(" | "));
         }
         s
@@ -280,7 +334,41 @@ pub(crate) mod tests {
             band_rows: 18,
             heat_map_max: 32.0,
             rows: vec![near, tri, same, extra],
+            orbit: None,
         }
+    }
+
+    #[test]
+    fn an_orbit_adds_its_columns_and_round_trips() {
+        let mut r = sample();
+        assert!(!r.to_markdown().contains("flicker"));
+        r.orbit = Some(Orbit {
+            frames: 8,
+            step_deg: 0.1,
+            reference_flicker: 1.25,
+        });
+        r.rows[0].flicker = Some(3.5);
+        r.rows[0].psnr_orbit = Some(14.25);
+        let md = r.to_markdown();
+        assert!(md.contains("| PSNR orbit (dB) | flicker |"), "{md}");
+        assert!(md.contains("| 14.25 | 3.50 |"), "{md}");
+        assert!(md.contains("the reference's own change is 1.25"), "{md}");
+        // Rows without the figures (extras) show dashes; every row has the header's cell count.
+        let header_cells = md
+            .lines()
+            .find(|l| l.starts_with("| filter"))
+            .unwrap()
+            .matches('|')
+            .count();
+        for line in md.lines().filter(|l| l.starts_with("| ")) {
+            assert_eq!(
+                line.matches('|').count() - line.matches("\\|").count(),
+                header_cells,
+                "{line}"
+            );
+        }
+        assert!(r.to_html().contains("<th>flicker</th>"));
+        assert_eq!(Report::from_json(&r.to_json()).unwrap(), r);
     }
 
     #[test]

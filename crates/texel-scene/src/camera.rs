@@ -35,6 +35,20 @@ impl Camera {
     pub fn clip_from_world(&self, aspect: f32) -> Mat4 {
         self.clip_from_view(aspect) * self.view_from_world()
     }
+
+    /// The camera orbited by `degrees` about the `up` axis through the target (counter-clockwise
+    /// seen from above): the eye keeps its height and distance, and still looks at the target.
+    /// Unchanged when `up` is zero or not finite.
+    pub fn orbited(&self, degrees: f32) -> Camera {
+        let Some(axis) = self.up.try_normalize() else {
+            return *self;
+        };
+        let r = glam::Quat::from_axis_angle(axis, degrees.to_radians());
+        Camera {
+            eye: self.target + r * (self.eye - self.target),
+            ..*self
+        }
+    }
 }
 
 #[cfg(test)]
@@ -65,6 +79,33 @@ mod tests {
         // w is the distance along the view direction.
         let c = m * (cam.eye + dir * 7.0).extend(1.0);
         assert!((c.w - 7.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn an_orbit_keeps_height_distance_and_target() {
+        let cam = Camera {
+            eye: Vec3::new(0.0, 1.0, 0.0),
+            target: Vec3::new(0.0, 0.75, -10.0),
+            up: Vec3::Y,
+            fovy_deg: 50.0,
+            near: 0.05,
+            far: 100.0,
+        };
+        let o = cam.orbited(90.0);
+        // A quarter turn about +y through the target takes the eye from +z of it to +x of it.
+        assert!(
+            (o.eye - Vec3::new(10.0, 1.0, -10.0)).length() < 1e-4,
+            "{}",
+            o.eye
+        );
+        assert_eq!(
+            (o.target, o.up, o.fovy_deg),
+            (cam.target, cam.up, cam.fovy_deg)
+        );
+        let small = cam.orbited(0.1);
+        assert!(((small.eye - cam.target).length() - (cam.eye - cam.target).length()).abs() < 1e-5);
+        assert_eq!(small.eye.y, 1.0);
+        assert_eq!(cam.orbited(0.0), cam);
     }
 
     #[test]

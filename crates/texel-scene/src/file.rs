@@ -11,10 +11,10 @@
 //! near = 0.05
 //! far = 2000.0
 //! [textures.checker]            # path = "file.png" (relative to the scene file) or
-//! procedural = "checker"        # procedural = checker | zoneplate | grid | uv | solid | bumps;
-//! size = 1024                   # color = "srgb" (default) | "linear"; see `Procedural` for each
-//! checks = 8                    # kind's parameters (size or width + height, checks, cells,
-//! color = "srgb"                # line_width, rgba)
+//! procedural = "checker"        # procedural = checker | zoneplate | grid | uv | solid | bumps |
+//! size = 1024                   # waves | wave-heights; color = "srgb" (default) | "linear"; see
+//! checks = 8                    # `Procedural` for each kind's parameters (size or width +
+//! color = "srgb"                # height, checks, cells, line_width, rgba, slope, waves, seed)
 //! [[meshes]]                    # texture = NAME; address_mode (both axes), address_mode_u/_v:
 //! texture = "checker"           # repeat | mirror-repeat | clamp-to-edge | clamp-to-border |
 //! address_mode = "repeat"       # mirror-clamp-to-edge (default repeat, or the glTF sampler's)
@@ -222,7 +222,7 @@ struct RawCamera {
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
-#[serde(rename_all = "lowercase")]
+#[serde(rename_all = "kebab-case")]
 enum Kind {
     Checker,
     Zoneplate,
@@ -230,6 +230,8 @@ enum Kind {
     Uv,
     Solid,
     Bumps,
+    Waves,
+    WaveHeights,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -253,6 +255,24 @@ struct RawTexture {
     line_width: Option<f32>,
     rgba: Option<[u8; 4]>,
     slope: Option<f32>,
+    waves: Option<u32>,
+    seed: Option<u32>,
+}
+
+impl Kind {
+    /// The name scene files use.
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Checker => "checker",
+            Kind::Zoneplate => "zoneplate",
+            Kind::Grid => "grid",
+            Kind::Uv => "uv",
+            Kind::Solid => "solid",
+            Kind::Bumps => "bumps",
+            Kind::Waves => "waves",
+            Kind::WaveHeights => "wave-heights",
+        }
+    }
 }
 
 /// Address mode names in scene files (kebab-case WebGPU names).
@@ -322,6 +342,8 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
         ("line_width", t.line_width.is_some()),
         ("rgba", t.rgba.is_some()),
         ("slope", t.slope.is_some()),
+        ("waves", t.waves.is_some()),
+        ("seed", t.seed.is_some()),
     ]
     .iter()
     .filter(|p| p.1)
@@ -346,11 +368,12 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Uv => &["size", "width", "height"],
                 Kind::Solid => &["size", "width", "height", "rgba"],
                 Kind::Bumps => &["size", "cells", "slope"],
+                Kind::Waves | Kind::WaveHeights => &["size", "waves", "cells", "slope", "seed"],
             };
             if let Some(k) = given.iter().find(|k| !allowed.contains(k)) {
                 return Err(bad(format!(
                     "{k} is not a parameter of {} (it takes {})",
-                    format!("{kind:?}").to_lowercase(),
+                    kind.name(),
                     allowed.join(", ")
                 )));
             }
@@ -358,7 +381,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Checker | Kind::Zoneplate | Kind::Grid => 1024,
                 Kind::Uv => 256,
                 Kind::Solid => 1,
-                Kind::Bumps => 512,
+                Kind::Bumps | Kind::Waves | Kind::WaveHeights => 512,
             };
             let (width, height) = match (t.size, t.width, t.height) {
                 (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
@@ -368,6 +391,10 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 (None, Some(w), Some(h)) => (w, h),
                 (None, None, None) => (default_size, default_size),
                 _ => return Err(bad("width and height go together".into())),
+            };
+            let slope = |v: Option<f32>, default: f32| match v.unwrap_or(default) {
+                s if s.is_finite() && s >= 0.0 => Ok(s),
+                s => Err(bad(format!("slope = {s} must be finite and >= 0"))),
             };
             let positive = |v: Option<u32>, key: &str, default: u32| match v {
                 Some(0) => Err(bad(format!("{key} must be at least 1"))),
@@ -396,17 +423,19 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                     }
                 }
                 Kind::Uv => Procedural::Uv { width, height },
-                Kind::Bumps => {
-                    let slope = t.slope.unwrap_or(0.5);
-                    if !(slope.is_finite() && slope >= 0.0) {
-                        return Err(bad(format!("slope = {slope} must be finite and >= 0")));
-                    }
-                    Procedural::Bumps {
-                        size: width,
-                        cells: positive(t.cells, "cells", 32)?,
-                        slope,
-                    }
-                }
+                Kind::Bumps => Procedural::Bumps {
+                    size: width,
+                    cells: positive(t.cells, "cells", 32)?,
+                    slope: slope(t.slope, 0.5)?,
+                },
+                Kind::Waves | Kind::WaveHeights => Procedural::Waves {
+                    size: width,
+                    waves: positive(t.waves, "waves", 64)?,
+                    cells: positive(t.cells, "cells", 32)?,
+                    slope: slope(t.slope, 0.3)?,
+                    seed: t.seed.unwrap_or(1),
+                    heights: matches!(kind, Kind::WaveHeights),
+                },
                 Kind::Solid => Procedural::Solid {
                     width,
                     height,

@@ -1,4 +1,5 @@
-//! Procedural textures: checker, zone plate, grid, uv and solid.
+//! Procedural textures: checker, zone plate, grid, uv, solid, and the bump and wave normal and
+//! height maps.
 //!
 //! Each generator gives the 8-bit code of every texel (`code(i, j)`, row 0 at the top); the texture
 //! is then made with `Texture::from_rgba8` and the spec's colour space, so `color = "srgb"` decodes
@@ -67,6 +68,34 @@ pub enum Procedural {
         /// Steepest slope (rise over run, `>= 0`, finite).
         slope: f32,
     },
+    /// Random waves (use with `color = "linear"`): the height field
+    /// `h(x, y) = sum_k a_k sin(2 pi (m_k x + n_k y) / size + phi_k)` of `waves` sinusoids, with
+    /// integer wave numbers `(m_k, n_k)` (so it tiles) drawn uniformly from the ring
+    /// `cells / 2 <= |(m, n)| <= cells` and phases `phi_k` uniform, from a SplitMix64 stream
+    /// seeded by `seed`; `a_k = 1 / |(m_k, n_k)|` gives every wave the same steepest slope, and
+    /// the whole is scaled so the root-mean-square slope `sqrt(E[|grad h|^2])` (per texel) is
+    /// `slope`. Being a sum of many independent waves, its slopes are close to Gaussian, the
+    /// distribution LEAN and Toksvig assume, and it has no period shorter than the texture to
+    /// beat against the pixel grid. `heights = false` (`"waves"`): the tangent-space normal map,
+    /// coded as [`Procedural::Bumps`]'s; `heights = true` (`"wave-heights"`): the heights,
+    /// `code = round(255 (0.5 + h / (8 sigma)))` clamped, `sigma` the heights' standard
+    /// deviation (so +-4 sigma fill the range; the slope of the coded map is then
+    /// `slope / (8 sigma)` per texel in map units). Square; `size = 512`, `waves = 64`,
+    /// `cells = 32`, `slope = 0.3`, `seed = 1` by default.
+    Waves {
+        /// Side in texels.
+        size: u32,
+        /// Number of sinusoids (`>= 1`).
+        waves: u32,
+        /// Largest wave number, cycles per texture side (`>= 1`).
+        cells: u32,
+        /// Root-mean-square slope (rise over run, `>= 0`, finite).
+        slope: f32,
+        /// Seed of the random waves.
+        seed: u32,
+        /// Heights instead of normals.
+        heights: bool,
+    },
     /// One colour everywhere (8-bit codes, `rgba = [255, 255, 255, 255]` and `size = 1` by default).
     Solid {
         /// Width in texels.
@@ -86,7 +115,9 @@ impl Procedural {
             | Procedural::Grid { width, height, .. }
             | Procedural::Uv { width, height }
             | Procedural::Solid { width, height, .. } => (width, height),
-            Procedural::ZonePlate { size } | Procedural::Bumps { size, .. } => (size, size),
+            Procedural::ZonePlate { size }
+            | Procedural::Bumps { size, .. }
+            | Procedural::Waves { size, .. } => (size, size),
         }
     }
 
@@ -127,8 +158,48 @@ impl Procedural {
                 let enc = |c: f64| (255.0 * (c + 1.0) / 2.0).round().clamp(0.0, 255.0) as u8;
                 [enc(n[0]), enc(n[1]), enc(n[2]), 255]
             }
+            Procedural::Waves { .. } => (self.coder())(i, j),
             Procedural::Solid { rgba, .. } => rgba,
         }
+    }
+
+    /// The code of every texel as a function: [`Procedural::code`], with the wave set of
+    /// [`Procedural::Waves`] drawn once instead of per texel.
+    fn coder(&self) -> Box<dyn Fn(u32, u32) -> [u8; 4] + '_> {
+        let Procedural::Waves {
+            size,
+            waves,
+            cells,
+            slope,
+            seed,
+            heights,
+        } = *self
+        else {
+            return Box::new(|i, j| self.code(i, j));
+        };
+        let set = wave_set(size, waves, cells, slope, seed);
+        let enc = |c: f64| (255.0 * (c + 1.0) / 2.0).round().clamp(0.0, 255.0) as u8;
+        Box::new(move |i, j| {
+            let (x, y) = (f64::from(i) + 0.5, f64::from(j) + 0.5);
+            let (mut h, mut gx, mut gy) = (0.0, 0.0, 0.0);
+            for w in &set.waves {
+                let t = w.kx * x + w.ky * y + w.phase;
+                h += w.amplitude * t.sin();
+                let c = w.amplitude * t.cos();
+                gx += c * w.kx;
+                gy += c * w.ky;
+            }
+            if heights {
+                let v = (255.0 * (0.5 + h / (8.0 * set.sigma)))
+                    .round()
+                    .clamp(0.0, 255.0) as u8;
+                [v, v, v, 255]
+            } else {
+                let n = [-gx, gy, 1.0];
+                let len = (gx * gx + gy * gy + 1.0).sqrt();
+                [enc(n[0] / len), enc(n[1] / len), enc(n[2] / len), 255]
+            }
+        })
     }
 
     /// The unit tangent-space normal of [`Procedural::Bumps`] at texel `(i, j)` (`+y` up the image).
@@ -156,12 +227,69 @@ impl Procedural {
             ColorSpace::Linear => Format::Rgba8Unorm,
         };
         limits.check(w, h, format)?;
+        let code = self.coder();
         let texels = (0..h)
             .flat_map(|j| (0..w).map(move |i| (i, j)))
-            .map(|(i, j)| self.code(i, j))
+            .map(|(i, j)| code(i, j))
             .collect();
         Texture::from_rgba8(w, h, texels, color, limits)
     }
+}
+
+/// One sinusoid of [`Procedural::Waves`], in texel units: `amplitude sin(kx x + ky y + phase)`.
+#[derive(Clone, Copy, Debug)]
+struct Wave {
+    kx: f64,
+    ky: f64,
+    phase: f64,
+    amplitude: f64,
+}
+
+/// The waves of [`Procedural::Waves`], scaled to the slope asked, and the heights' standard
+/// deviation.
+struct WaveSet {
+    waves: Vec<Wave>,
+    sigma: f64,
+}
+
+fn wave_set(size: u32, count: u32, cells: u32, slope: f32, seed: u32) -> WaveSet {
+    use std::f64::consts::TAU;
+    let mut rng = texel_texture::rng::SplitMix64::new(u64::from(seed));
+    let (lo, hi) = (f64::from(cells) / 2.0, f64::from(cells).max(1.0));
+    let span = hi.ceil() as i64;
+    let mut waves = Vec::with_capacity(count as usize);
+    while waves.len() < count as usize {
+        // Uniform over the ring's integer points by rejection from the bounding square.
+        let m = (rng.next_f64() * (2 * span + 1) as f64).floor() as i64 - span;
+        let n = (rng.next_f64() * (2 * span + 1) as f64).floor() as i64 - span;
+        let r = ((m * m + n * n) as f64).sqrt();
+        if r == 0.0 || r < lo || r > hi {
+            continue;
+        }
+        let k = TAU / f64::from(size);
+        waves.push(Wave {
+            kx: k * m as f64,
+            ky: k * n as f64,
+            phase: rng.next_f64() * TAU,
+            amplitude: 1.0 / r,
+        });
+    }
+    // Each wave's gradient has mean square (a |k|)^2 / 2; the waves are independent.
+    let mean_square: f64 = waves
+        .iter()
+        .map(|w| w.amplitude * w.amplitude * (w.kx * w.kx + w.ky * w.ky) / 2.0)
+        .sum();
+    let scale = f64::from(slope) / mean_square.sqrt();
+    for w in &mut waves {
+        w.amplitude *= scale;
+    }
+    let sigma = waves
+        .iter()
+        .map(|w| w.amplitude * w.amplitude / 2.0)
+        .sum::<f64>()
+        .sqrt()
+        .max(f64::MIN_POSITIVE);
+    WaveSet { waves, sigma }
 }
 
 #[cfg(test)]
@@ -206,6 +334,64 @@ mod tests {
         // Local frequency at the edge: phase step between (63, 32) and (62, 32) is about pi.
         let phase = |i: f64| std::f64::consts::PI * ((i + 0.5 - 32.0).powi(2) + 0.25) / 64.0;
         assert!((phase(63.0) - phase(62.0) - std::f64::consts::PI * 62.0 / 64.0).abs() < 1e-12);
+    }
+
+    /// The waves' slopes have the root-mean-square asked (measured over the texels, from the
+    /// decoded normals), the map tiles, and the heights use the range as documented.
+    #[test]
+    fn waves_have_the_slope_asked_and_tile() {
+        use std::f64::consts::TAU;
+        let p = Procedural::Waves {
+            size: 128,
+            waves: 48,
+            cells: 12,
+            slope: 0.3,
+            seed: 7,
+            heights: false,
+        };
+        let code = p.coder();
+        let mut sum = 0.0;
+        for j in 0..128 {
+            for i in 0..128 {
+                let c = code(i, j).map(|c| f64::from(c) / 255.0 * 2.0 - 1.0);
+                let (sx, sy) = (c[0] / c[2], c[1] / c[2]);
+                sum += sx * sx + sy * sy;
+            }
+        }
+        let rms = (sum / (128.0 * 128.0)).sqrt();
+        // Quantisation and the finite texel sample: within 5%.
+        assert!((rms - 0.3).abs() < 0.015, "rms slope {rms}");
+        let set = wave_set(128, 48, 12, 0.3, 7);
+        // Integer wave numbers (a whole texture later the phase is the same) in the ring.
+        for w in &set.waves {
+            let (m, n) = (w.kx * 128.0 / TAU, w.ky * 128.0 / TAU);
+            assert!((m - m.round()).abs() < 1e-9 && (n - n.round()).abs() < 1e-9);
+            assert!((6.0..=12.0).contains(&m.hypot(n)), "({m}, {n})");
+        }
+        let heights = Procedural::Waves {
+            size: 128,
+            waves: 48,
+            cells: 12,
+            slope: 0.3,
+            seed: 7,
+            heights: true,
+        };
+        let mean = (0..128)
+            .flat_map(|j| (0..128).map(move |i| (i, j)))
+            .map(|(i, j)| f64::from(heights.code(i, j)[0]))
+            .sum::<f64>()
+            / (128.0 * 128.0);
+        assert!((mean - 127.5).abs() < 8.0, "mean code {mean}");
+        // Another seed, other waves.
+        let other = Procedural::Waves {
+            size: 128,
+            waves: 48,
+            cells: 12,
+            slope: 0.3,
+            seed: 8,
+            heights: false,
+        };
+        assert_ne!(other.code(3, 5), p.code(3, 5));
     }
 
     #[test]

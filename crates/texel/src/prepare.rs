@@ -282,10 +282,20 @@ impl PreparedScene {
         self.build_structures(samplers)
     }
 
-    /// The draw calls of the whole scene with `samplers` (one per mesh).
+    /// The draw calls of the whole scene with `samplers` (one per mesh), seen by the scene's
+    /// camera.
     pub fn draws<'a>(&'a self, samplers: &'a [Sampler]) -> Vec<DrawCall<'a>> {
+        self.draws_from(samplers, &self.scene.camera)
+    }
+
+    /// [`PreparedScene::draws`] seen by `camera` instead (an orbit, the viewer's fly camera).
+    pub fn draws_from<'a>(
+        &'a self,
+        samplers: &'a [Sampler],
+        camera: &texel_scene::Camera,
+    ) -> Vec<DrawCall<'a>> {
         let aspect = self.width as f32 / self.height as f32;
-        let clip_from_world = self.scene.camera.clip_from_world(aspect);
+        let clip_from_world = camera.clip_from_world(aspect);
         self.scene
             .meshes
             .iter()
