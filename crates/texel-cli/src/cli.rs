@@ -119,7 +119,7 @@ pub enum ViewArg {
 #[derive(Debug, Args)]
 pub struct SceneArgs {
     /// Scene file (TOML) or built-in scene (builtin:ground, builtin:ground-rotated, builtin:zoneplate,
-    /// builtin:cube, builtin:sphere, builtin:triangle, builtin:glossy).
+    /// builtin:cube, builtin:sphere, builtin:triangle, builtin:glossy, builtin:bricks).
     #[arg(default_value = "builtin:ground")]
     pub scene: String,
     /// Colour handling.
@@ -137,6 +137,23 @@ pub struct SceneArgs {
     /// without a height map are unaffected).
     #[arg(long, value_enum)]
     pub displacement: Option<DisplacementArg>,
+    /// With displacement = tessellate: the longest projected edge kept, in pixels (0.25 to 256;
+    /// default 4).
+    #[arg(long, value_name = "PX", value_parser = parse_edge_px)]
+    pub edge_px: Option<f32>,
+}
+
+/// `--edge-px`: a finite number of pixels in `[0.25, 256]`.
+fn parse_edge_px(s: &str) -> Result<f32, String> {
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number of pixels"))?;
+    if v.is_finite() && (0.25..=256.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{s} pixels per edge is outside 0.25 to 256"))
+    }
 }
 
 /// How height maps shape the surface (see texel-raster's `Displacement`).
@@ -148,6 +165,9 @@ pub enum DisplacementArg {
     Bump,
     /// Parallax occlusion mapping (Tatarchuk 2006): the view ray marched through the heights.
     Pom,
+    /// True displacement: the mesh tessellated to --edge-px and its vertices moved by the
+    /// heights, filtered to the edge length.
+    Tessellate,
 }
 
 impl From<DisplacementArg> for texel_scene::Displacement {
@@ -156,6 +176,7 @@ impl From<DisplacementArg> for texel_scene::Displacement {
             DisplacementArg::None => texel_scene::Displacement::None,
             DisplacementArg::Bump => texel_scene::Displacement::Bump,
             DisplacementArg::Pom => texel_scene::Displacement::Pom,
+            DisplacementArg::Tessellate => texel_scene::Displacement::Tessellate,
         }
     }
 }

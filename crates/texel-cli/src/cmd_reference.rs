@@ -37,7 +37,7 @@ pub fn reference_frame_from(
     // The reference samples level 0 bilinearly with each mesh's address modes; the filter only
     // supplies those.
     let samplers = scene.samplers(Filter::Bilinear)?;
-    let draws = scene.draws_from(&samplers, camera);
+    let draws = scene.reference_draws_from(&samplers, camera)?;
     let settings = scene.settings();
     let (n, m) = strata(spp);
     let pb = progress::bar(1000, "reference");

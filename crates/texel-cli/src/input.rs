@@ -101,12 +101,14 @@ pub fn load_scene(args: &SceneArgs, input: &mut Input) -> Result<PreparedScene> 
 }
 
 /// What the CLI overrides in every material (`--specular-aa`, `--displacement`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct MaterialOverrides {
     /// `--specular-aa`.
     pub specular_aa: Option<SpecularAa>,
     /// `--displacement`.
     pub displacement: Option<texel_scene::Displacement>,
+    /// `--edge-px`.
+    pub edge_px: Option<f32>,
 }
 
 impl MaterialOverrides {
@@ -115,6 +117,7 @@ impl MaterialOverrides {
         MaterialOverrides {
             specular_aa: args.specular_aa.map(SpecularAaArg::into),
             displacement: args.displacement.map(Into::into),
+            edge_px: args.edge_px,
         }
     }
 }
@@ -148,6 +151,7 @@ pub fn load_scene_with(
         replace_non_finite: input.sanitize,
         specular_aa: overrides.specular_aa,
         displacement: overrides.displacement,
+        edge_px: overrides.edge_px,
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;

@@ -189,27 +189,20 @@ pub(crate) fn shading_normal(
     let tex = height.input.texture;
     let du = bump_step(fp.dudx, fp.dudy, tex.width());
     let dv = bump_step(fp.dvdx, fp.dvdy, tex.height());
-    let h0 = channel(height, fp, count, texels);
-    let hu = channel(
-        height,
-        &Footprint {
+    // Central differences: pbrt's forward ones are centred half a step away, which shifts
+    // every slope (a bevel's shading) by a quarter of the footprint.
+    let at = |du: f32, dv: f32, texels: &mut u32| {
+        let fp = Footprint {
             u: fp.u + du,
-            ..*fp
-        },
-        count,
-        texels,
-    );
-    let hv = channel(
-        height,
-        &Footprint {
             v: fp.v + dv,
             ..*fp
-        },
-        count,
-        texels,
-    );
+        };
+        channel(height, &fp, count, texels)
+    };
+    let (hu0, hu1) = (at(-du / 2.0, 0.0, texels), at(du / 2.0, 0.0, texels));
+    let (hv0, hv1) = (at(0.0, -dv / 2.0, texels), at(0.0, dv / 2.0, texels));
     let s = m.height_scale;
-    let g = Vec2::new((hu - h0) / du, (hv - h0) / dv) * s;
+    let g = Vec2::new((hu1 - hu0) / du, (hv1 - hv0) / dv) * s;
     let normal = normal_from_gradient(a, b, n, g);
     let mut roughness = roughness;
     if let (SpecularAa::Lean | SpecularAa::Toksvig, Some(moments)) = (aa, m.height_moments) {

@@ -23,6 +23,8 @@ pub const ZONEPLATE_TOML: &str = include_str!("builtin/zoneplate.toml");
 pub const TRIANGLE_TOML: &str = include_str!("builtin/triangle.toml");
 /// The glossy normal-mapped plane's TOML.
 pub const GLOSSY_TOML: &str = include_str!("builtin/glossy.toml");
+/// The brick wall's TOML.
+pub const BRICKS_TOML: &str = include_str!("builtin/bricks.toml");
 
 /// Angle by which `ground-rotated` turns the ground's uvs, in degrees.
 pub const GROUND_ROTATION_DEG: f32 = 30.0;
@@ -48,9 +50,11 @@ pub fn builtin_names() -> &'static [&'static str] {
 
 /// Built-in scenes lit by lights and shaded with materials (`builtin:NAME` accepts them too):
 /// - `glossy`: a glossy plane, normal-mapped with bumps, receding to the horizon under a low
-///   light from the far side (specular aliasing).
+///   light from the far side (specular aliasing);
+/// - `bricks`: a brick wall with mortar joints as a height map (parallax occlusion mapping),
+///   seen along its length, from 50 degrees to grazing.
 pub fn shaded_builtin_names() -> &'static [&'static str] {
-    &["glossy"]
+    &["glossy", "bricks"]
 }
 
 fn from_toml(name: &str, text: &str) -> Result<Scene, SceneError> {
@@ -77,6 +81,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "zoneplate" => from_toml(name, ZONEPLATE_TOML),
         "triangle" => from_toml(name, TRIANGLE_TOML),
         "glossy" => from_toml(name, GLOSSY_TOML),
+        "bricks" => from_toml(name, BRICKS_TOML),
         "cube" => Ok(cube()),
         "sphere" => Ok(sphere()),
         _ => Err(SceneError::UnknownBuiltin {

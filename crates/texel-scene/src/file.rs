@@ -12,9 +12,10 @@
 //! far = 2000.0
 //! [textures.checker]            # path = "file.png" (relative to the scene file) or
 //! procedural = "checker"        # procedural = checker | zoneplate | grid | uv | solid | bumps |
-//! size = 1024                   # waves | wave-heights; color = "srgb" (default) | "linear"; see
-//! checks = 8                    # `Procedural` for each kind's parameters (size or width +
-//! color = "srgb"                # height, checks, cells, line_width, rgba, slope, waves, seed)
+//! size = 1024                   # waves | wave-heights | bricks | brick-heights; color = "srgb"
+//! checks = 8                    # (default) | "linear"; see `Procedural` for each kind's
+//! color = "srgb"                # parameters (size or width + height, checks, cells, line_width,
+//!                               # rgba, slope, waves, seed, rows, columns, mortar, bevel)
 //! [[meshes]]                    # texture = NAME; address_mode (both axes), address_mode_u/_v:
 //! texture = "checker"           # repeat | mirror-repeat | clamp-to-edge | clamp-to-border |
 //! address_mode = "repeat"       # mirror-clamp-to-edge (default repeat, or the glTF sampler's)
@@ -34,7 +35,7 @@
 //! normal = "bumps"              # specular_aa = "none" | "toksvig" | "lean" | "projected";
 //! specular_aa = "toksvig"       # height = "TEXTURE" (red, color = "linear"), height_scale
 //!                               # (world units, default 0.05), displacement = "none" | "bump" |
-//!                               # "pom" (| "tessellate" and layers: parsed, refused until built)
+//!                               # "pom" | "tessellate" (layers: parsed, refused until built)
 //! ```
 //!
 //! Every table denies unknown keys; a syntax or type error is reported with its line and column.
@@ -232,6 +233,8 @@ enum Kind {
     Bumps,
     Waves,
     WaveHeights,
+    Bricks,
+    BrickHeights,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -257,6 +260,10 @@ struct RawTexture {
     slope: Option<f32>,
     waves: Option<u32>,
     seed: Option<u32>,
+    rows: Option<u32>,
+    columns: Option<u32>,
+    mortar: Option<f32>,
+    bevel: Option<f32>,
 }
 
 impl Kind {
@@ -271,6 +278,8 @@ impl Kind {
             Kind::Bumps => "bumps",
             Kind::Waves => "waves",
             Kind::WaveHeights => "wave-heights",
+            Kind::Bricks => "bricks",
+            Kind::BrickHeights => "brick-heights",
         }
     }
 }
@@ -344,6 +353,10 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
         ("slope", t.slope.is_some()),
         ("waves", t.waves.is_some()),
         ("seed", t.seed.is_some()),
+        ("rows", t.rows.is_some()),
+        ("columns", t.columns.is_some()),
+        ("mortar", t.mortar.is_some()),
+        ("bevel", t.bevel.is_some()),
     ]
     .iter()
     .filter(|p| p.1)
@@ -369,6 +382,9 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Solid => &["size", "width", "height", "rgba"],
                 Kind::Bumps => &["size", "cells", "slope"],
                 Kind::Waves | Kind::WaveHeights => &["size", "waves", "cells", "slope", "seed"],
+                Kind::Bricks | Kind::BrickHeights => &[
+                    "size", "width", "height", "rows", "columns", "mortar", "bevel",
+                ],
             };
             if let Some(k) = given.iter().find(|k| !allowed.contains(k)) {
                 return Err(bad(format!(
@@ -382,6 +398,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Uv => 256,
                 Kind::Solid => 1,
                 Kind::Bumps | Kind::Waves | Kind::WaveHeights => 512,
+                Kind::Bricks | Kind::BrickHeights => 0,
             };
             let (width, height) = match (t.size, t.width, t.height) {
                 (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
@@ -389,6 +406,9 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 }
                 (Some(s), None, None) => (s, s),
                 (None, Some(w), Some(h)) => (w, h),
+                (None, None, None) if matches!(kind, Kind::Bricks | Kind::BrickHeights) => {
+                    (1024, 512)
+                }
                 (None, None, None) => (default_size, default_size),
                 _ => return Err(bad("width and height go together".into())),
             };
@@ -436,6 +456,22 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                     seed: t.seed.unwrap_or(1),
                     heights: matches!(kind, Kind::WaveHeights),
                 },
+                Kind::Bricks | Kind::BrickHeights => {
+                    let texels =
+                        |v: Option<f32>, key: &str, default: f32| match v.unwrap_or(default) {
+                            x if x.is_finite() && x >= 0.0 => Ok(x),
+                            x => Err(bad(format!("{key} = {x} must be finite and >= 0"))),
+                        };
+                    Procedural::Bricks {
+                        width,
+                        height,
+                        rows: positive(t.rows, "rows", 14)?,
+                        columns: positive(t.columns, "columns", 9)?,
+                        mortar: texels(t.mortar, "mortar", 4.0)?,
+                        bevel: texels(t.bevel, "bevel", 3.0)?,
+                        heights: matches!(kind, Kind::BrickHeights),
+                    }
+                }
                 Kind::Solid => Procedural::Solid {
                     width,
                     height,

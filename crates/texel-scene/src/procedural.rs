@@ -96,6 +96,31 @@ pub enum Procedural {
         /// Heights instead of normals.
         heights: bool,
     },
+    /// A running-bond brick wall, `rows` courses of `columns` bricks each, odd courses shifted by
+    /// half a brick (so `rows` even tiles vertically), with mortar joints `mortar` texels wide.
+    /// Texel `(i, j)` lies at `d` texels inside its brick's edge (negative in the mortar).
+    /// `heights = false` (`"bricks"`, sRGB): mortar `[176, 170, 160]`, bricks
+    /// `[150, 62, 46]` scaled by a per-brick factor in `[0.8, 1.1]` (a hash of the brick's course
+    /// and column); `heights = true` (`"brick-heights"`, use `color = "linear"`): 0 in the
+    /// mortar rising to 255 over `bevel` texels, `code = round(255 smoothstep(0, bevel, d))`.
+    /// `width = 1024`, `height = 512`, `rows = 14`, `columns = 9`, `mortar = 4`, `bevel = 3` by
+    /// default.
+    Bricks {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+        /// Courses (`>= 1`).
+        rows: u32,
+        /// Bricks per course (`>= 1`).
+        columns: u32,
+        /// Mortar joint width in texels (`>= 0`, finite).
+        mortar: f32,
+        /// Bevel width in texels (`>= 0`, finite).
+        bevel: f32,
+        /// Heights instead of colours.
+        heights: bool,
+    },
     /// One colour everywhere (8-bit codes, `rgba = [255, 255, 255, 255]` and `size = 1` by default).
     Solid {
         /// Width in texels.
@@ -114,6 +139,7 @@ impl Procedural {
             Procedural::Checker { width, height, .. }
             | Procedural::Grid { width, height, .. }
             | Procedural::Uv { width, height }
+            | Procedural::Bricks { width, height, .. }
             | Procedural::Solid { width, height, .. } => (width, height),
             Procedural::ZonePlate { size }
             | Procedural::Bumps { size, .. }
@@ -159,6 +185,42 @@ impl Procedural {
                 [enc(n[0]), enc(n[1]), enc(n[2]), 255]
             }
             Procedural::Waves { .. } => (self.coder())(i, j),
+            Procedural::Bricks {
+                width,
+                height,
+                rows,
+                columns,
+                mortar,
+                bevel,
+                heights,
+            } => {
+                let bh = f64::from(height) / f64::from(rows.max(1));
+                let bw = f64::from(width) / f64::from(columns.max(1));
+                let (x, y) = (f64::from(i) + 0.5, f64::from(j) + 0.5);
+                let row = (y / bh).floor();
+                let shifted = if row as u64 % 2 == 1 { x + bw / 2.0 } else { x };
+                let col = (shifted / bw).floor();
+                let (lx, ly) = (shifted - col * bw, y - row * bh);
+                let d = lx.min(bw - lx).min(ly).min(bh - ly) - f64::from(mortar) / 2.0;
+                if heights {
+                    let b = f64::from(bevel);
+                    let t = if b > 0.0 {
+                        (d / b).clamp(0.0, 1.0)
+                    } else {
+                        f64::from(u8::from(d >= 0.0))
+                    };
+                    grey((255.0 * t * t * (3.0 - 2.0 * t)).round() as u8)
+                } else if d < 0.0 {
+                    [176, 170, 160, 255]
+                } else {
+                    // Per-brick shade; the column wraps so the texture tiles.
+                    let c = (col as i64).rem_euclid(i64::from(columns.max(1))) as u64;
+                    let h = texel_texture::rng::mix64((row as u64) << 32 | c);
+                    let f = 0.8 + 0.3 * (h >> 11) as f64 / (1u64 << 53) as f64;
+                    let s = |v: f64| (v * f).round().clamp(0.0, 255.0) as u8;
+                    [s(150.0), s(62.0), s(46.0), 255]
+                }
+            }
             Procedural::Solid { rgba, .. } => rgba,
         }
     }
@@ -392,6 +454,34 @@ mod tests {
             heights: false,
         };
         assert_ne!(other.code(3, 5), p.code(3, 5));
+    }
+
+    #[test]
+    fn bricks_lay_in_running_bond_with_mortar_and_bevels() {
+        let b = |heights| Procedural::Bricks {
+            width: 64,
+            height: 32,
+            rows: 4,
+            columns: 4,
+            mortar: 2.0,
+            bevel: 2.0,
+            heights,
+        };
+        let (c, h) = (b(false), b(true));
+        // Bricks are 16 x 8 texels. Texel (0, 0) lies in the mortar (d = 0.5 - 1 < 0).
+        assert_eq!(c.code(0, 0), [176, 170, 160, 255]);
+        assert_eq!(h.code(0, 0)[0], 0);
+        // The middle of the first brick: d = 3.5 - 1 = 2.5 > bevel: full height, brick red.
+        assert_eq!(h.code(8, 4)[0], 255);
+        assert!(c.code(8, 4)[0] > c.code(8, 4)[1]);
+        // On the bevel: d = 1.5 - 1 = 0.5 of 2, smoothstep(0.25) = 0.15625.
+        assert_eq!(h.code(8, 1)[0], (255.0f64 * 0.15625).round() as u8);
+        // Course 1 is shifted by half a brick: its joint is at x = 8, course 0's at x = 0, 16.
+        assert_eq!(h.code(8, 12)[0], 0);
+        assert_eq!(h.code(16, 12)[0], 255);
+        // Tiles: the last column and the first share the shade pattern of one brick across the
+        // seam in the shifted course.
+        assert_eq!(c.code(63, 12), c.code(0, 12));
     }
 
     #[test]

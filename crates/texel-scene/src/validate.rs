@@ -278,15 +278,13 @@ impl Scene {
             )));
         }
         // Parsed so that scene files written for the full schema are read, refused until built.
-        let missing = if m.displacement == Displacement::Tessellate {
-            Some("displacement = \"tessellate\"")
-        } else if m.layers > 0 {
+        let missing = if m.layers > 0 {
             Some("layered materials")
         } else {
             None
         };
         if let Some(what) = missing {
-            return Err(bad(format!("{what} is not implemented yet")));
+            return Err(bad(format!("{what} are not implemented yet")));
         }
         Ok(())
     }

@@ -138,6 +138,7 @@ fn every_specular_aa_method_and_height_maps_parse() {
         ("none", Displacement::None),
         ("bump", Displacement::Bump),
         ("pom", Displacement::Pom),
+        ("tessellate", Displacement::Tessellate),
     ] {
         let s = parse(&format!(
             "[materials.m]\nbase_color = \"grey\"\nheight = \"rough\"\nheight_scale = 0.2\ndisplacement = \"{name}\"\n"
@@ -181,7 +182,7 @@ fn bad_lights_and_materials_are_refused_with_the_reason() {
             "height_scale = -0.1 must be at least 0",
         ),
         (
-            "[materials.m]\nbase_color = \"grey\"\ndisplacement = \"tessellate\"\nheight = \"rough\"\n",
+            "[materials.m]\nbase_color = \"grey\"\n[[materials.m.layers]]\nbase_color = \"grey\"\n",
             "not implemented yet",
         ),
         (

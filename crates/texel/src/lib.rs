@@ -30,6 +30,7 @@ mod error;
 mod filter;
 pub mod memory;
 mod prepare;
+pub mod tessellate;
 
 pub use texel_quality as quality;
 pub use texel_raster as raster;

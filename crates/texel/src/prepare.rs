@@ -3,7 +3,7 @@
 //! filter. The CLI, the examples and (later) the GPU path and the viewer all draw through this.
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 use texel_raster::{
     ChannelInput, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
@@ -14,6 +14,7 @@ use texel_texture::color::srgb_to_linear;
 use texel_texture::{ColorSpace, Limits, Sampler, Texture};
 
 use crate::memory::{raster_bytes, FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_BYTES};
+use crate::tessellate::Tessellated;
 use crate::{Error, Filter, MemoryBudget};
 
 /// How 8-bit texture bytes and output bytes are interpreted (the CLI's `--color`).
@@ -27,7 +28,7 @@ pub enum ColorHandling {
 }
 
 /// How a scene is prepared.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SceneOptions {
     /// Output size `(width, height)` in pixels, overriding the scene's.
     pub size: Option<(u32, u32)>,
@@ -42,6 +43,9 @@ pub struct SceneOptions {
     /// What every material's height map does, overriding each one's `displacement` (the CLI's
     /// `--displacement`; materials without a height map are unaffected).
     pub displacement: Option<texel_scene::Displacement>,
+    /// The projected edge length, pixels, that `displacement = "tessellate"` tessellates to
+    /// (the CLI's `--edge-px`); `None`: [`crate::tessellate::RENDER_EDGE_PX`].
+    pub edge_px: Option<f32>,
 }
 
 /// A loaded scene, ready to render with any filter.
@@ -74,6 +78,13 @@ pub struct PreparedScene {
     /// Slope moment maps ([`texel_raster::material::height_moments`]) of the height maps of
     /// bump-mapped materials without a normal map that use LEAN or Toksvig, by texture name.
     height_moments: BTreeMap<String, Texture>,
+    /// Per mesh, its tessellated and displaced geometry where its material tessellates
+    /// (built for the scene's camera: other views reuse it).
+    tessellated: Vec<Option<Tessellated>>,
+    /// Per mesh, the reference's geometry where its material displaces at all: tessellated to
+    /// [`crate::tessellate::REFERENCE_EDGE_PX`] and displaced by level-0 heights (built on first
+    /// use).
+    reference_geometry: OnceLock<Vec<Option<Tessellated>>>,
 }
 
 impl PreparedScene {
@@ -180,7 +191,27 @@ impl PreparedScene {
                 m.generate_tangents();
             }
         }
-        let vertices = scene.meshes.iter().map(texel_vertices).collect();
+        let vertices: Vec<Vec<Vertex>> = scene.meshes.iter().map(texel_vertices).collect();
+        let mut tessellated = Vec::new();
+        for (mesh, verts) in scene.meshes.iter().zip(&vertices) {
+            let geometry = displaced_geometry(
+                &scene,
+                mesh,
+                verts,
+                &textures,
+                (width, height),
+                options,
+                Geometry::Render,
+            )?;
+            if let Some(g) = &geometry {
+                budget.take(
+                    "the tessellated geometry",
+                    g.vertices.len() as u64 * VERTEX_BYTES
+                        + g.triangles.len() as u64 * TRIANGLE_BYTES,
+                )?;
+            }
+            tessellated.push(geometry);
+        }
         Ok(PreparedScene {
             scene,
             textures,
@@ -194,6 +225,8 @@ impl PreparedScene {
             displacement: options.displacement,
             lean_maps,
             height_moments,
+            tessellated,
+            reference_geometry: OnceLock::new(),
         })
     }
 
@@ -294,20 +327,78 @@ impl PreparedScene {
         samplers: &'a [Sampler],
         camera: &texel_scene::Camera,
     ) -> Vec<DrawCall<'a>> {
+        self.draws_over(samplers, camera, &self.tessellated, false)
+    }
+
+    /// The draw calls the reference renders, seen by `camera`: [`PreparedScene::draws_from`],
+    /// except that meshes whose material displaces (bump, parallax or tessellation, in the scene
+    /// file or by [`SceneOptions::displacement`]; `none` as an override still shows the relief
+    /// it leaves out) are drawn as
+    /// the true displaced surface, tessellated finely ([`crate::tessellate::REFERENCE_EDGE_PX`]
+    /// for the scene's camera) and displaced by level-0 heights, with the exact normals of the
+    /// height map (bump mapping at level 0): what every displacement method approximates.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] when the fine tessellation would pass its triangle limit.
+    pub fn reference_draws_from<'a>(
+        &'a self,
+        samplers: &'a [Sampler],
+        camera: &texel_scene::Camera,
+    ) -> Result<Vec<DrawCall<'a>>, Error> {
+        if self.reference_geometry.get().is_none() {
+            let options = SceneOptions {
+                displacement: self.displacement,
+                ..SceneOptions::default()
+            };
+            let mut built = Vec::new();
+            for (mesh, verts) in self.scene.meshes.iter().zip(&self.vertices) {
+                built.push(displaced_geometry(
+                    &self.scene,
+                    mesh,
+                    verts,
+                    &self.textures,
+                    (self.width, self.height),
+                    &options,
+                    Geometry::Reference,
+                )?);
+            }
+            // Another thread may have set it meanwhile: either copy is the same.
+            let _ = self.reference_geometry.set(built);
+        }
+        let geometry = self.reference_geometry.get().map_or(&[][..], Vec::as_slice);
+        Ok(self.draws_over(samplers, camera, geometry, true))
+    }
+
+    /// Draws over each mesh's own geometry, or `geometry[k]` where it is given; with `exact`,
+    /// meshes drawn from `geometry` shade with the bump normals of their heights.
+    fn draws_over<'a>(
+        &'a self,
+        samplers: &'a [Sampler],
+        camera: &texel_scene::Camera,
+        geometry: &'a [Option<Tessellated>],
+        exact: bool,
+    ) -> Vec<DrawCall<'a>> {
         let aspect = self.width as f32 / self.height as f32;
         let clip_from_world = camera.clip_from_world(aspect);
         self.scene
             .meshes
             .iter()
-            .zip(&self.vertices)
+            .enumerate()
             .zip(samplers)
-            .map(|((mesh, vertices), sampler)| DrawCall {
-                vertices,
-                triangles: &mesh.triangles,
-                texture: &self.textures[&mesh.texture],
-                sampler,
-                clip_from_world,
-                material: self.material(mesh, sampler),
+            .map(|((k, mesh), sampler)| {
+                let own = geometry.get(k).and_then(Option::as_ref);
+                let mut material = self.material(mesh, sampler);
+                if let (Some(m), true, Some(_)) = (&mut material, exact, own) {
+                    m.displacement = Displacement::Bump;
+                }
+                DrawCall {
+                    vertices: own.map_or(&self.vertices[k][..], |g| &g.vertices[..]),
+                    triangles: own.map_or(&mesh.triangles[..], |g| &g.triangles[..]),
+                    texture: &self.textures[&mesh.texture],
+                    sampler,
+                    clip_from_world,
+                    material,
+                }
             })
             .collect()
     }
@@ -427,6 +518,73 @@ fn specular_aa(spec: &texel_scene::MaterialSpec, overridden: Option<SpecularAa>)
         SpecularAaSpec::None => SpecularAa::None,
     })
 }
+
+/// Which displaced geometry [`displaced_geometry`] builds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Geometry {
+    /// `displacement = "tessellate"`: to the options' edge length, heights filtered to it.
+    Render,
+    /// The reference's: for every displacement, finely, level-0 heights.
+    Reference,
+}
+
+/// The tessellated, displaced geometry of `mesh` (whose vertices are `verts`) for `kind`, or
+/// `None` where its material does not ask for it.
+fn displaced_geometry(
+    scene: &Scene,
+    mesh: &texel_scene::Mesh,
+    verts: &[Vertex],
+    textures: &BTreeMap<String, Texture>,
+    (width, height): (u32, u32),
+    options: &SceneOptions,
+    kind: Geometry,
+) -> Result<Option<Tessellated>, Error> {
+    use crate::tessellate::{self, HeightFilter};
+    use texel_scene::Displacement as D;
+    let Some(spec) = mesh.material.as_ref().and_then(|n| scene.materials.get(n)) else {
+        return Ok(None);
+    };
+    let Some(heights) = spec.height.as_ref().and_then(|h| textures.get(h)) else {
+        return Ok(None);
+    };
+    let shape = displacement(spec, options.displacement);
+    // The reference shows the true relief when the scene's material or the override displaces:
+    // `--displacement none` is then scored against the relief it leaves out.
+    let truth = spec.displacement != D::None || shape != D::None;
+    let (edge_px, filter) = match (kind, shape) {
+        (Geometry::Reference, _) if !truth => return Ok(None),
+        (Geometry::Render, D::None | D::Bump | D::Pom) => return Ok(None),
+        (Geometry::Render, D::Tessellate) => (
+            options.edge_px.unwrap_or(tessellate::RENDER_EDGE_PX),
+            HeightFilter::EdgeMatched,
+        ),
+        (Geometry::Reference, _) => (tessellate::REFERENCE_EDGE_PX, HeightFilter::Level0),
+    };
+    let setup = tessellate::Tessellation {
+        clip_from_world: scene.camera.clip_from_world(width as f32 / height as f32),
+        width,
+        height,
+        edge_px,
+        max_triangles: MAX_TESSELLATED_TRIANGLES,
+    };
+    let mut geometry = tessellate::tessellate(verts, &mesh.triangles, &setup).map_err(|e| {
+        texel_scene::SceneError::Material {
+            name: mesh.material.clone().unwrap_or_default(),
+            reason: format!("{e} (at {edge_px} pixels per edge): raise --edge-px or lower --size"),
+        }
+    })?;
+    tessellate::displace(
+        &mut geometry,
+        heights,
+        (mesh.address_mode_u, mesh.address_mode_v),
+        spec.height_scale,
+        filter,
+    )?;
+    Ok(Some(geometry))
+}
+
+/// The most triangles a tessellated mesh may have.
+pub const MAX_TESSELLATED_TRIANGLES: usize = 8 << 20;
 
 /// The displacement a material gets: `overridden` (the CLI's `--displacement`) or its own.
 fn displacement(
