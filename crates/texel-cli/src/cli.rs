@@ -143,17 +143,22 @@ pub struct SceneArgs {
     pub edge_px: Option<f32>,
 }
 
-/// `--edge-px`: a finite number of pixels in `[0.25, 256]`.
-fn parse_edge_px(s: &str) -> Result<f32, String> {
+/// A finite number in `[lo, hi]` of `unit` (the error names both).
+fn parse_in(s: &str, lo: f32, hi: f32, unit: &str) -> Result<f32, String> {
     let v: f32 = s
         .trim()
         .parse()
-        .map_err(|_| format!("{s:?} is not a number of pixels"))?;
-    if v.is_finite() && (0.25..=256.0).contains(&v) {
+        .map_err(|_| format!("{s:?} is not a number of {unit}"))?;
+    if v.is_finite() && (lo..=hi).contains(&v) {
         Ok(v)
     } else {
-        Err(format!("{s} pixels per edge is outside 0.25 to 256"))
+        Err(format!("{s} {unit} is outside {lo} to {hi}"))
     }
+}
+
+/// `--edge-px`: pixels in `[0.25, 256]`.
+fn parse_edge_px(s: &str) -> Result<f32, String> {
+    parse_in(s, 0.25, 256.0, "pixels per edge")
 }
 
 /// How height maps shape the surface (see texel-raster's `Displacement`).
@@ -331,17 +336,9 @@ pub struct CompareArgs {
     pub out: PathBuf,
 }
 
-/// `--orbit-step`: a finite number of degrees in `[0, 10]`.
+/// `--orbit-step`: degrees in `[0, 10]`.
 fn parse_orbit_step(s: &str) -> Result<f32, String> {
-    let v: f32 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("{s:?} is not a number of degrees"))?;
-    if v.is_finite() && (0.0..=10.0).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!("{s} degrees per frame is outside 0 to 10"))
-    }
+    parse_in(s, 0.0, 10.0, "degrees per frame")
 }
 
 /// `texel demo`.

@@ -1,42 +1,16 @@
 //! Height maps: bump mapping and parallax occlusion mapping against the analytic surfaces they
 //! stand for, and projected-space NDF filtering on a surface whose normal does not vary.
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+mod lit_plane;
+
+use glam::{Mat4, Vec3};
+use lit_plane::{plane, view, H, PLANE_TRIANGLES, W};
 use texel_raster::material::{radiance, Surface};
 use texel_raster::{
-    camera, render, ChannelInput, Displacement, DrawCall, Light, Material, RenderSettings,
-    SpecularAa, TextureInput, Vertex, MAX_LIGHTS,
+    render, ChannelInput, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
+    TextureInput, Vertex, MAX_LIGHTS,
 };
 use texel_texture::{AddressMode, Format, Limits, Sampler, SamplerDescriptor, Texture};
-
-const W: u32 = 96;
-const H: u32 = 64;
-
-/// The square `[-1, 1]^2` in z = 0 facing +z, u along +x, v down (-y): 2 world units per unit
-/// of u and of v.
-fn plane() -> Vec<Vertex> {
-    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-        .iter()
-        .map(|&(x, y)| {
-            let mut v = Vertex::new(
-                Vec3::new(x, y, 0.0),
-                Vec2::new((x + 1.0) / 2.0, (1.0 - y) / 2.0),
-            );
-            v.normal = Vec3::Z;
-            v.tangent = Vec4::new(1.0, 0.0, 0.0, 1.0);
-            v
-        })
-        .collect()
-}
-
-const PLANE_TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
-
-fn view() -> (Mat4, Vec3) {
-    let eye = Vec3::new(0.4, 0.3, 3.0);
-    let m = camera::perspective(50f32.to_radians(), W as f32 / H as f32, 0.1, 10.0)
-        * camera::look_at(eye, Vec3::ZERO, Vec3::Y);
-    (m, eye)
-}
 
 /// The ray from `eye` through pixel `(i, j)`'s centre (unit direction).
 fn ray(m: Mat4, eye: Vec3, i: u32, j: u32) -> Vec3 {
@@ -57,6 +31,48 @@ fn float_map(f: impl Fn(f32, f32) -> f32) -> Texture {
 fn trilinear_clamped() -> Sampler {
     let d = SamplerDescriptor::lab_mode(4).unwrap();
     Sampler::new(d.with_address_mode(AddressMode::ClampToEdge)).unwrap()
+}
+
+/// A height map read through `sampler`, red channel.
+fn heights_of<'a>(texture: &'a Texture, sampler: &'a Sampler) -> ChannelInput<'a> {
+    ChannelInput {
+        input: TextureInput { texture, sampler },
+        channel: 0,
+    }
+}
+
+/// A material with height map `heights` (if any) shaping the surface as `displacement`.
+fn relief_material<'a>(
+    heights: Option<&'a Texture>,
+    sampler: &'a Sampler,
+    height_scale: f32,
+    displacement: Displacement,
+) -> Material<'a> {
+    Material {
+        roughness: 0.4,
+        height_map: heights.map(|t| heights_of(t, sampler)),
+        height_scale,
+        displacement,
+        ..Material::default()
+    }
+}
+
+/// The plane with `texture`, shaded with `material`.
+fn plane_draw<'a>(
+    vertices: &'a [Vertex],
+    texture: &'a Texture,
+    sampler: &'a Sampler,
+    clip_from_world: Mat4,
+    material: Material<'a>,
+) -> DrawCall<'a> {
+    DrawCall {
+        vertices,
+        triangles: &PLANE_TRIANGLES,
+        texture,
+        sampler,
+        clip_from_world,
+        material: Some(material),
+    }
 }
 
 fn lit(light: Light) -> RenderSettings {
@@ -83,27 +99,8 @@ fn bump_mapping_a_ramp_gives_the_tilted_planes_normal() {
         intensity: Vec3::splat(3.0),
     };
     for s in [0.2f32, 1.0] {
-        let material = Material {
-            roughness: 0.4,
-            height_map: Some(ChannelInput {
-                input: TextureInput {
-                    texture: &heights,
-                    sampler: &sampler,
-                },
-                channel: 0,
-            }),
-            height_scale: s,
-            displacement: Displacement::Bump,
-            ..Material::default()
-        };
-        let draw = DrawCall {
-            vertices: &vertices,
-            triangles: &PLANE_TRIANGLES,
-            texture: &white,
-            sampler: &sampler,
-            clip_from_world: m,
-            material: Some(material),
-        };
+        let material = relief_material(Some(&heights), &sampler, s, Displacement::Bump);
+        let draw = plane_draw(&vertices, &white, &sampler, m, material);
         let frame = render(&lit(light), &[draw]).unwrap();
         // The reference's sub-samples bump-map from level 0 with their own small step: the
         // same plane's normal (1 sample per pixel at the centre, so the same positions).
@@ -151,27 +148,8 @@ fn parallax_reads_where_the_ray_meets_the_relief() {
     let vertices = plane();
     let (m, eye) = view();
     let s = 0.4f32;
-    let material = Material {
-        roughness: 0.4,
-        height_map: Some(ChannelInput {
-            input: TextureInput {
-                texture: &heights,
-                sampler: &sampler,
-            },
-            channel: 0,
-        }),
-        height_scale: s,
-        displacement: Displacement::Pom,
-        ..Material::default()
-    };
-    let draw = DrawCall {
-        vertices: &vertices,
-        triangles: &PLANE_TRIANGLES,
-        texture: &ramp,
-        sampler: &sampler,
-        clip_from_world: m,
-        material: Some(material),
-    };
+    let material = relief_material(Some(&heights), &sampler, s, Displacement::Pom);
+    let draw = plane_draw(&vertices, &ramp, &sampler, m, material);
     let ambient = Light::Ambient {
         intensity: Vec3::ONE,
     };
@@ -227,33 +205,21 @@ fn projected_filtering_widens_only_where_the_normal_varies() {
         intensity: Vec3::splat(3.0),
     };
     let frame = |aa: SpecularAa, height: Option<&Texture>| {
+        let shape = if height.is_some() {
+            Displacement::Bump
+        } else {
+            Displacement::None
+        };
         let material = Material {
             roughness: 0.2,
-            height_map: height.map(|t| ChannelInput {
-                input: TextureInput {
-                    texture: t,
-                    sampler: &sampler,
-                },
-                channel: 0,
-            }),
-            height_scale: 0.02,
-            displacement: if height.is_some() {
-                Displacement::Bump
-            } else {
-                Displacement::None
-            },
             specular_aa: aa,
-            ..Material::default()
+            ..relief_material(height, &sampler, 0.02, shape)
         };
-        let draw = DrawCall {
-            vertices: &vertices,
-            triangles: &PLANE_TRIANGLES,
-            texture: &white,
-            sampler: &sampler,
-            clip_from_world: m,
-            material: Some(material),
-        };
-        render(&lit(light), &[draw]).unwrap()
+        render(
+            &lit(light),
+            &[plane_draw(&vertices, &white, &sampler, m, material)],
+        )
+        .unwrap()
     };
     assert_eq!(
         frame(SpecularAa::Projected, None).color,

@@ -1,45 +1,16 @@
 //! Lighting with materials: a normal-mapped plane against the shading model evaluated by hand.
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+mod lit_plane;
+
+use glam::{Mat4, Vec3};
+use lit_plane::{plane, view, H, PLANE_TRIANGLES, W};
 use texel_raster::material::{radiance, Surface};
-use texel_raster::{
-    camera, render, DrawCall, Light, Material, RenderSettings, TextureInput, Vertex, MAX_LIGHTS,
-};
+use texel_raster::{render, DrawCall, Light, Material, RenderSettings, TextureInput, MAX_LIGHTS};
 use texel_texture::{Format, Limits, Sampler, SamplerDescriptor, Texture};
-
-const W: u32 = 96;
-const H: u32 = 64;
-
-/// The unit square `[-1, 1]^2` in z = 0 facing +z, u along +x, v down (-y), tangent +x with
-/// `w = 1` (`cross(z, x) = +y`, up the image).
-fn plane() -> Vec<Vertex> {
-    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-        .iter()
-        .map(|&(x, y)| {
-            let mut v = Vertex::new(
-                Vec3::new(x, y, 0.0),
-                Vec2::new((x + 1.0) / 2.0, (1.0 - y) / 2.0),
-            );
-            v.normal = Vec3::Z;
-            v.tangent = Vec4::new(1.0, 0.0, 0.0, 1.0);
-            v
-        })
-        .collect()
-}
-
-/// The two counter-clockwise triangles of [`plane`].
-const PLANE_TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
 
 /// A 1x1 RGBA8 (linear) texture of grey level `v` (stored as its 8-bit code).
 fn grey(v: f32) -> Texture {
     Texture::from_fn(1, 1, Format::Rgba8Unorm, &Limits::default(), |_, _| [v; 4]).unwrap()
-}
-
-fn view() -> (Mat4, Vec3) {
-    let eye = Vec3::new(0.4, 0.3, 3.0);
-    let m = camera::perspective(50f32.to_radians(), W as f32 / H as f32, 0.1, 10.0)
-        * camera::look_at(eye, Vec3::ZERO, Vec3::Y);
-    (m, eye)
 }
 
 /// Where the ray through pixel `(i, j)`'s centre meets z = 0.
