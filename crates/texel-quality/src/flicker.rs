@@ -17,8 +17,7 @@ pub fn mean_abs_change(
     mask_a: &Mask,
     mask_b: &Mask,
 ) -> Result<f64, QualityError> {
-    let zero = Image8::filled(a.width(), a.height(), [0; 4])?;
-    excess_change([a, b], [&zero, &zero], [mask_a, mask_b])
+    change([a, b], None, [mask_a, mask_b])
 }
 
 /// Flicker beyond the reference's: the mean absolute difference between an image sequence's
@@ -36,9 +35,20 @@ pub fn excess_change(
     reference: [&Image8; 2],
     masks: [&Mask; 2],
 ) -> Result<f64, QualityError> {
+    change(frames, Some(reference), masks)
+}
+
+/// `mean |(b - a) - (b_ref - a_ref)|` over the pixels in both masks and over RGB, the reference
+/// terms 0 without a reference.
+fn change(
+    frames: [&Image8; 2],
+    reference: Option<[&Image8; 2]>,
+    masks: [&Mask; 2],
+) -> Result<f64, QualityError> {
     let size = frames[0].size();
-    let sizes = [frames[1].size(), reference[0].size(), reference[1].size()]
+    let sizes = [frames[1].size()]
         .into_iter()
+        .chain(reference.into_iter().flatten().map(Image8::size))
         .chain(masks.map(Mask::size));
     for s in sizes {
         if s != size {
@@ -50,15 +60,16 @@ pub fn excess_change(
             });
         }
     }
+    let step = |pair: [&Image8; 2], k: usize, c: usize| {
+        i64::from(pair[1].pixels()[k][c]) - i64::from(pair[0].pixels()[k][c])
+    };
     let mut sum = 0i64;
     let mut n = 0u64;
-    let px = |img: &Image8, k: usize, c: usize| i64::from(img.pixels()[k][c]);
     for k in 0..frames[0].pixels().len() {
         if masks[0].bits()[k] && masks[1].bits()[k] {
             for c in 0..3 {
-                let change = px(frames[1], k, c) - px(frames[0], k, c);
-                let ref_change = px(reference[1], k, c) - px(reference[0], k, c);
-                sum += (change - ref_change).abs();
+                let ref_change = reference.map_or(0, |r| step(r, k, c));
+                sum += (step(frames, k, c) - ref_change).abs();
             }
             n += 1;
         }

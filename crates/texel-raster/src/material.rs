@@ -231,9 +231,7 @@ impl Material<'_> {
             && channel_ok(&self.roughness_map)
             && channel_ok(&self.metallic_map)
     }
-}
 
-impl Material<'_> {
     /// Whether the height map gives the normal (a displacement is set and there is a height map).
     pub fn bumped(&self) -> bool {
         self.displacement != Displacement::None && self.height_map.is_some()
@@ -443,13 +441,30 @@ pub fn height_moments(
     })
 }
 
-/// Read `input` at `footprint`; also returns the texels read.
-pub(crate) fn sample(input: &TextureInput, fp: &Footprint, count: bool) -> ([f32; 4], u32) {
+/// Read `input` at `fp`, adding the texels read to `texels` when `count`.
+pub(crate) fn read(
+    input: &TextureInput,
+    fp: &Footprint,
+    count: bool,
+    texels: &mut u32,
+) -> [f32; 4] {
     if count {
-        input.sampler.sample_counted(input.texture, fp)
+        let (t, n) = input.sampler.sample_counted(input.texture, fp);
+        *texels += n;
+        t
     } else {
-        (input.sampler.sample(input.texture, fp), 0)
+        input.sampler.sample(input.texture, fp)
     }
+}
+
+/// One channel of `input` at `fp`, adding the texels read to `texels` when `count`.
+pub(crate) fn read_channel(
+    input: &ChannelInput,
+    fp: &Footprint,
+    count: bool,
+    texels: &mut u32,
+) -> f32 {
+    read(&input.input, fp, count, texels)[input.channel]
 }
 
 #[cfg(test)]

@@ -9,11 +9,11 @@
 //! surface's normal `normalize((dp/du + g_u n) x (dp/dv + g_v n))`, turned to `n`'s side
 //! (pbrt-v4 `BumpMap`, without the `h dn/du` term, which is 0 on flat triangles).
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use texel_texture::{Footprint, Format};
 
 use crate::draw::Vertex;
-use crate::material::{self, ChannelInput, Material, SpecularAa, TextureInput};
+use crate::material::{self, read_channel, ChannelInput, Material, SpecularAa, TextureInput};
 
 /// How far an 8-bit normal map's decoded vector may fall short of unit length by quantisation
 /// alone (each of three components off by up to 1/255): Toksvig counts lengths within it as 1.
@@ -93,20 +93,6 @@ fn tangent_frame(verts: [&Vertex; 3], l: Vec3, normal: Vec3) -> Option<(Vec3, Ve
     Some((t, normal.cross(t) * sign))
 }
 
-/// One channel of `input` at `fp`, adding the texels read to `texels` when `count`.
-fn channel(input: &ChannelInput, fp: &Footprint, count: bool, texels: &mut u32) -> f32 {
-    let (t, n) = material::sample(&input.input, fp, count);
-    *texels += n;
-    t[input.channel]
-}
-
-/// A texture read at `fp`, adding the texels read to `texels` when `count`.
-fn read(input: &TextureInput, fp: &Footprint, count: bool, texels: &mut u32) -> [f32; 4] {
-    let (t, n) = material::sample(input, fp, count);
-    *texels += n;
-    t
-}
-
 /// Bump mapping's step along one texture axis: half the footprint's extent along it (pbrt-v4
 /// `BumpMap`: `du = (|du/dx| + |du/dy|) / 2`), or an eighth of a level-0 texel where the footprint
 /// is a point (the reference's sub-samples), for a map `size` texels across.
@@ -144,7 +130,7 @@ pub(crate) fn shading_normal(
             return plain;
         };
         let to_world = |v: Vec3| t * v.x + b * v.y + n * v.z;
-        let texel = read(map, fp, count, texels);
+        let texel = material::read(map, fp, count, texels);
         // The filtered map normal: the mean of the normals under the footprint.
         let raw = Vec3::new(texel[0], texel[1], texel[2]) * 2.0 - Vec3::ONE;
         let mean = raw * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
@@ -155,7 +141,7 @@ pub(crate) fn shading_normal(
                     texture: lean,
                     sampler: map.sampler,
                 };
-                let a = read(&moments, fp, count, texels);
+                let a = material::read(&moments, fp, count, texels);
                 let (nt, r) = material::lean_normal_roughness(a, m.normal_scale, roughness);
                 roughness = r;
                 Some(nt)
@@ -197,7 +183,7 @@ pub(crate) fn shading_normal(
             v: fp.v + dv,
             ..*fp
         };
-        channel(height, &fp, count, texels)
+        read_channel(height, &fp, count, texels)
     };
     let (hu0, hu1) = (at(-du / 2.0, 0.0, texels), at(du / 2.0, 0.0, texels));
     let (hv0, hv1) = (at(0.0, -dv / 2.0, texels), at(0.0, dv / 2.0, texels));
@@ -212,7 +198,7 @@ pub(crate) fn shading_normal(
             texture: moments,
             sampler: height.input.sampler,
         };
-        let e = read(&input, fp, count, texels);
+        let e = material::read(&input, fp, count, texels);
         let s2 = s * s;
         let var_u = (e[2] - e[0] * e[0]) * s2 / a.length_squared();
         let var_v = (e[3] - e[1] * e[1]) * s2 / b.length_squared();
@@ -289,7 +275,7 @@ pub(crate) fn parallax(
             ..*fp
         };
         // How far the relief lies below the ray: positive while the ray is above it.
-        s * (1.0 - channel(height, &fp, count, texels)) - depth
+        s * (1.0 - read_channel(height, &fp, count, texels)) - depth
     };
     let mut prev = (0.0f32, at(0.0, texels));
     let mut hit = 0.0;
@@ -314,11 +300,6 @@ pub(crate) fn parallax(
         },
         position: position + dir * (hit / cos),
     })
-}
-
-/// `lambda + d` as single precision barycentrics (a neighbouring pixel's).
-pub(crate) fn shifted(lambda: DVec3, d: DVec3) -> Vec3 {
-    (lambda + d).as_vec3()
 }
 
 #[cfg(test)]

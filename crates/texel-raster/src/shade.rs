@@ -211,30 +211,21 @@ pub(crate) fn shade(
         if let Some(hit) = hit {
             fp = hit.footprint;
             position = hit.position;
-            let (t, n) = material::sample(
-                &TextureInput {
-                    texture: ctx.texture,
-                    sampler: ctx.sampler,
-                },
-                &fp,
-                count,
-            );
-            tex = t;
-            texels += n;
+            let base = TextureInput {
+                texture: ctx.texture,
+                sampler: ctx.sampler,
+            };
+            tex = material::read(&base, &fp, count, &mut texels);
         }
     }
     let c = base_color(ctx, verts, l, tex);
     let mut roughness = m.roughness;
     let mut metallic = m.metallic;
     if let Some(map) = &m.roughness_map {
-        let (t, n) = material::sample(&map.input, &fp, count);
-        roughness *= t[map.channel];
-        texels += n;
+        roughness *= material::read_channel(map, &fp, count, &mut texels);
     }
     if let Some(map) = &m.metallic_map {
-        let (t, n) = material::sample(&map.input, &fp, count);
-        metallic *= t[map.channel];
-        texels += n;
+        metallic *= material::read_channel(map, &fp, count, &mut texels);
     }
     let mut shading = relief::shading_normal(
         m,
@@ -250,7 +241,7 @@ pub(crate) fn shade(
     if m.specular_aa == SpecularAa::Projected {
         // The normals one pixel right and one down, as a fragment quad's ddx and ddy see them.
         let neighbour = |dl: DVec3, duv: [f32; 2], texels: &mut u32| {
-            let l = relief::shifted(lambda, dl);
+            let l = (lambda + dl).as_vec3();
             let n = relief::geometric_normal(verts, l);
             let fp = Footprint {
                 u: fp.u + duv[0],

@@ -278,13 +278,8 @@ impl Scene {
             )));
         }
         // Parsed so that scene files written for the full schema are read, refused until built.
-        let missing = if m.layers > 0 {
-            Some("layered materials")
-        } else {
-            None
-        };
-        if let Some(what) = missing {
-            return Err(bad(format!("{what} are not implemented yet")));
+        if m.layers > 0 {
+            return Err(bad("layered materials are not implemented yet".into()));
         }
         Ok(())
     }

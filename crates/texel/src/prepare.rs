@@ -144,15 +144,21 @@ impl PreparedScene {
         let mut height_moments = BTreeMap::new();
         for mat in scene.materials.values() {
             let aa = specular_aa(mat, options.specular_aa);
-            let bumped = displacement(mat, options.displacement) != texel_scene::Displacement::None
-                && mat.height.is_some()
-                && mat.normal.is_none();
-            let (name, kind, out) = match (&mat.normal, &mat.height) {
-                (Some(n), _) if aa == SpecularAa::Lean => (n, "LEAN moments", &mut lean_maps),
+            let bumped = displacement(mat, options.displacement) != texel_scene::Displacement::None;
+            type Build = fn(&Texture, &Limits) -> Result<Texture, texel_texture::TextureError>;
+            let (name, kind, out, build): (_, _, _, Build) = match (&mat.normal, &mat.height) {
+                (Some(n), _) if aa == SpecularAa::Lean => (
+                    n,
+                    "LEAN moments",
+                    &mut lean_maps,
+                    texel_raster::material::lean_map,
+                ),
                 (None, Some(h))
                     if bumped && matches!(aa, SpecularAa::Lean | SpecularAa::Toksvig) =>
                 {
-                    (h, "slope moments", &mut height_moments)
+                    (h, "slope moments", &mut height_moments, |t, limits| {
+                        texel_raster::material::height_moments(t, 0, limits)
+                    })
                 }
                 _ => continue,
             };
@@ -166,16 +172,12 @@ impl PreparedScene {
                 max_bytes: budget.remaining(),
                 ..Limits::default()
             };
-            let built = if kind == "LEAN moments" {
-                texel_raster::material::lean_map(map, &limits)
-            } else {
-                texel_raster::material::height_moments(map, 0, &limits)
-            };
-            let moments = built.map_err(|source| texel_scene::SceneError::Texture {
-                name: format!("{name} ({kind})"),
-                path: None,
-                source,
-            })?;
+            let moments =
+                build(map, &limits).map_err(|source| texel_scene::SceneError::Texture {
+                    name: format!("{name} ({kind})"),
+                    path: None,
+                    source,
+                })?;
             budget.take(&format!("the {kind} of {name:?}"), moments.pyramid_bytes())?;
             out.insert(name.clone(), moments);
         }
