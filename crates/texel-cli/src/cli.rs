@@ -141,6 +141,28 @@ pub struct SceneArgs {
     /// default 4).
     #[arg(long, value_name = "PX", value_parser = parse_edge_px)]
     pub edge_px: Option<f32>,
+    /// Where every layered material blends its layers, overriding the scene's `layer_order`
+    /// (e.g. builtin:terrain).
+    #[arg(long, value_enum)]
+    pub layer_order: Option<LayerOrderArg>,
+}
+
+/// Where a layered material blends (see texel-raster's `layers` module).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LayerOrderArg {
+    /// Every layer's maps and the mask filtered over the pixel, then blended (a shader's way).
+    FilterThenBlend,
+    /// The layers blended texel by texel at level 0 into baked maps, which are then filtered.
+    BlendThenFilter,
+}
+
+impl From<LayerOrderArg> for texel_scene::LayerOrder {
+    fn from(a: LayerOrderArg) -> Self {
+        match a {
+            LayerOrderArg::FilterThenBlend => texel_scene::LayerOrder::FilterThenBlend,
+            LayerOrderArg::BlendThenFilter => texel_scene::LayerOrder::BlendThenFilter,
+        }
+    }
 }
 
 /// A finite number in `[lo, hi]` of `unit` (the error names both).

@@ -109,6 +109,8 @@ pub struct MaterialOverrides {
     pub displacement: Option<texel_scene::Displacement>,
     /// `--edge-px`.
     pub edge_px: Option<f32>,
+    /// `--layer-order`.
+    pub layer_order: Option<texel_scene::LayerOrder>,
 }
 
 impl MaterialOverrides {
@@ -118,6 +120,7 @@ impl MaterialOverrides {
             specular_aa: args.specular_aa.map(SpecularAaArg::into),
             displacement: args.displacement.map(Into::into),
             edge_px: args.edge_px,
+            layer_order: args.layer_order.map(Into::into),
         }
     }
 }
@@ -152,6 +155,7 @@ pub fn load_scene_with(
         specular_aa: overrides.specular_aa,
         displacement: overrides.displacement,
         edge_px: overrides.edge_px,
+        layer_order: overrides.layer_order,
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;

@@ -46,6 +46,7 @@ mod draw;
 mod error;
 mod frame;
 pub mod interp;
+pub mod layers;
 pub mod material;
 pub mod reference;
 mod relief;
@@ -58,6 +59,7 @@ pub mod views;
 pub use draw::{DrawCall, Vertex};
 pub use error::RasterError;
 pub use frame::Frame;
+pub use layers::{Layer, LayerBlend, Layers};
 pub use material::{
     ChannelInput, Displacement, Light, Material, SpecularAa, TextureInput, MAX_LIGHTS,
 };

@@ -29,6 +29,8 @@
 use glam::{Vec3, Vec4};
 use texel_texture::{Footprint, Sampler, Texture};
 
+use crate::layers::Layers;
+
 /// The most lights a frame has (as fixed-function GPUs had 8).
 pub const MAX_LIGHTS: usize = 8;
 
@@ -183,6 +185,11 @@ pub struct Material<'a> {
     /// sampler; used by [`SpecularAa::Lean`] and [`SpecularAa::Toksvig`] on bump-mapped
     /// surfaces without a normal map.
     pub height_moments: Option<&'a Texture>,
+    /// Layers blended by a mask ([`crate::layers`]), filtered then blended. Their blended base
+    /// colour multiplies the draw's texture and `base_color`, their roughness multiplies
+    /// `roughness`; their normals (where some layer has a normal map) replace `normal_map`, and
+    /// their blended height replaces `height_map` when a layer gives a height.
+    pub layers: Option<Layers<'a>>,
 }
 
 impl Default for Material<'_> {
@@ -202,6 +209,7 @@ impl Default for Material<'_> {
             height_scale: 0.05,
             displacement: Displacement::None,
             height_moments: None,
+            layers: None,
         }
     }
 }
@@ -218,9 +226,10 @@ impl Material<'_> {
                 (None, true) => self.height_moments.is_some(),
                 (None, false) => true,
             };
-        let height_ok = self.displacement == Displacement::None || self.height_map.is_some();
+        let height_ok = self.displacement == Displacement::None || self.has_height();
         lean_ok
             && height_ok
+            && self.layers.as_ref().is_none_or(Layers::is_valid)
             && self.height_scale.is_finite()
             && self.height_scale >= 0.0
             && channel_ok(&self.height_map)
@@ -232,9 +241,34 @@ impl Material<'_> {
             && channel_ok(&self.metallic_map)
     }
 
-    /// Whether the height map gives the normal (a displacement is set and there is a height map).
+    /// Whether the height map gives the normal (a displacement is set and there is a height map
+    /// or layers with heights).
     pub fn bumped(&self) -> bool {
-        self.displacement != Displacement::None && self.height_map.is_some()
+        self.displacement != Displacement::None && self.has_height()
+    }
+
+    /// Whether there are heights: a height map, or layers that give heights.
+    pub fn has_height(&self) -> bool {
+        self.height_map.is_some() || self.layers.as_ref().is_some_and(|l| l.heights)
+    }
+
+    /// The height in `[0, 1]` at `fp`: the layers' blended height where they give heights, else
+    /// the height map's; `None` without either. Adds the texels read to `texels` when `count`.
+    pub fn height_at(&self, fp: &Footprint, count: bool, texels: &mut u32) -> Option<f32> {
+        match (&self.layers, &self.height_map) {
+            (Some(l), _) if l.heights => Some(l.height(fp, count, texels)),
+            (_, Some(h)) => Some(read_channel(h, fp, count, texels)),
+            _ => None,
+        }
+    }
+
+    /// The width and height in texels of what gives the heights (bump mapping's fallback step).
+    pub fn height_size(&self) -> (u32, u32) {
+        match (&self.layers, &self.height_map) {
+            (Some(l), _) if l.heights => l.height_size(),
+            (_, Some(h)) => (h.input.texture.width(), h.input.texture.height()),
+            _ => (1, 1),
+        }
     }
 }
 

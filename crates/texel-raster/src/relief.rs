@@ -13,11 +13,8 @@ use glam::{Vec2, Vec3};
 use texel_texture::{Footprint, Format};
 
 use crate::draw::Vertex;
-use crate::material::{self, read_channel, ChannelInput, Material, SpecularAa, TextureInput};
-
-/// How far an 8-bit normal map's decoded vector may fall short of unit length by quantisation
-/// alone (each of three components off by up to 1/255): Toksvig counts lengths within it as 1.
-const UNORM8_NORMAL_SLACK: f32 = 0.006_8;
+use crate::layers::{LayerSample, MapNormal, UNORM8_NORMAL_SLACK};
+use crate::material::{self, Material, SpecularAa, TextureInput};
 
 /// The fewest and the most linear steps of the parallax march (at normal incidence and at
 /// grazing angles; Tatarchuk 2006 interpolates between them by `n.v`).
@@ -105,12 +102,51 @@ fn bump_step(d_dx: f32, d_dy: f32, size: u32) -> f32 {
     }
 }
 
+/// The filtered tangent-space normal of `m`'s own normal map at `fp` (with LEAN's moments when
+/// `aa` is LEAN and the moment map is there), as [`MapNormal`].
+fn map_normal(
+    m: &Material,
+    map: &TextureInput,
+    fp: &Footprint,
+    aa: SpecularAa,
+    count: bool,
+    texels: &mut u32,
+) -> MapNormal {
+    let texel = material::read(map, fp, count, texels);
+    let raw = Vec3::new(texel[0], texel[1], texel[2]) * 2.0 - Vec3::ONE;
+    let s = m.normal_scale;
+    let moments = match (aa, m.lean) {
+        (SpecularAa::Lean, Some(lean)) => {
+            let input = TextureInput {
+                texture: lean,
+                sampler: map.sampler,
+            };
+            let e = material::read(&input, fp, count, texels);
+            Some([e[0] * s, e[1] * s, e[2] * s * s, e[3] * s * s])
+        }
+        _ => None,
+    };
+    MapNormal {
+        raw,
+        mean: raw * Vec3::new(s, s, 1.0),
+        moments,
+        slack: if map.texture.format() == Format::Rgba32Float {
+            0.0
+        } else {
+            UNORM8_NORMAL_SLACK
+        },
+    }
+}
+
 /// The shading normal and roughness of material `m` at a fragment with interpolated unit normal
 /// `n`, barycentrics `l` and footprint `fp`, with specular antialiasing `aa` (what
-/// [`SpecularAa::Projected`] adds is the caller's: it needs the neighbours' normals).
+/// [`SpecularAa::Projected`] adds is the caller's: it needs the neighbours' normals). `layered`
+/// is the fragment's [`LayerSample`] for a layered material (its blended normal, if any, is used
+/// in place of the normal map).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shading_normal(
     m: &Material,
+    layered: Option<&LayerSample>,
     verts: [&Vertex; 3],
     l: Vec3,
     n: Vec3,
@@ -125,56 +161,50 @@ pub(crate) fn shading_normal(
         diffuse_normal: None,
         roughness,
     };
-    if let Some(map) = &m.normal_map {
+    let layer_normal = layered.and_then(|s| s.normal);
+    if layer_normal.is_some() || m.normal_map.is_some() {
         let Some((t, b)) = tangent_frame(verts, l, n) else {
             return plain;
         };
         let to_world = |v: Vec3| t * v.x + b * v.y + n * v.z;
-        let texel = material::read(map, fp, count, texels);
         // The filtered map normal: the mean of the normals under the footprint.
-        let raw = Vec3::new(texel[0], texel[1], texel[2]) * 2.0 - Vec3::ONE;
-        let mean = raw * Vec3::new(m.normal_scale, m.normal_scale, 1.0);
+        let mapped = match (layer_normal, &m.normal_map) {
+            (Some(ln), _) => ln,
+            (None, Some(map)) => map_normal(m, map, fp, aa, count, texels),
+            (None, None) => return plain,
+        };
         let mut roughness = roughness;
-        let antialiased = match (aa, m.lean) {
-            (SpecularAa::Lean, Some(lean)) => {
-                let moments = TextureInput {
-                    texture: lean,
-                    sampler: map.sampler,
-                };
-                let a = material::read(&moments, fp, count, texels);
-                let (nt, r) = material::lean_normal_roughness(a, m.normal_scale, roughness);
+        let antialiased = match (aa, mapped.moments) {
+            (SpecularAa::Lean, Some(moments)) => {
+                let (nt, r) = material::lean_normal_roughness(moments, 1.0, roughness);
                 roughness = r;
                 Some(nt)
             }
-            (SpecularAa::Toksvig, _) => {
-                let slack = if map.texture.format() == Format::Rgba32Float {
-                    0.0
-                } else {
-                    UNORM8_NORMAL_SLACK
-                };
-                let len = (raw.length() + slack).min(1.0);
+            // Toksvig's rule, also LEAN's fallback where a layer has no moment map.
+            (SpecularAa::Toksvig | SpecularAa::Lean, _) => {
+                let len = (mapped.raw.length() + mapped.slack).min(1.0);
                 roughness = material::toksvig_roughness(roughness, len);
-                Some(mean)
+                Some(mapped.mean)
             }
             _ => None,
         };
         return Shading {
-            normal: to_world(antialiased.unwrap_or(mean)).normalize_or(n),
+            normal: to_world(antialiased.unwrap_or(mapped.mean)).normalize_or(n),
             // Antialiased methods light the diffuse term with the mean normal (no longer than 1:
             // scaling by `normal_scale` can lengthen it).
-            diffuse_normal: antialiased.map(|_| to_world(mean).clamp_length_max(1.0)),
+            diffuse_normal: antialiased.map(|_| to_world(mapped.mean).clamp_length_max(1.0)),
             roughness,
         };
     }
-    let Some(height) = m.height_map.as_ref().filter(|_| m.bumped()) else {
+    if !m.bumped() {
         return plain;
-    };
+    }
     let Some((a, b)) = surface_derivatives(verts, n) else {
         return plain;
     };
-    let tex = height.input.texture;
-    let du = bump_step(fp.dudx, fp.dudy, tex.width());
-    let dv = bump_step(fp.dvdx, fp.dvdy, tex.height());
+    let (w, h) = m.height_size();
+    let du = bump_step(fp.dudx, fp.dudy, w);
+    let dv = bump_step(fp.dvdx, fp.dvdy, h);
     // Central differences: pbrt's forward ones are centred half a step away, which shifts
     // every slope (a bevel's shading) by a quarter of the footprint.
     let at = |du: f32, dv: f32, texels: &mut u32| {
@@ -183,7 +213,7 @@ pub(crate) fn shading_normal(
             v: fp.v + dv,
             ..*fp
         };
-        read_channel(height, &fp, count, texels)
+        m.height_at(&fp, count, texels).unwrap_or(1.0)
     };
     let (hu0, hu1) = (at(-du / 2.0, 0.0, texels), at(du / 2.0, 0.0, texels));
     let (hv0, hv1) = (at(0.0, -dv / 2.0, texels), at(0.0, dv / 2.0, texels));
@@ -191,7 +221,10 @@ pub(crate) fn shading_normal(
     let g = Vec2::new((hu1 - hu0) / du, (hv1 - hv0) / dv) * s;
     let normal = normal_from_gradient(a, b, n, g);
     let mut roughness = roughness;
-    if let (SpecularAa::Lean | SpecularAa::Toksvig, Some(moments)) = (aa, m.height_moments) {
+    let moments = m
+        .height_moments
+        .zip(m.height_map.filter(|_| m.layers.is_none()));
+    if let (SpecularAa::Lean | SpecularAa::Toksvig, Some((moments, height))) = (aa, moments) {
         // Toksvig measures an averaged normal's length, which a height map does not have; its
         // moments carry the same information (the spread of the normals), so both use them.
         let input = TextureInput {
@@ -221,7 +254,7 @@ pub(crate) struct Parallax {
     pub position: Vec3,
 }
 
-/// Parallax occlusion mapping (Tatarchuk 2006) of material `m` (which has a height map) for the
+/// Parallax occlusion mapping (Tatarchuk 2006) of material `m` (which has heights) for the
 /// fragment at `position` with unit normal `n` and footprint `fp`, seen from `eye`: march the view
 /// ray below the polygon in [`POM_STEPS`] linear steps of depth, reading the height through the
 /// footprint, until it passes below the relief, then intersect the last segment with the relief
@@ -230,7 +263,6 @@ pub(crate) struct Parallax {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn parallax(
     m: &Material,
-    height: &ChannelInput,
     verts: [&Vertex; 3],
     n: Vec3,
     position: Vec3,
@@ -275,7 +307,7 @@ pub(crate) fn parallax(
             ..*fp
         };
         // How far the relief lies below the ray: positive while the ray is above it.
-        s * (1.0 - read_channel(height, &fp, count, texels)) - depth
+        s * (1.0 - m.height_at(&fp, count, texels).unwrap_or(1.0)) - depth
     };
     let mut prev = (0.0f32, at(0.0, texels));
     let mut hit = 0.0;

@@ -17,6 +17,7 @@ use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};
 use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
 use crate::draw::{DrawCall, Vertex};
+use crate::layers::Needs;
 use crate::material::{
     self, Displacement, Light, Material, SpecularAa, Surface, TextureInput, MIN_ROUGHNESS,
 };
@@ -174,10 +175,18 @@ pub(crate) fn shade(
     count: bool,
 ) -> ([f32; 4], u32) {
     let l = lambda.as_vec3();
-    let Some(lighting) = lighting else {
-        return (base_color(ctx, verts, l, tex).to_array(), 0);
-    };
     let mut texels = 0;
+    let Some(lighting) = lighting else {
+        let mut c = base_color(ctx, verts, l, tex);
+        if let Some(layers) = ctx.material.as_ref().and_then(|m| m.layers.as_ref()) {
+            let needs = Needs {
+                color: true,
+                ..Needs::default()
+            };
+            c *= layers.sample(fp, needs, count, &mut texels).base;
+        }
+        return (c.to_array(), texels);
+    };
     let mut position = relief::interpolate(verts, l, |v| v.position);
     let normal = relief::geometric_normal(verts, l);
     let Some(m) = &ctx.material else {
@@ -196,18 +205,8 @@ pub(crate) fn shade(
     // Parallax occlusion mapping moves every read to where the view ray meets the relief.
     let mut fp = *fp;
     let mut tex = tex;
-    if let (Displacement::Pom, Some(height)) = (m.displacement, &m.height_map) {
-        let hit = relief::parallax(
-            m,
-            height,
-            verts,
-            normal,
-            position,
-            ctx.eye,
-            &fp,
-            count,
-            &mut texels,
-        );
+    if m.displacement == Displacement::Pom && m.has_height() {
+        let hit = relief::parallax(m, verts, normal, position, ctx.eye, &fp, count, &mut texels);
         if let Some(hit) = hit {
             fp = hit.footprint;
             position = hit.position;
@@ -218,8 +217,21 @@ pub(crate) fn shade(
             tex = material::read(&base, &fp, count, &mut texels);
         }
     }
-    let c = base_color(ctx, verts, l, tex);
+    let needs = Needs {
+        color: true,
+        normal: true,
+        moments: m.specular_aa == SpecularAa::Lean,
+    };
+    let layered = m
+        .layers
+        .as_ref()
+        .map(|layers| layers.sample(&fp, needs, count, &mut texels));
+    let mut c = base_color(ctx, verts, l, tex);
     let mut roughness = m.roughness;
+    if let Some(s) = &layered {
+        c *= s.base;
+        roughness *= s.roughness;
+    }
     let mut metallic = m.metallic;
     if let Some(map) = &m.roughness_map {
         roughness *= material::read_channel(map, &fp, count, &mut texels);
@@ -229,6 +241,7 @@ pub(crate) fn shade(
     }
     let mut shading = relief::shading_normal(
         m,
+        layered.as_ref(),
         verts,
         l,
         normal,
@@ -248,8 +261,28 @@ pub(crate) fn shade(
                 v: fp.v + duv[1],
                 ..fp
             };
+            let needs = Needs {
+                normal: true,
+                ..Needs::default()
+            };
+            let layered = m
+                .layers
+                .as_ref()
+                .map(|ly| ly.sample(&fp, needs, count, texels));
             let aa = SpecularAa::None;
-            relief::shading_normal(m, verts, l, n, &fp, aa, roughness, count, texels).normal
+            relief::shading_normal(
+                m,
+                layered.as_ref(),
+                verts,
+                l,
+                n,
+                &fp,
+                aa,
+                roughness,
+                count,
+                texels,
+            )
+            .normal
         };
         let nx = neighbour(dlambda[0], [fp.dudx, fp.dvdx], &mut texels);
         let ny = neighbour(dlambda[1], [fp.dudy, fp.dvdy], &mut texels);

@@ -25,6 +25,8 @@ pub const TRIANGLE_TOML: &str = include_str!("builtin/triangle.toml");
 pub const GLOSSY_TOML: &str = include_str!("builtin/glossy.toml");
 /// The brick wall's TOML.
 pub const BRICKS_TOML: &str = include_str!("builtin/bricks.toml");
+/// The layered terrain's TOML.
+pub const TERRAIN_TOML: &str = include_str!("builtin/terrain.toml");
 
 /// Angle by which `ground-rotated` turns the ground's uvs, in degrees.
 pub const GROUND_ROTATION_DEG: f32 = 30.0;
@@ -52,9 +54,11 @@ pub fn builtin_names() -> &'static [&'static str] {
 /// - `glossy`: a glossy plane, normal-mapped with bumps, receding to the horizon under a low
 ///   light from the far side (specular aliasing);
 /// - `bricks`: a brick wall with mortar joints as a height map (parallax occlusion mapping),
-///   seen along its length, from 50 degrees to grazing.
+///   seen along its length, from 50 degrees to grazing;
+/// - `terrain`: ground receding to 200 m with four layers (grass, rock, sand, snow) blended by a
+///   mask and their heights, bump-mapped from the blended heights.
 pub fn shaded_builtin_names() -> &'static [&'static str] {
-    &["glossy", "bricks"]
+    &["glossy", "bricks", "terrain"]
 }
 
 fn from_toml(name: &str, text: &str) -> Result<Scene, SceneError> {
@@ -82,6 +86,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "triangle" => from_toml(name, TRIANGLE_TOML),
         "glossy" => from_toml(name, GLOSSY_TOML),
         "bricks" => from_toml(name, BRICKS_TOML),
+        "terrain" => from_toml(name, TERRAIN_TOML),
         "cube" => Ok(cube()),
         "sphere" => Ok(sphere()),
         _ => Err(SceneError::UnknownBuiltin {

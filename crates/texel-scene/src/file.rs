@@ -12,10 +12,11 @@
 //! far = 2000.0
 //! [textures.checker]            # path = "file.png" (relative to the scene file) or
 //! procedural = "checker"        # procedural = checker | zoneplate | grid | uv | solid | bumps |
-//! size = 1024                   # waves | wave-heights | bricks | brick-heights; color = "srgb"
-//! checks = 8                    # (default) | "linear"; see `Procedural` for each kind's
-//! color = "srgb"                # parameters (size or width + height, checks, cells, line_width,
-//!                               # rgba, slope, waves, seed, rows, columns, mortar, bevel)
+//! size = 1024                   # waves | wave-heights | bricks | brick-heights | noise |
+//! checks = 8                    # noise-heights | splat; color = "srgb" (default) | "linear";
+//! color = "srgb"                # see `Procedural` for each kind's parameters (size or width +
+//!                               # height, checks, cells, line_width, rgba, slope, waves, seed,
+//!                               # rows, columns, mortar, bevel, layers)
 //! [[meshes]]                    # texture = NAME; address_mode (both axes), address_mode_u/_v:
 //! texture = "checker"           # repeat | mirror-repeat | clamp-to-edge | clamp-to-border |
 //! address_mode = "repeat"       # mirror-clamp-to-edge (default repeat, or the glTF sampler's)
@@ -35,7 +36,13 @@
 //! normal = "bumps"              # specular_aa = "none" | "toksvig" | "lean" | "projected";
 //! specular_aa = "toksvig"       # height = "TEXTURE" (red, color = "linear"), height_scale
 //!                               # (world units, default 0.05), displacement = "none" | "bump" |
-//!                               # "pom" | "tessellate" (layers: parsed, refused until built)
+//!                               # "pom" | "tessellate"
+//! [materials.terrain]           # layered: mask = "TEXTURE" (linear; channel k weighs layer k),
+//! mask = "splat"                #   blend = "linear" | "height", blend_depth (default 0.2),
+//! blend = "height"              #   layer_order = "filter-then-blend" | "blend-then-filter";
+//! [[materials.terrain.layers]]  #   up to 4 layers: base_color, roughness, normal, normal_scale,
+//! base_color = "grass"          #   height = "TEXTURE" or number in [0, 1]; metallic,
+//! height = "grass-heights"      #   height_scale, displacement and specular_aa still apply
 //! ```
 //!
 //! Every table denies unknown keys; a syntax or type error is reported with its line and column.
@@ -52,10 +59,10 @@ use crate::camera::Camera;
 use crate::error::SceneError;
 use crate::limits::SceneLimits;
 use crate::model::{
-    ColorInput, Displacement, LightSpec, MaterialSpec, Mesh, Output, ScalarInput, Scene,
-    SpecularAaSpec, TextureSource, TextureSpec,
+    ColorInput, Displacement, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec, MaterialSpec, Mesh,
+    Output, ScalarInput, Scene, SpecularAaSpec, TextureSource, TextureSpec,
 };
-use crate::procedural::Procedural;
+use crate::procedural::{NoiseKind, Procedural};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -133,7 +140,62 @@ struct RawMaterial {
     height_scale: Option<f32>,
     displacement: Option<RawDisplacement>,
     specular_aa: Option<RawSpecularAa>,
-    layers: Option<Vec<toml::Table>>,
+    layers: Option<Vec<RawLayer>>,
+    mask: Option<String>,
+    blend: Option<RawBlend>,
+    blend_depth: Option<f32>,
+    layer_order: Option<RawLayerOrder>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLayer {
+    base_color: Option<RawColor>,
+    roughness: Option<RawScalar>,
+    normal: Option<String>,
+    normal_scale: Option<f32>,
+    height: Option<RawScalar>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum RawBlend {
+    Linear,
+    Height,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+enum RawLayerOrder {
+    FilterThenBlend,
+    BlendThenFilter,
+}
+
+fn scalar(s: Option<RawScalar>, default: ScalarInput) -> ScalarInput {
+    match s {
+        Some(RawScalar::Texture(t)) => ScalarInput::Texture(t),
+        Some(RawScalar::Value(v)) => ScalarInput::Value(v),
+        None => default,
+    }
+}
+
+fn color(c: Option<RawColor>, default: ColorInput) -> ColorInput {
+    match c {
+        Some(RawColor::Texture(t)) => ColorInput::Texture(t),
+        Some(RawColor::Rgb(c)) => ColorInput::Rgb(c.into()),
+        None => default,
+    }
+}
+
+fn layer_spec(l: RawLayer) -> LayerSpec {
+    let d = LayerSpec::default();
+    LayerSpec {
+        base_color: color(l.base_color, d.base_color),
+        roughness: scalar(l.roughness, d.roughness),
+        normal: l.normal,
+        normal_scale: l.normal_scale.unwrap_or(d.normal_scale),
+        height: l.height.map(|h| scalar(Some(h), ScalarInput::Value(0.5))),
+    }
 }
 
 fn light_spec(l: RawLight) -> LightSpec {
@@ -160,17 +222,8 @@ fn light_spec(l: RawLight) -> LightSpec {
 
 fn material_spec(m: RawMaterial) -> MaterialSpec {
     let d = MaterialSpec::default();
-    let scalar = |s: Option<RawScalar>, default: ScalarInput| match s {
-        Some(RawScalar::Texture(t)) => ScalarInput::Texture(t),
-        Some(RawScalar::Value(v)) => ScalarInput::Value(v),
-        None => default,
-    };
     MaterialSpec {
-        base_color: match m.base_color {
-            Some(RawColor::Texture(t)) => ColorInput::Texture(t),
-            Some(RawColor::Rgb(c)) => ColorInput::Rgb(c.into()),
-            None => d.base_color,
-        },
+        base_color: color(m.base_color, d.base_color),
         roughness: scalar(m.roughness, d.roughness),
         metallic: scalar(m.metallic, d.metallic),
         normal: m.normal,
@@ -189,7 +242,19 @@ fn material_spec(m: RawMaterial) -> MaterialSpec {
             Some(RawSpecularAa::Lean) => SpecularAaSpec::Lean,
             Some(RawSpecularAa::Projected) => SpecularAaSpec::Projected,
         },
-        layers: m.layers.map_or(0, |l| l.len()),
+        layers: m
+            .layers
+            .map_or_else(Vec::new, |l| l.into_iter().map(layer_spec).collect()),
+        mask: m.mask,
+        blend: match m.blend {
+            None | Some(RawBlend::Linear) => LayerBlendSpec::Linear,
+            Some(RawBlend::Height) => LayerBlendSpec::Height,
+        },
+        blend_depth: m.blend_depth.unwrap_or(d.blend_depth),
+        layer_order: match m.layer_order {
+            None | Some(RawLayerOrder::FilterThenBlend) => LayerOrder::FilterThenBlend,
+            Some(RawLayerOrder::BlendThenFilter) => LayerOrder::BlendThenFilter,
+        },
     }
 }
 
@@ -235,6 +300,9 @@ enum Kind {
     WaveHeights,
     Bricks,
     BrickHeights,
+    Noise,
+    NoiseHeights,
+    Splat,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -264,6 +332,7 @@ struct RawTexture {
     columns: Option<u32>,
     mortar: Option<f32>,
     bevel: Option<f32>,
+    layers: Option<u32>,
 }
 
 impl Kind {
@@ -280,6 +349,9 @@ impl Kind {
             Kind::WaveHeights => "wave-heights",
             Kind::Bricks => "bricks",
             Kind::BrickHeights => "brick-heights",
+            Kind::Noise => "noise",
+            Kind::NoiseHeights => "noise-heights",
+            Kind::Splat => "splat",
         }
     }
 }
@@ -357,6 +429,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
         ("columns", t.columns.is_some()),
         ("mortar", t.mortar.is_some()),
         ("bevel", t.bevel.is_some()),
+        ("layers", t.layers.is_some()),
     ]
     .iter()
     .filter(|p| p.1)
@@ -385,6 +458,9 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Bricks | Kind::BrickHeights => &[
                     "size", "width", "height", "rows", "columns", "mortar", "bevel",
                 ],
+                Kind::Noise => &["size", "cells", "seed", "rgba"],
+                Kind::NoiseHeights => &["size", "cells", "seed"],
+                Kind::Splat => &["size", "cells", "seed", "layers"],
             };
             if let Some(k) = given.iter().find(|k| !allowed.contains(k)) {
                 return Err(bad(format!(
@@ -398,6 +474,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Uv => 256,
                 Kind::Solid => 1,
                 Kind::Bumps | Kind::Waves | Kind::WaveHeights => 512,
+                Kind::Noise | Kind::NoiseHeights | Kind::Splat => 512,
                 Kind::Bricks | Kind::BrickHeights => 0,
             };
             let (width, height) = match (t.size, t.width, t.height) {
@@ -477,6 +554,23 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                     height,
                     rgba: t.rgba.unwrap_or([255; 4]),
                 },
+                Kind::Noise | Kind::NoiseHeights | Kind::Splat => Procedural::Noise {
+                    size: width,
+                    cells: positive(t.cells, "cells", 8)?,
+                    seed: t.seed.unwrap_or(1),
+                    kind: match kind {
+                        Kind::Noise => NoiseKind::Color {
+                            rgba: t.rgba.unwrap_or([255; 4]),
+                        },
+                        Kind::NoiseHeights => NoiseKind::Heights,
+                        _ => NoiseKind::Splat {
+                            layers: match t.layers.unwrap_or(4) {
+                                l @ 1..=4 => l,
+                                l => return Err(bad(format!("layers = {l} must be 1 to 4"))),
+                            },
+                        },
+                    },
+                },
             })
         }
     };
@@ -494,7 +588,25 @@ fn mesh_texture(
         mesh: index,
         reason,
     };
-    let from_material = match m.material.as_ref().and_then(|n| materials.get(n)) {
+    let material = m.material.as_ref().and_then(|n| materials.get(n));
+    if let Some(mat) = material.filter(|mat| !mat.layers.is_empty()) {
+        // A layered material's colour is its layers': the mesh's texture slot names a texture
+        // the material reads (its mask where it has one), which the draw does not show.
+        if m.texture.is_some() {
+            return Err(src(
+                "its material is layered and takes its colour from its layers: leave texture out"
+                    .to_string(),
+            ));
+        }
+        let slot = mat
+            .mask
+            .as_deref()
+            .or_else(|| mat.textures().first().copied());
+        return slot.map(str::to_string).ok_or_else(|| {
+            src("its layered material reads no texture: give it a mask or a layer texture".into())
+        });
+    }
+    let from_material = match material {
         Some(MaterialSpec {
             base_color: ColorInput::Texture(t),
             ..

@@ -52,9 +52,10 @@ pub use error::SceneError;
 pub use gltf_import::{load_gltf, load_gltf_slice, load_gltf_with};
 pub use limits::SceneLimits;
 pub use model::{
-    ColorInput, Displacement, LightSpec, MaterialSpec, Mesh, MeshFilters, Output, ScalarInput,
-    Scene, SpecularAaSpec, TextureSource, TextureSpec, MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
+    ColorInput, Displacement, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec, MaterialSpec, Mesh,
+    MeshFilters, Output, ScalarInput, Scene, SpecularAaSpec, TextureSource, TextureSpec,
+    MAX_LAYERS, MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
 };
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
-pub use procedural::Procedural;
+pub use procedural::{NoiseKind, Procedural};
 pub use texture::TextureUse;

@@ -137,8 +137,82 @@ pub struct MaterialSpec {
     pub displacement: Displacement,
     /// `specular_aa`.
     pub specular_aa: SpecularAaSpec,
-    /// Number of `[[materials.NAME.layers]]` tables given.
-    pub layers: usize,
+    /// `[[materials.NAME.layers]]`: up to four layers blended by `mask` (empty: not layered).
+    /// A layered material takes base colour, roughness, normals and heights from its layers.
+    pub layers: Vec<LayerSpec>,
+    /// `mask`: the texture whose channel `k` (red, green, blue, alpha) weighs layer `k`
+    /// (`color = "linear"`); required for two layers or more.
+    pub mask: Option<String>,
+    /// `blend`.
+    pub blend: LayerBlendSpec,
+    /// `blend_depth`: the transition width of `blend = "height"`, in height units, `(0, 1]`.
+    /// Default 0.2.
+    pub blend_depth: f32,
+    /// `layer_order`.
+    pub layer_order: LayerOrder,
+}
+
+/// The most layers a material has (one per channel of its mask).
+pub const MAX_LAYERS: usize = 4;
+
+/// One layer of a layered material (`[[materials.NAME.layers]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayerSpec {
+    /// `base_color`: a texture name or `[r, g, b]` (linear). Default white.
+    pub base_color: ColorInput,
+    /// `roughness`: number in `[0, 1]` or texture name (red). Default 0.5.
+    pub roughness: ScalarInput,
+    /// `normal`: tangent-space normal map (texture name, `color = "linear"`).
+    pub normal: Option<String>,
+    /// `normal_scale`. Default 1.
+    pub normal_scale: f32,
+    /// `height`: number in `[0, 1]` or height map name (red, `color = "linear"`); `None`: 0.5,
+    /// and the layer gives no height of its own.
+    pub height: Option<ScalarInput>,
+}
+
+impl Default for LayerSpec {
+    fn default() -> Self {
+        LayerSpec {
+            base_color: ColorInput::Rgb(Vec3::ONE),
+            roughness: ScalarInput::Value(0.5),
+            normal: None,
+            normal_scale: 1.0,
+            height: None,
+        }
+    }
+}
+
+/// How a layered material weighs its layers (`blend = ...`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LayerBlendSpec {
+    /// `"linear"`: the mask's weights.
+    #[default]
+    Linear,
+    /// `"height"`: the mask's weights sharpened by the layers' heights.
+    Height,
+}
+
+/// Where a layered material's blend happens relative to texture filtering (`layer_order = ...`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LayerOrder {
+    /// `"filter-then-blend"`: every map is filtered over the pixel's footprint, then the
+    /// filtered values are blended (what a shader does).
+    #[default]
+    FilterThenBlend,
+    /// `"blend-then-filter"`: the layers are blended texel by texel at level 0 into one set of
+    /// maps when the scene is prepared, and those are filtered (a baked material).
+    BlendThenFilter,
+}
+
+impl LayerOrder {
+    /// The name scene files use.
+    pub fn name(self) -> &'static str {
+        match self {
+            LayerOrder::FilterThenBlend => "filter-then-blend",
+            LayerOrder::BlendThenFilter => "blend-then-filter",
+        }
+    }
 }
 
 impl Default for MaterialSpec {
@@ -153,7 +227,11 @@ impl Default for MaterialSpec {
             height_scale: 0.05,
             displacement: Displacement::None,
             specular_aa: SpecularAaSpec::None,
-            layers: 0,
+            layers: Vec::new(),
+            mask: None,
+            blend: LayerBlendSpec::Linear,
+            blend_depth: 0.2,
+            layer_order: LayerOrder::FilterThenBlend,
         }
     }
 }
@@ -161,18 +239,48 @@ impl Default for MaterialSpec {
 impl MaterialSpec {
     /// Every texture name the material reads.
     pub fn textures(&self) -> Vec<&str> {
-        let mut out = Vec::new();
-        if let ColorInput::Texture(t) = &self.base_color {
-            out.push(t.as_str());
-        }
-        for s in [&self.roughness, &self.metallic] {
-            if let ScalarInput::Texture(t) = s {
-                out.push(t.as_str());
+        self.texture_uses().into_iter().map(|(t, _)| t).collect()
+    }
+
+    /// Every texture name the material reads, each with whether it holds colours (base colour
+    /// textures, which the CLI's `--color raw` applies to) rather than data.
+    pub fn texture_uses(&self) -> Vec<(&str, bool)> {
+        fn color<'a>(c: &'a ColorInput, out: &mut Vec<(&'a str, bool)>) {
+            if let ColorInput::Texture(t) = c {
+                out.push((t.as_str(), true));
             }
         }
-        out.extend(self.normal.as_deref());
-        out.extend(self.height.as_deref());
+        fn scalar<'a>(s: &'a ScalarInput, out: &mut Vec<(&'a str, bool)>) {
+            if let ScalarInput::Texture(t) = s {
+                out.push((t.as_str(), false));
+            }
+        }
+        let mut out = Vec::new();
+        color(&self.base_color, &mut out);
+        scalar(&self.roughness, &mut out);
+        scalar(&self.metallic, &mut out);
+        out.extend(self.normal.as_deref().map(|t| (t, false)));
+        out.extend(self.height.as_deref().map(|t| (t, false)));
+        out.extend(self.mask.as_deref().map(|t| (t, false)));
+        for l in &self.layers {
+            color(&l.base_color, &mut out);
+            scalar(&l.roughness, &mut out);
+            out.extend(l.normal.as_deref().map(|t| (t, false)));
+            if let Some(h) = &l.height {
+                scalar(h, &mut out);
+            }
+        }
         out
+    }
+
+    /// Whether any layer gives a height (the blended height then shapes the surface).
+    pub fn layer_heights(&self) -> bool {
+        self.layers.iter().any(|l| l.height.is_some())
+    }
+
+    /// Whether the material has heights: a height map, or layers that give heights.
+    pub fn has_heights(&self) -> bool {
+        self.height.is_some() || self.layer_heights()
     }
 }
 

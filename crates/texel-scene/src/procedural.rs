@@ -121,6 +121,27 @@ pub enum Procedural {
         /// Heights instead of colours.
         heights: bool,
     },
+    /// Tiling fractal value noise: `v = sum_o 2^-o n(2^o cells x / size, ...) / sum_o 2^-o` over
+    /// [`NOISE_OCTAVES`] octaves, `n` value noise on an integer lattice of `cells` (doubled per
+    /// octave) cells per side, wrapping so the texture tiles, with quintic interpolation
+    /// (`6t^5 - 15t^4 + 10t^3`, Perlin 2002) between lattice values hashed from `seed`; `v` lies in
+    /// `[0, 1]`. `kind = Color` (`"noise"`): the colour `rgba` scaled by `0.4 + 0.6 v` (alpha
+    /// `rgba`'s); `Heights` (`"noise-heights"`, use `color = "linear"`): grey `round(255 v)`;
+    /// `Splat` (`"splat"`, use `color = "linear"`): a layer mask, one independent noise `v_k`
+    /// per channel (seeds `seed + k`) turned into weights summing to 1 by a softmax,
+    /// `w_k = exp(24 v_k) / sum exp(24 v)` over the first `layers` channels (the rest 0), coded
+    /// `round(255 w_k)`. Square; `size = 512`, `cells = 8`, `seed = 1`,
+    /// `rgba = [255, 255, 255, 255]`, `layers = 4` by default.
+    Noise {
+        /// Side in texels.
+        size: u32,
+        /// Lattice cells along each side at the coarsest octave (`>= 1`).
+        cells: u32,
+        /// Seed of the lattice values.
+        seed: u32,
+        /// What is made of the noise.
+        kind: NoiseKind,
+    },
     /// One colour everywhere (8-bit codes, `rgba = [255, 255, 255, 255]` and `size = 1` by default).
     Solid {
         /// Width in texels.
@@ -143,7 +164,8 @@ impl Procedural {
             | Procedural::Solid { width, height, .. } => (width, height),
             Procedural::ZonePlate { size }
             | Procedural::Bumps { size, .. }
-            | Procedural::Waves { size, .. } => (size, size),
+            | Procedural::Waves { size, .. }
+            | Procedural::Noise { size, .. } => (size, size),
         }
     }
 
@@ -224,6 +246,32 @@ impl Procedural {
                 }
             }
             Procedural::Solid { rgba, .. } => rgba,
+            Procedural::Noise {
+                size,
+                cells,
+                seed,
+                kind,
+            } => {
+                let v = |seed: u32| noise(size, cells, seed, i, j);
+                let code = |x: f64| (255.0 * x).round().clamp(0.0, 255.0) as u8;
+                match kind {
+                    NoiseKind::Color { rgba } => {
+                        let f = 0.4 + 0.6 * v(seed);
+                        let c = |k: usize| (f64::from(rgba[k]) * f).round() as u8;
+                        [c(0), c(1), c(2), rgba[3]]
+                    }
+                    NoiseKind::Heights => grey(code(v(seed))),
+                    NoiseKind::Splat { layers } => {
+                        let n = layers.clamp(1, 4) as usize;
+                        let mut e = [0.0f64; 4];
+                        for (k, e) in e.iter_mut().enumerate().take(n) {
+                            *e = (24.0 * v(seed.wrapping_add(k as u32))).exp();
+                        }
+                        let sum: f64 = e.iter().sum();
+                        e.map(|x| code(x / sum))
+                    }
+                }
+            }
         }
     }
 
@@ -298,6 +346,53 @@ impl Procedural {
             .collect();
         Texture::from_rgba8(w, h, texels, color, limits)
     }
+}
+
+/// What [`Procedural::Noise`] makes of its noise.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NoiseKind {
+    /// `"noise"`: a colour texture, `rgba` scaled by the noise.
+    Color {
+        /// The brightest colour's 8-bit codes.
+        rgba: [u8; 4],
+    },
+    /// `"noise-heights"`: a height map.
+    Heights,
+    /// `"splat"`: a mask of `layers` (1 to 4) weights.
+    Splat {
+        /// Channels holding weights.
+        layers: u32,
+    },
+}
+
+/// The octaves of [`Procedural::Noise`].
+pub const NOISE_OCTAVES: u32 = 5;
+
+/// [`Procedural::Noise`]'s fractal value noise at texel `(i, j)` of a `size`-texel square.
+fn noise(size: u32, cells: u32, seed: u32, i: u32, j: u32) -> f64 {
+    let (x, y) = (
+        (f64::from(i) + 0.5) / f64::from(size.max(1)),
+        (f64::from(j) + 0.5) / f64::from(size.max(1)),
+    );
+    let (mut sum, mut norm) = (0.0, 0.0);
+    for o in 0..NOISE_OCTAVES {
+        let n = u64::from(cells.max(1)) << o;
+        let lattice = |a: u64, b: u64| {
+            let key = (u64::from(seed) << 40) ^ (u64::from(o) << 56) ^ ((a % n) << 20) ^ (b % n);
+            (texel_texture::rng::mix64(key) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (fx, fy) = (x * n as f64, y * n as f64);
+        let (a, b) = (fx.floor(), fy.floor());
+        let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+        let (tx, ty) = (fade(fx - a), fade(fy - b));
+        let (a, b) = (a as u64, b as u64);
+        let top = lattice(a, b) + tx * (lattice(a + 1, b) - lattice(a, b));
+        let bottom = lattice(a, b + 1) + tx * (lattice(a + 1, b + 1) - lattice(a, b + 1));
+        let w = 0.5f64.powi(o as i32);
+        sum += w * (top + ty * (bottom - top));
+        norm += w;
+    }
+    sum / norm
 }
 
 /// One sinusoid of [`Procedural::Waves`], in texel units: `amplitude sin(kx x + ky y + phase)`.
@@ -485,6 +580,61 @@ mod tests {
         // Tiles: the last column and the first share the shade pattern of one brick across the
         // seam in the shifted course.
         assert_eq!(c.code(63, 12), c.code(0, 12));
+    }
+
+    #[test]
+    fn noise_tiles_stays_in_range_and_splat_weights_sum_to_one() {
+        for kind in [
+            NoiseKind::Heights,
+            NoiseKind::Splat { layers: 3 },
+            NoiseKind::Color {
+                rgba: [200, 100, 50, 255],
+            },
+        ] {
+            let p = Procedural::Noise {
+                size: 64,
+                cells: 4,
+                seed: 7,
+                kind,
+            };
+            let t: Vec<[u8; 4]> = (0..64 * 64).map(|k| p.code(k % 64, k / 64)).collect();
+            // Opposite edges continue each other: neighbours across the seam differ no more than
+            // neighbours inside.
+            let step =
+                |a: [u8; 4], b: [u8; 4]| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
+            let inner = (0..64)
+                .map(|j| step(t[j * 64 + 31], t[j * 64 + 32]))
+                .max()
+                .unwrap();
+            let seam = (0..64)
+                .map(|j| step(t[j * 64 + 63], t[j * 64]))
+                .max()
+                .unwrap();
+            assert!(
+                seam <= inner.max(1) * 2,
+                "{kind:?}: seam {seam}, inner {inner}"
+            );
+            match kind {
+                NoiseKind::Splat { layers } => {
+                    for c in &t {
+                        let sum: u32 = c.iter().map(|&x| u32::from(x)).sum();
+                        assert!((253..=257).contains(&sum), "{c:?}");
+                        assert_eq!(c[3], 0, "only {layers} channels weigh");
+                    }
+                }
+                NoiseKind::Color { rgba } => {
+                    assert!(t
+                        .iter()
+                        .all(|c| c[0] <= rgba[0] && c[0] >= 80 && c[3] == 255));
+                }
+                NoiseKind::Heights => {
+                    let (lo, hi) = t
+                        .iter()
+                        .fold((255, 0), |(lo, hi), c| (c[0].min(lo), c[0].max(hi)));
+                    assert!(hi - lo > 100, "a range of heights: {lo}..{hi}");
+                }
+            }
+        }
     }
 
     #[test]

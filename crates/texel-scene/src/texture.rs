@@ -92,10 +92,9 @@ impl Scene {
                 .material
                 .as_ref()
                 .and_then(|n| self.materials.get(n))
-                .map(|mat| mat.textures())
+                .map(|mat| mat.texture_uses())
                 .unwrap_or_default();
-            let uses = std::iter::once((m.texture.as_str(), true))
-                .chain(maps.into_iter().map(|t| (t, false)));
+            let uses = std::iter::once((m.texture.as_str(), true)).chain(maps);
             for (name, color) in uses {
                 if !out.iter().any(|u| u.name == name) {
                     out.push(TextureUse { mesh, name, color });

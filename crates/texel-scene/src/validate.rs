@@ -4,8 +4,8 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::SceneError;
 use crate::model::{
-    ColorInput, Displacement, LightSpec, MaterialSpec, ScalarInput, Scene, MAX_OUTPUT_SIDE,
-    MAX_SCENE_LIGHTS,
+    ColorInput, Displacement, LightSpec, MaterialSpec, ScalarInput, Scene, MAX_LAYERS,
+    MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
 };
 
 fn finite3(what: impl Fn() -> String, v: Vec3) -> Result<(), SceneError> {
@@ -252,18 +252,10 @@ impl Scene {
             }
         }
         if let Some(n) = &m.normal {
-            if self.textures[n].color != texel_texture::ColorSpace::Linear {
-                return Err(bad(format!(
-                    "normal map {n:?} holds vectors, not colours: give it color = \"linear\""
-                )));
-            }
+            self.linear("normal map", n, "vectors").map_err(bad)?;
         }
         if let Some(h) = &m.height {
-            if self.textures[h].color != texel_texture::ColorSpace::Linear {
-                return Err(bad(format!(
-                    "height map {h:?} holds heights, not colours: give it color = \"linear\""
-                )));
-            }
+            self.linear("height map", h, "heights").map_err(bad)?;
         }
         if m.height_scale < 0.0 {
             return Err(bad(format!(
@@ -271,15 +263,101 @@ impl Scene {
                 m.height_scale
             )));
         }
-        if m.displacement != Displacement::None && m.height.is_none() {
+        if m.displacement != Displacement::None && !m.has_heights() {
             return Err(bad(format!(
-                "displacement = \"{}\" needs a height map: give it height = \"TEXTURE\"",
+                "displacement = \"{}\" needs a height map: give it height = \"TEXTURE\" (or \
+                 layers with heights)",
                 m.displacement.name()
             )));
         }
-        // Parsed so that scene files written for the full schema are read, refused until built.
-        if m.layers > 0 {
-            return Err(bad("layered materials are not implemented yet".into()));
+        self.validate_layers(m).map_err(bad)
+    }
+
+    /// That texture `t` (defined), read as `what`, is `color = "linear"`.
+    fn linear(&self, what: &str, t: &str, holds: &str) -> Result<(), String> {
+        match self.textures.get(t).map(|t| t.color) {
+            Some(texel_texture::ColorSpace::Linear) | None => Ok(()),
+            Some(_) => Err(format!(
+                "{what} {t:?} holds {holds}, not colours: give it color = \"linear\""
+            )),
+        }
+    }
+
+    /// The layers of a layered material (or that a plain one has none of their keys).
+    fn validate_layers(&self, m: &MaterialSpec) -> Result<(), String> {
+        let d = MaterialSpec::default();
+        if m.layers.is_empty() {
+            let layer_keys = m.mask.is_some()
+                || m.blend != d.blend
+                || m.blend_depth != d.blend_depth
+                || m.layer_order != d.layer_order;
+            return match layer_keys {
+                true => Err(
+                    "mask, blend, blend_depth and layer_order belong to layered \
+                             materials: give [[materials.NAME.layers]]"
+                        .into(),
+                ),
+                false => Ok(()),
+            };
+        }
+        if m.layers.len() > MAX_LAYERS {
+            return Err(format!(
+                "{} layers given; at most {MAX_LAYERS} (one per mask channel)",
+                m.layers.len()
+            ));
+        }
+        let own = m.base_color != d.base_color
+            || m.roughness != d.roughness
+            || m.normal.is_some()
+            || m.height.is_some();
+        if own {
+            return Err(
+                "a layered material takes base_color, roughness, normal and height \
+                        from its layers: give them per layer"
+                    .into(),
+            );
+        }
+        if m.layers.len() > 1 && m.mask.is_none() {
+            return Err(format!(
+                "{} layers need a mask = \"TEXTURE\" to weigh them",
+                m.layers.len()
+            ));
+        }
+        if !(m.blend_depth > 0.0 && m.blend_depth <= 1.0) {
+            return Err(format!("blend_depth = {} must be in (0, 1]", m.blend_depth));
+        }
+        if let Some(mask) = &m.mask {
+            self.linear("mask", mask, "weights")?;
+        }
+        for (k, l) in m.layers.iter().enumerate() {
+            let at = |e: String| format!("layer {k}: {e}");
+            for (key, s) in [
+                ("roughness", Some(&l.roughness)),
+                ("height", l.height.as_ref()),
+            ] {
+                if let Some(ScalarInput::Value(v)) = s {
+                    if !(0.0..=1.0).contains(v) {
+                        return Err(at(format!("{key} = {v} must be in [0, 1]")));
+                    }
+                }
+            }
+            if let ColorInput::Rgb(c) = l.base_color {
+                if !c.is_finite() || c.min_element() < 0.0 {
+                    return Err(at(format!(
+                        "base_color = {:?} must be finite and >= 0",
+                        c.to_array()
+                    )));
+                }
+            }
+            if !l.normal_scale.is_finite() {
+                return Err(at("normal_scale must be finite".into()));
+            }
+            if let Some(n) = &l.normal {
+                self.linear("normal map", n, "vectors").map_err(at)?;
+            }
+            if let Some(ScalarInput::Texture(h)) = &l.height {
+                self.linear("height map", h, "heights").map_err(at)?;
+            }
         }
         Ok(())
     }

@@ -4,8 +4,8 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use texel_scene::{
-    ColorInput, Displacement, LightSpec, MaterialSpec, Mesh, Procedural, ScalarInput, Scene,
-    SceneError, SpecularAaSpec,
+    ColorInput, Displacement, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec, MaterialSpec, Mesh,
+    Procedural, ScalarInput, Scene, SceneError, SpecularAaSpec,
 };
 
 const BASE: &str = r#"
@@ -153,9 +153,122 @@ fn every_specular_aa_method_and_height_maps_parse() {
     }
 }
 
+/// Layered materials: keys, defaults, the mesh's texture slot, and every refusal with its reason.
+#[test]
+fn layered_materials_parse_and_bad_ones_are_refused() {
+    let s = parse(
+        r#"
+[textures.mask]
+procedural = "splat"
+size = 16
+layers = 2
+color = "linear"
+[materials.m]
+mask = "mask"
+blend = "height"
+blend_depth = 0.1
+layer_order = "blend-then-filter"
+displacement = "bump"
+[[materials.m.layers]]
+base_color = "grey"
+roughness = 0.7
+normal = "bumps"
+height = "rough"
+[[materials.m.layers]]
+base_color = [0.5, 0.4, 0.3]
+height = 0.25
+"#,
+    )
+    .unwrap();
+    let m = &s.materials["m"];
+    assert_eq!(m.layers.len(), 2);
+    assert_eq!(
+        (m.blend, m.blend_depth, m.layer_order),
+        (LayerBlendSpec::Height, 0.1, LayerOrder::BlendThenFilter)
+    );
+    assert_eq!(
+        m.layers[0].height,
+        Some(ScalarInput::Texture("rough".into()))
+    );
+    assert_eq!(m.layers[1].height, Some(ScalarInput::Value(0.25)));
+    assert_eq!(m.layers[1].roughness, LayerSpec::default().roughness);
+    assert_eq!(
+        m.layers[1].base_color,
+        ColorInput::Rgb(Vec3::new(0.5, 0.4, 0.3))
+    );
+    assert!(m.has_heights() && m.textures().contains(&"bumps"));
+    // The mesh's texture slot names the mask (the draw shows the layers' colour).
+    assert_eq!(s.meshes[0].texture, "mask");
+    let mask = "[textures.mask]\nprocedural = \"splat\"\nsize = 16\ncolor = \"linear\"\n";
+    let layer = "[[materials.m.layers]]\nbase_color = \"grey\"\n";
+    let five = layer.repeat(5);
+    let cases = [
+        (
+            format!("{mask}[materials.m]\nmask = \"mask\"\n{five}"),
+            "5 layers given; at most 4",
+        ),
+        (
+            format!("[materials.m]\n{layer}{layer}"),
+            "2 layers need a mask",
+        ),
+        (
+            format!("{mask}[materials.m]\nmask = \"mask\"\nroughness = 0.3\n{layer}"),
+            "takes base_color, roughness, normal and height from its layers",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\nmask = \"grey\"\n".to_string(),
+            "belong to layered materials",
+        ),
+        (
+            format!("[materials.m]\nmask = \"grey\"\n{layer}"),
+            "mask \"grey\" holds weights, not colours",
+        ),
+        (
+            format!("[materials.m]\n{layer}roughness = 2.0\n"),
+            "layer 0: roughness = 2 must be in [0, 1]",
+        ),
+        (
+            "[materials.m]\n[[materials.m.layers]]\nnormal = \"grey\"\n".to_string(),
+            "layer 0: normal map \"grey\" holds vectors",
+        ),
+        (
+            format!("{mask}[materials.m]\nmask = \"mask\"\nblend_depth = 0.0\n{layer}"),
+            "blend_depth = 0 must be in (0, 1]",
+        ),
+        (
+            format!("[materials.m]\n{layer}gloss = 1.0\n"),
+            "unknown field `gloss`",
+        ),
+        (
+            format!("[materials.m]\nlayer_order = \"sideways\"\n{layer}"),
+            "unknown variant `sideways`",
+        ),
+        (
+            "[materials.m]\n[[materials.m.layers]]\nbase_color = [0.5, 0.5, 0.5]\n".to_string(),
+            "reads no texture",
+        ),
+    ];
+    for (extra, needle) in &cases {
+        let e = parse(extra).unwrap_err().to_string();
+        assert!(e.contains(needle), "{extra}: {e}");
+    }
+    // A mesh that names a texture under a layered material is refused.
+    let text = format!(
+        "{BASE}[materials.m]\n{layer}{}",
+        MESH.replace("material = \"m\"", "material = \"m\"\ntexture = \"grey\"")
+    );
+    let e = Scene::from_toml_str(&text, Path::new("t.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("leave texture out"), "{e}");
+    // The built-in terrain is a layered material of four layers.
+    let t = Scene::load("builtin:terrain").unwrap();
+    assert_eq!(t.materials["terrain"].layers.len(), 4);
+}
+
 #[test]
 fn bad_lights_and_materials_are_refused_with_the_reason() {
-    let cases: [(&str, &str); 12] = [
+    let cases: [(&str, &str); 11] = [
         (
             "[materials.m]\nbase_color = \"grey\"\nshininess = 3.0\n",
             "unknown field `shininess`",
@@ -180,10 +293,6 @@ fn bad_lights_and_materials_are_refused_with_the_reason() {
         (
             "[materials.m]\nbase_color = \"grey\"\nheight = \"rough\"\nheight_scale = -0.1\n",
             "height_scale = -0.1 must be at least 0",
-        ),
-        (
-            "[materials.m]\nbase_color = \"grey\"\n[[materials.m.layers]]\nbase_color = \"grey\"\n",
-            "not implemented yet",
         ),
         (
             "[materials.m]\nbase_color = \"grey\"\nspecular_aa = \"sharpen\"\n",

@@ -175,7 +175,7 @@ fn unknown_key_and_bad_values_are_toml_errors() {
         parse(&text),
         Err(SceneError::Toml { line: 3, .. })
     ));
-    let text = format!("{HEAD}{TRI}").replace("procedural = \"uv\"", "procedural = \"noise\"");
+    let text = format!("{HEAD}{TRI}").replace("procedural = \"uv\"", "procedural = \"perlin\"");
     assert!(matches!(parse(&text), Err(SceneError::Toml { .. })));
 }
 

@@ -26,6 +26,7 @@
 //! For more control (several filters on one loaded scene, debug views, threads, timing), use
 //! [`PreparedScene`] with [`raster::render`] as `examples/render_scene.rs` does.
 
+pub mod bake;
 mod error;
 mod filter;
 pub mod memory;

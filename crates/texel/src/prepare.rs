@@ -5,14 +5,19 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::{Mutex, OnceLock};
 
+use texel_raster::layers::{Layer, LayerBlend, Layers, MAX_LAYERS};
 use texel_raster::{
     ChannelInput, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
     TextureInput, Vertex,
 };
-use texel_scene::{ColorInput, LightSpec, ScalarInput, Scene, SpecularAaSpec};
+use texel_scene::{
+    ColorInput, LayerBlendSpec, LayerOrder, LightSpec, MaterialSpec, ScalarInput, Scene,
+    SpecularAaSpec,
+};
 use texel_texture::color::srgb_to_linear;
-use texel_texture::{ColorSpace, Limits, Sampler, Texture};
+use texel_texture::{AddressMode, ColorSpace, Limits, Sampler, Texture};
 
+use crate::bake::{self, Composite};
 use crate::memory::{raster_bytes, FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_BYTES};
 use crate::tessellate::Tessellated;
 use crate::{Error, Filter, MemoryBudget};
@@ -46,6 +51,9 @@ pub struct SceneOptions {
     /// The projected edge length, pixels, that `displacement = "tessellate"` tessellates to
     /// (the CLI's `--edge-px`); `None`: [`crate::tessellate::RENDER_EDGE_PX`].
     pub edge_px: Option<f32>,
+    /// Where every layered material blends, overriding each one's `layer_order` (the CLI's
+    /// `--layer-order`).
+    pub layer_order: Option<LayerOrder>,
 }
 
 /// A loaded scene, ready to render with any filter.
@@ -78,6 +86,14 @@ pub struct PreparedScene {
     /// Slope moment maps ([`texel_raster::material::height_moments`]) of the height maps of
     /// bump-mapped materials without a normal map that use LEAN or Toksvig, by texture name.
     height_moments: BTreeMap<String, Texture>,
+    /// [`SceneOptions::layer_order`].
+    layer_order: Option<LayerOrder>,
+    /// Baked layered materials ([`crate::bake`]), by material name: those that blend then
+    /// filter, and those whose heights displace.
+    composites: BTreeMap<String, Baked>,
+    /// A 1x1 white texture: the draw's colour texture under a layered material that filters
+    /// then blends (the layers give the colour).
+    white: Texture,
     /// Per mesh, its tessellated and displaced geometry where its material tessellates
     /// (built for the scene's camera: other views reuse it).
     tessellated: Vec<Option<Tessellated>>,
@@ -138,48 +154,104 @@ impl PreparedScene {
             )?;
             textures.insert(u.name.to_string(), loaded.texture);
         }
-        // LEAN reads moment maps made from the normal maps, and LEAN and Toksvig on bump maps
-        // moment maps made from the height maps (float, charged like any texture).
+        // LEAN reads moment maps made from the normal maps (a layered material's too), and LEAN
+        // and Toksvig on bump maps moment maps made from the height maps (float, charged like
+        // any texture).
+        type Build = fn(&Texture, &Limits) -> Result<Texture, texel_texture::TextureError>;
+        let lean: Build = texel_raster::material::lean_map;
+        let slopes: Build = |t, limits| texel_raster::material::height_moments(t, 0, limits);
         let mut lean_maps = BTreeMap::new();
         let mut height_moments = BTreeMap::new();
         for mat in scene.materials.values() {
             let aa = specular_aa(mat, options.specular_aa);
             let bumped = displacement(mat, options.displacement) != texel_scene::Displacement::None;
-            type Build = fn(&Texture, &Limits) -> Result<Texture, texel_texture::TextureError>;
-            let (name, kind, out, build): (_, _, _, Build) = match (&mat.normal, &mat.height) {
-                (Some(n), _) if aa == SpecularAa::Lean => (
-                    n,
-                    "LEAN moments",
-                    &mut lean_maps,
-                    texel_raster::material::lean_map,
-                ),
+            let layer_normals = mat.layers.iter().filter_map(|l| l.normal.as_ref());
+            // (the map, whether its moments are LEAN's of normals rather than slopes of heights)
+            let jobs: Vec<(&String, bool)> = match (&mat.normal, &mat.height) {
+                _ if aa == SpecularAa::Lean && !mat.layers.is_empty() => {
+                    layer_normals.map(|n| (n, true)).collect()
+                }
+                (Some(n), _) if aa == SpecularAa::Lean => vec![(n, true)],
                 (None, Some(h))
                     if bumped && matches!(aa, SpecularAa::Lean | SpecularAa::Toksvig) =>
                 {
-                    (h, "slope moments", &mut height_moments, |t, limits| {
-                        texel_raster::material::height_moments(t, 0, limits)
-                    })
+                    vec![(h, false)]
                 }
                 _ => continue,
             };
-            let Some(map) = textures.get(name) else {
-                continue;
-            };
-            if out.contains_key(name) {
+            for (name, normals) in jobs {
+                let (kind, out, build) = if normals {
+                    ("LEAN moments", &mut lean_maps, lean)
+                } else {
+                    ("slope moments", &mut height_moments, slopes)
+                };
+                let Some(map) = textures.get(name) else {
+                    continue;
+                };
+                if !out.contains_key(name) {
+                    let moments = moment_map(build, map, budget, &format!("{name} ({kind})"))?;
+                    out.insert(name.clone(), moments);
+                }
+            }
+        }
+        // Layered materials that blend then filter, or whose heights displace, are baked.
+        let mut composites = BTreeMap::new();
+        for (name, mat) in &scene.materials {
+            let order = options.layer_order.unwrap_or(mat.layer_order);
+            let displaced = displacement(mat, options.displacement)
+                != texel_scene::Displacement::None
+                || mat.displacement != texel_scene::Displacement::None;
+            let wanted = order == LayerOrder::BlendThenFilter || (displaced && mat.layer_heights());
+            if mat.layers.is_empty() || !wanted {
                 continue;
             }
+            let modes = scene
+                .meshes
+                .iter()
+                .find(|m| m.material.as_ref() == Some(name))
+                .map_or((AddressMode::Repeat, AddressMode::Repeat), |m| {
+                    (m.address_mode_u, m.address_mode_v)
+                });
+            let level0 = bake::level0_sampler(modes)?;
+            let layers = layers_of(mat, &textures, &lean_maps, &level0);
             let limits = Limits {
                 max_bytes: budget.remaining(),
                 ..Limits::default()
             };
-            let moments =
-                build(map, &limits).map_err(|source| texel_scene::SceneError::Texture {
-                    name: format!("{name} ({kind})"),
+            let what = || format!("{name} (its layers baked)");
+            let composite = bake::bake(&layers, &level0, &limits).map_err(|source| {
+                texel_scene::SceneError::Texture {
+                    name: what(),
                     path: None,
                     source,
-                })?;
-            budget.take(&format!("the {kind} of {name:?}"), moments.pyramid_bytes())?;
-            out.insert(name.clone(), moments);
+                }
+            })?;
+            budget.take(
+                &format!("the baked layers of material {name:?}"),
+                composite.bytes(),
+            )?;
+            let aa = specular_aa(mat, options.specular_aa);
+            let bumped = displacement(mat, options.displacement) != texel_scene::Displacement::None;
+            let lean = match &composite.normal {
+                Some(n) if aa == SpecularAa::Lean => Some(moment_map(lean, n, budget, &what())?),
+                _ => None,
+            };
+            let slope_moments = match (&composite.normal, &composite.height) {
+                (None, Some(h))
+                    if bumped && matches!(aa, SpecularAa::Lean | SpecularAa::Toksvig) =>
+                {
+                    Some(moment_map(slopes, h, budget, &what())?)
+                }
+                _ => None,
+            };
+            composites.insert(
+                name.clone(),
+                Baked {
+                    composite,
+                    lean,
+                    slope_moments,
+                },
+            );
         }
         // Normal maps need tangents: MikkTSpace where the mesh brings none.
         let mut scene = scene;
@@ -188,7 +260,9 @@ impl PreparedScene {
                 .material
                 .as_ref()
                 .and_then(|n| scene.materials.get(n))
-                .is_some_and(|mat| mat.normal.is_some());
+                .is_some_and(|mat| {
+                    mat.normal.is_some() || mat.layers.iter().any(|l| l.normal.is_some())
+                });
             if mapped && m.tangents.is_none() {
                 m.generate_tangents();
             }
@@ -200,7 +274,7 @@ impl PreparedScene {
                 &scene,
                 mesh,
                 verts,
-                &textures,
+                heights_of(mesh, &scene, &textures, &composites),
                 (width, height),
                 options,
                 Geometry::Render,
@@ -227,6 +301,15 @@ impl PreparedScene {
             displacement: options.displacement,
             lean_maps,
             height_moments,
+            layer_order: options.layer_order,
+            composites,
+            white: Texture::from_fn(
+                1,
+                1,
+                texel_texture::Format::Rgba8Unorm,
+                &Limits::default(),
+                |_, _| [1.0; 4],
+            )?,
             tessellated,
             reference_geometry: OnceLock::new(),
         })
@@ -358,7 +441,7 @@ impl PreparedScene {
                     &self.scene,
                     mesh,
                     verts,
-                    &self.textures,
+                    heights_of(mesh, &self.scene, &self.textures, &self.composites),
                     (self.width, self.height),
                     &options,
                     Geometry::Reference,
@@ -371,8 +454,9 @@ impl PreparedScene {
         Ok(self.draws_over(samplers, camera, geometry, true))
     }
 
-    /// Draws over each mesh's own geometry, or `geometry[k]` where it is given; with `exact`,
-    /// meshes drawn from `geometry` shade with the bump normals of their heights.
+    /// Draws over each mesh's own geometry, or `geometry[k]` where it is given; with `exact` (the
+    /// reference), meshes drawn from `geometry` shade with the bump normals of their heights and
+    /// layered materials blend their layers per sample, baked or not.
     fn draws_over<'a>(
         &'a self,
         samplers: &'a [Sampler],
@@ -389,14 +473,14 @@ impl PreparedScene {
             .zip(samplers)
             .map(|((k, mesh), sampler)| {
                 let own = geometry.get(k).and_then(Option::as_ref);
-                let mut material = self.material(mesh, sampler);
+                let mut material = self.material(mesh, sampler, exact);
                 if let (Some(m), true, Some(_)) = (&mut material, exact, own) {
                     m.displacement = Displacement::Bump;
                 }
                 DrawCall {
                     vertices: own.map_or(&self.vertices[k][..], |g| &g.vertices[..]),
                     triangles: own.map_or(&mesh.triangles[..], |g| &g.triangles[..]),
-                    texture: &self.textures[&mesh.texture],
+                    texture: self.draw_texture(mesh, exact),
                     sampler,
                     clip_from_world,
                     material,
@@ -405,39 +489,58 @@ impl PreparedScene {
             .collect()
     }
 
-    /// The rasterizer's material of `mesh`, its maps read through `sampler`.
+    /// The colour texture `mesh` is drawn with: its own, or for a layered material the baked
+    /// base colour (blend then filter) or white (filter then blend, and the reference, which
+    /// blends every sub-sample: the layers give the colour).
+    fn draw_texture(&self, mesh: &texel_scene::Mesh, reference: bool) -> &Texture {
+        let layered = mesh
+            .material
+            .as_ref()
+            .and_then(|n| Some((n, self.scene.materials.get(n)?)))
+            .filter(|(_, spec)| !spec.layers.is_empty());
+        match layered {
+            Some((name, spec)) => match self.baked(name, spec).filter(|_| !reference) {
+                Some(b) => &b.composite.base,
+                None => &self.white,
+            },
+            None => &self.textures[&mesh.texture],
+        }
+    }
+
+    /// The baked maps of layered material `name` where it blends then filters.
+    fn baked(&self, name: &str, spec: &MaterialSpec) -> Option<&Baked> {
+        let order = self.layer_order.unwrap_or(spec.layer_order);
+        (order == LayerOrder::BlendThenFilter)
+            .then(|| self.composites.get(name))
+            .flatten()
+    }
+
+    /// The rasterizer's material of `mesh`, its maps read through `sampler`; for the
+    /// `reference`, layered materials blend their layers (per sub-sample) even where they are
+    /// baked.
     fn material<'a>(
         &'a self,
         mesh: &texel_scene::Mesh,
         sampler: &'a Sampler,
+        reference: bool,
     ) -> Option<Material<'a>> {
-        let spec = self.scene.materials.get(mesh.material.as_ref()?)?;
+        let name = mesh.material.as_ref()?;
+        let spec = self.scene.materials.get(name)?;
         let input = |name: &str| TextureInput {
             texture: &self.textures[name],
             sampler,
         };
-        let scalar = |s: &ScalarInput| match s {
-            ScalarInput::Value(v) => (*v, None),
-            ScalarInput::Texture(t) => (
-                1.0,
-                Some(ChannelInput {
-                    input: input(t),
-                    channel: 0,
-                }),
-            ),
+        let channel = |texture: &'a Texture| ChannelInput {
+            input: TextureInput { texture, sampler },
+            channel: 0,
         };
-        let (roughness, roughness_map) = scalar(&spec.roughness);
-        let (metallic, metallic_map) = scalar(&spec.metallic);
+        let (roughness, roughness_map) = scalar(&spec.roughness, &self.textures, sampler);
+        let (metallic, metallic_map) = scalar(&spec.metallic, &self.textures, sampler);
         let base_color = match spec.base_color {
             ColorInput::Rgb(c) => c.extend(1.0),
             ColorInput::Texture(_) => glam::Vec4::ONE,
         };
         let mut specular_aa = specular_aa(spec, self.specular_aa);
-        let lean = spec.normal.as_ref().and_then(|n| self.lean_maps.get(n));
-        let height_moments = spec
-            .height
-            .as_ref()
-            .and_then(|h| self.height_moments.get(h));
         let shape = match displacement(spec, self.displacement) {
             texel_scene::Displacement::None => Displacement::None,
             texel_scene::Displacement::Bump => Displacement::Bump,
@@ -445,11 +548,7 @@ impl PreparedScene {
             // Tessellated geometry is displaced before drawing; its normal is the bump map's.
             texel_scene::Displacement::Tessellate => Displacement::Bump,
         };
-        if specular_aa == SpecularAa::Lean && lean.is_none() && height_moments.is_none() {
-            // No normal or bump map: nothing varies within a pixel to antialias.
-            specular_aa = SpecularAa::None;
-        }
-        Some(Material {
+        let mut m = Material {
             base_color,
             roughness,
             metallic,
@@ -458,19 +557,47 @@ impl PreparedScene {
             normal_map: spec.normal.as_deref().map(input),
             normal_scale: spec.normal_scale,
             specular_aa,
-            lean,
-            height_map: spec.height.as_deref().map(|h| ChannelInput {
-                input: input(h),
-                channel: 0,
-            }),
+            lean: spec.normal.as_ref().and_then(|n| self.lean_maps.get(n)),
+            height_map: spec.height.as_deref().map(|h| channel(&self.textures[h])),
             height_scale: spec.height_scale,
-            displacement: if spec.height.is_some() {
-                shape
-            } else {
-                Displacement::None
-            },
-            height_moments,
-        })
+            displacement: Displacement::None,
+            height_moments: spec
+                .height
+                .as_ref()
+                .and_then(|h| self.height_moments.get(h)),
+            layers: None,
+        };
+        if !spec.layers.is_empty() {
+            // The layers give the roughness (validation keeps the material's own at its default).
+            m.roughness = 1.0;
+        }
+        if let Some(b) = self.baked(name, spec).filter(|_| !reference) {
+            // Blend then filter: the baked maps are an ordinary material's.
+            let c = &b.composite;
+            m.roughness_map = Some(channel(&c.roughness));
+            m.normal_map = c
+                .normal
+                .as_ref()
+                .map(|texture| TextureInput { texture, sampler });
+            m.normal_scale = 1.0;
+            m.lean = b.lean.as_ref();
+            m.height_map = c.height.as_ref().map(channel);
+            m.height_moments = b.slope_moments.as_ref();
+        } else if !spec.layers.is_empty() {
+            m.layers = Some(layers_of(spec, &self.textures, &self.lean_maps, sampler));
+        }
+        if m.has_height() {
+            m.displacement = shape;
+        }
+        let moments = m.lean.is_some()
+            || m.height_moments.is_some()
+            || m.layers.as_ref().is_some_and(Layers::has_normals);
+        if specular_aa == SpecularAa::Lean && !moments {
+            // No normal or bump map: nothing varies within a pixel to antialias.
+            specular_aa = SpecularAa::None;
+        }
+        m.specular_aa = specular_aa;
+        Some(m)
     }
 
     /// Render settings for this scene's size, background (decoded as the colour handling says)
@@ -536,7 +663,7 @@ fn displaced_geometry(
     scene: &Scene,
     mesh: &texel_scene::Mesh,
     verts: &[Vertex],
-    textures: &BTreeMap<String, Texture>,
+    heights: Option<&Texture>,
     (width, height): (u32, u32),
     options: &SceneOptions,
     kind: Geometry,
@@ -546,7 +673,7 @@ fn displaced_geometry(
     let Some(spec) = mesh.material.as_ref().and_then(|n| scene.materials.get(n)) else {
         return Ok(None);
     };
-    let Some(heights) = spec.height.as_ref().and_then(|h| textures.get(h)) else {
+    let Some(heights) = heights else {
         return Ok(None);
     };
     let shape = displacement(spec, options.displacement);
@@ -583,6 +710,122 @@ fn displaced_geometry(
         filter,
     )?;
     Ok(Some(geometry))
+}
+
+/// The height map that displaces `mesh`: its material's, or the baked heights of its layers.
+fn heights_of<'a>(
+    mesh: &texel_scene::Mesh,
+    scene: &Scene,
+    textures: &'a BTreeMap<String, Texture>,
+    composites: &'a BTreeMap<String, Baked>,
+) -> Option<&'a Texture> {
+    let name = mesh.material.as_ref()?;
+    let spec = scene.materials.get(name)?;
+    match &spec.height {
+        Some(h) => textures.get(h),
+        None => composites.get(name)?.composite.height.as_ref(),
+    }
+}
+
+/// A baked layered material and the moment maps its specular antialiasing reads.
+#[derive(Debug)]
+struct Baked {
+    composite: Composite,
+    /// LEAN moments of the baked normals.
+    lean: Option<Texture>,
+    /// Slope moments of the baked heights (bump-mapped, without normals).
+    slope_moments: Option<Texture>,
+}
+
+/// Build a moment map of `map` with `build` within what `budget` has left, and charge it.
+fn moment_map(
+    build: fn(&Texture, &Limits) -> Result<Texture, texel_texture::TextureError>,
+    map: &Texture,
+    budget: &mut MemoryBudget,
+    what: &str,
+) -> Result<Texture, Error> {
+    let limits = Limits {
+        max_bytes: budget.remaining(),
+        ..Limits::default()
+    };
+    let moments = build(map, &limits).map_err(|source| texel_scene::SceneError::Texture {
+        name: what.to_string(),
+        path: None,
+        source,
+    })?;
+    budget.take(&format!("the moments of {what}"), moments.pyramid_bytes())?;
+    Ok(moments)
+}
+
+/// A number, or a texture's red channel read through `sampler`.
+fn scalar<'a>(
+    s: &ScalarInput,
+    textures: &'a BTreeMap<String, Texture>,
+    sampler: &'a Sampler,
+) -> (f32, Option<ChannelInput<'a>>) {
+    match s {
+        ScalarInput::Value(v) => (*v, None),
+        ScalarInput::Texture(t) => (
+            1.0,
+            Some(ChannelInput {
+                input: TextureInput {
+                    texture: &textures[t],
+                    sampler,
+                },
+                channel: 0,
+            }),
+        ),
+    }
+}
+
+/// The rasterizer's layers of layered material `spec`, every input read through `sampler`.
+fn layers_of<'a>(
+    spec: &MaterialSpec,
+    textures: &'a BTreeMap<String, Texture>,
+    lean_maps: &'a BTreeMap<String, Texture>,
+    sampler: &'a Sampler,
+) -> Layers<'a> {
+    let input = |name: &String| TextureInput {
+        texture: &textures[name],
+        sampler,
+    };
+    let mut layers = [Layer::default(); MAX_LAYERS];
+    for (slot, l) in layers.iter_mut().zip(&spec.layers) {
+        let (roughness, roughness_map) = scalar(&l.roughness, textures, sampler);
+        let (height, height_map) = match &l.height {
+            Some(h) => scalar(h, textures, sampler),
+            None => (Layer::default().height, None),
+        };
+        *slot = Layer {
+            base_color: match l.base_color {
+                ColorInput::Rgb(c) => c.extend(1.0),
+                ColorInput::Texture(_) => glam::Vec4::ONE,
+            },
+            base_map: match &l.base_color {
+                ColorInput::Texture(t) => Some(input(t)),
+                ColorInput::Rgb(_) => None,
+            },
+            roughness,
+            roughness_map,
+            normal_map: l.normal.as_ref().map(input),
+            normal_scale: l.normal_scale,
+            lean: l.normal.as_ref().and_then(|n| lean_maps.get(n)),
+            height,
+            height_map,
+        };
+    }
+    Layers {
+        mask: spec.mask.as_ref().map(input),
+        layers,
+        count: spec.layers.len().min(MAX_LAYERS),
+        blend: match spec.blend {
+            LayerBlendSpec::Linear => LayerBlend::Linear,
+            LayerBlendSpec::Height => LayerBlend::Height {
+                depth: spec.blend_depth,
+            },
+        },
+        heights: spec.layer_heights(),
+    }
 }
 
 /// The most triangles a tessellated mesh may have.
