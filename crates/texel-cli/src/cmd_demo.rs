@@ -1,7 +1,7 @@
 //! `texel demo`: the comparison on every built-in scene, with an index page linking the reports.
 //!
-//! Defaults: each scene at its own size (1280 x 720 for the ground planes) against a 256-sample
-//! (16 x 16) reference, which finishes well under three minutes on a 2-core machine (measured in the
+//! Defaults: each scene at its own size (1280 x 720 for the ground planes; the lit scenes glossy,
+//! bricks and terrain at half theirs) against a 256-sample (16 x 16) reference (measured in the
 //! README). `--size` and `--spp` change them.
 
 use std::fmt::Write as _;
@@ -21,7 +21,8 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let started = std::time::Instant::now();
     let reports = publish_dir(&args.out, |dir| -> Result<Vec<(String, Report)>> {
         let mut reports: Vec<(String, Report)> = Vec::new();
-        for name in texel_scene::builtin_names() {
+        let shaded = texel_scene::shaded_builtin_names();
+        for name in texel_scene::builtin_names().iter().chain(shaded) {
             let label = format!("builtin:{name}");
             eprintln!("texel demo: {label} ...");
             // Scenes are rendered one after another: each gets the whole memory account.
@@ -29,10 +30,17 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
                 budget: input.budget.clone(),
                 sanitize: input.sanitize,
             };
+            // Lit scenes shade every sub-sample of the reference (and bricks draws a finely
+            // tessellated relief): they run at half their size unless --size says otherwise.
+            let size = match args.size {
+                Some(s) => Some(s),
+                None if shaded.contains(name) => Some(half_size(name)?),
+                None => None,
+            };
             let scene = load_scene_with(
                 &label,
                 ColorArg::Srgb,
-                args.size,
+                size,
                 Default::default(),
                 &mut scene_input,
             )?;
@@ -68,6 +76,15 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     );
     println!("open {}", index.display());
     Ok(())
+}
+
+/// Half the output size of built-in scene `name`.
+fn half_size(name: &str) -> Result<crate::cli::Size> {
+    let o = texel_scene::builtin(name)?.output;
+    Ok(crate::cli::Size {
+        width: (o.width / 2).max(1),
+        height: (o.height / 2).max(1),
+    })
 }
 
 /// The index page: one row per scene with the best filter and a few reference points, and links.

@@ -14,13 +14,16 @@ use texel_quality::Image8;
 pub(crate) const FILTERS: [&str; 12] = texel::Filter::NAMES;
 
 /// The built-in scenes the demo covers.
-pub(crate) const BUILTINS: [&str; 6] = [
+pub(crate) const BUILTINS: [&str; 9] = [
     "ground",
     "ground-rotated",
     "zoneplate",
     "cube",
     "sphere",
     "triangle",
+    "glossy",
+    "bricks",
+    "terrain",
 ];
 
 /// Run `texel` with `args`.
