@@ -2,7 +2,7 @@
 //! shows sparkle (specular aliasing is seen in motion).
 
 use crate::error::QualityError;
-use crate::image8::Image8;
+use crate::image8::{check_same, Image8};
 use crate::mask::Mask;
 
 /// The mean absolute change from `a` to `b`, in 8-bit units: over the pixels covered in both
@@ -51,14 +51,7 @@ fn change(
         .chain(reference.into_iter().flatten().map(Image8::size))
         .chain(masks.map(Mask::size));
     for s in sizes {
-        if s != size {
-            return Err(QualityError::SizeMismatch {
-                a_width: size.0,
-                a_height: size.1,
-                b_width: s.0,
-                b_height: s.1,
-            });
-        }
+        check_same(size, s)?;
     }
     let step = |pair: [&Image8; 2], k: usize, c: usize| {
         i64::from(pair[1].pixels()[k][c]) - i64::from(pair[0].pixels()[k][c])

@@ -34,9 +34,9 @@ pub const MAX_LAYERS: usize = 4;
 /// The transition width of [`LayerBlend::Height`] that Mishkinis (2013) uses.
 pub const DEFAULT_BLEND_DEPTH: f32 = 0.2;
 
-/// How a 8-bit normal map's decoded vector may fall short of unit length by quantisation alone
+/// How far an 8-bit normal map's decoded vector may fall short of unit length by quantisation alone
 /// (each of three components off by up to 1/255): Toksvig counts lengths within it as 1.
-pub(crate) const UNORM8_NORMAL_SLACK: f32 = 0.006_8;
+const UNORM8_NORMAL_SLACK: f32 = 0.006_8;
 
 /// One layer of a [`Layers`] material. Inputs are read through their own samplers (normally the
 /// draw's filter).
@@ -146,8 +146,6 @@ pub struct LayerSample {
     pub roughness: f32,
     /// Blended normal where asked for and some layer has a normal map.
     pub normal: Option<MapNormal>,
-    /// Blended height, `[0, 1]`.
-    pub height: f32,
     /// The layers' weights (summing to 1).
     pub weights: [f32; MAX_LAYERS],
 }
@@ -207,35 +205,28 @@ impl<'a> Layers<'a> {
             input: input(c.input),
             channel: c.channel,
         };
-        let layer = |l: &Layer<'a>| Layer {
-            base_color: l.base_color,
+        let layer = |l: Layer<'a>| Layer {
             base_map: l.base_map.map(input),
-            roughness: l.roughness,
             roughness_map: l.roughness_map.map(channel),
             normal_map: l.normal_map.map(input),
-            normal_scale: l.normal_scale,
-            lean: l.lean,
-            height: l.height,
             height_map: l.height_map.map(channel),
+            ..l
         };
         Layers {
             mask: self.mask.map(input),
-            layers: [
-                layer(&self.layers[0]),
-                layer(&self.layers[1]),
-                layer(&self.layers[2]),
-                layer(&self.layers[3]),
-            ],
+            layers: self.layers.map(layer),
             count: self.count,
             blend: self.blend,
             heights: self.heights,
         }
     }
 
-    /// The layers' weights and heights at `fp` (module docs).
+    /// The layers' weights at `fp` (module docs), and their heights where `heights` asks for
+    /// them or the blend needs them (0 where not read, and for layers the mask leaves out).
     fn weights(
         &self,
         fp: &Footprint,
+        heights: bool,
         count: bool,
         texels: &mut u32,
     ) -> ([f32; MAX_LAYERS], [f32; MAX_LAYERS]) {
@@ -252,15 +243,15 @@ impl<'a> Layers<'a> {
         }
         normalise(&mut m);
         let mut h = [0.0f32; MAX_LAYERS];
-        let needed = self.heights || matches!(self.blend, LayerBlend::Height { .. });
-        for k in 0..n {
-            let l = &self.layers[k];
-            // Under linear blending a layer without weight needs no read.
-            let skip = matches!(self.blend, LayerBlend::Linear) && m[k] == 0.0;
-            h[k] = match (&l.height_map, needed && !skip) {
-                (Some(map), true) => l.height * read_channel(map, fp, count, texels),
-                _ => l.height,
-            };
+        let by_height = matches!(self.blend, LayerBlend::Height { .. });
+        if heights || by_height {
+            // A layer the mask leaves out has no weight under either blend: no read.
+            for k in (0..n).filter(|&k| m[k] > 0.0) {
+                let l = &self.layers[k];
+                h[k] = l.height_map.map_or(l.height, |map| {
+                    l.height * read_channel(&map, fp, count, texels)
+                });
+            }
         }
         if let LayerBlend::Height { depth } = self.blend {
             let top = (0..n)
@@ -282,7 +273,7 @@ impl<'a> Layers<'a> {
 
     /// The blended height at `fp`, `[0, 1]`.
     pub fn height(&self, fp: &Footprint, count: bool, texels: &mut u32) -> f32 {
-        let (w, h) = self.weights(fp, count, texels);
+        let (w, h) = self.weights(fp, true, count, texels);
         w.iter().zip(&h).map(|(w, h)| w * h).sum()
     }
 
@@ -295,12 +286,11 @@ impl<'a> Layers<'a> {
         count: bool,
         texels: &mut u32,
     ) -> LayerSample {
-        let (w, h) = self.weights(fp, count, texels);
+        let (w, _) = self.weights(fp, false, count, texels);
         let mut out = LayerSample {
             base: if needs.color { Vec4::ZERO } else { Vec4::ONE },
             roughness: if needs.color { 0.0 } else { 1.0 },
             normal: None,
-            height: w.iter().zip(&h).map(|(w, h)| w * h).sum(),
             weights: w,
         };
         let normals = needs.normal && self.has_normals();
@@ -332,36 +322,54 @@ impl<'a> Layers<'a> {
                 normal.mean += wk * Vec3::Z;
                 continue;
             };
-            let t = read(map, fp, count, texels);
-            let raw = Vec3::new(t[0], t[1], t[2]) * 2.0 - Vec3::ONE;
-            let s = l.normal_scale;
-            normal.raw += wk * raw;
-            normal.mean += wk * raw * Vec3::new(s, s, 1.0);
-            if map.texture.format() != Format::Rgba32Float {
-                normal.slack = UNORM8_NORMAL_SLACK;
-            }
-            normal.moments = match (normal.moments, l.lean) {
-                (Some(acc), Some(lean)) => {
-                    let input = TextureInput {
-                        texture: lean,
-                        sampler: map.sampler,
-                    };
-                    let e = read(&input, fp, count, texels);
-                    let s2 = s * s;
-                    Some([
-                        acc[0] + wk * e[0] * s,
-                        acc[1] + wk * e[1] * s,
-                        acc[2] + wk * e[2] * s2,
-                        acc[3] + wk * e[3] * s2,
-                    ])
-                }
-                _ => None,
-            };
+            let lean = l.lean.filter(|_| normal.moments.is_some());
+            let n = read_normal(map, l.normal_scale, lean, fp, count, texels);
+            normal.raw += wk * n.raw;
+            normal.mean += wk * n.mean;
+            normal.slack = normal.slack.max(n.slack);
+            normal.moments = normal
+                .moments
+                .zip(n.moments)
+                .map(|(acc, e)| std::array::from_fn(|c| acc[c] + wk * e[c]));
         }
         if normals {
             out.normal = Some(normal);
         }
         out
+    }
+}
+
+/// One normal map's filtered tangent-space normal at `fp` with its x and y scaled by `scale`, and
+/// LEAN's moments read from `lean` (scaled likewise: `b` by `scale`, `b^2` by its square) where it
+/// is given.
+pub(crate) fn read_normal(
+    map: &TextureInput,
+    scale: f32,
+    lean: Option<&Texture>,
+    fp: &Footprint,
+    count: bool,
+    texels: &mut u32,
+) -> MapNormal {
+    let t = read(map, fp, count, texels);
+    let raw = Vec3::new(t[0], t[1], t[2]) * 2.0 - Vec3::ONE;
+    let moments = lean.map(|texture| {
+        let input = TextureInput {
+            texture,
+            sampler: map.sampler,
+        };
+        let e = read(&input, fp, count, texels);
+        let s2 = scale * scale;
+        [e[0] * scale, e[1] * scale, e[2] * s2, e[3] * s2]
+    });
+    MapNormal {
+        raw,
+        mean: raw * Vec3::new(scale, scale, 1.0),
+        moments,
+        slack: if map.texture.format() == Format::Rgba32Float {
+            0.0
+        } else {
+            UNORM8_NORMAL_SLACK
+        },
     }
 }
 
@@ -490,7 +498,7 @@ mod tests {
         let mut texels = 0;
         let got = layers.sample(&point(), Needs::default(), false, &mut texels);
         assert!((got.weights[0] - 1.0).abs() < 1e-6 && got.weights[1] == 0.0);
-        assert!((got.height - 0.9).abs() < 1e-6);
+        assert!((layers.height(&point(), false, &mut texels) - 0.9).abs() < 1e-6);
         layers.layers[0] = Layer {
             height: 1.0,
             height_map: Some(ch(0)),

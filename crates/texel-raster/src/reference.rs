@@ -160,10 +160,10 @@ fn channel<'a>(c: Option<ChannelInput<'a>>, s: &'a Option<Sampler>) -> Option<Ch
     })
 }
 
-/// `sampler` reading level 0 bilinearly (no mipmaps, no anisotropy), with its address modes and
-/// border colour.
-fn level0(sampler: &Sampler) -> Result<Sampler, RasterError> {
-    Ok(Sampler::new(SamplerDescriptor {
+/// How the reference reads every texture: `desc` made to read level 0 bilinearly (no mipmaps,
+/// no anisotropy), keeping its address modes and border colour.
+pub fn level0_descriptor(desc: &SamplerDescriptor) -> SamplerDescriptor {
+    SamplerDescriptor {
         mag_filter: FilterMode::Linear,
         min_filter: FilterMode::Linear,
         mipmap_filter: MipmapFilterMode::None,
@@ -171,8 +171,13 @@ fn level0(sampler: &Sampler) -> Result<Sampler, RasterError> {
         lod_min_clamp: 0.0,
         lod_max_clamp: 32.0,
         lod_bias: 0.0,
-        ..*sampler.descriptor()
-    })?)
+        ..*desc
+    }
+}
+
+/// `sampler` as the reference reads through it ([`level0_descriptor`]).
+fn level0(sampler: &Sampler) -> Result<Sampler, RasterError> {
+    Ok(Sampler::new(level0_descriptor(sampler.descriptor()))?)
 }
 
 struct Context<'a> {

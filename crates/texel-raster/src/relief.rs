@@ -10,10 +10,10 @@
 //! (pbrt-v4 `BumpMap`, without the `h dn/du` term, which is 0 on flat triangles).
 
 use glam::{Vec2, Vec3};
-use texel_texture::{Footprint, Format};
+use texel_texture::Footprint;
 
 use crate::draw::Vertex;
-use crate::layers::{LayerSample, MapNormal, UNORM8_NORMAL_SLACK};
+use crate::layers::{read_normal, LayerSample};
 use crate::material::{self, Material, SpecularAa, TextureInput};
 
 /// The fewest and the most linear steps of the parallax march (at normal incidence and at
@@ -102,42 +102,6 @@ fn bump_step(d_dx: f32, d_dy: f32, size: u32) -> f32 {
     }
 }
 
-/// The filtered tangent-space normal of `m`'s own normal map at `fp` (with LEAN's moments when
-/// `aa` is LEAN and the moment map is there), as [`MapNormal`].
-fn map_normal(
-    m: &Material,
-    map: &TextureInput,
-    fp: &Footprint,
-    aa: SpecularAa,
-    count: bool,
-    texels: &mut u32,
-) -> MapNormal {
-    let texel = material::read(map, fp, count, texels);
-    let raw = Vec3::new(texel[0], texel[1], texel[2]) * 2.0 - Vec3::ONE;
-    let s = m.normal_scale;
-    let moments = match (aa, m.lean) {
-        (SpecularAa::Lean, Some(lean)) => {
-            let input = TextureInput {
-                texture: lean,
-                sampler: map.sampler,
-            };
-            let e = material::read(&input, fp, count, texels);
-            Some([e[0] * s, e[1] * s, e[2] * s * s, e[3] * s * s])
-        }
-        _ => None,
-    };
-    MapNormal {
-        raw,
-        mean: raw * Vec3::new(s, s, 1.0),
-        moments,
-        slack: if map.texture.format() == Format::Rgba32Float {
-            0.0
-        } else {
-            UNORM8_NORMAL_SLACK
-        },
-    }
-}
-
 /// The shading normal and roughness of material `m` at a fragment with interpolated unit normal
 /// `n`, barycentrics `l` and footprint `fp`, with specular antialiasing `aa` (what
 /// [`SpecularAa::Projected`] adds is the caller's: it needs the neighbours' normals). `layered`
@@ -170,7 +134,10 @@ pub(crate) fn shading_normal(
         // The filtered map normal: the mean of the normals under the footprint.
         let mapped = match (layer_normal, &m.normal_map) {
             (Some(ln), _) => ln,
-            (None, Some(map)) => map_normal(m, map, fp, aa, count, texels),
+            (None, Some(map)) => {
+                let lean = m.lean.filter(|_| aa == SpecularAa::Lean);
+                read_normal(map, m.normal_scale, lean, fp, count, texels)
+            }
             (None, None) => return plain,
         };
         let mut roughness = roughness;

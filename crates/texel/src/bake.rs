@@ -12,9 +12,9 @@
 
 use glam::Vec3;
 use texel_raster::layers::{Layers, Needs};
+use texel_raster::reference::level0_descriptor;
 use texel_texture::{
-    AddressMode, FilterMode, Footprint, Format, Limits, MipmapFilterMode, Sampler,
-    SamplerDescriptor, Texture, TextureError,
+    AddressMode, Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture, TextureError,
 };
 
 /// A layered material's blend, baked.
@@ -42,16 +42,14 @@ impl Composite {
     }
 }
 
-/// A sampler reading level 0 bilinearly with address modes `modes`.
+/// A sampler reading level 0 bilinearly with address modes `modes`, as the reference reads
+/// ([`texel_raster::reference::level0_descriptor`]).
 pub fn level0_sampler(modes: (AddressMode, AddressMode)) -> Result<Sampler, TextureError> {
-    Sampler::new(SamplerDescriptor {
+    Sampler::new(level0_descriptor(&SamplerDescriptor {
         address_mode_u: modes.0,
         address_mode_v: modes.1,
-        mag_filter: FilterMode::Linear,
-        min_filter: FilterMode::Linear,
-        mipmap_filter: MipmapFilterMode::None,
         ..SamplerDescriptor::default()
-    })
+    }))
 }
 
 /// The size the layers are baked at: the largest width and height of the textures they read.
@@ -77,17 +75,15 @@ pub fn composite_size(layers: &Layers) -> (u32, u32) {
 pub fn bake(layers: &Layers, level0: &Sampler, limits: &Limits) -> Result<Composite, TextureError> {
     let layers = layers.with_sampler(level0);
     let (w, h) = composite_size(&layers);
-    let at = |i: u32, j: u32, needs: Needs| {
-        let fp = Footprint {
-            u: (i as f32 + 0.5) / w as f32,
-            v: (j as f32 + 0.5) / h as f32,
-            dudx: 0.0,
-            dudy: 0.0,
-            dvdx: 0.0,
-            dvdy: 0.0,
-        };
-        layers.sample(&fp, needs, false, &mut 0)
+    let centre = |i: u32, j: u32| Footprint {
+        u: (i as f32 + 0.5) / w as f32,
+        v: (j as f32 + 0.5) / h as f32,
+        dudx: 0.0,
+        dudy: 0.0,
+        dvdx: 0.0,
+        dvdy: 0.0,
     };
+    let at = |i: u32, j: u32, needs: Needs| layers.sample(&centre(i, j), needs, false, &mut 0);
     let color = Needs {
         color: true,
         ..Needs::default()
@@ -116,7 +112,7 @@ pub fn bake(layers: &Layers, level0: &Sampler, limits: &Limits) -> Result<Compos
     };
     let height = if layers.heights {
         Some(map(&|i, j| {
-            let h = at(i, j, Needs::default()).height;
+            let h = layers.height(&centre(i, j), false, &mut 0);
             [h, h, h, 1.0]
         })?)
     } else {

@@ -156,51 +156,42 @@ impl PreparedScene {
         }
         // LEAN reads moment maps made from the normal maps (a layered material's too), and LEAN
         // and Toksvig on bump maps moment maps made from the height maps (float, charged like
-        // any texture).
-        type Build = fn(&Texture, &Limits) -> Result<Texture, texel_texture::TextureError>;
-        let lean: Build = texel_raster::material::lean_map;
-        let slopes: Build = |t, limits| texel_raster::material::height_moments(t, 0, limits);
+        // any texture). Layered materials that blend then filter, or whose heights displace,
+        // are baked, and their baked maps get moment maps by the same rule.
         let mut lean_maps = BTreeMap::new();
         let mut height_moments = BTreeMap::new();
-        for mat in scene.materials.values() {
+        let mut composites = BTreeMap::new();
+        for (material, mat) in &scene.materials {
             let aa = specular_aa(mat, options.specular_aa);
-            let bumped = displacement(mat, options.displacement) != texel_scene::Displacement::None;
-            let layer_normals = mat.layers.iter().filter_map(|l| l.normal.as_ref());
-            // (the map, whether its moments are LEAN's of normals rather than slopes of heights)
-            let jobs: Vec<(&String, bool)> = match (&mat.normal, &mat.height) {
-                _ if aa == SpecularAa::Lean && !mat.layers.is_empty() => {
-                    layer_normals.map(|n| (n, true)).collect()
-                }
-                (Some(n), _) if aa == SpecularAa::Lean => vec![(n, true)],
-                (None, Some(h))
-                    if bumped && matches!(aa, SpecularAa::Lean | SpecularAa::Toksvig) =>
-                {
-                    vec![(h, false)]
-                }
-                _ => continue,
+            let shape = displacement(mat, options.displacement);
+            let bumped = shape != texel_scene::Displacement::None;
+            let jobs: Vec<(&String, Moments)> = if !mat.layers.is_empty() {
+                let normals = mat.layers.iter().filter_map(|l| l.normal.as_ref());
+                let lean = aa == SpecularAa::Lean;
+                normals
+                    .filter(|_| lean)
+                    .map(|n| (n, Moments::Lean))
+                    .collect()
+            } else {
+                moment_source(aa, bumped, mat.normal.as_ref(), mat.height.as_ref())
+                    .into_iter()
+                    .collect()
             };
-            for (name, normals) in jobs {
-                let (kind, out, build) = if normals {
-                    ("LEAN moments", &mut lean_maps, lean)
-                } else {
-                    ("slope moments", &mut height_moments, slopes)
+            for (name, kind) in jobs {
+                let out = match kind {
+                    Moments::Lean => &mut lean_maps,
+                    Moments::Slopes => &mut height_moments,
                 };
                 let Some(map) = textures.get(name) else {
                     continue;
                 };
                 if !out.contains_key(name) {
-                    let moments = moment_map(build, map, budget, &format!("{name} ({kind})"))?;
+                    let moments = moment_map(kind, map, budget, name)?;
                     out.insert(name.clone(), moments);
                 }
             }
-        }
-        // Layered materials that blend then filter, or whose heights displace, are baked.
-        let mut composites = BTreeMap::new();
-        for (name, mat) in &scene.materials {
             let order = options.layer_order.unwrap_or(mat.layer_order);
-            let displaced = displacement(mat, options.displacement)
-                != texel_scene::Displacement::None
-                || mat.displacement != texel_scene::Displacement::None;
+            let displaced = bumped || mat.displacement != texel_scene::Displacement::None;
             let wanted = order == LayerOrder::BlendThenFilter || (displaced && mat.layer_heights());
             if mat.layers.is_empty() || !wanted {
                 continue;
@@ -208,7 +199,7 @@ impl PreparedScene {
             let modes = scene
                 .meshes
                 .iter()
-                .find(|m| m.material.as_ref() == Some(name))
+                .find(|m| m.material.as_ref() == Some(material))
                 .map_or((AddressMode::Repeat, AddressMode::Repeat), |m| {
                     (m.address_mode_u, m.address_mode_v)
                 });
@@ -218,40 +209,34 @@ impl PreparedScene {
                 max_bytes: budget.remaining(),
                 ..Limits::default()
             };
-            let what = || format!("{name} (its layers baked)");
+            let what = format!("{material} (its layers baked)");
             let composite = bake::bake(&layers, &level0, &limits).map_err(|source| {
                 texel_scene::SceneError::Texture {
-                    name: what(),
+                    name: what.clone(),
                     path: None,
                     source,
                 }
             })?;
             budget.take(
-                &format!("the baked layers of material {name:?}"),
+                &format!("the baked layers of material {material:?}"),
                 composite.bytes(),
             )?;
-            let aa = specular_aa(mat, options.specular_aa);
-            let bumped = displacement(mat, options.displacement) != texel_scene::Displacement::None;
-            let lean = match &composite.normal {
-                Some(n) if aa == SpecularAa::Lean => Some(moment_map(lean, n, budget, &what())?),
-                _ => None,
+            let mut baked = Baked {
+                lean: None,
+                slope_moments: None,
+                composite,
             };
-            let slope_moments = match (&composite.normal, &composite.height) {
-                (None, Some(h))
-                    if bumped && matches!(aa, SpecularAa::Lean | SpecularAa::Toksvig) =>
-                {
-                    Some(moment_map(slopes, h, budget, &what())?)
+            let c = &baked.composite;
+            if let Some((map, kind)) =
+                moment_source(aa, bumped, c.normal.as_ref(), c.height.as_ref())
+            {
+                let moments = Some(moment_map(kind, map, budget, &what)?);
+                match kind {
+                    Moments::Lean => baked.lean = moments,
+                    Moments::Slopes => baked.slope_moments = moments,
                 }
-                _ => None,
-            };
-            composites.insert(
-                name.clone(),
-                Baked {
-                    composite,
-                    lean,
-                    slope_moments,
-                },
-            );
+            }
+            composites.insert(material.clone(), baked);
         }
         // Normal maps need tangents: MikkTSpace where the mesh brings none.
         let mut scene = scene;
@@ -530,10 +515,7 @@ impl PreparedScene {
             texture: &self.textures[name],
             sampler,
         };
-        let channel = |texture: &'a Texture| ChannelInput {
-            input: TextureInput { texture, sampler },
-            channel: 0,
-        };
+        let channel = |texture: &'a Texture| red(texture, sampler);
         let (roughness, roughness_map) = scalar(&spec.roughness, &self.textures, sampler);
         let (metallic, metallic_map) = scalar(&spec.metallic, &self.textures, sampler);
         let base_color = match spec.base_color {
@@ -737,9 +719,37 @@ struct Baked {
     slope_moments: Option<Texture>,
 }
 
-/// Build a moment map of `map` with `build` within what `budget` has left, and charge it.
+/// The two kinds of moment map specular antialiasing reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Moments {
+    /// LEAN's moments of a normal map ([`texel_raster::material::lean_map`]).
+    Lean,
+    /// The slope moments of a height map ([`texel_raster::material::height_moments`]).
+    Slopes,
+}
+
+/// The moment map a material with these maps reads under specular antialiasing `aa`: LEAN's of
+/// its normal map; or, bump-mapped without a normal map under LEAN or Toksvig, the slope moments
+/// of its height map; `None` otherwise.
+fn moment_source<T>(
+    aa: SpecularAa,
+    bumped: bool,
+    normal: Option<T>,
+    height: Option<T>,
+) -> Option<(T, Moments)> {
+    match (normal, height) {
+        (Some(n), _) if aa == SpecularAa::Lean => Some((n, Moments::Lean)),
+        (None, Some(h)) if bumped && matches!(aa, SpecularAa::Lean | SpecularAa::Toksvig) => {
+            Some((h, Moments::Slopes))
+        }
+        _ => None,
+    }
+}
+
+/// Build the `kind` moment map of `map` (named `what` in errors) within what `budget` has left,
+/// and charge it.
 fn moment_map(
-    build: fn(&Texture, &Limits) -> Result<Texture, texel_texture::TextureError>,
+    kind: Moments,
     map: &Texture,
     budget: &mut MemoryBudget,
     what: &str,
@@ -748,12 +758,22 @@ fn moment_map(
         max_bytes: budget.remaining(),
         ..Limits::default()
     };
-    let moments = build(map, &limits).map_err(|source| texel_scene::SceneError::Texture {
-        name: what.to_string(),
+    let (built, name) = match kind {
+        Moments::Lean => (
+            texel_raster::material::lean_map(map, &limits),
+            "LEAN moments",
+        ),
+        Moments::Slopes => (
+            texel_raster::material::height_moments(map, 0, &limits),
+            "slope moments",
+        ),
+    };
+    let moments = built.map_err(|source| texel_scene::SceneError::Texture {
+        name: format!("{what} ({name})"),
         path: None,
         source,
     })?;
-    budget.take(&format!("the moments of {what}"), moments.pyramid_bytes())?;
+    budget.take(&format!("the {name} of {what}"), moments.pyramid_bytes())?;
     Ok(moments)
 }
 
@@ -765,16 +785,15 @@ fn scalar<'a>(
 ) -> (f32, Option<ChannelInput<'a>>) {
     match s {
         ScalarInput::Value(v) => (*v, None),
-        ScalarInput::Texture(t) => (
-            1.0,
-            Some(ChannelInput {
-                input: TextureInput {
-                    texture: &textures[t],
-                    sampler,
-                },
-                channel: 0,
-            }),
-        ),
+        ScalarInput::Texture(t) => (1.0, Some(red(&textures[t], sampler))),
+    }
+}
+
+/// The red channel of `texture` read through `sampler`.
+fn red<'a>(texture: &'a Texture, sampler: &'a Sampler) -> ChannelInput<'a> {
+    ChannelInput {
+        input: TextureInput { texture, sampler },
+        channel: 0,
     }
 }
 
