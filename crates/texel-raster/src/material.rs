@@ -15,7 +15,8 @@
 //!   2014, eq. 99);
 //! - `f = (1 - F) c_diff / pi + F D Vis` with `c_diff = c (1 - m)`;
 //! - outgoing radiance `L = sum over lights of f E (n.l)` for `n.l > 0`, plus `A (c_diff + F0)` for
-//!   ambient light `A`. The diffuse part's `n.l` uses [`Surface::diffuse_normal`] (the mean normal
+//!   ambient light `A`, times the ambient visibility [`Surface::occlusion`] (glTF's occlusion
+//!   texture applies to ambient light only). The diffuse part's `n.l` uses [`Surface::diffuse_normal`] (the mean normal
 //!   under the pixel where specular antialiasing keeps it; the shading normal otherwise).
 //!
 //! Units follow glTF's `KHR_lights_punctual`: a directional light's `intensity` is the illuminance
@@ -190,6 +191,12 @@ pub struct Material<'a> {
     /// `roughness`; their normals (where some layer has a normal map) replace `normal_map`, and
     /// their blended height replaces `height_map` when a layer gives a height.
     pub layers: Option<Layers<'a>>,
+    /// Ambient occlusion from a texture channel (glTF: red of `occlusionTexture`), `1`
+    /// unoccluded; it dims ambient light only (glTF 2.0 5.19.4: occlusion applies to indirect
+    /// lighting), by `1 + occlusion_strength (ao - 1)`.
+    pub occlusion_map: Option<ChannelInput<'a>>,
+    /// How much of `occlusion_map` applies, `[0, 1]` (glTF `occlusionTexture.strength`).
+    pub occlusion_strength: f32,
 }
 
 impl Default for Material<'_> {
@@ -210,6 +217,8 @@ impl Default for Material<'_> {
             displacement: Displacement::None,
             height_moments: None,
             layers: None,
+            occlusion_map: None,
+            occlusion_strength: 1.0,
         }
     }
 }
@@ -289,6 +298,9 @@ pub struct Surface {
     pub diffuse_normal: Vec3,
     /// World-space position.
     pub position: Vec3,
+    /// Ambient visibility in `[0, 1]` (baked ambient occlusion; 1 unoccluded): multiplies the
+    /// ambient lights only.
+    pub occlusion: f32,
 }
 
 /// GGX's normal distribution `D(n.h)` for `alpha` (see the module docs).
@@ -356,7 +368,7 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
                 (d / d2.sqrt(), intensity / d2)
             }
             Light::Ambient { intensity } => {
-                out += intensity * (c_diff + f0);
+                out += intensity * (c_diff + f0) * surface.occlusion;
                 continue;
             }
         };
@@ -549,6 +561,7 @@ mod tests {
             normal: Vec3::Y,
             diffuse_normal: Vec3::Y,
             position: Vec3::ZERO,
+            occlusion: 1.0,
         };
         let sun = [Light::Directional {
             direction: Vec3::Y,
@@ -596,6 +609,7 @@ mod tests {
                 normal: Vec3::Z,
                 diffuse_normal: Vec3::Z,
                 position: Vec3::ZERO,
+                occlusion: 1.0,
             };
             let eye = Vec3::new(0.5, 0.0, 1.0) * 10.0;
             let (nt, np) = (400, 400);

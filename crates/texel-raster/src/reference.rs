@@ -101,9 +101,9 @@ pub fn render_reference_strata(
     // antialiasing: the sub-samples resolve the variation it approximates).
     let map_samplers = draws
         .iter()
-        .map(|d| -> Result<[Option<Sampler>; 5], RasterError> {
+        .map(|d| -> Result<[Option<Sampler>; 6], RasterError> {
             let Some(m) = d.material else {
-                return Ok([None, None, None, None, None]);
+                return Ok([None, None, None, None, None, None]);
             };
             Ok([
                 m.roughness_map
@@ -116,18 +116,22 @@ pub fn render_reference_strata(
                 m.height_map.map(|c| level0(c.input.sampler)).transpose()?,
                 // Every input of a layered material is read through the draw's own filter.
                 m.layers.map(|_| level0(d.sampler)).transpose()?,
+                m.occlusion_map
+                    .map(|c| level0(c.input.sampler))
+                    .transpose()?,
             ])
         })
         .collect::<Result<Vec<_>, _>>()?;
     let materials: Vec<Option<Material>> = draws
         .iter()
         .zip(&map_samplers)
-        .map(|(d, [r, m, n, h, ly])| {
+        .map(|(d, [r, m, n, h, ly, o])| {
             d.material.map(|mat| Material {
                 layers: mat.layers.zip(ly.as_ref()).map(|(l, s)| l.with_sampler(s)),
                 roughness_map: channel(mat.roughness_map, r),
                 metallic_map: channel(mat.metallic_map, m),
                 height_map: channel(mat.height_map, h),
+                occlusion_map: channel(mat.occlusion_map, o),
                 normal_map: mat
                     .normal_map
                     .zip(n.as_ref())

@@ -146,13 +146,17 @@ impl<'a> DrawContext<'a> {
 #[derive(Clone, Debug)]
 pub(crate) struct Lighting {
     lights: Vec<Light>,
+    /// Some light is ambient (only ambient light reads the occlusion map).
+    ambient: bool,
 }
 
 impl Lighting {
     /// The lights of `settings`, or `None` for an unlit frame.
     pub fn of(settings: &RenderSettings) -> Option<Self> {
-        settings.is_lit().then(|| Lighting {
-            lights: settings.active_lights().copied().collect(),
+        settings.is_lit().then(|| {
+            let lights: Vec<Light> = settings.active_lights().copied().collect();
+            let ambient = lights.iter().any(|l| matches!(l, Light::Ambient { .. }));
+            Lighting { lights, ambient }
         })
     }
 }
@@ -198,6 +202,7 @@ pub(crate) fn shade(
             normal,
             diffuse_normal: normal,
             position,
+            occlusion: 1.0,
         };
         let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, true);
         return (rgb.extend(c.w).to_array(), 0);
@@ -238,6 +243,11 @@ pub(crate) fn shade(
     }
     if let Some(map) = &m.metallic_map {
         metallic *= material::read_channel(map, &fp, count, &mut texels);
+    }
+    let mut occlusion = 1.0;
+    if let Some(map) = m.occlusion_map.as_ref().filter(|_| lighting.ambient) {
+        let ao = material::read_channel(map, &fp, count, &mut texels);
+        occlusion = (1.0 + m.occlusion_strength * (ao - 1.0)).clamp(0.0, 1.0);
     }
     let mut shading = relief::shading_normal(
         m,
@@ -296,6 +306,7 @@ pub(crate) fn shade(
         normal: shading.normal,
         diffuse_normal: shading.diffuse_normal.unwrap_or(shading.normal),
         position,
+        occlusion,
     };
     let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, false);
     (rgb.extend(c.w).to_array(), texels)

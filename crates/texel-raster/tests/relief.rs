@@ -126,6 +126,7 @@ fn bump_mapping_a_ramp_gives_the_tilted_planes_normal() {
                 normal,
                 diffuse_normal: normal,
                 position: eye + d * (-eye.z / d.z),
+                occlusion: 1.0,
             };
             let want = radiance(&surface, eye, &[light], false);
             let got = Vec3::from_slice(&frame.color[k][..3]);

@@ -98,10 +98,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
 fn one_texture(name: &str, p: Procedural) -> std::collections::BTreeMap<String, TextureSpec> {
     [(
         name.to_string(),
-        TextureSpec {
-            source: TextureSource::Procedural(p),
-            color: ColorSpace::Srgb,
-        },
+        TextureSpec::new(TextureSource::Procedural(p), ColorSpace::Srgb),
     )]
     .into()
 }

@@ -25,7 +25,8 @@
 //! triangles = [[0, 1, 2]]       # optional: normals = [[x, y, z], ...], colors = [[r, g, b, a], ...]
 //! # or: obj = "file.obj"  /  gltf = "file.gltf" or "file.glb" (relative to the scene file)
 //! # material = "NAME" (optional; `texture` may then be left out if the material's base_color
-//! # is a texture)
+//! # is a texture; a glTF mesh without one uses the file's own materials and textures, named
+//! # "FILE#materialN" and "FILE#textureN.srgb" / ".linear", and `texture` may be left out)
 //! [[lights]]                    # type = "directional" (direction towards the light) |
 //! type = "directional"          #   "point" (position) | "ambient"; intensity = [r, g, b]
 //! direction = [0.0, 0.25, -1.0] #   linear (glTF KHR_lights_punctual units); at most 8 lights
@@ -36,7 +37,8 @@
 //! normal = "bumps"              # specular_aa = "none" | "toksvig" | "lean" | "projected";
 //! specular_aa = "toksvig"       # height = "TEXTURE" (red, color = "linear"), height_scale
 //!                               # (world units, default 0.05), displacement = "none" | "bump" |
-//!                               # "pom" | "tessellate"
+//!                               # "pom" | "tessellate"; occlusion = "TEXTURE" (red, linear; dims
+//!                               # ambient light), occlusion_strength (default 1)
 //! [materials.terrain]           # layered: mask = "TEXTURE" (linear; channel k weighs layer k),
 //! mask = "splat"                #   blend = "linear" | "height", blend_depth (default 0.2),
 //! blend = "height"              #   layer_order = "filter-then-blend" | "blend-then-filter";
@@ -57,6 +59,7 @@ use texel_texture::{AddressMode, ColorSpace};
 
 use crate::camera::Camera;
 use crate::error::SceneError;
+use crate::gltf_import::GltfScene;
 use crate::limits::SceneLimits;
 use crate::model::{
     ColorInput, Displacement, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec, MaterialSpec, Mesh,
@@ -145,6 +148,8 @@ struct RawMaterial {
     blend: Option<RawBlend>,
     blend_depth: Option<f32>,
     layer_order: Option<RawLayerOrder>,
+    occlusion: Option<String>,
+    occlusion_strength: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -255,6 +260,8 @@ fn material_spec(m: RawMaterial) -> MaterialSpec {
             None | Some(RawLayerOrder::FilterThenBlend) => LayerOrder::FilterThenBlend,
             Some(RawLayerOrder::BlendThenFilter) => LayerOrder::BlendThenFilter,
         },
+        occlusion: m.occlusion,
+        occlusion_strength: m.occlusion_strength.unwrap_or(d.occlusion_strength),
     }
 }
 
@@ -574,16 +581,17 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
             })
         }
     };
-    Ok(TextureSpec { source, color })
+    Ok(TextureSpec::new(source, color))
 }
 
 /// The texture a mesh is drawn with: its own `texture`, or its material's `base_color` texture
-/// (they must agree when both are given).
+/// (they must agree when both are given); `None` for a glTF mesh that names neither (its own
+/// materials give it).
 fn mesh_texture(
     index: usize,
     m: &RawMesh,
     materials: &BTreeMap<String, MaterialSpec>,
-) -> Result<String, SceneError> {
+) -> Result<Option<String>, SceneError> {
     let src = |reason: String| SceneError::MeshMaterial {
         mesh: index,
         reason,
@@ -602,7 +610,7 @@ fn mesh_texture(
             .mask
             .as_deref()
             .or_else(|| mat.textures().first().copied());
-        return slot.map(str::to_string).ok_or_else(|| {
+        return slot.map(|s| Some(s.to_string())).ok_or_else(|| {
             src("its layered material reads no texture: give it a mask or a layer texture".into())
         });
     }
@@ -617,21 +625,24 @@ fn mesh_texture(
         (Some(a), Some(b)) if *a != b => Err(src(format!(
             "texture = {a:?} differs from its material's base_color = {b:?}; give one"
         ))),
-        (Some(a), _) => Ok(a.clone()),
-        (None, Some(b)) => Ok(b),
+        (Some(a), _) => Ok(Some(a.clone())),
+        (None, Some(b)) => Ok(Some(b)),
+        (None, None) if m.gltf.is_some() && m.material.is_none() => Ok(None),
         (None, None) => Err(src(
             "give texture = NAME, or a material whose base_color is a texture".to_string(),
         )),
     }
 }
 
+/// The meshes of `[[meshes]]` entry `index`; a glTF file's own textures and materials beside them
+/// where the entry names no material.
 fn meshes(
     index: usize,
     m: RawMesh,
     base: &Path,
     limits: &SceneLimits,
     materials: &BTreeMap<String, MaterialSpec>,
-) -> Result<Vec<Mesh>, SceneError> {
+) -> Result<GltfScene, SceneError> {
     let src = |reason| SceneError::MeshSource {
         mesh: index,
         reason,
@@ -649,23 +660,29 @@ fn meshes(
     let both = m.address_mode.map(AddressMode::from);
     let mode_u = m.address_mode_u.map(AddressMode::from).or(both);
     let mode_v = m.address_mode_v.map(AddressMode::from).or(both);
+    let inline_texture = || {
+        texture.clone().ok_or(SceneError::MeshMaterial {
+            mesh: index,
+            reason: "give texture = NAME, or a material whose base_color is a texture".into(),
+        })
+    };
     let mut out = if let Some(positions) = m.positions {
         let (Some(uvs), Some(triangles)) = (m.uvs, m.triangles) else {
             return Err(src("inline meshes need positions, uvs and triangles"));
         };
-        vec![Mesh {
+        GltfScene::from(vec![Mesh {
             positions: positions.into_iter().map(Vec3::from).collect(),
             uvs: uvs.into_iter().map(Vec2::from).collect(),
             normals: m.normals.map(|v| v.into_iter().map(Vec3::from).collect()),
             colors: m.colors.map(|v| v.into_iter().map(Vec4::from).collect()),
             triangles,
-            texture: texture.clone(),
+            texture: inline_texture()?,
             address_mode_u: AddressMode::Repeat,
             address_mode_v: AddressMode::Repeat,
             filters: None,
             material: None,
             tangents: None,
-        }]
+        }])
     } else {
         if m.uvs.is_some() || m.triangles.is_some() || m.normals.is_some() || m.colors.is_some() {
             return Err(src(
@@ -673,18 +690,28 @@ fn meshes(
             ));
         }
         if let Some(obj) = m.obj {
-            vec![crate::obj::load_obj_with(
+            GltfScene::from(vec![crate::obj::load_obj_with(
                 &base.join(obj),
-                &texture,
+                &inline_texture()?,
                 limits,
-            )?]
+            )?])
         } else {
-            let path = base.join(m.gltf.expect("one source"));
-            crate::gltf_import::load_gltf_with(&path, &texture, limits)?
+            let file = m.gltf.expect("one source");
+            let path = base.join(&file);
+            match &m.material {
+                Some(_) => GltfScene::from(crate::gltf_import::load_gltf_with(
+                    &path,
+                    &inline_texture()?,
+                    limits,
+                )?),
+                None => crate::gltf_import::import_gltf(&path, texture.as_deref(), &file, limits)?,
+            }
         }
     };
-    for mesh in &mut out {
-        mesh.material.clone_from(&m.material);
+    for mesh in &mut out.meshes {
+        if m.material.is_some() {
+            mesh.material.clone_from(&m.material);
+        }
         if let Some(u) = mode_u {
             mesh.address_mode_u = u;
         }
@@ -693,6 +720,18 @@ fn meshes(
         }
     }
     Ok(out)
+}
+
+/// The error for a glTF import (mesh `index`) whose `table.name` the scene already defines
+/// otherwise.
+fn imported_clash(index: usize, table: &str, name: &str) -> SceneError {
+    SceneError::MeshMaterial {
+        mesh: index,
+        reason: format!(
+            "its glTF file's own {table} are imported as {table}.{name:?}, which the scene \
+             defines otherwise: rename the scene's"
+        ),
+    }
 }
 
 impl Scene {
@@ -727,7 +766,7 @@ impl Scene {
             }
         })?;
         let base = path.parent().map_or_else(PathBuf::new, Path::to_path_buf);
-        let textures = raw
+        let textures: BTreeMap<String, TextureSpec> = raw
             .textures
             .into_iter()
             .map(|(name, t)| texture_spec(&name, t, &base).map(|s| (name, s)))
@@ -737,6 +776,7 @@ impl Scene {
             .into_iter()
             .map(|(name, m)| (name, material_spec(m)))
             .collect();
+        let (mut textures, mut materials) = (textures, materials);
         let mut all = Vec::new();
         for (i, m) in raw.meshes.into_iter().enumerate() {
             // Each mesh file gets what the meshes before it left of the scene's limits.
@@ -748,7 +788,20 @@ impl Scene {
                 max_vertices: limits.max_vertices.saturating_sub(verts),
                 ..*limits
             };
-            all.extend(meshes(i, m, &base, &left, &materials)?);
+            let imported = meshes(i, m, &base, &left, &materials)?;
+            all.extend(imported.meshes);
+            for (name, t) in imported.textures {
+                if textures.get(&name).is_some_and(|old| *old != t) {
+                    return Err(imported_clash(i, "textures", &name));
+                }
+                textures.insert(name, t);
+            }
+            for (name, spec) in imported.materials {
+                if materials.get(&name).is_some_and(|old| *old != spec) {
+                    return Err(imported_clash(i, "materials", &name));
+                }
+                materials.insert(name, spec);
+            }
         }
         let tris: u64 = all.iter().map(|m| m.triangles.len() as u64).sum();
         let verts: u64 = all.iter().map(|m| m.positions.len() as u64).sum();

@@ -4,14 +4,17 @@
 //! The default scene (else the first; else every mesh untransformed) is walked from its root nodes;
 //! each node's local transform is composed with its parent's, and every primitive becomes one
 //! [`Mesh`] with world-space positions (normals by the inverse transpose, renormalised).
-//! `POSITION` and `TEXCOORD_0` are required; `NORMAL` and `COLOR_0` are kept when present; without
+//! `POSITION` and `TEXCOORD_0` are required; `NORMAL`, `TANGENT` (its `xyz` by the node's
+//! transform, `w` flipped where the transform mirrors) and `COLOR_0` are kept when present; without
 //! `indices` the vertices are taken in order. `TRIANGLES`, `TRIANGLE_STRIP` and `TRIANGLE_FAN`
 //! are turned into triangle lists (glTF 2.0 spec 3.7.2.1); points and lines are an error.
 //!
 //! The base colour texture's sampler gives the address modes (`wrapS`/`wrapT`: `REPEAT` ->
 //! Repeat, `MIRRORED_REPEAT` -> MirrorRepeat, `CLAMP_TO_EDGE` -> ClampToEdge; glTF's default is
-//! Repeat) and the filters ([`MeshFilters`]). Images are not loaded: the scene file names the
-//! texture.
+//! Repeat) and the filters ([`MeshFilters`]). [`load_gltf`] reads geometry only (the scene file
+//! names the texture); [`import_gltf`] also imports the file's `pbrMetallicRoughness` materials
+//! and their images (files beside the glTF, `data:` URIs or buffer views), each texture with its
+//! own sampler.
 //!
 //! Hostile files are refused before they cost anything ([`SceneLimits`]): the node hierarchy must
 //! be disjoint trees as glTF 2.0 requires (a node with two parents, a cycle, or a scene root that
@@ -22,17 +25,22 @@
 //! allowed, other schemes are not), and their `byteLength`s together within the file bound.
 //! Accessors outside their buffers read as missing and are reported.
 
+use std::collections::BTreeMap;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
 use gltf::texture::{MagFilter, MinFilter, WrappingMode};
-use texel_texture::{AddressMode, FilterMode, MipmapFilterMode};
+use texel_texture::{AddressMode, ColorSpace, FilterMode, MipmapFilterMode};
 
 use crate::error::SceneError;
 use crate::limits::SceneLimits;
-use crate::model::{Mesh, MeshFilters};
+use crate::model::{
+    ColorInput, EncodedImage, MaterialSpec, Mesh, MeshFilters, ScalarInput, TextureSampler,
+    TextureSource, TextureSpec,
+};
+use crate::procedural::Procedural;
 
 fn wrap(m: WrappingMode) -> AddressMode {
     match m {
@@ -69,9 +77,19 @@ const MAX_DEPTH: usize = 256;
 
 struct Ctx<'a> {
     path: &'a Path,
-    texture: &'a str,
+    /// The scene's `texture` for every mesh, or `None` to take each primitive's base colour
+    /// texture (with `import`).
+    texture: Option<&'a str>,
+    /// Import materials (the scene names none).
+    import: bool,
+    /// Prefix of imported names (`"FILE#"`).
+    prefix: &'a str,
+    base: Option<&'a Path>,
     buffers: &'a [Vec<u8>],
+    limits: &'a SceneLimits,
     out: Vec<Mesh>,
+    textures: BTreeMap<String, TextureSpec>,
+    materials: BTreeMap<String, MaterialSpec>,
 }
 
 impl Ctx<'_> {
@@ -157,11 +175,24 @@ impl Ctx<'_> {
                     )))
                 }
             };
-            let sampler = prim
-                .material()
-                .pbr_metallic_roughness()
-                .base_color_texture()
-                .map(|info| info.texture().sampler());
+            let tangents = match reader.read_tangents() {
+                // A mirroring transform flips the bitangent: w follows the determinant's sign.
+                Some(it) => {
+                    let flip = Mat3::from_mat4(world).determinant().signum();
+                    let linear = Mat3::from_mat4(world);
+                    Some(
+                        it.map(|t| {
+                            let xyz = (linear * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
+                            xyz.extend(if t[3] < 0.0 { -flip } else { flip })
+                        })
+                        .collect::<Vec<_>>(),
+                    )
+                }
+                None => None,
+            };
+            let material = prim.material();
+            let base_info = material.pbr_metallic_roughness().base_color_texture();
+            let sampler = base_info.as_ref().map(|info| info.texture().sampler());
             let (address_mode_u, address_mode_v, filters) = match &sampler {
                 Some(s) => (
                     wrap(s.wrap_s()),
@@ -174,22 +205,203 @@ impl Ctx<'_> {
                 // Nothing to draw (glTF allows it); the file is refused only if nothing is left.
                 continue;
             }
+            let imported = match material.index() {
+                Some(index) if self.import => Some(self.material(&material, index)?),
+                _ => None,
+            };
+            let texture = match (self.texture, base_info) {
+                (Some(t), _) => t.to_string(),
+                (None, Some(info)) if self.import => self.texture(
+                    &info.texture(),
+                    info.tex_coord(),
+                    ColorSpace::Srgb,
+                    "baseColorTexture",
+                )?,
+                (None, _) => self.white(),
+            };
             self.out.push(Mesh {
                 positions,
                 uvs,
                 normals,
                 colors,
                 triangles,
-                texture: self.texture.to_string(),
+                texture,
                 address_mode_u,
                 address_mode_v,
                 filters,
-                material: None,
-                tangents: None,
+                material: imported,
+                tangents,
             });
         }
         Ok(())
     }
+
+    /// The scene material of glTF material `m` (number `index`), imported on first use: its
+    /// `pbrMetallicRoughness` base colour factor (the base colour texture is the mesh's own),
+    /// roughness and metalness (factors times the green and blue of `metallicRoughnessTexture`),
+    /// normal texture and scale, occlusion texture and strength.
+    fn material(&mut self, m: &gltf::Material, index: usize) -> Result<String, SceneError> {
+        let name = format!("{}material{index}", self.prefix);
+        if self.materials.contains_key(&name) {
+            return Ok(name);
+        }
+        let pbr = m.pbr_metallic_roughness();
+        let [r, g, b, _] = pbr.base_color_factor();
+        let mut spec = MaterialSpec {
+            base_color: ColorInput::Rgb(Vec3::new(r, g, b)),
+            roughness: ScalarInput::Value(pbr.roughness_factor()),
+            metallic: ScalarInput::Value(pbr.metallic_factor()),
+            ..MaterialSpec::default()
+        };
+        let what = |key: &str| format!("material {index}: {key}");
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            let t = self.texture(
+                &info.texture(),
+                info.tex_coord(),
+                ColorSpace::Linear,
+                &what("metallicRoughnessTexture"),
+            )?;
+            spec.roughness = ScalarInput::Channel {
+                texture: t.clone(),
+                channel: 1,
+                factor: pbr.roughness_factor(),
+            };
+            spec.metallic = ScalarInput::Channel {
+                texture: t,
+                channel: 2,
+                factor: pbr.metallic_factor(),
+            };
+        }
+        if let Some(n) = m.normal_texture() {
+            let t = &n.texture();
+            spec.normal =
+                Some(self.texture(t, n.tex_coord(), ColorSpace::Linear, &what("normalTexture"))?);
+            spec.normal_scale = n.scale();
+        }
+        if let Some(o) = m.occlusion_texture() {
+            let t = &o.texture();
+            spec.occlusion = Some(self.texture(
+                t,
+                o.tex_coord(),
+                ColorSpace::Linear,
+                &what("occlusionTexture"),
+            )?);
+            spec.occlusion_strength = o.strength();
+        }
+        self.materials.insert(name.clone(), spec);
+        Ok(name)
+    }
+
+    /// The scene texture of glTF texture `t` read as `color` (base colours sRGB, data linear),
+    /// with its sampler, added on first use. Only `TEXCOORD_0` is read (`tex_coord` must be 0).
+    fn texture(
+        &mut self,
+        t: &gltf::Texture,
+        tex_coord: u32,
+        color: ColorSpace,
+        what: &str,
+    ) -> Result<String, SceneError> {
+        if tex_coord != 0 {
+            return Err(self.bad(format!(
+                "{what} reads TEXCOORD_{tex_coord}; texel reads one uv set, TEXCOORD_0"
+            )));
+        }
+        let space = match color {
+            ColorSpace::Srgb => "srgb",
+            ColorSpace::Linear => "linear",
+        };
+        let name = format!("{}texture{}.{space}", self.prefix, t.index());
+        if !self.textures.contains_key(&name) {
+            let source = self.image(&t.source())?;
+            let s = t.sampler();
+            let sampler = TextureSampler {
+                address_mode_u: wrap(s.wrap_s()),
+                address_mode_v: wrap(s.wrap_t()),
+                filters: filters(s.mag_filter(), s.min_filter()),
+            };
+            let spec = TextureSpec {
+                sampler: Some(sampler),
+                ..TextureSpec::new(source, color)
+            };
+            self.textures.insert(name.clone(), spec);
+        }
+        Ok(name)
+    }
+
+    /// Where glTF image `image`'s bytes are: a buffer view (GLB or embedded buffers), a base64
+    /// `data:` URI, or a file beside the glTF (as buffers are found).
+    fn image(&self, image: &gltf::Image) -> Result<TextureSource, SceneError> {
+        let i = image.index();
+        let origin = format!("{}, image {i}", self.path.display());
+        let bytes: Vec<u8> = match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let data = self.buffers.get(view.buffer().index()).ok_or_else(|| {
+                    self.bad(format!("image {i}: its buffer view's buffer is missing"))
+                })?;
+                let (start, len) = (view.offset(), view.length());
+                let range = start..start.saturating_add(len);
+                if range.end > view.buffer().length() {
+                    return Err(self.bad(format!(
+                        "image {i}: buffer view bytes {start}..{} lie outside buffer {} ({} bytes)",
+                        range.end,
+                        view.buffer().index(),
+                        view.buffer().length()
+                    )));
+                }
+                data.get(range)
+                    .ok_or_else(|| self.bad(format!("image {i}: its buffer view is cut short")))?
+                    .to_vec()
+            }
+            gltf::image::Source::Uri { uri, .. } => match uri.strip_prefix("data:") {
+                Some(rest) => decode_data_uri(rest, self.limits.max_mesh_file_bytes)
+                    .map_err(|e| self.bad(format!("image {i}: {e}")))?,
+                None => {
+                    let path = buffer_path(uri, self.base)
+                        .map_err(|e| self.bad(format!("image {i}: {e}")))?;
+                    return Ok(TextureSource::File(path));
+                }
+            },
+        };
+        Ok(TextureSource::Encoded(EncodedImage {
+            bytes: bytes.into(),
+            origin,
+        }))
+    }
+
+    /// A 1 x 1 white texture for meshes with no base colour texture and none named.
+    fn white(&mut self) -> String {
+        let name = format!("{}white", self.prefix);
+        self.textures.entry(name.clone()).or_insert_with(|| {
+            TextureSpec::new(
+                TextureSource::Procedural(Procedural::Solid {
+                    width: 1,
+                    height: 1,
+                    rgba: [255; 4],
+                }),
+                ColorSpace::Srgb,
+            )
+        });
+        name
+    }
+}
+
+/// The bytes of a base64 `data:` URI's payload (`rest` is what follows `data:`), at most
+/// `max_bytes` of them.
+fn decode_data_uri(rest: &str, max_bytes: u64) -> Result<Vec<u8>, String> {
+    let b64 = rest
+        .split_once(";base64,")
+        .map(|(_, d)| d)
+        .ok_or("a data URI that is not base64")?;
+    if b64.len() as u64 / 4 * 3 > max_bytes {
+        return Err(format!(
+            "a data URI of {} base64 characters, over the limit of {max_bytes} bytes",
+            b64.len()
+        ));
+    }
+    use base64::Engine;
+    base64::engine::general_purpose::STANDARD
+        .decode(b64.trim_end())
+        .map_err(|e| format!("invalid base64 data URI: {e}"))
 }
 
 /// Triangles a primitive of `mode` makes from `n` indices (glTF 2.0 spec 3.7.2.1).
@@ -257,7 +469,7 @@ fn check_hierarchy(document: &gltf::Document) -> Result<(), String> {
 }
 
 /// Check what the gltf crate's readers assume and do not check (its readers hit `unreachable!`
-/// on other types): POSITION and NORMAL `VEC3` floats, TEXCOORD_0 `VEC2` of floats or normalised
+/// on other types): POSITION and NORMAL `VEC3` floats, TANGENT `VEC4` floats, TEXCOORD_0 `VEC2` of floats or normalised
 /// u8/u16, COLOR_0 `VEC3`/`VEC4` of those, indices scalar u8/u16/u32; every attribute with as many
 /// elements as POSITION (glTF 2.0 3.7.2.1), and at most `3 * max_triangles + 2` indices (read
 /// before the mode is looked at). Counts are checked here, before a sparse accessor of billions
@@ -273,6 +485,7 @@ fn check_primitive(prim: &gltf::Primitive, limits: &SceneLimits) -> Result<(), S
             Semantic::Positions | Semantic::Normals => {
                 (a.data_type(), a.dimensions()) == (T::F32, D::Vec3)
             }
+            Semantic::Tangents => (a.data_type(), a.dimensions()) == (T::F32, D::Vec4),
             Semantic::TexCoords(_) => {
                 matches!(a.data_type(), T::F32 | T::U8 | T::U16) && a.dimensions() == D::Vec2
             }
@@ -353,20 +566,9 @@ fn read_buffer(
         }
         gltf::buffer::Source::Uri(uri) => {
             if let Some(rest) = uri.strip_prefix("data:") {
-                let b64 = rest
-                    .split_once(";base64,")
-                    .map(|(_, d)| d)
-                    .ok_or(format!("buffer {i}: a data URI that is not base64"))?;
-                if b64.len() / 4 > len / 3 + 1 {
-                    return Err(format!(
-                        "buffer {i}: the data URI holds {} base64 characters, more than byteLength {len} needs",
-                        b64.len()
-                    ));
-                }
-                use base64::Engine;
-                base64::engine::general_purpose::STANDARD
-                    .decode(b64.trim_end())
-                    .map_err(|e| format!("buffer {i}: invalid base64 data URI: {e}"))?
+                // byteLength bounds the payload (a base64 quad carries 3 bytes).
+                decode_data_uri(rest, (len as u64 / 3 + 1) * 3)
+                    .map_err(|e| format!("buffer {i}: {e}"))?
             } else {
                 let path = buffer_path(uri, base).map_err(|e| format!("buffer {i}: {e}"))?;
                 let file = texel_texture::input::open_regular(&path)
@@ -415,6 +617,29 @@ fn buffer_path(uri: &str, base: Option<&Path>) -> Result<PathBuf, String> {
     })
 }
 
+/// What a glTF file brings into a scene: its meshes, and the textures and materials they use
+/// where the file's own materials were imported ([`import_gltf`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GltfScene {
+    /// Every triangle primitive, one mesh each.
+    pub meshes: Vec<Mesh>,
+    /// The textures the meshes and imported materials name (`"PREFIX#textureN.srgb"` or
+    /// `.linear` for glTF texture `N` read as colours or as data, `"PREFIX#white"`).
+    pub textures: BTreeMap<String, TextureSpec>,
+    /// The imported materials (`"PREFIX#materialN"` for glTF material `N`).
+    pub materials: BTreeMap<String, MaterialSpec>,
+}
+
+impl From<Vec<Mesh>> for GltfScene {
+    /// Meshes without imported textures or materials.
+    fn from(meshes: Vec<Mesh>) -> Self {
+        GltfScene {
+            meshes,
+            ..GltfScene::default()
+        }
+    }
+}
+
 /// Load every triangle primitive of `path` (module docs) as meshes using texture `texture`,
 /// within the default [`SceneLimits`].
 ///
@@ -441,6 +666,28 @@ pub fn load_gltf_with(
     load_gltf_slice(&bytes, Some(base), path, texture, limits)
 }
 
+/// Load `path` with its own materials (glTF 2.0 `pbrMetallicRoughness`): every primitive with a
+/// material gets it as a scene material (its base colour factor, metallic-roughness texture and
+/// factors, normal texture and scale, occlusion texture and strength; emission, alpha and
+/// extensions are not read), each texture with its own sampler ([`TextureSpec::sampler`]).
+/// The meshes are drawn with `texture` where it is given (replacing the glTF's base colour
+/// texture), else with their base colour texture, else white. Primitives without a material
+/// keep none (texel's Lambertian default). Imported names start with `prefix` and `#`.
+///
+/// # Errors
+/// As [`load_gltf_with`]; also a material map that reads another uv set than `TEXCOORD_0`, and an
+/// image whose buffer view lies outside its buffer.
+pub fn import_gltf(
+    path: &Path,
+    texture: Option<&str>,
+    prefix: &str,
+    limits: &SceneLimits,
+) -> Result<GltfScene, SceneError> {
+    let bytes = limits.read_mesh_file(path)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    import_slice(&bytes, Some(base), path, texture, Some(prefix), limits)
+}
+
 /// As [`load_gltf_with`], from the bytes of a `.gltf` or `.glb` file. External buffer files are
 /// read relative to `base`; with `base = None` only embedded buffers are allowed. `path` names the
 /// file in errors.
@@ -454,6 +701,19 @@ pub fn load_gltf_slice(
     texture: &str,
     limits: &SceneLimits,
 ) -> Result<Vec<Mesh>, SceneError> {
+    import_slice(bytes, base, path, Some(texture), None, limits).map(|s| s.meshes)
+}
+
+/// Load the meshes of a glTF file's bytes; with `prefix`, import its materials and textures
+/// ([`import_gltf`]).
+fn import_slice(
+    bytes: &[u8],
+    base: Option<&Path>,
+    path: &Path,
+    texture: Option<&str>,
+    prefix: Option<&str>,
+    limits: &SceneLimits,
+) -> Result<GltfScene, SceneError> {
     let bad = |reason: String| SceneError::MeshFile {
         path: path.to_path_buf(),
         reason: format!("cannot load glTF: {reason}"),
@@ -552,11 +812,18 @@ pub fn load_gltf_slice(
         .map(|b| read_buffer(&b, base, blob.as_deref()))
         .collect::<Result<Vec<_>, _>>()
         .map_err(bad)?;
+    let prefix = prefix.map(|p| format!("{p}#"));
     let mut ctx = Ctx {
         path,
         texture,
+        import: prefix.is_some(),
+        prefix: prefix.as_deref().unwrap_or(""),
+        base,
         buffers: &buffers,
+        limits,
         out: Vec::new(),
+        textures: BTreeMap::new(),
+        materials: BTreeMap::new(),
     };
     if document.scenes().len() == 0 {
         for mesh in document.meshes() {
@@ -570,5 +837,9 @@ pub fn load_gltf_slice(
     if ctx.out.is_empty() {
         return Err(bad("no triangles in the file's scene".into()));
     }
-    Ok(ctx.out)
+    Ok(GltfScene {
+        meshes: ctx.out,
+        textures: ctx.textures,
+        materials: ctx.materials,
+    })
 }

@@ -49,12 +49,12 @@ pub use builtin::{
 };
 pub use camera::Camera;
 pub use error::SceneError;
-pub use gltf_import::{load_gltf, load_gltf_slice, load_gltf_with};
+pub use gltf_import::{import_gltf, load_gltf, load_gltf_slice, load_gltf_with, GltfScene};
 pub use limits::SceneLimits;
 pub use model::{
-    ColorInput, Displacement, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec, MaterialSpec, Mesh,
-    MeshFilters, Output, ScalarInput, Scene, SpecularAaSpec, TextureSource, TextureSpec,
-    MAX_LAYERS, MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
+    ColorInput, Displacement, EncodedImage, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec,
+    MaterialSpec, Mesh, MeshFilters, Output, ScalarInput, Scene, SpecularAaSpec, TextureSampler,
+    TextureSource, TextureSpec, MAX_LAYERS, MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
 };
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::{NoiseKind, Procedural};

@@ -66,13 +66,48 @@ pub enum ColorInput {
     Rgb(Vec3),
 }
 
-/// A scalar input: a constant, or a texture's red channel (linear) by name.
+/// A scalar input: a constant, or a texture's channel (linear) by name.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ScalarInput {
     /// A constant in `[0, 1]`.
     Value(f32),
     /// The red channel of the texture of this name.
     Texture(String),
+    /// Channel `channel` (`0` red ... `3` alpha) of texture `texture` times `factor` (`[0, 1]`),
+    /// as glTF's `metallicRoughnessTexture` (roughness green, metalness blue, each times its
+    /// factor).
+    Channel {
+        /// The texture's name.
+        texture: String,
+        /// The channel read, `0..=3`.
+        channel: u8,
+        /// Multiplies the channel, in `[0, 1]`.
+        factor: f32,
+    },
+}
+
+impl ScalarInput {
+    /// The texture read, if any.
+    pub fn texture(&self) -> Option<&str> {
+        match self {
+            ScalarInput::Value(_) => None,
+            ScalarInput::Texture(t) | ScalarInput::Channel { texture: t, .. } => Some(t),
+        }
+    }
+
+    /// The factor, the texture's name and the channel: `(v, None)` for a constant `v`,
+    /// `(1, Some((name, 0)))` for a texture's red channel.
+    pub fn parts(&self) -> (f32, Option<(&str, u8)>) {
+        match self {
+            ScalarInput::Value(v) => (*v, None),
+            ScalarInput::Texture(t) => (1.0, Some((t, 0))),
+            ScalarInput::Channel {
+                texture,
+                channel,
+                factor,
+            } => (*factor, Some((texture, *channel))),
+        }
+    }
 }
 
 /// How a material's height map displaces the surface (`displacement = ...`).
@@ -150,6 +185,11 @@ pub struct MaterialSpec {
     pub blend_depth: f32,
     /// `layer_order`.
     pub layer_order: LayerOrder,
+    /// `occlusion`: ambient occlusion map (texture name, red channel, `color = "linear"`;
+    /// glTF's `occlusionTexture`): ambient light is multiplied by `1 + strength (ao - 1)`.
+    pub occlusion: Option<String>,
+    /// `occlusion_strength`: how much of the occlusion map applies, `[0, 1]`. Default 1.
+    pub occlusion_strength: f32,
 }
 
 /// The most layers a material has (one per channel of its mask).
@@ -232,6 +272,8 @@ impl Default for MaterialSpec {
             blend: LayerBlendSpec::Linear,
             blend_depth: 0.2,
             layer_order: LayerOrder::FilterThenBlend,
+            occlusion: None,
+            occlusion_strength: 1.0,
         }
     }
 }
@@ -251,9 +293,7 @@ impl MaterialSpec {
             }
         }
         fn scalar<'a>(s: &'a ScalarInput, out: &mut Vec<(&'a str, bool)>) {
-            if let ScalarInput::Texture(t) = s {
-                out.push((t.as_str(), false));
-            }
+            out.extend(s.texture().map(|t| (t, false)));
         }
         let mut out = Vec::new();
         color(&self.base_color, &mut out);
@@ -262,6 +302,7 @@ impl MaterialSpec {
         out.extend(self.normal.as_deref().map(|t| (t, false)));
         out.extend(self.height.as_deref().map(|t| (t, false)));
         out.extend(self.mask.as_deref().map(|t| (t, false)));
+        out.extend(self.occlusion.as_deref().map(|t| (t, false)));
         for l in &self.layers {
             color(&l.base_color, &mut out);
             scalar(&l.roughness, &mut out);
@@ -303,6 +344,32 @@ pub struct TextureSpec {
     /// How 8-bit values are interpreted (`color = "srgb" | "linear"`, default sRGB). The CLI's
     /// `--color raw` overrides it with linear for every texture.
     pub color: ColorSpace,
+    /// The texture's own sampler (a glTF texture's), which a material reads it through; `None`
+    /// (every texture of a scene file): the sampler of the mesh it is drawn on. A mesh's colour
+    /// texture is always read through the mesh's sampler.
+    pub sampler: Option<TextureSampler>,
+}
+
+impl TextureSpec {
+    /// A texture from `source` read as `color`, with no sampler of its own.
+    pub fn new(source: TextureSource, color: ColorSpace) -> Self {
+        TextureSpec {
+            source,
+            color,
+            sampler: None,
+        }
+    }
+}
+
+/// A texture's own address modes and filters (glTF 2.0 5.26 "Sampler").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureSampler {
+    /// Address mode along u (`wrapS`).
+    pub address_mode_u: AddressMode,
+    /// Address mode along v (`wrapT`).
+    pub address_mode_v: AddressMode,
+    /// `magFilter` and `minFilter`, used when no filter is named (as a mesh's [`MeshFilters`]).
+    pub filters: MeshFilters,
 }
 
 /// The origin of a texture's texels.
@@ -312,6 +379,28 @@ pub enum TextureSource {
     File(PathBuf),
     /// A generated texture.
     Procedural(Procedural),
+    /// An encoded image held in memory (a glTF image embedded in a GLB buffer or a `data:` URI).
+    Encoded(EncodedImage),
+}
+
+/// The bytes of an encoded image (PNG, JPEG, ...) and where they came from.
+#[derive(Clone, PartialEq)]
+pub struct EncodedImage {
+    /// The encoded file's bytes.
+    pub bytes: std::sync::Arc<[u8]>,
+    /// Where they came from, for messages (`"scene.glb, image 2"`).
+    pub origin: String,
+}
+
+impl std::fmt::Debug for EncodedImage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "EncodedImage({}, {} bytes)",
+            self.origin,
+            self.bytes.len()
+        )
+    }
 }
 
 /// A triangle mesh with one texture.

@@ -54,6 +54,17 @@ impl TextureSpec {
                     source,
                 })
             }
+            TextureSource::Encoded(e) => {
+                let options = LoadOptions {
+                    replace_non_finite,
+                    ..LoadOptions::new(color, *limits)
+                };
+                Texture::decode_with(&e.bytes, &options).map_err(|source| SceneError::Texture {
+                    name: format!("{name} ({})", e.origin),
+                    path: None,
+                    source,
+                })
+            }
             TextureSource::Procedural(p) => p
                 .generate(color, limits)
                 .map(|texture| Loaded {

@@ -228,6 +228,11 @@ impl Scene {
             ScalarInput::Value(v) if !(0.0..=1.0).contains(v) => {
                 Err(bad(format!("{key} = {v} must be in [0, 1]")))
             }
+            ScalarInput::Channel {
+                channel, factor, ..
+            } if *channel > 3 || !(0.0..=1.0).contains(factor) => Err(bad(format!(
+                "{key}: channel {channel} (at most 3) with factor {factor} (in [0, 1])"
+            ))),
             _ => Ok(()),
         };
         unit("roughness", &m.roughness)?;
@@ -256,6 +261,16 @@ impl Scene {
         }
         if let Some(h) = &m.height {
             self.linear("height map", h, "heights").map_err(bad)?;
+        }
+        if let Some(o) = &m.occlusion {
+            self.linear("occlusion map", o, "visibilities")
+                .map_err(bad)?;
+        }
+        if !(0.0..=1.0).contains(&m.occlusion_strength) {
+            return Err(bad(format!(
+                "occlusion_strength = {} must be in [0, 1]",
+                m.occlusion_strength
+            )));
         }
         if m.height_scale < 0.0 {
             return Err(bad(format!(
@@ -355,7 +370,7 @@ impl Scene {
             if let Some(n) = &l.normal {
                 self.linear("normal map", n, "vectors").map_err(at)?;
             }
-            if let Some(ScalarInput::Texture(h)) = &l.height {
+            if let Some(h) = l.height.as_ref().and_then(ScalarInput::texture) {
                 self.linear("height map", h, "heights").map_err(at)?;
             }
         }

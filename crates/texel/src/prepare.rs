@@ -12,7 +12,7 @@ use texel_raster::{
 };
 use texel_scene::{
     ColorInput, LayerBlendSpec, LayerOrder, LightSpec, MaterialSpec, ScalarInput, Scene,
-    SpecularAaSpec,
+    SpecularAaSpec, TextureSampler,
 };
 use texel_texture::color::srgb_to_linear;
 use texel_texture::{AddressMode, ColorSpace, Limits, Sampler, Texture};
@@ -94,6 +94,11 @@ pub struct PreparedScene {
     /// A 1x1 white texture: the draw's colour texture under a layered material that filters
     /// then blends (the layers give the colour).
     white: Texture,
+    /// The distinct samplers of textures that bring their own ([`texel_scene::TextureSpec::sampler`], glTF
+    /// textures), in the order [`PreparedScene::samplers`] lists them after the meshes'.
+    own_samplers: Vec<TextureSampler>,
+    /// Per texture with its own sampler, its index in `own_samplers`.
+    own_sampler_of: BTreeMap<String, usize>,
     /// Per mesh, its tessellated and displaced geometry where its material tessellates
     /// (built for the scene's camera: other views reuse it).
     tessellated: Vec<Option<Tessellated>>,
@@ -154,6 +159,21 @@ impl PreparedScene {
             )?;
             textures.insert(u.name.to_string(), loaded.texture);
         }
+        let mut own_samplers: Vec<TextureSampler> = Vec::new();
+        let mut own_sampler_of = BTreeMap::new();
+        for u in scene.used_textures() {
+            let Some(own) = scene.texture_spec(&u)?.sampler else {
+                continue;
+            };
+            let i = match own_samplers.iter().position(|s| *s == own) {
+                Some(i) => i,
+                None => {
+                    own_samplers.push(own);
+                    own_samplers.len() - 1
+                }
+            };
+            own_sampler_of.insert(u.name.to_string(), i);
+        }
         // LEAN reads moment maps made from the normal maps (a layered material's too), and LEAN
         // and Toksvig on bump maps moment maps made from the height maps (float, charged like
         // any texture). Layered materials that blend then filter, or whose heights displace,
@@ -204,7 +224,13 @@ impl PreparedScene {
                     (m.address_mode_u, m.address_mode_v)
                 });
             let level0 = bake::level0_sampler(modes)?;
-            let layers = layers_of(mat, &textures, &lean_maps, &level0);
+            let maps = MapInputs {
+                textures: &textures,
+                mesh: &level0,
+                own: &[],
+                own_of: &BTreeMap::new(),
+            };
+            let layers = layers_of(mat, maps, &lean_maps);
             let limits = Limits {
                 max_bytes: budget.remaining(),
                 ..Limits::default()
@@ -297,38 +323,55 @@ impl PreparedScene {
             )?,
             tessellated,
             reference_geometry: OnceLock::new(),
+            own_samplers,
+            own_sampler_of,
         })
     }
 
-    /// One sampler per mesh for `filter`, with each mesh's address modes.
+    /// One sampler per mesh for `filter`, with each mesh's address modes; then one per distinct
+    /// sampler that textures bring of their own (glTF textures' `wrapS`/`wrapT`), through which
+    /// materials read those textures. Pass the whole list to [`PreparedScene::draws`]; a list
+    /// of the meshes' alone reads every map through its mesh's sampler.
     ///
     /// # Errors
     /// [`Error::Texture`] if the descriptor is invalid (it never is for the built-in filters).
     pub fn samplers(&self, filter: Filter) -> Result<Vec<Sampler>, Error> {
-        self.scene
+        let meshes = self
+            .scene
             .meshes
             .iter()
-            .map(|m| {
-                Ok(Sampler::new(
-                    filter.descriptor(m.address_mode_u, m.address_mode_v),
-                )?)
-            })
+            .map(|m| (m.address_mode_u, m.address_mode_v));
+        let own = self
+            .own_samplers
+            .iter()
+            .map(|s| (s.address_mode_u, s.address_mode_v));
+        meshes
+            .chain(own)
+            .map(|(u, v)| Ok(Sampler::new(filter.descriptor(u, v))?))
             .collect()
     }
 
-    /// One sampler per mesh when no filter is named: a glTF mesh's own sampler filters
-    /// (`magFilter`/`minFilter`; what the glTF leaves unspecified is linear, as for trilinear),
-    /// and trilinear for every other mesh.
+    /// The samplers of [`PreparedScene::samplers`] when no filter is named: a glTF mesh's or
+    /// texture's own sampler filters (`magFilter`/`minFilter`; what the glTF leaves unspecified
+    /// is linear, as for trilinear), and trilinear for every other mesh.
     ///
     /// # Errors
     /// [`Error::Texture`] for an invalid combination from the glTF file.
     pub fn default_samplers(&self) -> Result<Vec<Sampler>, Error> {
-        self.scene
+        let meshes = self
+            .scene
             .meshes
             .iter()
-            .map(|m| {
-                let mut desc = Filter::Trilinear.descriptor(m.address_mode_u, m.address_mode_v);
-                if let Some(f) = &m.filters {
+            .map(|m| (m.address_mode_u, m.address_mode_v, m.filters));
+        let own = self
+            .own_samplers
+            .iter()
+            .map(|s| (s.address_mode_u, s.address_mode_v, Some(s.filters)));
+        meshes
+            .chain(own)
+            .map(|(u, v, filters)| {
+                let mut desc = Filter::Trilinear.descriptor(u, v);
+                if let Some(f) = &filters {
                     desc.mag_filter = f.mag_filter.unwrap_or(desc.mag_filter);
                     desc.min_filter = f.min_filter.unwrap_or(desc.min_filter);
                     desc.mipmap_filter = f.mipmap_filter.unwrap_or(desc.mipmap_filter);
@@ -451,6 +494,7 @@ impl PreparedScene {
     ) -> Vec<DrawCall<'a>> {
         let aspect = self.width as f32 / self.height as f32;
         let clip_from_world = camera.clip_from_world(aspect);
+        let own_samplers = samplers.get(self.scene.meshes.len()..).unwrap_or(&[]);
         self.scene
             .meshes
             .iter()
@@ -458,7 +502,13 @@ impl PreparedScene {
             .zip(samplers)
             .map(|((k, mesh), sampler)| {
                 let own = geometry.get(k).and_then(Option::as_ref);
-                let mut material = self.material(mesh, sampler, exact);
+                let maps = MapInputs {
+                    textures: &self.textures,
+                    mesh: sampler,
+                    own: own_samplers,
+                    own_of: &self.own_sampler_of,
+                };
+                let mut material = self.material(mesh, maps, exact);
                 if let (Some(m), true, Some(_)) = (&mut material, exact, own) {
                     m.displacement = Displacement::Bump;
                 }
@@ -500,24 +550,22 @@ impl PreparedScene {
             .flatten()
     }
 
-    /// The rasterizer's material of `mesh`, its maps read through `sampler`; for the
+    /// The rasterizer's material of `mesh`, its maps read through `maps`; for the
     /// `reference`, layered materials blend their layers (per sub-sample) even where they are
     /// baked.
     fn material<'a>(
         &'a self,
         mesh: &texel_scene::Mesh,
-        sampler: &'a Sampler,
+        maps: MapInputs<'a>,
         reference: bool,
     ) -> Option<Material<'a>> {
         let name = mesh.material.as_ref()?;
         let spec = self.scene.materials.get(name)?;
-        let input = |name: &str| TextureInput {
-            texture: &self.textures[name],
-            sampler,
-        };
+        let sampler = maps.mesh;
+        let input = |name: &str| maps.input(name);
         let channel = |texture: &'a Texture| red(texture, sampler);
-        let (roughness, roughness_map) = scalar(&spec.roughness, &self.textures, sampler);
-        let (metallic, metallic_map) = scalar(&spec.metallic, &self.textures, sampler);
+        let (roughness, roughness_map) = maps.scalar(&spec.roughness);
+        let (metallic, metallic_map) = maps.scalar(&spec.metallic);
         let base_color = match spec.base_color {
             ColorInput::Rgb(c) => c.extend(1.0),
             ColorInput::Texture(_) => glam::Vec4::ONE,
@@ -540,7 +588,10 @@ impl PreparedScene {
             normal_scale: spec.normal_scale,
             specular_aa,
             lean: spec.normal.as_ref().and_then(|n| self.lean_maps.get(n)),
-            height_map: spec.height.as_deref().map(|h| channel(&self.textures[h])),
+            height_map: spec.height.as_deref().map(|h| ChannelInput {
+                input: input(h),
+                channel: 0,
+            }),
             height_scale: spec.height_scale,
             displacement: Displacement::None,
             height_moments: spec
@@ -548,6 +599,11 @@ impl PreparedScene {
                 .as_ref()
                 .and_then(|h| self.height_moments.get(h)),
             layers: None,
+            occlusion_map: spec.occlusion.as_deref().map(|o| ChannelInput {
+                input: input(o),
+                channel: 0,
+            }),
+            occlusion_strength: spec.occlusion_strength,
         };
         if !spec.layers.is_empty() {
             // The layers give the roughness (validation keeps the material's own at its default).
@@ -566,7 +622,7 @@ impl PreparedScene {
             m.height_map = c.height.as_ref().map(channel);
             m.height_moments = b.slope_moments.as_ref();
         } else if !spec.layers.is_empty() {
-            m.layers = Some(layers_of(spec, &self.textures, &self.lean_maps, sampler));
+            m.layers = Some(layers_of(spec, maps, &self.lean_maps));
         }
         if m.has_height() {
             m.displacement = shape;
@@ -777,15 +833,38 @@ fn moment_map(
     Ok(moments)
 }
 
-/// A number, or a texture's red channel read through `sampler`.
-fn scalar<'a>(
-    s: &ScalarInput,
+/// Where a material's maps are read through: a texture's own sampler where it brings one
+/// ([`texel_scene::TextureSpec::sampler`]; the entries after the meshes' in
+/// [`PreparedScene::samplers`]), else the mesh's.
+#[derive(Clone, Copy)]
+struct MapInputs<'a> {
     textures: &'a BTreeMap<String, Texture>,
-    sampler: &'a Sampler,
-) -> (f32, Option<ChannelInput<'a>>) {
-    match s {
-        ScalarInput::Value(v) => (*v, None),
-        ScalarInput::Texture(t) => (1.0, Some(red(&textures[t], sampler))),
+    /// The mesh's sampler.
+    mesh: &'a Sampler,
+    /// The textures' own samplers.
+    own: &'a [Sampler],
+    /// Per texture with its own sampler, its index in `own`.
+    own_of: &'a BTreeMap<String, usize>,
+}
+
+impl<'a> MapInputs<'a> {
+    /// Texture `name` read through its sampler.
+    fn input(&self, name: &str) -> TextureInput<'a> {
+        let sampler = self.own_of.get(name).and_then(|&i| self.own.get(i));
+        TextureInput {
+            texture: &self.textures[name],
+            sampler: sampler.unwrap_or(self.mesh),
+        }
+    }
+
+    /// A number, or a factor times a texture's channel.
+    fn scalar(&self, s: &ScalarInput) -> (f32, Option<ChannelInput<'a>>) {
+        let (factor, map) = s.parts();
+        let map = map.map(|(texture, channel)| ChannelInput {
+            input: self.input(texture),
+            channel: usize::from(channel),
+        });
+        (factor, map)
     }
 }
 
@@ -797,22 +876,18 @@ fn red<'a>(texture: &'a Texture, sampler: &'a Sampler) -> ChannelInput<'a> {
     }
 }
 
-/// The rasterizer's layers of layered material `spec`, every input read through `sampler`.
+/// The rasterizer's layers of layered material `spec`, every input read through `maps`.
 fn layers_of<'a>(
     spec: &MaterialSpec,
-    textures: &'a BTreeMap<String, Texture>,
+    maps: MapInputs<'a>,
     lean_maps: &'a BTreeMap<String, Texture>,
-    sampler: &'a Sampler,
 ) -> Layers<'a> {
-    let input = |name: &String| TextureInput {
-        texture: &textures[name],
-        sampler,
-    };
+    let input = |name: &String| maps.input(name);
     let mut layers = [Layer::default(); MAX_LAYERS];
     for (slot, l) in layers.iter_mut().zip(&spec.layers) {
-        let (roughness, roughness_map) = scalar(&l.roughness, textures, sampler);
+        let (roughness, roughness_map) = maps.scalar(&l.roughness);
         let (height, height_map) = match &l.height {
-            Some(h) => scalar(h, textures, sampler),
+            Some(h) => maps.scalar(h),
             None => (Layer::default().height, None),
         };
         *slot = Layer {
