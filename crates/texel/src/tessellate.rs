@@ -6,8 +6,9 @@
 //! its midpoint, recursively, a triangle with one, two or three long edges becoming two, three or
 //! four. Whether an edge splits depends on its two end points only, and a midpoint is made once
 //! per edge, so neighbouring triangles agree and the mesh stays watertight (no T-junctions), as
-//! the rasterizer's shared-vertex rule needs. Edges with an end behind the eye are not split, and
-//! triangles wholly outside one plane of the view frustum are kept as they are.
+//! the rasterizer's shared-vertex rule needs. An edge that crosses the near plane is measured by
+//! its part in front of it (edges wholly behind are not split), and triangles wholly outside one
+//! plane of the view frustum are kept as they are.
 //!
 //! Displacement moves each vertex along its unit normal to `p + height_scale (h - 1) n` (the mesh
 //! is the top of the relief, [`texel_raster::Displacement`]). pbrt-v4 reads `h` from level 0 at
@@ -61,6 +62,21 @@ pub struct TooManyTriangles {
 }
 
 impl Tessellation {
+    /// The projected length, pixels, of the part of clip-space segment `a`-`b` in front of the
+    /// near plane (`z >= -w`); `None` where all of it is behind. A segment that crosses the near
+    /// plane is measured from its visible end to where it crosses (an edge with an end behind
+    /// the eye is still split where its visible part is long).
+    fn visible_length(&self, a: Vec4, b: Vec4) -> Option<f32> {
+        let (da, db) = (a.z + a.w, b.z + b.w);
+        let (a, b) = match (da >= 0.0, db >= 0.0) {
+            (true, true) => (a, b),
+            (false, false) => return None,
+            (true, false) => (a, a + (b - a) * (da / (da - db))),
+            (false, true) => (b + (a - b) * (db / (db - da)), b),
+        };
+        Some(self.pixel(a)?.distance(self.pixel(b)?))
+    }
+
     /// The pixel position of a clip-space point in front of the eye.
     fn pixel(&self, c: Vec4) -> Option<Vec2> {
         (c.w > 1e-6).then(|| {
@@ -126,9 +142,9 @@ pub fn tessellate(
             out.push(tri);
             continue;
         }
-        let long = |a: u32, b: u32| match (t.pixel(clip[a as usize]), t.pixel(clip[b as usize])) {
-            (Some(p), Some(q)) => p.distance(q) > limit,
-            _ => false,
+        let long = |a: u32, b: u32| {
+            t.visible_length(clip[a as usize], clip[b as usize])
+                .is_some_and(|l| l > limit)
         };
         let split = [0, 1, 2].map(|e| long(tri[e], tri[(e + 1) % 3]));
         if !split.contains(&true) {
@@ -336,6 +352,36 @@ mod tests {
             })
             .collect();
         assert_eq!(tessellate(&behind, &t, &setup(1.0)).unwrap().triangles, t);
+    }
+
+    /// A floor below the eye that runs from behind it to far in front (as a wall seen along its
+    /// length does): every edge of its two triangles has an end behind the eye, yet its visible
+    /// part is split until the edges in view are short. (Measuring only edges with both ends in
+    /// front left such meshes, and the reference's true relief, untessellated.)
+    #[test]
+    fn edges_that_cross_the_near_plane_split_by_their_visible_part() {
+        let v: Vec<Vertex> = [(-1.0, 1.0), (1.0, 1.0), (1.0, -8.0), (-1.0, -8.0)]
+            .iter()
+            .map(|&(x, z)| {
+                let mut v = Vertex::new(Vec3::new(x, -0.5, z), Vec2::new(x, z));
+                v.normal = Vec3::Y;
+                v
+            })
+            .collect();
+        let t = vec![[0, 1, 2], [0, 2, 3]];
+        let s = setup(4.0);
+        let out = tessellate(&v, &t, &s).unwrap();
+        assert!(out.triangles.len() > 200, "{}", out.triangles.len());
+        for tri in &out.triangles {
+            let c = tri.map(|k| s.clip_from_world * out.vertices[k as usize].position.extend(1.0));
+            if outside(c) {
+                continue;
+            }
+            for e in 0..3 {
+                let l = s.visible_length(c[e], c[(e + 1) % 3]);
+                assert!(l.is_none_or(|l| l <= 4.0 + 1e-3), "{l:?}");
+            }
+        }
     }
 
     /// Heights 0.25 everywhere move the square `0.75 s` down its normal; a ramp displaces each
