@@ -372,3 +372,48 @@ fn a_named_material_or_texture_wins_over_the_gltf_and_bad_maps_are_refused() {
     assert!(e.to_string().contains("orm.png"), "{e}");
     fs::remove_dir_all(&d).unwrap();
 }
+
+/// `TANGENT` is kept, its direction through the node's transform; a mirroring transform flips
+/// its handedness `w` (the bitangent `w cross(n, t)` must follow the mirrored surface).
+#[test]
+fn tangents_are_read_and_mirroring_flips_their_handedness() {
+    let d = scratch("tangents");
+    let with_tangents = |j: String| {
+        j.replace(
+            "\"NORMAL\": 1, \"TEXCOORD_0\": 2",
+            "\"NORMAL\": 1, \"TEXCOORD_0\": 2, \"TANGENT\": 4",
+        )
+        .replace(
+            "\"count\": 6, \"type\": \"SCALAR\"}",
+            "\"count\": 6, \"type\": \"SCALAR\"}, \
+             {\"bufferView\": 5, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC4\"}",
+        )
+        .replace(
+            "}\n  ],\n  \"accessors\"",
+            "}, {\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 64}\n  ],\n  \"accessors\"",
+        )
+    };
+    // The tangents are the position floats read four at a time: (-1, -1, 0, 1), (-1, 0, 1, 1),
+    // (0, -1, 1, 0), (0, 0, 1, 0).
+    let raw = [
+        glam::Vec4::new(-1.0, -1.0, 0.0, 1.0),
+        glam::Vec4::new(-1.0, 0.0, 1.0, 1.0),
+        glam::Vec4::new(0.0, -1.0, 1.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
+    ];
+    for (node, mirror) in [
+        ("{\"mesh\": 0}", 1.0),
+        ("{\"mesh\": 0, \"scale\": [-1, 1, 1]}", -1.0),
+    ] {
+        quad_gltf(&d, |j| with_tangents(j).replace("{\"mesh\": 0}", node));
+        let s = load(&d, "[[meshes]]\ngltf = \"quad.gltf\"\n").unwrap();
+        let t = s.meshes[0].tangents.as_ref().expect("TANGENT read");
+        for (got, raw) in t.iter().zip(&raw) {
+            let xyz = (raw.truncate() * glam::Vec3::new(mirror, 1.0, 1.0)).normalize();
+            assert!((got.truncate() - xyz).length() < 1e-6, "{got} vs {xyz}");
+            let w = if raw.w < 0.0 { -mirror } else { mirror };
+            assert_eq!(got.w, w);
+        }
+    }
+    fs::remove_dir_all(&d).unwrap();
+}
