@@ -585,13 +585,12 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
 }
 
 /// The texture a mesh is drawn with: its own `texture`, or its material's `base_color` texture
-/// (they must agree when both are given); `None` for a glTF mesh that names neither (its own
-/// materials give it).
+/// (they must agree when both are given).
 fn mesh_texture(
     index: usize,
     m: &RawMesh,
     materials: &BTreeMap<String, MaterialSpec>,
-) -> Result<Option<String>, SceneError> {
+) -> Result<String, SceneError> {
     let src = |reason: String| SceneError::MeshMaterial {
         mesh: index,
         reason,
@@ -610,7 +609,7 @@ fn mesh_texture(
             .mask
             .as_deref()
             .or_else(|| mat.textures().first().copied());
-        return slot.map(|s| Some(s.to_string())).ok_or_else(|| {
+        return slot.map(str::to_string).ok_or_else(|| {
             src("its layered material reads no texture: give it a mask or a layer texture".into())
         });
     }
@@ -625,9 +624,8 @@ fn mesh_texture(
         (Some(a), Some(b)) if *a != b => Err(src(format!(
             "texture = {a:?} differs from its material's base_color = {b:?}; give one"
         ))),
-        (Some(a), _) => Ok(Some(a.clone())),
-        (None, Some(b)) => Ok(Some(b)),
-        (None, None) if m.gltf.is_some() && m.material.is_none() => Ok(None),
+        (Some(a), _) => Ok(a.clone()),
+        (None, Some(b)) => Ok(b),
         (None, None) => Err(src(
             "give texture = NAME, or a material whose base_color is a texture".to_string(),
         )),
@@ -647,7 +645,12 @@ fn meshes(
         mesh: index,
         reason,
     };
-    let texture = mesh_texture(index, &m, materials)?;
+    // A glTF mesh without a scene material brings its own, and its texture where none is named.
+    let own_materials = m.gltf.is_some() && m.material.is_none();
+    let texture = match own_materials {
+        true => String::new(), // unused: the import takes `m.texture`
+        false => mesh_texture(index, &m, materials)?,
+    };
     let sources = [m.positions.is_some(), m.obj.is_some(), m.gltf.is_some()]
         .iter()
         .filter(|&&b| b)
@@ -660,12 +663,6 @@ fn meshes(
     let both = m.address_mode.map(AddressMode::from);
     let mode_u = m.address_mode_u.map(AddressMode::from).or(both);
     let mode_v = m.address_mode_v.map(AddressMode::from).or(both);
-    let inline_texture = || {
-        texture.clone().ok_or(SceneError::MeshMaterial {
-            mesh: index,
-            reason: "give texture = NAME, or a material whose base_color is a texture".into(),
-        })
-    };
     let mut out = if let Some(positions) = m.positions {
         let (Some(uvs), Some(triangles)) = (m.uvs, m.triangles) else {
             return Err(src("inline meshes need positions, uvs and triangles"));
@@ -676,7 +673,7 @@ fn meshes(
             normals: m.normals.map(|v| v.into_iter().map(Vec3::from).collect()),
             colors: m.colors.map(|v| v.into_iter().map(Vec4::from).collect()),
             triangles,
-            texture: inline_texture()?,
+            texture: texture.clone(),
             address_mode_u: AddressMode::Repeat,
             address_mode_v: AddressMode::Repeat,
             filters: None,
@@ -692,19 +689,19 @@ fn meshes(
         if let Some(obj) = m.obj {
             GltfScene::from(vec![crate::obj::load_obj_with(
                 &base.join(obj),
-                &inline_texture()?,
+                &texture,
                 limits,
             )?])
         } else {
             let file = m.gltf.expect("one source");
             let path = base.join(&file);
-            match &m.material {
-                Some(_) => GltfScene::from(crate::gltf_import::load_gltf_with(
-                    &path,
-                    &inline_texture()?,
-                    limits,
-                )?),
-                None => crate::gltf_import::import_gltf(&path, texture.as_deref(), &file, limits)?,
+            match own_materials {
+                true => {
+                    crate::gltf_import::import_gltf(&path, m.texture.as_deref(), &file, limits)?
+                }
+                false => {
+                    GltfScene::from(crate::gltf_import::load_gltf_with(&path, &texture, limits)?)
+                }
             }
         }
     };
@@ -722,16 +719,27 @@ fn meshes(
     Ok(out)
 }
 
-/// The error for a glTF import (mesh `index`) whose `table.name` the scene already defines
-/// otherwise.
-fn imported_clash(index: usize, table: &str, name: &str) -> SceneError {
-    SceneError::MeshMaterial {
-        mesh: index,
-        reason: format!(
-            "its glTF file's own {table} are imported as {table}.{name:?}, which the scene \
-             defines otherwise: rename the scene's"
-        ),
+/// Add what mesh `index`'s glTF file imported into the scene's `table`; an entry the scene (or an
+/// earlier import) defines otherwise is an error.
+fn merge_imported<T: PartialEq>(
+    into: &mut BTreeMap<String, T>,
+    imported: BTreeMap<String, T>,
+    index: usize,
+    table: &str,
+) -> Result<(), SceneError> {
+    for (name, entry) in imported {
+        if into.get(&name).is_some_and(|old| *old != entry) {
+            return Err(SceneError::MeshMaterial {
+                mesh: index,
+                reason: format!(
+                    "its glTF file's own {table} are imported as {table}.{name:?}, which the \
+                     scene defines otherwise: rename the scene's"
+                ),
+            });
+        }
+        into.insert(name, entry);
     }
+    Ok(())
 }
 
 impl Scene {
@@ -790,18 +798,8 @@ impl Scene {
             };
             let imported = meshes(i, m, &base, &left, &materials)?;
             all.extend(imported.meshes);
-            for (name, t) in imported.textures {
-                if textures.get(&name).is_some_and(|old| *old != t) {
-                    return Err(imported_clash(i, "textures", &name));
-                }
-                textures.insert(name, t);
-            }
-            for (name, spec) in imported.materials {
-                if materials.get(&name).is_some_and(|old| *old != spec) {
-                    return Err(imported_clash(i, "materials", &name));
-                }
-                materials.insert(name, spec);
-            }
+            merge_imported(&mut textures, imported.textures, i, "textures")?;
+            merge_imported(&mut materials, imported.materials, i, "materials")?;
         }
         let tris: u64 = all.iter().map(|m| m.triangles.len() as u64).sum();
         let verts: u64 = all.iter().map(|m| m.positions.len() as u64).sum();

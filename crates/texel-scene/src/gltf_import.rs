@@ -78,11 +78,10 @@ const MAX_DEPTH: usize = 256;
 struct Ctx<'a> {
     path: &'a Path,
     /// The scene's `texture` for every mesh, or `None` to take each primitive's base colour
-    /// texture (with `import`).
+    /// texture (when importing).
     texture: Option<&'a str>,
-    /// Import materials (the scene names none).
-    import: bool,
-    /// Prefix of imported names (`"FILE#"`).
+    /// Prefix of imported names (`"FILE#"`); empty where materials are not imported (the scene
+    /// names one).
     prefix: &'a str,
     base: Option<&'a Path>,
     buffers: &'a [Vec<u8>],
@@ -93,6 +92,11 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// Whether the file's materials are imported.
+    fn importing(&self) -> bool {
+        !self.prefix.is_empty()
+    }
+
     fn bad(&self, reason: String) -> SceneError {
         SceneError::MeshFile {
             path: self.path.to_path_buf(),
@@ -118,7 +122,10 @@ impl Ctx<'_> {
     }
 
     fn mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
-        let normal_from_world = Mat3::from_mat4(world).inverse().transpose();
+        let linear = Mat3::from_mat4(world);
+        let normal_from_world = linear.inverse().transpose();
+        // A mirroring transform flips the bitangent: a tangent's w follows the determinant's sign.
+        let flip = linear.determinant().signum();
         for (pi, prim) in mesh.primitives().enumerate() {
             let what = format!("mesh {} primitive {pi}", mesh.index());
             let buffers = self.buffers;
@@ -175,21 +182,13 @@ impl Ctx<'_> {
                     )))
                 }
             };
-            let tangents = match reader.read_tangents() {
-                // A mirroring transform flips the bitangent: w follows the determinant's sign.
-                Some(it) => {
-                    let flip = Mat3::from_mat4(world).determinant().signum();
-                    let linear = Mat3::from_mat4(world);
-                    Some(
-                        it.map(|t| {
-                            let xyz = (linear * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
-                            xyz.extend(if t[3] < 0.0 { -flip } else { flip })
-                        })
-                        .collect::<Vec<_>>(),
-                    )
-                }
-                None => None,
-            };
+            let tangents = reader.read_tangents().map(|it| {
+                it.map(|t| {
+                    let xyz = (linear * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
+                    xyz.extend(if t[3] < 0.0 { -flip } else { flip })
+                })
+                .collect::<Vec<_>>()
+            });
             let material = prim.material();
             let base_info = material.pbr_metallic_roughness().base_color_texture();
             let sampler = base_info.as_ref().map(|info| info.texture().sampler());
@@ -206,12 +205,12 @@ impl Ctx<'_> {
                 continue;
             }
             let imported = match material.index() {
-                Some(index) if self.import => Some(self.material(&material, index)?),
+                Some(index) if self.importing() => Some(self.material(&material, index)?),
                 _ => None,
             };
             let texture = match (self.texture, base_info) {
                 (Some(t), _) => t.to_string(),
-                (None, Some(info)) if self.import => self.texture(
+                (None, Some(info)) if self.importing() => self.texture(
                     &info.texture(),
                     info.tex_coord(),
                     ColorSpace::Srgb,
@@ -335,21 +334,22 @@ impl Ctx<'_> {
         let origin = format!("{}, image {i}", self.path.display());
         let bytes: Vec<u8> = match image.source() {
             gltf::image::Source::View { view, .. } => {
-                let data = self.buffers.get(view.buffer().index()).ok_or_else(|| {
-                    self.bad(format!("image {i}: its buffer view's buffer is missing"))
-                })?;
-                let (start, len) = (view.offset(), view.length());
-                let range = start..start.saturating_add(len);
-                if range.end > view.buffer().length() {
-                    return Err(self.bad(format!(
-                        "image {i}: buffer view bytes {start}..{} lie outside buffer {} ({} bytes)",
-                        range.end,
-                        view.buffer().index(),
-                        view.buffer().length()
-                    )));
-                }
-                data.get(range)
-                    .ok_or_else(|| self.bad(format!("image {i}: its buffer view is cut short")))?
+                // A buffer holds its byteLength bytes (padded to 4 after them, not readable).
+                let buffer = view.buffer();
+                let (start, end) = (view.offset(), view.offset().saturating_add(view.length()));
+                let bytes = self
+                    .buffers
+                    .get(buffer.index())
+                    .and_then(|d| d.get(..buffer.length())?.get(start..end));
+                bytes
+                    .ok_or_else(|| {
+                        self.bad(format!(
+                            "image {i}: buffer view bytes {start}..{end} lie outside buffer {} \
+                             ({} bytes)",
+                            buffer.index(),
+                            buffer.length()
+                        ))
+                    })?
                     .to_vec()
             }
             gltf::image::Source::Uri { uri, .. } => match uri.strip_prefix("data:") {
@@ -816,7 +816,6 @@ fn import_slice(
     let mut ctx = Ctx {
         path,
         texture,
-        import: prefix.is_some(),
         prefix: prefix.as_deref().unwrap_or(""),
         base,
         buffers: &buffers,

@@ -562,7 +562,6 @@ impl PreparedScene {
         let name = mesh.material.as_ref()?;
         let spec = self.scene.materials.get(name)?;
         let sampler = maps.mesh;
-        let input = |name: &str| maps.input(name);
         let channel = |texture: &'a Texture| red(texture, sampler);
         let (roughness, roughness_map) = maps.scalar(&spec.roughness);
         let (metallic, metallic_map) = maps.scalar(&spec.metallic);
@@ -584,14 +583,11 @@ impl PreparedScene {
             metallic,
             roughness_map,
             metallic_map,
-            normal_map: spec.normal.as_deref().map(input),
+            normal_map: spec.normal.as_deref().map(|n| maps.input(n)),
             normal_scale: spec.normal_scale,
             specular_aa,
             lean: spec.normal.as_ref().and_then(|n| self.lean_maps.get(n)),
-            height_map: spec.height.as_deref().map(|h| ChannelInput {
-                input: input(h),
-                channel: 0,
-            }),
+            height_map: spec.height.as_deref().map(|h| maps.red(h)),
             height_scale: spec.height_scale,
             displacement: Displacement::None,
             height_moments: spec
@@ -599,10 +595,7 @@ impl PreparedScene {
                 .as_ref()
                 .and_then(|h| self.height_moments.get(h)),
             layers: None,
-            occlusion_map: spec.occlusion.as_deref().map(|o| ChannelInput {
-                input: input(o),
-                channel: 0,
-            }),
+            occlusion_map: spec.occlusion.as_deref().map(|o| maps.red(o)),
             occlusion_strength: spec.occlusion_strength,
         };
         if !spec.layers.is_empty() {
@@ -854,6 +847,14 @@ impl<'a> MapInputs<'a> {
         TextureInput {
             texture: &self.textures[name],
             sampler: sampler.unwrap_or(self.mesh),
+        }
+    }
+
+    /// The red channel of texture `name`.
+    fn red(&self, name: &str) -> ChannelInput<'a> {
+        ChannelInput {
+            input: self.input(name),
+            channel: 0,
         }
     }
 
