@@ -2,7 +2,8 @@
 # Do two texel binaries render the same images, byte for byte? For refactors that must not change
 # a pixel. Usage: scripts/same_images.sh OLD_TEXEL NEW_TEXEL [OUT_DIR]
 # Renders every filter on every built-in scene and ../shared/scenes/ground.toml at 320x180, the
-# 16-spp reference and five debug views at 160x90 (126 images), and compares the PNG files.
+# 16-spp reference and five debug views at 160x90, the lit built-ins and raw colour (134 images),
+# and compares the PNG files.
 # A binary of an older commit: git worktree add /tmp/base REV && cargo build --release
 #   --manifest-path /tmp/base/Cargo.toml --target-dir /tmp/base-target -p texel-cli
 set -euo pipefail
@@ -30,6 +31,16 @@ for s in "${scenes[@]}"; do
   for v in uv mip lod aniso fetches; do
     check "$tag-$v" render "$s" --size 160x90 --view "$v"
   done
+done
+# Lit materials (normal, roughness and height maps, layers) and raw colour output.
+for s in builtin:glossy builtin:bricks builtin:terrain; do
+  tag=$(echo "$s" | tr '/:.' '___')
+  for f in trilinear aniso16; do
+    check "$tag-$f" render "$s" --size 320x180 --filter "$f"
+  done
+done
+for f in nearest trilinear; do
+  check "ground-raw-$f" render builtin:ground --size 320x180 --filter "$f" --color raw
 done
 echo "$n images compared, $differ differ (images in $out)"
 [ "$differ" -eq 0 ]

@@ -398,9 +398,13 @@ pub struct BenchArgs {
     /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
-    /// Print JSON in the shape of ../shared/peers/llvmpipe_bench.py.
+    /// Print JSON in the shape of ../shared/peers/llvmpipe_bench.py (plus the CPU, the SIMD level
+    /// and the colour target).
     #[arg(long)]
     pub json: bool,
+    /// The colour render target the frames are drawn into.
+    #[arg(long, value_enum, default_value_t = TargetArg::Rgba8)]
+    pub target: TargetArg,
     /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has):
     /// wall time per frame (submission, rendering, reading the frame back) and, where the device
     /// has timestamp queries, the render pass's device time (the last column; `device_ms` in JSON).
@@ -409,6 +413,16 @@ pub struct BenchArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
+}
+
+/// A colour render target ([`texel::ColorTarget`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TargetArg {
+    /// RGBA8 in the output's encoding (sRGB, or unorm with `--color raw`): what `texel render`
+    /// writes, 4 bytes a pixel.
+    Rgba8,
+    /// Linear RGBA `f32`, 16 bytes a pixel.
+    Float,
 }
 
 /// How 8-bit texture bytes and output bytes are interpreted ([`texel::ColorHandling`]).

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
-use crate::cli::BenchArgs;
+use crate::cli::{BenchArgs, TargetArg};
 use crate::filters::parse_list;
 use crate::input::{load_scene, Input};
 use crate::threads::{thread_count, with_threads};
@@ -114,6 +114,9 @@ fn time_gpu(
         let draws = scene.draws(&samplers);
         let mut settings = scene.settings();
         settings.derivatives = texel_raster::Derivatives::Quad;
+        if args.target == TargetArg::Float {
+            settings.target = texel::ColorTarget::Float;
+        }
         let prepared = gpu.prepare(&draws, gpu_filter)?;
         let start = Instant::now();
         let mut k = 0;
@@ -163,7 +166,10 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
                 let samplers = scene.samplers(*filter)?;
                 scene.build_structures_within(&samplers, budget)?;
                 let draws = scene.draws(&samplers);
-                let settings = scene.settings();
+                let mut settings = scene.settings();
+                if args.target == TargetArg::Float {
+                    settings.target = texel::ColorTarget::Float;
+                }
                 let mut times =
                     time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;
                 let (min_ms, max_ms) = times
@@ -195,7 +201,10 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         };
         writeln!(
             stdout,
-            "{{\n \"renderer\": \"{renderer}\",\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
+            "{{\n \"renderer\": \"{renderer}\",\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
+            serde_json::Value::from(cpu_model()),
+            simd_level(),
+            target_name(args.target),
             scene.width,
             scene.height,
             args.frames,
@@ -206,9 +215,15 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     } else {
         writeln!(
             stdout,
-            "texel bench: {} at {}x{}, {threads} threads, median of {} frames after {} warm-up",
-            args.scene.scene, scene.width, scene.height, args.frames, args.warmup
+            "texel bench: {} at {}x{}, {threads} threads, {} target, median of {} frames after {} warm-up",
+            args.scene.scene,
+            scene.width,
+            scene.height,
+            target_name(args.target),
+            args.frames,
+            args.warmup
         )?;
+        writeln!(stdout, "cpu: {}; simd: {}", cpu_model(), simd_level())?;
         writeln!(
             stdout,
             "{:<12} {:>10} {:>10} {:>10} {:>10}",
@@ -227,6 +242,49 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The target's name in the report.
+fn target_name(t: TargetArg) -> &'static str {
+    match t {
+        TargetArg::Rgba8 => "rgba8",
+        TargetArg::Float => "rgba32f",
+    }
+}
+
+/// The CPU's model name (Linux's `/proc/cpuinfo`), else the architecture.
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+/// The SIMD instruction sets the binary was compiled to use (texel has no runtime dispatch: the
+/// code runs on what the build's target features allow, the x86-64 baseline's SSE2 by default).
+fn simd_level() -> String {
+    let on: Vec<&str> = [
+        ("avx512f", cfg!(target_feature = "avx512f")),
+        ("avx2", cfg!(target_feature = "avx2")),
+        ("fma", cfg!(target_feature = "fma")),
+        ("sse4.2", cfg!(target_feature = "sse4.2")),
+        ("sse2", cfg!(target_feature = "sse2")),
+        ("neon", cfg!(target_feature = "neon")),
+    ]
+    .into_iter()
+    .filter_map(|(name, enabled)| enabled.then_some(name))
+    .collect();
+    let level = if on.is_empty() {
+        "scalar".to_string()
+    } else {
+        on.join("+")
+    };
+    format!("{level} (compile-time, no runtime dispatch)")
 }
 
 #[cfg(test)]

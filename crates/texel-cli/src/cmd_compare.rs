@@ -213,7 +213,7 @@ pub fn compare(
     let (w, h) = (reference.width, reference.height);
     let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
     ref_image.write_png(dir.join("reference.png"))?;
-    let coverage = Mask::new(w, h, reference.coverage.clone())?;
+    let coverage = Mask::new(w, h, reference.coverage())?;
     if coverage.count() == 0 {
         bail!("the scene covers no pixel: nothing to compare");
     }
@@ -247,7 +247,7 @@ pub fn compare(
         let mut counting = settings;
         counting.count_texels = true;
         let frame = render(&counting, &draws)?;
-        let image = Image8::from_linear(w, h, &frame.color, enc)?;
+        let image = texel::frame_image(&frame, enc)?;
         let mut row = scoring.row(filter.name(), filter.name(), &image, true)?;
         let (mean, max) = texel_stats(&frame);
         row.texels_per_pixel_mean = Some(mean);
@@ -274,7 +274,7 @@ pub fn compare(
     };
 
     for (label, frame, ms) in &extras.frames {
-        let image = Image8::from_linear(w, h, &frame.color, enc)?;
+        let image = texel::frame_image(frame, enc)?;
         let mut row = scoring.row(label, label, &image, true)?;
         row.extra = true;
         row.ms_per_frame = Some(*ms);
@@ -345,12 +345,12 @@ fn orbit_scores(
         let camera = scene.scene.camera.orbited(spec.step_deg * k as f32);
         let reference = reference_frame_from(scene, spp, &camera)?;
         let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
-        let coverage = Mask::new(w, h, reference.coverage)?;
+        let coverage = Mask::new(w, h, reference.coverage())?;
         ref_change += mean_abs_change(&prev_ref, &ref_image, &prev_cov, &coverage)?;
         for (i, &filter) in filters.iter().enumerate() {
             let samplers = scene.samplers(filter)?;
             let frame = render(&settings, &scene.draws_from(&samplers, &camera))?;
-            let image = Image8::from_linear(w, h, &frame.color, enc)?;
+            let image = texel::frame_image(&frame, enc)?;
             change[i] += excess_change(
                 [&prev[i], &image],
                 [&prev_ref, &ref_image],
@@ -379,8 +379,8 @@ fn texel_stats(frame: &Frame) -> (f64, u64) {
     let mut sum = 0u64;
     let mut n = 0u64;
     let mut max = 0u64;
-    for (&t, &c) in frame.texels_read.iter().zip(&frame.coverage) {
-        if c {
+    for (&t, &z) in frame.texels_read.iter().zip(&frame.depth) {
+        if z < f32::INFINITY {
             sum += u64::from(t);
             n += 1;
             max = max.max(u64::from(t));

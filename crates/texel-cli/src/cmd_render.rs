@@ -2,12 +2,12 @@
 
 use anyhow::{bail, Result};
 use texel_gpu::{Gpu, GpuFilter};
-use texel_raster::{render, Derivatives, Perspective, View};
+use texel_raster::{render, ColorTarget, Derivatives, Perspective, View};
 
 use crate::cli::{ColorArg, DerivativesArg, PerspectiveArg, RenderArgs, ViewArg};
 use crate::filters::Filter;
 use crate::input::{load_scene, Input};
-use crate::output::write_png;
+use crate::output::{encoding, write_image};
 use crate::threads::with_threads;
 
 /// Run `texel render`.
@@ -40,6 +40,14 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         ViewArg::Fetches => View::Fetches,
         ViewArg::Barycentric => View::Barycentric,
     };
+    // The frame is rendered into the 8-bit target the PNG holds; debug views hold display values
+    // meant for sRGB encoding whatever --color says.
+    let color = if settings.view == View::Color {
+        args.scene.color
+    } else {
+        settings.target = ColorTarget::Srgb8;
+        ColorArg::Srgb
+    };
     let draws = scene.draws(&samplers);
     let frame = if args.gpu {
         let filter = filter.unwrap_or(Filter::Trilinear);
@@ -57,13 +65,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     } else {
         with_threads(args.threads, || render(&settings, &draws))??
     };
-    // Debug views hold display values meant for sRGB encoding whatever --color says.
-    let color = if settings.view == View::Color {
-        args.scene.color
-    } else {
-        ColorArg::Srgb
-    };
-    write_png(&args.output, frame.width, frame.height, &frame.color, color)
+    write_image(&args.output, &texel::frame_image(&frame, encoding(color))?)
 }
 
 /// Run `texel gpu-info`: every adapter, and which one `--gpu` would pick.

@@ -59,15 +59,23 @@ fn bench_json_has_the_llvmpipe_shape() {
         keys,
         [
             "clear_ms",
+            "cpu",
             "frames",
             "height",
             "median_ms",
             "renderer",
+            "simd",
+            "target",
             "threads",
             "width"
         ]
     );
     assert_eq!(v["renderer"], "texel");
+    assert_eq!(v["target"], "rgba8");
+    assert!(v["cpu"].as_str().is_some_and(|c| !c.is_empty()));
+    assert!(v["simd"]
+        .as_str()
+        .is_some_and(|s| s.contains("compile-time")));
     assert_eq!(v["threads"], 1);
     assert_eq!(
         (v["width"].as_u64(), v["height"].as_u64()),

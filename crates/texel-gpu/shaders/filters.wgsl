@@ -333,7 +333,9 @@ fn ewa(uv: vec2<f32>, px: vec2<f32>, py: vec2<f32>, iso_lod: f32) -> vec4<f32> {
 
 struct FragmentOut {
     @location(0) color: vec4<f32>,
-    @location(1) coverage: vec4<f32>,
+    // The fragment's NDC depth in the CPU's convention (OpenGL's z / w in [-1, 1]); the target is
+    // cleared to +inf, so coverage is implied by depth, as in the CPU's frame.
+    @location(1) depth: vec4<f32>,
 }
 
 @fragment
@@ -368,6 +370,6 @@ fn fs_main(in: VertexOut) -> FragmentOut {
     }
     var out: FragmentOut;
     out.color = c * in.color;
-    out.coverage = vec4<f32>(1.0);
+    out.depth = vec4<f32>(2.0 * in.clip.z - 1.0, 0.0, 0.0, 0.0);
     return out;
 }

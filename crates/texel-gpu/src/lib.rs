@@ -320,7 +320,7 @@ impl Gpu {
 }
 
 const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-const COVERAGE: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+const FRAG_DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// position (3), uv (2), colour (4) as `f32`.
 const VERTEX_FLOATS: usize = 9;
@@ -365,7 +365,7 @@ fn create_pipeline(
                 constants: &constants,
                 ..Default::default()
             },
-            targets: &[Some(COLOR.into()), Some(COVERAGE.into())],
+            targets: &[Some(COLOR.into()), Some(FRAG_DEPTH.into())],
         }),
         multiview_mask: None,
         cache: None,
@@ -500,7 +500,7 @@ fn params(draw: &DrawCall, filter: GpuFilter) -> Vec<u8> {
 }
 
 /// Render `draws` with `filter` on `gpu`: the same frame [`texel_raster::render`] makes (linear
-/// colour and coverage; no texel counts), filtered by the shader. Uploads the textures and meshes
+/// colour and depth; no texel counts), filtered by the shader. Uploads the textures and meshes
 /// and renders once; [`GpuDraws`] keeps them for many frames.
 ///
 /// # Errors
@@ -694,7 +694,7 @@ impl GpuDraws<'_> {
             Some(t) if t.size == (w, h) => t,
             _ => Targets::new(device, w, h),
         };
-        let (color, coverage, depth) = (&targets.color, &targets.coverage, &targets.depth);
+        let (color, frag_depth, depth) = (&targets.color, &targets.frag_depth, &targets.depth);
         let mut encoder = device.create_command_encoder(&Default::default());
         let queries = gpu.timestamps.then(|| {
             device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -705,7 +705,7 @@ impl GpuDraws<'_> {
         });
         {
             let color_view = color.create_view(&Default::default());
-            let coverage_view = coverage.create_view(&Default::default());
+            let frag_depth_view = frag_depth.create_view(&Default::default());
             let depth_view = depth.create_view(&Default::default());
             let [r, g, b, a] = settings.background.map(f64::from);
             let attachment = |view, clear| {
@@ -723,7 +723,13 @@ impl GpuDraws<'_> {
                 label: Some("texel frame"),
                 color_attachments: &[
                     attachment(&color_view, wgpu::Color { r, g, b, a }),
-                    attachment(&coverage_view, wgpu::Color::TRANSPARENT),
+                    attachment(
+                        &frag_depth_view,
+                        wgpu::Color {
+                            r: f64::INFINITY,
+                            ..wgpu::Color::TRANSPARENT
+                        },
+                    ),
                 ],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
@@ -756,7 +762,7 @@ impl GpuDraws<'_> {
             }
         }
         let color_bytes = read_back(gpu, &mut encoder, color, 16);
-        let coverage_bytes = read_back(gpu, &mut encoder, coverage, 1);
+        let frag_depth_bytes = read_back(gpu, &mut encoder, frag_depth, 4);
         let time_bytes = queries.as_ref().map(|q| {
             let resolve = device.create_buffer(&wgpu::BufferDescriptor {
                 label: None,
@@ -786,15 +792,22 @@ impl GpuDraws<'_> {
             return Err(GpuError::Failed(e.to_string()));
         }
         let color_data = color_bytes.wait(gpu)?;
-        let coverage_data = coverage_bytes.wait(gpu)?;
+        let frag_depth_data = frag_depth_bytes.wait(gpu)?;
         let mut frame = Frame::new(settings);
-        for (px, b) in frame.color.iter_mut().zip(color_data.chunks_exact(16)) {
-            *px = std::array::from_fn(|c| {
-                f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])
-            });
+        let f32_at = |b: &[u8], c: usize| {
+            f32::from_le_bytes([b[4 * c], b[4 * c + 1], b[4 * c + 2], b[4 * c + 3]])
+        };
+        let target = settings.target;
+        for (k, b) in color_data.chunks_exact(16).enumerate() {
+            let c: [f32; 4] = std::array::from_fn(|c| f32_at(b, c));
+            if target.is_8bit() {
+                frame.color8[k] = target.encode(c);
+            } else {
+                frame.color[k] = c;
+            }
         }
-        for (c, &b) in frame.coverage.iter_mut().zip(&coverage_data) {
-            *c = b > 0;
+        for (z, b) in frame.depth.iter_mut().zip(frag_depth_data.chunks_exact(4)) {
+            *z = f32_at(b, 0);
         }
         let ms = match time_bytes {
             Some(t) => {
@@ -810,11 +823,12 @@ impl GpuDraws<'_> {
     }
 }
 
-/// A frame's render targets: linear colour, coverage and depth, `size` pixels.
+/// A frame's render targets: linear colour, fragment depth and the depth buffer, `size` pixels.
 struct Targets {
     size: (u32, u32),
     color: wgpu::Texture,
-    coverage: wgpu::Texture,
+    /// The fragment shader's NDC depth (`R32Float`, cleared to +inf): read back as the frame's depth.
+    frag_depth: wgpu::Texture,
     depth: wgpu::Texture,
 }
 
@@ -840,7 +854,7 @@ impl Targets {
         Targets {
             size: (w, h),
             color: target(COLOR, copy),
-            coverage: target(COVERAGE, copy),
+            frag_depth: target(FRAG_DEPTH, copy),
             depth: target(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT),
         }
     }

@@ -7,7 +7,7 @@
 //! Needs a Vulkan or GL adapter (Mesa's lavapipe: `apt-get install mesa-vulkan-drivers`). Without
 //! one the tests print why and pass, unless `CI=true`, where a missing adapter fails them.
 
-use texel::raster::Derivatives;
+use texel::raster::{ColorTarget, Derivatives};
 use texel::{Filter, MemoryBudget, PreparedScene, Scene, SceneOptions};
 use texel_gpu::{Gpu, GpuError, GpuFilter};
 
@@ -32,7 +32,7 @@ fn psnr(a: &texel::Frame, b: &texel::Frame) -> (f64, u8, usize) {
     let enc = |x: f32| texel::texture::color::linear_to_srgb8(x);
     let (mut sum, mut n, mut worst) = (0.0f64, 0usize, 0u8);
     for k in 0..a.color.len() {
-        if !(a.coverage[k] && b.coverage[k]) {
+        if !(a.covered(k) && b.covered(k)) {
             continue;
         }
         for c in 0..3 {
@@ -67,6 +67,7 @@ fn agree(scene: &str) {
     let prepared = small(scene);
     let mut settings = prepared.settings();
     settings.derivatives = Derivatives::Quad;
+    settings.target = ColorTarget::Float;
     for filter in GpuFilter::filters() {
         let name = filter.name();
         let samplers = prepared.samplers(filter).unwrap();
@@ -81,6 +82,17 @@ fn agree(scene: &str) {
             db >= 45.0,
             "{name}: {db:.1} dB (largest difference {worst}/255)"
         );
+        // The GPU's depth target holds the CPU's NDC depth (coverage is implied by it): equal
+        // coverage up to edge pixels, equal depths up to f32 interpolation.
+        let both = (0..cpu.depth.len())
+            .filter(|&k| cpu.covered(k) && gpu_frame.covered(k))
+            .count();
+        assert!(both * 100 >= 99 * cpu.covered_pixels(), "{name}: {both}");
+        let worst_z = (0..cpu.depth.len())
+            .filter(|&k| cpu.covered(k) && gpu_frame.covered(k))
+            .map(|k| (cpu.depth[k] - gpu_frame.depth[k]).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst_z < 1e-4, "{name}: depths differ by {worst_z}");
     }
 }
 
@@ -111,7 +123,7 @@ fn device_time_is_measured_when_the_device_can() {
     let t0 = std::time::Instant::now();
     let (frame, ms) = gpu_draws.render_timed(&prepared.settings()).unwrap();
     let wall = t0.elapsed().as_secs_f64() * 1e3;
-    assert!(frame.coverage.iter().any(|&c| c));
+    assert!(frame.covered_pixels() > 0);
     match ms {
         Some(ms) => {
             assert!(gpu.has_timestamps());
@@ -130,7 +142,8 @@ fn a_moved_camera_and_a_scissor_match_fresh_draws() {
     let prepared = small("builtin:ground");
     let samplers = prepared.samplers(Filter::Aniso8).unwrap();
     let mut draws = prepared.draws(&samplers);
-    let settings = prepared.settings();
+    let mut settings = prepared.settings();
+    settings.target = ColorTarget::Float;
     let first = gpu.prepare(&draws, GpuFilter::Lab(8)).unwrap();
     let mut camera = prepared.scene.camera;
     camera.eye.y += 0.7;
@@ -143,7 +156,7 @@ fn a_moved_camera_and_a_scissor_match_fresh_draws() {
     }
     let fresh = texel_gpu::render(&gpu, &settings, &draws, GpuFilter::Lab(8)).unwrap();
     assert_eq!(via_update.color, fresh.color);
-    assert!(fresh.coverage.iter().filter(|&&c| c).count() > 1000);
+    assert!(fresh.covered_pixels() > 1000);
 
     let scissor = [30, 20, 111, 77];
     let part = first
@@ -159,7 +172,7 @@ fn a_moved_camera_and_a_scissor_match_fresh_draws() {
                 assert_eq!(part.color[k], fresh.color[k], "pixel ({i}, {j})");
             } else {
                 assert_eq!(part.color[k], settings.background, "pixel ({i}, {j})");
-                assert!(!part.coverage[k]);
+                assert!(!part.covered(k));
             }
         }
     }

@@ -1,10 +1,11 @@
-//! The rendered frame and its 8-bit encodings.
+//! The rendered frame: its colour target, depth and optional side channels.
+
+use std::borrow::Cow;
 
 use rayon::prelude::*;
-use texel_texture::color::{linear_to_srgb8, unorm8};
 use texel_texture::Footprint;
 
-use crate::settings::RenderSettings;
+use crate::settings::{ColorTarget, RenderSettings};
 
 /// Elements per parallel chunk when clearing a buffer (large enough that rayon's overhead is noise).
 const CLEAR_CHUNK: usize = 1 << 15;
@@ -25,23 +26,34 @@ fn reset_buffer<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, value: T) {
     }
 }
 
-/// A rendered image with its per-pixel side channels. Every buffer is row-major, row 0 at the top,
-/// `width * height` long unless stated otherwise.
+/// A rendered image: its colour target, its depth and the side channels that were asked for.
+/// Every buffer is row-major, row 0 at the top, `width * height` long unless stated otherwise.
+///
+/// As on a GPU, the frame holds colour in the target's format (8 bytes a pixel with depth for an
+/// 8-bit target, 20 for a float one) and nothing else unless asked: coverage is implied by depth
+/// ([`Frame::covered`]), texel counts and footprints are filled only when the settings ask.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// Linear RGBA colour. Debug views store the linear value whose sRGB encoding is the displayed
-    /// value (see [`crate::views`]).
+    /// The colour target's format: which of [`Frame::color`] and [`Frame::color8`] holds the
+    /// image.
+    pub target: ColorTarget,
+    /// Linear RGBA colour ([`ColorTarget::Float`]; empty for 8-bit targets). Debug views store the
+    /// linear value whose sRGB encoding is the displayed value (see [`crate::views`]).
     pub color: Vec<[f32; 4]>,
+    /// 8-bit RGBA colour in the target's encoding ([`ColorTarget::Srgb8`] or
+    /// [`ColorTarget::Unorm8`]; empty for a float target).
+    pub color8: Vec<[u8; 4]>,
     /// Texels the filter read for the pixel's visible fragment (0 for background). Filled when
     /// counting ([`crate::RenderSettings::counts_texels`]); empty otherwise and for reference frames.
     pub texels_read: Vec<u32>,
-    /// Whether any triangle covers the pixel (its centre for `render`, any sample for the reference).
-    pub coverage: Vec<bool>,
-    /// NDC depth of the visible fragment, `+inf` where nothing is drawn. Empty for reference frames.
+    /// NDC depth of the visible fragment, `+inf` where nothing is drawn (for the reference, the
+    /// nearest depth among the pixel's sub-samples). A pixel is covered exactly when its depth is
+    /// finite ([`Frame::covered`]): depth tests are strict (`z < depth`) and the setup skips
+    /// non-finite triangles, so no drawn fragment has depth `+inf`.
     pub depth: Vec<f32>,
     /// The footprint handed to the sampler for the visible fragment (zeroes for background). Filled
     /// when [`crate::RenderSettings::capture_footprints`] is on; empty otherwise.
@@ -55,9 +67,10 @@ impl Frame {
         let mut frame = Frame {
             width: 0,
             height: 0,
+            target: settings.target,
             color: Vec::new(),
+            color8: Vec::new(),
             texels_read: Vec::new(),
-            coverage: Vec::new(),
             depth: Vec::new(),
             footprints: Vec::new(),
         };
@@ -66,33 +79,41 @@ impl Frame {
     }
 
     /// Clear the frame for a render with `settings`, reusing its buffers when the size is unchanged:
-    /// colour to the background, depth to `+inf`, coverage to `false`; the texel counts
-    /// (when [`RenderSettings::counts_texels`]) and footprints (when
+    /// colour to the background (encoded once for an 8-bit target), depth to `+inf`; the texel
+    /// counts (when [`RenderSettings::counts_texels`]) and footprints (when
     /// [`RenderSettings::capture_footprints`]) to zero, and emptied otherwise. Runs on the current
     /// rayon pool. This is the "clear" of a GPU frame: [`crate::draw_into`] then draws on top.
     pub fn reset(&mut self, settings: &RenderSettings) {
         let n = settings.width as usize * settings.height as usize;
         self.width = settings.width;
         self.height = settings.height;
-        reset_buffer(&mut self.color, n, settings.background);
+        self.target = settings.target;
+        let (n_float, n_8) = if settings.target.is_8bit() {
+            (0, n)
+        } else {
+            (n, 0)
+        };
+        reset_buffer(&mut self.color, n_float, settings.background);
+        let background8 = settings.target.encode(settings.background);
+        reset_buffer(&mut self.color8, n_8, background8);
         reset_buffer(&mut self.depth, n, f32::INFINITY);
-        reset_buffer(&mut self.coverage, n, false);
         let counted = if settings.counts_texels() { n } else { 0 };
         reset_buffer(&mut self.texels_read, counted, 0);
         let captured = if settings.capture_footprints { n } else { 0 };
         reset_buffer(&mut self.footprints, captured, Footprint::default());
     }
 
-    /// Whether the frame's buffers have the size and side channels a render with `settings` writes
-    /// (what [`Frame::reset`] gives).
+    /// Whether the frame's buffers have the size, target and side channels a render with
+    /// `settings` writes (what [`Frame::reset`] gives).
     pub fn matches(&self, settings: &RenderSettings) -> bool {
         let n = settings.width as usize * settings.height as usize;
         let side = |on: bool| if on { n } else { 0 };
         self.width == settings.width
             && self.height == settings.height
-            && self.color.len() == n
+            && self.target == settings.target
+            && self.color.len() == side(!settings.target.is_8bit())
+            && self.color8.len() == side(settings.target.is_8bit())
             && self.depth.len() == n
-            && self.coverage.len() == n
             && self.texels_read.len() == side(settings.counts_texels())
             && self.footprints.len() == side(settings.capture_footprints)
     }
@@ -102,34 +123,64 @@ impl Frame {
         j as usize * self.width as usize + i as usize
     }
 
+    /// Whether any triangle covers pixel `k` (its centre for `render`, any sample for the
+    /// reference): its depth is finite. Panics if `k` is out of range.
+    pub fn covered(&self, k: usize) -> bool {
+        self.depth[k] < f32::INFINITY
+    }
+
+    /// [`Frame::covered`] for every pixel.
+    pub fn coverage(&self) -> Vec<bool> {
+        self.depth.iter().map(|&z| z < f32::INFINITY).collect()
+    }
+
+    /// Number of covered pixels.
+    pub fn covered_pixels(&self) -> usize {
+        self.depth.iter().filter(|&&z| z < f32::INFINITY).count()
+    }
+
+    /// The colour as linear RGBA floats: borrowed from a float target; decoded from an 8-bit one
+    /// ([`ColorTarget::decode`], so re-encoding gives the stored bytes back).
+    pub fn linear(&self) -> Cow<'_, [[f32; 4]]> {
+        if self.target.is_8bit() {
+            Cow::Owned(self.color8.iter().map(|&b| self.target.decode(b)).collect())
+        } else {
+            Cow::Borrowed(&self.color)
+        }
+    }
+
+    /// The colour as 8-bit bytes of `target`'s encoding: a float frame is encoded
+    /// ([`ColorTarget::encode`]), an 8-bit frame of that encoding copied, one of the other encoding
+    /// decoded and re-encoded. `4 * width * height` bytes.
+    pub fn to_8bit(&self, target: ColorTarget) -> Vec<u8> {
+        let target = if target.is_8bit() {
+            target
+        } else {
+            ColorTarget::Srgb8
+        };
+        if self.target == target {
+            return self.color8.iter().flatten().copied().collect();
+        }
+        if self.target.is_8bit() {
+            return self
+                .color8
+                .iter()
+                .flat_map(|&b| target.encode(self.target.decode(b)))
+                .collect();
+        }
+        self.color.iter().flat_map(|&c| target.encode(c)).collect()
+    }
+
     /// The colour as 8-bit RGBA bytes with RGB sRGB-encoded and alpha linear (what a PNG viewer
     /// expects). Values are clamped to `[0, 1]`; NaN encodes as 0. `4 * width * height` bytes.
     pub fn to_srgb8(&self) -> Vec<u8> {
-        self.color
-            .iter()
-            .flat_map(|c| {
-                [
-                    linear_to_srgb8(c[0]),
-                    linear_to_srgb8(c[1]),
-                    linear_to_srgb8(c[2]),
-                    unorm8(c[3].clamp(0.0, 1.0)),
-                ]
-            })
-            .collect()
+        self.to_8bit(ColorTarget::Srgb8)
     }
 
     /// The colour as raw 8-bit RGBA bytes, every channel `round(255 * clamp(c, 0, 1))` with no
     /// transfer function (a linear `*Unorm` render target).
     pub fn to_raw8(&self) -> Vec<u8> {
-        self.color
-            .iter()
-            .flat_map(|c| c.map(|x| unorm8(x.clamp(0.0, 1.0))))
-            .collect()
-    }
-
-    /// Number of pixels [`Frame::coverage`] marks as covered.
-    pub fn covered_pixels(&self) -> usize {
-        self.coverage.iter().filter(|&&c| c).count()
+        self.to_8bit(ColorTarget::Unorm8)
     }
 }
 
@@ -137,20 +188,63 @@ impl Frame {
 mod tests {
     use super::*;
 
-    #[test]
-    fn encodings() {
-        let f = Frame {
+    fn float_frame() -> Frame {
+        Frame {
             width: 2,
             height: 1,
+            target: ColorTarget::Float,
             color: vec![[0.0, 1.0, 0.2159, 0.5], [f32::NAN, 2.0, -1.0, 1.0]],
+            color8: vec![],
             texels_read: vec![],
-            coverage: vec![true, false],
-            depth: vec![],
+            depth: vec![0.5, f32::INFINITY],
             footprints: vec![],
-        };
+        }
+    }
+
+    #[test]
+    fn encodings() {
+        let f = float_frame();
         assert_eq!(f.to_srgb8(), vec![0, 255, 128, 128, 0, 255, 0, 255]);
         assert_eq!(f.to_raw8(), vec![0, 255, 55, 128, 0, 255, 0, 255]);
         assert_eq!(f.covered_pixels(), 1);
+        assert_eq!(f.coverage(), vec![true, false]);
         assert_eq!(f.index(1, 0), 1);
+    }
+
+    #[test]
+    fn eight_bit_frames_convert_through_linear() {
+        let f = float_frame();
+        for target in [ColorTarget::Srgb8, ColorTarget::Unorm8] {
+            let bytes = f.to_8bit(target);
+            let g = Frame {
+                target,
+                color: vec![],
+                color8: bytes
+                    .chunks_exact(4)
+                    .map(|c| [c[0], c[1], c[2], c[3]])
+                    .collect(),
+                ..f.clone()
+            };
+            // Its own encoding is a copy; the other goes through linear.
+            assert_eq!(g.to_8bit(target), bytes);
+            assert_eq!(g.linear().len(), 2);
+            let other = if target == ColorTarget::Srgb8 {
+                ColorTarget::Unorm8
+            } else {
+                ColorTarget::Srgb8
+            };
+            let via: Vec<u8> = g.linear().iter().flat_map(|&c| other.encode(c)).collect();
+            assert_eq!(g.to_8bit(other), via);
+        }
+    }
+
+    #[test]
+    fn decode_inverts_encode_for_every_byte() {
+        for target in [ColorTarget::Srgb8, ColorTarget::Unorm8] {
+            for b in 0..=255u8 {
+                let px = [b, b, b, b];
+                assert_eq!(target.encode(target.decode(px)), px, "{target:?} {b}");
+            }
+        }
     }
 }

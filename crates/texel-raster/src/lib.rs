@@ -64,7 +64,9 @@ pub use material::{
     ChannelInput, Displacement, Light, Material, SpecularAa, TextureInput, MAX_LIGHTS,
 };
 pub use reference::{render_reference, render_reference_strata};
-pub use settings::{Derivatives, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS};
+pub use settings::{
+    ColorTarget, Derivatives, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS,
+};
 
 /// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].
 ///

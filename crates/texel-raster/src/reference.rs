@@ -23,7 +23,9 @@
 //! Its time for 16 x 16 spp of the ground scene at 1280 x 720 is in README.md's Benchmarks section
 //! (`examples/frame_table.rs`; `examples/ground.rs` prints it too).
 //! The settings' `view`, `derivatives` and `perspective` are ignored (always colour, level 0,
-//! perspective-correct); `count_texels` and `capture_footprints` leave their buffers empty. A
+//! perspective-correct); `count_texels` and `capture_footprints` leave their buffers empty; the
+//! colour target is always [`crate::ColorTarget::Float`] (the reference's averages are quantised
+//! once, by whoever compares against them), and the depth is the nearest sub-sample's. A
 //! scissor rectangle limits the pixels rendered, which are the same as without it; the rest keep
 //! the background.
 
@@ -37,7 +39,7 @@ use crate::draw::DrawCall;
 use crate::error::RasterError;
 use crate::frame::Frame;
 use crate::material::{ChannelInput, Material, SpecularAa, TextureInput};
-use crate::settings::{Perspective, RenderSettings};
+use crate::settings::{ColorTarget, Perspective, RenderSettings};
 use crate::setup::{setup_draws, validate_draws, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
 use crate::tile::{bin, split_rows, tile_counts, TILE};
@@ -216,10 +218,11 @@ fn reference_frame(
     let mut frame = Frame {
         width,
         height,
+        target: ColorTarget::Float,
         color: vec![settings.background; pixels],
+        color8: Vec::new(),
         texels_read: Vec::new(),
-        coverage: vec![false; pixels],
-        depth: Vec::new(),
+        depth: vec![f32::INFINITY; pixels],
         footprints: Vec::new(),
     };
     let ref_draws: Vec<DrawCall> = draws
@@ -242,28 +245,28 @@ fn reference_frame(
     };
     let (tx, _) = tile_counts(width, height);
     let color = split_rows(&mut frame.color, width, height);
-    let coverage = split_rows(&mut frame.coverage, width, height);
+    let depth = split_rows(&mut frame.depth, width, height);
     let done = AtomicU64::new(0);
     let total = pixels as u64;
     color
         .into_par_iter()
-        .zip(coverage)
+        .zip(depth)
         .zip(bins.par_iter())
         .enumerate()
         .with_max_len(1)
-        .for_each(|(k, ((mut color, mut coverage), bin))| {
+        .for_each(|(k, ((mut color, mut depth), bin))| {
             let (x0, y0) = ((k as u32 % tx) * TILE, (k as u32 / tx) * TILE);
             let mut scratch = Scratch::default();
             // The tile's columns inside the scissor (as offsets into its rows).
             let [sx0, sy0, sx1, sy1] = settings.scissor_rect();
             let tw = color.first().map_or(0, |r| r.len() as u32);
             let (c0, c1) = (sx0.clamp(x0, x0 + tw) - x0, sx1.clamp(x0, x0 + tw) - x0);
-            for (r, (crow, cov)) in color.iter_mut().zip(coverage.iter_mut()).enumerate() {
+            for (r, (crow, drow)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
                 let j = y0 + r as u32;
                 if c0 < c1 && (sy0..sy1).contains(&j) {
                     let (c0, c1) = (c0 as usize, c1 as usize);
-                    let (crow, cov) = (&mut crow[c0..c1], &mut cov[c0..c1]);
-                    reference_row(&ctx, bin, x0 + c0 as u32, j, crow, cov, &mut scratch);
+                    let (crow, drow) = (&mut crow[c0..c1], &mut drow[c0..c1]);
+                    reference_row(&ctx, bin, x0 + c0 as u32, j, crow, drow, &mut scratch);
                 }
             }
             let tile_pixels = color.iter().map(|r| r.len() as u64).sum::<u64>();
@@ -291,7 +294,7 @@ fn reference_row(
     x0: u32,
     j: u32,
     color: &mut [[f32; 4]],
-    coverage: &mut [bool],
+    depth: &mut [f32],
     s: &mut Scratch,
 ) {
     let [nx, ny] = ctx.strata.map(|k| k as usize);
@@ -345,16 +348,15 @@ fn reference_row(
     }
     let background = Vec4::from_array(ctx.settings.background);
     let inv_spp = 1.0 / spp as f32;
-    for (p, (out, cov)) in color.iter_mut().zip(coverage.iter_mut()).enumerate() {
+    for (p, (out, nearest)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
         let mut sum = Vec4::ZERO;
-        let mut hit = false;
         for k in p * spp..(p + 1) * spp {
             let id = s.winner[k];
             if id == u32::MAX {
                 sum += background;
                 continue;
             }
-            hit = true;
+            *nearest = nearest.min(s.depth[k]);
             let t = &ctx.setups[id as usize];
             let dc = &ctx.draws[t.draw as usize];
             let pos = s.pos[k];
@@ -377,6 +379,5 @@ fn reference_row(
             sum += Vec4::from_array(c);
         }
         *out = (sum * inv_spp).to_array();
-        *cov = hit;
     }
 }

@@ -1,6 +1,8 @@
 //! How a frame is rendered: size, background, derivative and interpolation modes, debug view, light,
 //! threads.
 
+use texel_texture::color::{linear_to_srgb8, srgb_table, unorm8, unorm8_table};
+
 use crate::error::RasterError;
 use crate::material::{Light, MAX_LIGHTS};
 
@@ -58,6 +60,63 @@ pub enum View {
     Barycentric,
 }
 
+/// The colour render target's format: what [`crate::Frame`] stores per pixel, as a GPU's colour
+/// attachment format. Fragments are encoded as they are written, so an 8-bit target's bytes are
+/// exactly what [`crate::Frame::to_srgb8`] or [`crate::Frame::to_raw8`] make of a
+/// [`ColorTarget::Float`] frame of the same draws (the same `f32` colour goes through the same
+/// encoder).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ColorTarget {
+    /// Linear RGBA `f32` in [`crate::Frame::color`] (16 bytes a pixel): exact, unclamped; for
+    /// EXR output, accumulation and the reference.
+    #[default]
+    Float,
+    /// RGBA8 in [`crate::Frame::color8`] (4 bytes a pixel), RGB through the sRGB OETF (IEC
+    /// 61966-2-1) and alpha linear, as Vulkan's `R8G8B8A8_SRGB`: values clamp to `[0, 1]`, NaN
+    /// encodes as 0.
+    Srgb8,
+    /// RGBA8 in [`crate::Frame::color8`], every channel `round(255 * clamp(c, 0, 1))` with no
+    /// transfer function, as Vulkan's `R8G8B8A8_UNORM` (the CLI's `--color raw`).
+    Unorm8,
+}
+
+impl ColorTarget {
+    /// Whether the target stores 8-bit colour ([`crate::Frame::color8`]).
+    pub fn is_8bit(self) -> bool {
+        self != ColorTarget::Float
+    }
+
+    /// One linear RGBA colour as this 8-bit target stores it; [`ColorTarget::Float`] encodes as
+    /// [`ColorTarget::Srgb8`] (the display encoding).
+    #[inline(always)]
+    pub fn encode(self, c: [f32; 4]) -> [u8; 4] {
+        match self {
+            ColorTarget::Unorm8 => c.map(|x| unorm8(x.clamp(0.0, 1.0))),
+            _ => [
+                linear_to_srgb8(c[0]),
+                linear_to_srgb8(c[1]),
+                linear_to_srgb8(c[2]),
+                unorm8(c[3].clamp(0.0, 1.0)),
+            ],
+        }
+    }
+
+    /// The linear colour an 8-bit value of this target stands for (`Srgb8`: the sRGB EOTF on RGB;
+    /// `Unorm8` and `Float`: `b / 255`). `encode(decode(b)) == b` for every byte.
+    pub fn decode(self, b: [u8; 4]) -> [f32; 4] {
+        let (srgb, unorm) = (srgb_table(), unorm8_table());
+        match self {
+            ColorTarget::Srgb8 => [
+                srgb[b[0] as usize],
+                srgb[b[1] as usize],
+                srgb[b[2] as usize],
+                unorm[b[3] as usize],
+            ],
+            _ => b.map(|x| unorm[x as usize]),
+        }
+    }
+}
+
 /// Everything that configures one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -94,11 +153,16 @@ pub struct RenderSettings {
     /// keeps its differences). `None` draws the whole frame; the rectangle must lie in the frame
     /// and may be empty.
     pub scissor: Option<[u32; 4]>,
+    /// The colour target's format ([`ColorTarget::Float`] by default; the `texel` CLI renders
+    /// into the 8-bit target its output encodes to). The reference renderer always renders into
+    /// a float target.
+    pub target: ColorTarget,
 }
 
 impl RenderSettings {
     /// Defaults for a `width x height` frame: opaque black background, analytic derivatives,
-    /// perspective-correct colour view, no culling, no lights, rayon's global pool, no counting.
+    /// perspective-correct colour view, no culling, no lights, rayon's global pool, no counting,
+    /// a float colour target.
     pub fn new(width: u32, height: u32) -> Self {
         RenderSettings {
             width,
@@ -113,6 +177,7 @@ impl RenderSettings {
             count_texels: false,
             capture_footprints: false,
             scissor: None,
+            target: ColorTarget::Float,
         }
     }
 

@@ -43,7 +43,7 @@ use texel_texture::Footprint;
 use crate::draw::DrawCall;
 use crate::frame::Frame;
 use crate::interp::{self, quad_differences};
-use crate::settings::{Derivatives, Perspective, RenderSettings, View};
+use crate::settings::{ColorTarget, Derivatives, Perspective, RenderSettings, View};
 use crate::setup::{pixel_center_fixed, setup_chunks, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
 use crate::views;
@@ -105,11 +105,27 @@ struct TileTarget<'f> {
     y0: u32,
     w: u32,
     h: u32,
+    /// The colour target's format: which of `color` and `color8` holds rows.
+    target: ColorTarget,
     color: Vec<&'f mut [[f32; 4]]>,
+    color8: Vec<&'f mut [[u8; 4]]>,
     depth: Vec<&'f mut [f32]>,
-    coverage: Vec<&'f mut [bool]>,
     texels: Vec<&'f mut [u32]>,
     footprints: Vec<&'f mut [Footprint]>,
+}
+
+impl TileTarget<'_> {
+    /// Write a fragment's colour and depth at tile pixel `(li, lj)`, encoding the colour for an
+    /// 8-bit target.
+    #[inline(always)]
+    fn put(&mut self, li: usize, lj: usize, color: [f32; 4], z: f32) {
+        if self.target.is_8bit() {
+            self.color8[lj][li] = self.target.encode(color);
+        } else {
+            self.color[lj][li] = color;
+        }
+        self.depth[lj][li] = z;
+    }
 }
 
 /// Everything shared by the tiles of one frame.
@@ -153,8 +169,8 @@ pub(crate) fn draw_frame(
     };
     let (tx, _) = tile_counts(width, height);
     let mut color = split_rows(&mut frame.color, width, height).into_iter();
+    let mut color8 = split_rows(&mut frame.color8, width, height).into_iter();
     let mut depth = split_rows(&mut frame.depth, width, height).into_iter();
-    let mut coverage = split_rows(&mut frame.coverage, width, height).into_iter();
     let mut texels = split_rows(&mut frame.texels_read, width, height).into_iter();
     let mut footprints = split_rows(&mut frame.footprints, width, height).into_iter();
     let mut tiles = Vec::with_capacity(bins.len());
@@ -165,9 +181,10 @@ pub(crate) fn draw_frame(
             y0,
             w: TILE.min(width - x0),
             h: TILE.min(height - y0),
+            target: frame.target,
             color: color.next().unwrap_or_default(),
+            color8: color8.next().unwrap_or_default(),
             depth: depth.next().unwrap_or_default(),
-            coverage: coverage.next().unwrap_or_default(),
             texels: texels.next().unwrap_or_default(),
             footprints: footprints.next().unwrap_or_default(),
         });
@@ -446,30 +463,25 @@ fn flush_span(
     dc.sampler
         .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
     let verts = dc.vertices(t);
-    // Fragments arrive row by row: look each row's buffers up once per run of equal rows.
-    let mut k = 0;
-    while k < n {
-        let lj = span.lj[k];
-        let row = (
-            &mut *tile.color[lj as usize],
-            &mut *tile.depth[lj as usize],
-            &mut *tile.coverage[lj as usize],
-        );
-        let (color, depth, coverage) = row;
-        while k < n && span.lj[k] == lj {
-            let li = span.li[k] as usize;
-            let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
-            let dlambda = [
-                DVec3::new(span.ldx[0][k], span.ldx[1][k], span.ldx[2][k]),
-                DVec3::new(span.ldy[0][k], span.ldy[1][k], span.ldy[2][k]),
-            ];
-            let lit = ctx.lighting.as_ref();
-            let (tex, fp) = (span.texs[k], &span.fps[k]);
-            color[li] = shade(dc, verts, lambda, dlambda, tex, fp, lit, false).0;
-            depth[li] = span.z[k];
-            coverage[li] = true;
-            k += 1;
-        }
+    for k in 0..n {
+        let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
+        let dlambda = [
+            DVec3::new(span.ldx[0][k], span.ldx[1][k], span.ldx[2][k]),
+            DVec3::new(span.ldy[0][k], span.ldy[1][k], span.ldy[2][k]),
+        ];
+        let lit = ctx.lighting.as_ref();
+        let (tex, fp) = (span.texs[k], &span.fps[k]);
+        span.texs[k] = shade(dc, verts, lambda, dlambda, tex, fp, lit, false).0;
+    }
+    // Fragments arrive row by row: look each row's buffers up once per run of equal rows, with
+    // the target's format decided once per span.
+    if tile.target.is_8bit() {
+        let target = tile.target;
+        write_rows(span, &mut tile.color8, &mut tile.depth, |c| {
+            target.encode(c)
+        });
+    } else {
+        write_rows(span, &mut tile.color, &mut tile.depth, |c| c);
     }
     if ctx.capture {
         for k in 0..n {
@@ -477,6 +489,28 @@ fn flush_span(
         }
     }
     span.n = 0;
+}
+
+/// Write the span's shaded colours (`span.texs`, through `encode`) and depths into the tile's rows.
+#[inline(always)]
+fn write_rows<C>(
+    span: &Span,
+    color: &mut [&mut [C]],
+    depth: &mut [&mut [f32]],
+    encode: impl Fn([f32; 4]) -> C,
+) {
+    let n = span.n;
+    let mut k = 0;
+    while k < n {
+        let lj = span.lj[k] as usize;
+        let (color, depth) = (&mut *color[lj], &mut *depth[lj]);
+        while k < n && span.lj[k] as usize == lj {
+            let li = span.li[k] as usize;
+            color[li] = encode(span.texs[k]);
+            depth[li] = span.z[k];
+            k += 1;
+        }
+    }
 }
 
 /// Quad derivatives: walk aligned 2x2 quads; a quad with any covered pixel interpolates all four.
@@ -585,9 +619,7 @@ fn write_fragment(
         View::Fetches => views::fetches_color(count),
         View::Barycentric => views::barycentric_color(f.lambda),
     };
-    tile.color[lj][li] = color;
-    tile.depth[lj][li] = f.z;
-    tile.coverage[lj][li] = true;
+    tile.put(li, lj, color, f.z);
     if ctx.counting {
         tile.texels[lj][li] = count;
     }

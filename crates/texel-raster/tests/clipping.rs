@@ -43,7 +43,7 @@ fn ground_crossing_the_near_plane_renders_the_visible_part_only() {
     };
     for j in 0..h {
         for i in 0..w {
-            let covered = frame.coverage[frame.index(i, j)];
+            let covered = frame.covered(frame.index(i, j));
             if j + 2 < horizon {
                 assert!(!covered, "sky pixel ({i}, {j}) covered");
             } else if j > horizon + 2 {
@@ -52,9 +52,7 @@ fn ground_crossing_the_near_plane_renders_the_visible_part_only() {
         }
     }
     // The part behind the eye does not wrap around into the image: covered rows are contiguous.
-    let rows: Vec<bool> = (0..h)
-        .map(|j| frame.coverage[frame.index(128, j)])
-        .collect();
+    let rows: Vec<bool> = (0..h).map(|j| frame.covered(frame.index(128, j))).collect();
     let first = rows.iter().position(|&c| c).unwrap();
     assert!(rows[first..].iter().all(|&c| c));
 }
@@ -87,7 +85,7 @@ fn triangle_crossing_the_near_plane_matches_analytic_coverage() {
             let yn = 1.0 - 2.0 * (f64::from(j) + 0.5) / f64::from(h);
             let far = inv * glam::DVec4::new(xn, yn, 1.0, 1.0);
             let dir = far.truncate() / far.w;
-            let covered = frame.coverage[frame.index(i, j)];
+            let covered = frame.covered(frame.index(i, j));
             if dir.y >= 0.0 {
                 assert!(!covered, "({i}, {j}) above the horizon");
                 continue;

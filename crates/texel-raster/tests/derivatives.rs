@@ -112,7 +112,7 @@ fn quad_derivatives_are_differences_within_each_quad() {
         for qi in (0..w).step_by(2) {
             let px = [(qi, qj), (qi + 1, qj), (qi, qj + 1), (qi + 1, qj + 1)]
                 .map(|(i, j)| frame.index(i, j));
-            if !px.iter().all(|&k| frame.coverage[k]) {
+            if !px.iter().all(|&k| frame.covered(k)) {
                 continue;
             }
             let f = px.map(|k| frame.footprints[k]);

@@ -77,7 +77,7 @@ fn reference_of_a_constant_texture_is_exact_with_coverage_fractions() {
     let s = RenderSettings::new(w, h);
     let f = render_reference(&s, &[scene.draw(&sampler)], 4, 1, None).unwrap();
     let mut partial = 0;
-    for (c, &cov) in f.color.iter().zip(&f.coverage) {
+    for (c, &cov) in f.color.iter().zip(&f.coverage()) {
         if !cov {
             assert_eq!(*c, [0.0, 0.0, 0.0, 1.0]);
         } else if c[1] < 0.4999 {
@@ -129,9 +129,9 @@ fn reference_agrees_with_the_rasterizer_where_the_texture_is_magnified() {
     assert!(sum / f64::from(n) < 0.01, "{}", sum / f64::from(n));
     // Coverage of the reference includes the rasterizer's.
     assert!(raster
-        .coverage
+        .coverage()
         .iter()
-        .zip(&reference.coverage)
+        .zip(&reference.coverage())
         .all(|(&r, &f)| !r || f));
 }
 
@@ -183,7 +183,7 @@ fn reference_covers_tile_seams_and_subpixel_triangles() {
     assert_eq!(render(&s, &[draw]).unwrap().covered_pixels(), 0);
     let f = render_reference(&s, &[draw], 8, 7, None).unwrap();
     let k = (10 * w + 10) as usize;
-    assert!(f.coverage[k]);
+    assert!(f.covered(k));
     // Background black, triangle white: the pixel's grey is the covered fraction (area 0.08).
     assert!(
         f.color[k][0] > 0.02 && f.color[k][0] < 0.2,

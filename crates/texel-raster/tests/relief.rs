@@ -109,7 +109,7 @@ fn bump_mapping_a_ramp_gives_the_tilted_planes_normal() {
         let normal = Vec3::new(-s / 2.0, 0.0, 1.0).normalize();
         for (i, j) in [(48, 32), (35, 25), (60, 40)] {
             let k = frame.index(i, j);
-            assert!(frame.coverage[k]);
+            assert!(frame.covered(k));
             let (a, b) = (
                 Vec3::from_slice(&frame.color[k][..3]),
                 Vec3::from_slice(&reference.color[k][..3]),
@@ -169,7 +169,7 @@ fn parallax_reads_where_the_ray_meets_the_relief() {
     let mut moved = 0;
     for (i, j) in [(48, 32), (35, 25), (60, 40), (30, 40)] {
         let k = frame.index(i, j);
-        assert!(frame.coverage[k]);
+        assert!(frame.covered(k));
         let d = ray(m, eye, i, j);
         let q = eye + d * ((-s / 2.0 - eye.z) / d.z);
         let u = (q.x + 1.0) / 2.0;

@@ -24,11 +24,11 @@ fn check(whole: &Frame, part: &Frame, [x0, y0, x1, y1]: [u32; 4], background: [f
                     bits(whole.color[k]),
                     "pixel ({i}, {j})"
                 );
-                assert_eq!(part.coverage[k], whole.coverage[k], "pixel ({i}, {j})");
-                inside_covered += usize::from(whole.coverage[k]);
+                assert_eq!(part.covered(k), whole.covered(k), "pixel ({i}, {j})");
+                inside_covered += usize::from(whole.covered(k));
             } else {
                 assert_eq!(part.color[k], background, "pixel ({i}, {j}) outside");
-                assert!(!part.coverage[k], "pixel ({i}, {j}) outside");
+                assert!(!part.covered(k), "pixel ({i}, {j}) outside");
             }
         }
     }

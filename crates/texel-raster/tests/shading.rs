@@ -80,7 +80,7 @@ fn a_normal_map_tilts_the_shading_normal_in_gltf_tangent_space() {
         let world = (decoded * Vec3::new(scale, scale, 1.0)).normalize();
         for (i, j) in [(48, 32), (30, 20), (70, 45), (40, 50)] {
             let k = frame.index(i, j);
-            assert!(frame.coverage[k], "({i}, {j}) not covered");
+            assert!(frame.covered(k), "({i}, {j}) not covered");
             let surface = Surface {
                 base: Vec3::ONE,
                 roughness,
@@ -136,7 +136,7 @@ fn lights_without_a_material_are_lambertian_and_unlit_frames_ignore_normals() {
     )
     .unwrap();
     for (i, j) in [(48, 32), (36, 22)] {
-        assert!(lit.coverage[lit.index(i, j)]);
+        assert!(lit.covered(lit.index(i, j)));
         let p = hit(m, eye, i, j);
         let d = Vec3::new(0.0, 0.0, 2.0) - p;
         let cos = d.normalize().z;

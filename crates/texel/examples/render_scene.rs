@@ -9,7 +9,7 @@
 //! `render_scene.png`. The steps are the ones `texel::render_scene` takes, spelled out: load the
 //! scene, prepare it within a memory budget, build samplers, render, encode.
 
-use texel::quality::{Encoding, Image8};
+use texel::quality::Encoding;
 use texel::{render, Filter, MemoryBudget, PreparedScene, Scene, SceneOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -42,8 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let started = std::time::Instant::now();
     let frame = render(&prepared.settings(), &prepared.draws(&samplers))?;
     let ms = started.elapsed().as_secs_f64() * 1e3;
-    Image8::from_linear(frame.width, frame.height, &frame.color, Encoding::Srgb)?
-        .write_png(&out)?;
+    texel::frame_image(&frame, Encoding::Srgb)?.write_png(&out)?;
     println!(
         "{scene_arg}: {}x{} with {} in {ms:.1} ms ({structure_bytes} bytes of texture structures) -> {out}",
         frame.width,

@@ -19,7 +19,7 @@
 //! let frame = render_scene(&scene, &options)?;
 //! assert_eq!((frame.width, frame.height), (64, 36));
 //! // The ground covers the lower part of the frame; the sky is the background.
-//! assert!(frame.coverage[63 * 36 - 1] && !frame.coverage[0]);
+//! assert!(frame.covered(63 * 36 - 1) && !frame.covered(0));
 //! # Ok::<(), texel::Error>(())
 //! ```
 //!
@@ -42,7 +42,7 @@ pub use error::Error;
 pub use filter::Filter;
 pub use memory::MemoryBudget;
 pub use prepare::{ColorHandling, PreparedScene, SceneOptions};
-pub use texel_raster::{render, DrawCall, Frame, RenderSettings, View};
+pub use texel_raster::{render, ColorTarget, DrawCall, Frame, RenderSettings, View};
 pub use texel_scene::{Scene, SceneLimits};
 pub use texel_texture::{Sampler, SamplerDescriptor, Texture};
 
@@ -62,9 +62,27 @@ pub struct RenderOptions {
     pub max_memory: Option<u64>,
 }
 
+/// A frame's colour as an 8-bit image in `encoding`: an 8-bit frame of that encoding as stored,
+/// anything else through [`Frame::to_8bit`] (a float frame is quantised exactly as an 8-bit
+/// target of the same draws would store it).
+///
+/// # Errors
+/// [`quality::QualityError`] for a frame of no pixels or sides beyond [`quality::MAX_SIDE`].
+pub fn frame_image(
+    frame: &Frame,
+    encoding: quality::Encoding,
+) -> Result<quality::Image8, quality::QualityError> {
+    let target = match encoding {
+        quality::Encoding::Srgb => ColorTarget::Srgb8,
+        quality::Encoding::Linear => ColorTarget::Unorm8,
+    };
+    quality::Image8::from_rgba_bytes(frame.width, frame.height, &frame.to_8bit(target))
+}
+
 /// Render `scene` as the options say: load its textures, build the samplers (and any ripmap or
-/// summed-area table) and draw every mesh, on all cores. Output is the linear frame; encode it
-/// with [`quality::Image8::from_linear`] to write a PNG.
+/// summed-area table) and draw every mesh, on all cores. The frame's colour target is the 8-bit
+/// one the colour handling encodes to ([`PreparedScene::settings`]); [`frame_image`] gives it as
+/// an [`quality::Image8`] to write a PNG.
 ///
 /// # Errors
 /// [`Error::OverBudget`], [`Error::Scene`] (textures that cannot be loaded), [`Error::Texture`],

@@ -8,9 +8,10 @@
 
 use crate::Error;
 
-/// What a rendered frame holds per pixel, at most: linear colour (16), depth (4), coverage (1),
-/// texel counts (4), the 8-bit image (4), its RGBA bytes for the encoder (4) and the PNG (at most
-/// about 4 plus headers) = 37, rounded up. (Footprint capture, 24 more, is a debug option the
+/// What a rendered frame holds per pixel, at most: colour (16 for a float target, the reference's
+/// and the viewer's; 4 for the CLI's 8-bit targets), depth (4), a coverage mask derived from the
+/// depth (1), texel counts (4), the 8-bit image (4), its RGBA bytes for the encoder (4) and the
+/// PNG (at most about 4 plus headers) = 37, rounded up. (Footprint capture, 24 more, is a debug option the
 /// scene path does not use.)
 pub const FRAME_BYTES_PER_PIXEL: u64 = 40;
 

@@ -7,7 +7,7 @@ use std::sync::{Mutex, OnceLock};
 
 use texel_raster::layers::{Layer, LayerBlend, Layers, MAX_LAYERS};
 use texel_raster::{
-    ChannelInput, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
+    ChannelInput, ColorTarget, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
     TextureInput, Vertex,
 };
 use texel_scene::{
@@ -631,10 +631,18 @@ impl PreparedScene {
         Some(m)
     }
 
-    /// Render settings for this scene's size, background (decoded as the colour handling says)
-    /// and lights.
+    /// Render settings for this scene's size, background (decoded as the colour handling says),
+    /// lights and colour target: the 8-bit target the colour handling encodes to
+    /// ([`ColorTarget::Srgb8`] for [`ColorHandling::Srgb`], [`ColorTarget::Unorm8`] for
+    /// [`ColorHandling::Raw`]), so a frame holds the bytes a PNG of it holds. Set
+    /// `target = ColorTarget::Float` for linear floats (accumulating, comparing before
+    /// quantisation).
     pub fn settings(&self) -> RenderSettings {
         let mut s = RenderSettings::new(self.width, self.height);
+        s.target = match self.color {
+            ColorHandling::Srgb => ColorTarget::Srgb8,
+            ColorHandling::Raw => ColorTarget::Unorm8,
+        };
         for (slot, light) in s.lights.iter_mut().zip(&self.scene.lights) {
             *slot = Some(match *light {
                 LightSpec::Directional {

@@ -140,7 +140,9 @@ fn render(scene: Scene) -> Vec<[f32; 4]> {
     let mut budget = MemoryBudget::new(1 << 30, "test");
     let prepared = PreparedScene::new(scene, &SceneOptions::default(), &mut budget).unwrap();
     let samplers = prepared.samplers(Filter::Trilinear).unwrap();
-    texel::render(&prepared.settings(), &prepared.draws(&samplers))
+    let mut settings = prepared.settings();
+    settings.target = texel::ColorTarget::Float;
+    texel::render(&settings, &prepared.draws(&samplers))
         .unwrap()
         .color
 }

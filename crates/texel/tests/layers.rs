@@ -55,7 +55,9 @@ fn render(material: &str, options: &SceneOptions, filter: Filter) -> Vec<[f32; 4
     let mut budget = MemoryBudget::new(1 << 30, "test");
     let prepared = PreparedScene::new(scene, options, &mut budget).unwrap();
     let samplers = prepared.samplers(filter).unwrap();
-    let frame = texel::render(&prepared.settings(), &prepared.draws(&samplers)).unwrap();
+    let mut settings = prepared.settings();
+    settings.target = texel::ColorTarget::Float;
+    let frame = texel::render(&settings, &prepared.draws(&samplers)).unwrap();
     frame.color
 }
 

@@ -26,7 +26,9 @@ use texel::scene::Camera;
 use texel::{Filter, PreparedScene, Sampler, SamplerDescriptor};
 use texel_gpu::{Gpu, GpuDraws, GpuFilter};
 use texel_quality::Encoding;
-use texel_raster::{draw_into, render_reference_strata, DrawCall, Frame, RenderSettings, View};
+use texel_raster::{
+    draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, RenderSettings, View,
+};
 
 use super::controls::{Mode, ViewState};
 use crate::cli::ColorArg;
@@ -405,6 +407,8 @@ impl FrameContext<'_, '_> {
         settings.perspective = state.perspective;
         settings.derivatives = state.derivatives;
         settings.threads = None;
+        // Progressive passes accumulate linear floats.
+        settings.target = ColorTarget::Float;
         let clip = req.camera.clip_from_world(w as f32 / h as f32);
         let mut frame = match self.frame.take() {
             Some(mut f) if f.width == w && f.height == h => {
@@ -585,7 +589,7 @@ impl FrameContext<'_, '_> {
             let counted = texel_raster::render(&s, &draws)?;
             let (mut texels, mut covered) = (0u64, 0u64);
             for_rect(rect, s.width, |k| {
-                if counted.coverage[k] {
+                if counted.covered(k) {
                     texels += u64::from(counted.texels_read[k]);
                     covered += 1;
                 }
@@ -645,7 +649,7 @@ pub fn lod_range(
         };
         let d = &members[0];
         for_rect(rect, settings.width, |k| {
-            if f.coverage[k] {
+            if f.covered(k) {
                 add(d.sampler.lod(d.texture, &f.footprints[k]));
             }
         });
@@ -833,10 +837,10 @@ mod tests {
         scene.build_structures(&samplers).unwrap();
         let frame = texel::render(&scene.settings(), &scene.draws(&samplers)).unwrap();
         frame
-            .color
-            .iter()
-            .map(|&c| {
-                let [r, g, b, _] = Encoding::Srgb.encode(c);
+            .to_srgb8()
+            .chunks_exact(4)
+            .map(|p| {
+                let [r, g, b] = [p[0], p[1], p[2]];
                 u32::from(r) << 16 | u32::from(g) << 8 | u32::from(b)
             })
             .collect()
