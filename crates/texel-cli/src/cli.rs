@@ -405,6 +405,10 @@ pub struct BenchArgs {
     /// The colour render target the frames are drawn into.
     #[arg(long, value_enum, default_value_t = TargetArg::Rgba8)]
     pub target: TargetArg,
+    /// The instruction set of the tile rasterizer: the best the CPU has (x86-64-v3 where it has
+    /// AVX2 and FMA), or the baseline copy, to measure the difference (images are the same).
+    #[arg(long, value_enum, default_value_t = SimdArg::Best)]
+    pub simd: SimdArg,
     /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has):
     /// wall time per frame (submission, rendering, reading the frame back) and, where the device
     /// has timestamp queries, the render pass's device time (the last column; `device_ms` in JSON).
@@ -413,6 +417,15 @@ pub struct BenchArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
+}
+
+/// Which copy of the tile rasterizer runs (`texel_raster::simd_level`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SimdArg {
+    /// The best the CPU has.
+    Best,
+    /// The x86-64 baseline (SSE2) copy.
+    Baseline,
 }
 
 /// A colour render target ([`texel::ColorTarget`]).

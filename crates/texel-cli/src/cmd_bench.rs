@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
-use crate::cli::{BenchArgs, TargetArg};
+use crate::cli::{BenchArgs, SimdArg, TargetArg};
 use crate::filters::parse_list;
 use crate::input::{load_scene, Input};
 use crate::threads::{thread_count, with_threads};
@@ -157,6 +157,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let scene = load_scene(&args.scene, input)?;
     let filters = parse_list(&args.filters)?;
     let budget = &mut input.budget;
+    texel_raster::force_baseline(args.simd == SimdArg::Baseline);
     let timings = if args.gpu {
         time_gpu(args, &scene, &filters)?
     } else {
@@ -265,26 +266,10 @@ fn cpu_model() -> String {
         .unwrap_or_else(|| std::env::consts::ARCH.to_string())
 }
 
-/// The SIMD instruction sets the binary was compiled to use (texel has no runtime dispatch: the
-/// code runs on what the build's target features allow, the x86-64 baseline's SSE2 by default).
+/// The instruction set the rasterizer's tiles run on (run-time dispatch, see
+/// `texel_raster::simd_level`).
 fn simd_level() -> String {
-    let on: Vec<&str> = [
-        ("avx512f", cfg!(target_feature = "avx512f")),
-        ("avx2", cfg!(target_feature = "avx2")),
-        ("fma", cfg!(target_feature = "fma")),
-        ("sse4.2", cfg!(target_feature = "sse4.2")),
-        ("sse2", cfg!(target_feature = "sse2")),
-        ("neon", cfg!(target_feature = "neon")),
-    ]
-    .into_iter()
-    .filter_map(|(name, enabled)| enabled.then_some(name))
-    .collect();
-    let level = if on.is_empty() {
-        "scalar".to_string()
-    } else {
-        on.join("+")
-    };
-    format!("{level} (compile-time, no runtime dispatch)")
+    format!("{}, run-time dispatch", texel_raster::simd_level().name())
 }
 
 #[cfg(test)]

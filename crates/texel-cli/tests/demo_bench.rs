@@ -75,7 +75,7 @@ fn bench_json_has_the_llvmpipe_shape() {
     assert!(v["cpu"].as_str().is_some_and(|c| !c.is_empty()));
     assert!(v["simd"]
         .as_str()
-        .is_some_and(|s| s.contains("compile-time")));
+        .is_some_and(|s| s.contains("run-time dispatch")));
     assert_eq!(v["threads"], 1);
     assert_eq!(
         (v["width"].as_u64(), v["height"].as_u64()),

@@ -42,6 +42,7 @@
 
 pub mod camera;
 pub mod clip;
+mod dispatch;
 mod draw;
 mod error;
 mod frame;
@@ -56,6 +57,7 @@ mod shade;
 pub mod tile;
 pub mod views;
 
+pub use dispatch::{force_baseline, level as simd_level, SimdLevel};
 pub use draw::{DrawCall, Vertex};
 pub use error::RasterError;
 pub use frame::Frame;

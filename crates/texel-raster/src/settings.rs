@@ -1,7 +1,7 @@
 //! How a frame is rendered: size, background, derivative and interpolation modes, debug view, light,
 //! threads.
 
-use texel_texture::color::{linear_to_srgb8, srgb_table, unorm8, unorm8_table};
+use texel_texture::color::{srgb8_encoder, srgb_table, unorm8, unorm8_table};
 
 use crate::error::RasterError;
 use crate::material::{Light, MAX_LIGHTS};
@@ -90,14 +90,23 @@ impl ColorTarget {
     /// [`ColorTarget::Srgb8`] (the display encoding).
     #[inline(always)]
     pub fn encode(self, c: [f32; 4]) -> [u8; 4] {
-        match self {
-            ColorTarget::Unorm8 => c.map(|x| unorm8(x.clamp(0.0, 1.0))),
-            _ => [
-                linear_to_srgb8(c[0]),
-                linear_to_srgb8(c[1]),
-                linear_to_srgb8(c[2]),
-                unorm8(c[3].clamp(0.0, 1.0)),
+        self.encoder()(c)
+    }
+
+    /// [`ColorTarget::encode`] as a function with the target's choice (and the sRGB table) made
+    /// once, for encoding many colours.
+    #[inline(always)]
+    pub fn encoder(self) -> impl Fn([f32; 4]) -> [u8; 4] + Copy {
+        let srgb = (self != ColorTarget::Unorm8).then(srgb8_encoder);
+        let clamped = |x: f32| unorm8(x.clamp(0.0, 1.0));
+        move |c: [f32; 4]| match srgb {
+            Some(e) => [
+                e.encode(c[0]),
+                e.encode(c[1]),
+                e.encode(c[2]),
+                clamped(c[3]),
             ],
+            None => [clamped(c[0]), clamped(c[1]), clamped(c[2]), clamped(c[3])],
         }
     }
 

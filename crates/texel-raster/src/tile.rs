@@ -40,6 +40,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use texel_texture::Footprint;
 
+use crate::dispatch::Kernel;
 use crate::draw::DrawCall;
 use crate::frame::Frame;
 use crate::interp::{self, quad_differences};
@@ -197,7 +198,29 @@ pub(crate) fn draw_frame(
     Ok(())
 }
 
+/// Rasterise one tile, on the best instruction set the CPU has ([`crate::dispatch`]).
 fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
+    crate::dispatch::run(TileJob { ctx, tile, bin });
+}
+
+/// [`raster_tile`]'s arguments, as the dispatcher's unit of work.
+struct TileJob<'j, 'a, 'f, 's> {
+    ctx: &'j Context<'a>,
+    tile: &'j mut TileTarget<'f>,
+    bin: &'j [&'s TriangleSetup],
+}
+
+impl Kernel for TileJob<'_, '_, '_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        raster_tile_body(self.ctx, self.tile, self.bin);
+    }
+}
+
+/// [`raster_tile`]'s work, inlined into each instruction set's copy.
+#[inline(always)]
+fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
     // The tile's pixels inside the scissor, inclusive: [i0, j0, i1, j1].
     let [sx0, sy0, sx1, sy1] = ctx.settings.scissor_rect();
     let (ti0, tj0) = (tile.x0.max(sx0), tile.y0.max(sy0));
@@ -226,6 +249,7 @@ fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
 }
 
 /// Analytic derivatives: walk the pixels of `range`, stepping the edge functions along rows.
+#[inline(always)]
 fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: [u32; 4]) {
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];
@@ -395,6 +419,7 @@ impl Span {
 /// scratch) happens once per batch. Gathering several rows matters for small triangles: one call
 /// per row would make three calls of three samples for each triangle of a mesh of 100 352
 /// triangles of about nine pixels each.
+#[inline(always)]
 fn raster_pixels_batched(
     ctx: &Context,
     tile: &mut TileTarget,
@@ -444,6 +469,7 @@ fn raster_pixels_batched(
 
 /// Interpolate, sample, shade and write the `span.n` gathered fragments of triangle `t`, then empty
 /// the span.
+#[inline(always)]
 fn flush_span(
     ctx: &Context,
     tile: &mut TileTarget,
@@ -476,10 +502,8 @@ fn flush_span(
     // Fragments arrive row by row: look each row's buffers up once per run of equal rows, with
     // the target's format decided once per span.
     if tile.target.is_8bit() {
-        let target = tile.target;
-        write_rows(span, &mut tile.color8, &mut tile.depth, |c| {
-            target.encode(c)
-        });
+        let encode = tile.target.encoder();
+        write_rows(span, &mut tile.color8, &mut tile.depth, encode);
     } else {
         write_rows(span, &mut tile.color, &mut tile.depth, |c| c);
     }
@@ -514,6 +538,7 @@ fn write_rows<C>(
 }
 
 /// Quad derivatives: walk aligned 2x2 quads; a quad with any covered pixel interpolates all four.
+#[inline(always)]
 fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: [u32; 4]) {
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];

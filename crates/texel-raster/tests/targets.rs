@@ -1,13 +1,15 @@
 //! Colour targets: an 8-bit target stores exactly the encoding of what the float target stores,
 //! for every view, derivative mode and draw path, and `draw_into` on top of an 8-bit frame
-//! depth-tests against the frame's depth as on a float frame.
+//! depth-tests against the frame's depth as on a float frame. The tile code's baseline copy and
+//! its run-time dispatched x86-64-v3 copy draw the same bits.
 
 mod common;
 
 use common::{lab_sampler, screen_grid, Ground};
 use glam::Mat4;
 use texel_raster::{
-    draw_into, render, ColorTarget, Derivatives, DrawCall, Frame, RenderSettings, View,
+    draw_into, force_baseline, render, simd_level, ColorTarget, Derivatives, DrawCall, Frame,
+    RenderSettings, View,
 };
 
 fn settings(w: u32, h: u32, target: ColorTarget) -> RenderSettings {
@@ -62,6 +64,11 @@ fn eight_bit_targets_store_the_float_targets_encoding() {
                     let float = render(&s(ColorTarget::Float), &[draw]).unwrap();
                     let eight = render(&s(target), &[draw]).unwrap();
                     assert_encoded(&float, &eight, target, &label);
+                    // The baseline copy of the tile code draws the same bits as the CPU's best.
+                    force_baseline(true);
+                    let baseline = render(&s(target), &[draw]).unwrap();
+                    force_baseline(false);
+                    assert!(baseline == eight, "{label}: {:?}", simd_level());
                 }
             }
         }

@@ -218,6 +218,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
 /// Filter `footprints` into `out` (same length) with `s`'s core kernel: `min_filter` Nearest or
 /// Linear (equal to `mag_filter`), any `mipmap_filter`, level 0 below [`MAX_SIDE`] per side
 /// (`Sampler::new` decides; see `Sampler::sample_batch`).
+#[inline(always)]
 pub(crate) fn run<P: Pyramid>(p: &P, s: &Sampler, footprints: &[Footprint], out: &mut [[f32; 4]]) {
     match s.descriptor().min_filter {
         FilterMode::Nearest => run_with(p, Point, s, (footprints, out)),

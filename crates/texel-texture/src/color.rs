@@ -44,10 +44,90 @@ pub fn unorm8(x: f32) -> u8 {
     (x * 255.0 + 0.5) as u8
 }
 
-/// Linear `[0, 1]` to an 8-bit sRGB code (rounded, clamped; NaN gives 0).
+/// Linear `[0, 1]` to an 8-bit sRGB code (rounded, clamped; NaN gives 0): exactly
+/// `unorm8(linear_to_srgb(clamp(l, 0, 1)))` ([`linear_to_srgb8_exact`]), found by table instead of
+/// a `powf` per channel (see [`Srgb8Encoder`]).
 #[inline]
 pub fn linear_to_srgb8(l: f32) -> u8 {
+    srgb8_encoder().encode(l)
+}
+
+/// The definition [`linear_to_srgb8`] is built from and tested against: `unorm8` of the sRGB OETF
+/// of the clamped value, one `powf` per call.
+pub fn linear_to_srgb8_exact(l: f32) -> u8 {
     unorm8(linear_to_srgb(l.clamp(0.0, 1.0)))
+}
+
+/// Bits of an `f32` dropped to find its bucket: buckets are `2^16` consecutive bit patterns, 128
+/// per octave (1/128 of the value's octave wide).
+const BUCKET_SHIFT: u32 = 16;
+
+/// Buckets up to and including the one of 1.0 (`0x3F80_0000 >> 16`).
+const BUCKETS: usize = (0x3F80_0000 >> BUCKET_SHIFT) as usize + 1;
+
+/// An exact table encoder for [`linear_to_srgb8_exact`] (the way GPUs encode sRGB render targets
+/// without a `pow`): `threshold[k]` is the smallest `f32` whose code is at least `k`, found by
+/// binary search over bit patterns (positive floats order as their bits); `base[b]` is the code
+/// of the smallest value of bucket `b`. Every bucket holds at most one threshold (checked when the
+/// table is built: the codes are at least 1/(255 * 12.92) apart in linear light near 0, and about
+/// 0.0089 near 1, where a bucket is 0.0039 wide), so a value's code is its bucket's base, plus one
+/// if the value reaches the next threshold. 16 KB of bases and 1 KB of thresholds.
+///
+/// Exact for every `f32` provided `linear_to_srgb8_exact` is non-decreasing on `[0, 1]`, which was
+/// checked for all 1 065 353 217 floats in `[0, 1]` (`cargo run --release -p texel-texture
+/// --example srgb8_exhaustive`); the unit tests check every threshold and its neighbours.
+pub struct Srgb8Encoder {
+    base: Vec<u8>,
+    threshold: [f32; 257],
+}
+
+impl Srgb8Encoder {
+    fn new() -> Srgb8Encoder {
+        let mut threshold = [f32::INFINITY; 257];
+        threshold[0] = 0.0;
+        for (k, t) in threshold.iter_mut().enumerate().take(256).skip(1) {
+            // Smallest bits in [0, bits(1.0)] with code >= k (code(1.0) = 255 >= k).
+            let (mut lo, mut hi) = (0u32, 0x3F80_0000u32);
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if linear_to_srgb8_exact(f32::from_bits(mid)) >= k as u8 {
+                    hi = mid;
+                } else {
+                    lo = mid + 1;
+                }
+            }
+            *t = f32::from_bits(lo);
+        }
+        let base: Vec<u8> = (0..BUCKETS)
+            .map(|b| linear_to_srgb8_exact(f32::from_bits((b as u32) << BUCKET_SHIFT)))
+            .collect();
+        let encoder = Srgb8Encoder { base, threshold };
+        debug_assert!((0..BUCKETS).all(|b| {
+            let last = ((b as u32 + 1) << BUCKET_SHIFT) - 1;
+            let top = linear_to_srgb8_exact(f32::from_bits(last.min(0x3F80_0000)));
+            top <= encoder.base[b].saturating_add(1)
+        }));
+        encoder
+    }
+
+    /// [`linear_to_srgb8`].
+    #[inline(always)]
+    pub fn encode(&self, l: f32) -> u8 {
+        // NaN, zero and negatives give 0; the clamp keeps the bits within the table.
+        if l.is_nan() || l <= 0.0 {
+            return 0;
+        }
+        let l = l.min(1.0);
+        let b = (l.to_bits() >> BUCKET_SHIFT) as usize;
+        let k = self.base[b.min(BUCKETS - 1)];
+        k + u8::from(l >= self.threshold[k as usize + 1])
+    }
+}
+
+/// The shared [`Srgb8Encoder`], built at first use (about 20 000 `powf` calls).
+pub fn srgb8_encoder() -> &'static Srgb8Encoder {
+    static ENCODER: OnceLock<Srgb8Encoder> = OnceLock::new();
+    ENCODER.get_or_init(Srgb8Encoder::new)
 }
 
 /// The 256-entry table `SRGB_TO_LINEAR[b] = srgb_to_linear(b / 255)`.
@@ -80,6 +160,41 @@ mod tests {
     fn round_trip_every_code() {
         for b in 0..=255u8 {
             assert_eq!(linear_to_srgb8(srgb_table()[b as usize]), b);
+        }
+    }
+
+    /// The table encoder equals the `powf` definition at every threshold and the 8 floats on either
+    /// side, at every bucket's ends, at the special values and on a stride through all of `[0, 1]`
+    /// (the exhaustive check is `examples/srgb8_exhaustive.rs`).
+    #[test]
+    fn table_encoder_is_exact() {
+        let e = srgb8_encoder();
+        let check = |bits: u32| {
+            let l = f32::from_bits(bits);
+            assert_eq!(e.encode(l), linear_to_srgb8_exact(l), "{l:e} ({bits:#x})");
+        };
+        for &t in &e.threshold[1..256] {
+            let b = t.to_bits();
+            (b.saturating_sub(8)..=b + 8).for_each(check);
+        }
+        for b in 0..BUCKETS as u32 {
+            check(b << BUCKET_SHIFT);
+            check(((b + 1) << BUCKET_SHIFT) - 1);
+        }
+        (0..=0x3F80_0000u32).step_by(997).for_each(check);
+        for l in [
+            0.0,
+            -0.0,
+            -1.0,
+            1.0,
+            1.5,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            f32::MIN_POSITIVE,
+            1e-45,
+        ] {
+            assert_eq!(e.encode(l), linear_to_srgb8_exact(l), "{l}");
         }
     }
 

@@ -375,6 +375,7 @@ impl Sampler {
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
+    #[inline(always)]
     pub fn sample_batch(&self, texture: &Texture, footprints: &[Footprint], out: &mut [[f32; 4]]) {
         assert_eq!(
             footprints.len(),
