@@ -9,8 +9,9 @@ use common::{lab_sampler, screen_grid, Ground};
 use glam::Mat4;
 use texel_raster::{
     draw_into, force_baseline, render, simd_level, ColorTarget, Derivatives, DrawCall, Frame,
-    RenderSettings, View,
+    RenderSettings, Vertex, View,
 };
+use texel_texture::{Sampler, Texture};
 
 fn settings(w: u32, h: u32, target: ColorTarget) -> RenderSettings {
     RenderSettings {
@@ -36,6 +37,23 @@ fn assert_encoded(float: &Frame, eight: &Frame, target: ColorTarget, label: &str
     assert!(eight.covered_pixels() > 0, "{label}");
 }
 
+/// A draw of screen-space vertices (`common::screen_grid`'s).
+fn screen_draw<'a>(
+    vertices: &'a [Vertex],
+    triangles: &'a [[u32; 3]],
+    texture: &'a Texture,
+    sampler: &'a Sampler,
+) -> DrawCall<'a> {
+    DrawCall {
+        vertices,
+        triangles,
+        texture,
+        sampler,
+        clip_from_world: Mat4::IDENTITY,
+        material: None,
+    }
+}
+
 #[test]
 fn eight_bit_targets_store_the_float_targets_encoding() {
     let (w, h) = (300, 170); // not multiples of the tile size
@@ -43,14 +61,7 @@ fn eight_bit_targets_store_the_float_targets_encoding() {
     let sampler = lab_sampler(4);
     let (verts, tris, tex) = screen_grid(w, h, 23, 11);
     let grid_sampler = lab_sampler(2);
-    let grid = DrawCall {
-        vertices: &verts,
-        triangles: &tris,
-        texture: &tex,
-        sampler: &grid_sampler,
-        clip_from_world: Mat4::IDENTITY,
-        material: None,
-    };
+    let grid = screen_draw(&verts, &tris, &tex, &grid_sampler);
     for target in [ColorTarget::Srgb8, ColorTarget::Unorm8] {
         for view in [View::Color, View::Uv, View::Mip, View::Fetches] {
             for derivatives in [Derivatives::Analytic, Derivatives::Quad] {
@@ -82,14 +93,7 @@ fn drawing_on_top_of_an_eight_bit_frame_keeps_the_nearer_fragments() {
     let sampler = lab_sampler(4);
     let (verts, tris, tex) = screen_grid(w, h, 7, 5);
     let grid_sampler = lab_sampler(1);
-    let grid = DrawCall {
-        vertices: &verts,
-        triangles: &tris,
-        texture: &tex,
-        sampler: &grid_sampler,
-        clip_from_world: Mat4::IDENTITY,
-        material: None,
-    };
+    let grid = screen_draw(&verts, &tris, &tex, &grid_sampler);
     for target in [ColorTarget::Float, ColorTarget::Srgb8] {
         let s = settings(w, h, target);
         let mut frame = render(&s, &[ground.draw(&sampler)]).unwrap();
