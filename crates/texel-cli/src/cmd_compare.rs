@@ -379,8 +379,8 @@ fn texel_stats(frame: &Frame) -> (f64, u64) {
     let mut sum = 0u64;
     let mut n = 0u64;
     let mut max = 0u64;
-    for (&t, &z) in frame.texels_read.iter().zip(&frame.depth) {
-        if z < f32::INFINITY {
+    for (k, &t) in frame.texels_read.iter().enumerate() {
+        if frame.covered(k) {
             sum += u64::from(t);
             n += 1;
             max = max.max(u64::from(t));

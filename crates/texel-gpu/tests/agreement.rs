@@ -84,13 +84,17 @@ fn agree(scene: &str) {
         );
         // The GPU's depth target holds the CPU's NDC depth (coverage is implied by it): equal
         // coverage up to edge pixels, equal depths up to f32 interpolation.
-        let both = (0..cpu.depth.len())
+        let both: Vec<usize> = (0..cpu.depth.len())
             .filter(|&k| cpu.covered(k) && gpu_frame.covered(k))
-            .count();
-        assert!(both * 100 >= 99 * cpu.covered_pixels(), "{name}: {both}");
-        let worst_z = (0..cpu.depth.len())
-            .filter(|&k| cpu.covered(k) && gpu_frame.covered(k))
-            .map(|k| (cpu.depth[k] - gpu_frame.depth[k]).abs())
+            .collect();
+        assert!(
+            both.len() * 100 >= 99 * cpu.covered_pixels(),
+            "{name}: {}",
+            both.len()
+        );
+        let worst_z = both
+            .iter()
+            .map(|&k| (cpu.depth[k] - gpu_frame.depth[k]).abs())
             .fold(0.0f32, f32::max);
         assert!(worst_z < 1e-4, "{name}: depths differ by {worst_z}");
     }

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use texel_texture::color::{linear_to_srgb8, unorm8};
+use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8};
 
 use crate::error::QualityError;
 use crate::MAX_SIDE;
@@ -27,13 +27,8 @@ impl Encoding {
     /// One linear RGBA value as 8-bit display values (values outside `[0, 1]` clamp; NaN is 0).
     pub fn encode(self, c: [f32; 4]) -> [u8; 4] {
         match self {
-            Encoding::Srgb => [
-                linear_to_srgb8(c[0]),
-                linear_to_srgb8(c[1]),
-                linear_to_srgb8(c[2]),
-                unorm8(c[3]),
-            ],
-            Encoding::Linear => [unorm8(c[0]), unorm8(c[1]), unorm8(c[2]), unorm8(c[3])],
+            Encoding::Srgb => rgba_to_srgb8(c),
+            Encoding::Linear => rgba_to_unorm8(c),
         }
     }
 }

@@ -16,7 +16,8 @@
 //! reported every feature `v3` enables (the list below is the one `v3`'s attribute names).
 #![allow(unsafe_code)]
 
-use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::OnceLock;
 
 /// The instruction set the rasterizer's tiles run on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,24 +39,13 @@ impl SimdLevel {
     }
 }
 
-/// 0: not yet detected, 1: baseline, 2: x86-64-v3.
-static DETECTED: AtomicU8 = AtomicU8::new(0);
-
 /// Set by [`force_baseline`].
 static FORCE_BASELINE: AtomicBool = AtomicBool::new(false);
 
 /// What the CPU supports, detected once.
 fn detected() -> SimdLevel {
-    match DETECTED.load(Ordering::Relaxed) {
-        1 => SimdLevel::Baseline,
-        2 => SimdLevel::X86_64V3,
-        _ => {
-            let level = detect();
-            let code = if level == SimdLevel::X86_64V3 { 2 } else { 1 };
-            DETECTED.store(code, Ordering::Relaxed);
-            level
-        }
-    }
+    static DETECTED: OnceLock<SimdLevel> = OnceLock::new();
+    *DETECTED.get_or_init(detect)
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -225,17 +225,22 @@ mod tests {
                     .collect(),
                 ..f.clone()
             };
-            // Its own encoding is a copy; the other goes through linear.
+            // Its own encoding is a copy; the other goes through linear: sRGB code 128 is linear
+            // 0.21586, unorm code 55 (55.04); unorm 55 is linear 0.21569, sRGB code 128 (127.95).
             assert_eq!(g.to_8bit(target), bytes);
-            assert_eq!(g.linear().len(), 2);
-            let other = if target == ColorTarget::Srgb8 {
-                ColorTarget::Unorm8
-            } else {
-                ColorTarget::Srgb8
-            };
-            let via: Vec<u8> = g.linear().iter().flat_map(|&c| other.encode(c)).collect();
-            assert_eq!(g.to_8bit(other), via);
+            assert_eq!(g.to_srgb8(), vec![0, 255, 128, 128, 0, 255, 0, 255]);
+            assert_eq!(g.to_raw8(), vec![0, 255, 55, 128, 0, 255, 0, 255]);
         }
+        let srgb = Frame {
+            target: ColorTarget::Srgb8,
+            color: vec![],
+            color8: vec![[0, 255, 128, 128], [0, 255, 0, 255]],
+            ..f
+        };
+        let linear = srgb.linear();
+        assert_eq!(linear[0][..2], [0.0, 1.0]);
+        assert!((linear[0][2] - 0.215_860_5).abs() < 1e-6);
+        assert_eq!(linear[0][3], 128.0 / 255.0);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! How a frame is rendered: size, background, derivative and interpolation modes, debug view, light,
 //! threads.
 
-use texel_texture::color::{srgb8_encoder, srgb_table, unorm8, unorm8_table};
+use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8, srgb_table, unorm8_table};
 
 use crate::error::RasterError;
 use crate::material::{Light, MAX_LIGHTS};
@@ -86,27 +86,14 @@ impl ColorTarget {
         self != ColorTarget::Float
     }
 
-    /// One linear RGBA colour as this 8-bit target stores it; [`ColorTarget::Float`] encodes as
-    /// [`ColorTarget::Srgb8`] (the display encoding).
+    /// One linear RGBA colour as this 8-bit target stores it ([`rgba_to_srgb8`] or
+    /// [`rgba_to_unorm8`]); [`ColorTarget::Float`] encodes as [`ColorTarget::Srgb8`] (the display
+    /// encoding).
     #[inline(always)]
     pub fn encode(self, c: [f32; 4]) -> [u8; 4] {
-        self.encoder()(c)
-    }
-
-    /// [`ColorTarget::encode`] as a function with the target's choice (and the sRGB table) made
-    /// once, for encoding many colours.
-    #[inline(always)]
-    pub fn encoder(self) -> impl Fn([f32; 4]) -> [u8; 4] + Copy {
-        let srgb = (self != ColorTarget::Unorm8).then(srgb8_encoder);
-        let clamped = |x: f32| unorm8(x.clamp(0.0, 1.0));
-        move |c: [f32; 4]| match srgb {
-            Some(e) => [
-                e.encode(c[0]),
-                e.encode(c[1]),
-                e.encode(c[2]),
-                clamped(c[3]),
-            ],
-            None => [clamped(c[0]), clamped(c[1]), clamped(c[2]), clamped(c[3])],
+        match self {
+            ColorTarget::Unorm8 => rgba_to_unorm8(c),
+            _ => rgba_to_srgb8(c),
         }
     }
 

@@ -38,6 +38,7 @@
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8};
 use texel_texture::Footprint;
 
 use crate::dispatch::Kernel;
@@ -501,11 +502,11 @@ fn flush_span(
     }
     // Fragments arrive row by row: look each row's buffers up once per run of equal rows, with
     // the target's format decided once per span.
-    if tile.target.is_8bit() {
-        let encode = tile.target.encoder();
-        write_rows(span, &mut tile.color8, &mut tile.depth, encode);
-    } else {
-        write_rows(span, &mut tile.color, &mut tile.depth, |c| c);
+    let (color8, depth) = (&mut tile.color8, &mut tile.depth);
+    match tile.target {
+        ColorTarget::Float => write_rows(span, &mut tile.color, depth, |c| c),
+        ColorTarget::Srgb8 => write_rows(span, color8, depth, rgba_to_srgb8),
+        ColorTarget::Unorm8 => write_rows(span, color8, depth, rgba_to_unorm8),
     }
     if ctx.capture {
         for k in 0..n {

@@ -52,6 +52,26 @@ pub fn linear_to_srgb8(l: f32) -> u8 {
     srgb8_encoder().encode(l)
 }
 
+/// One linear RGBA colour as 8-bit sRGB display bytes: RGB through [`linear_to_srgb8`], alpha
+/// linear ([`unorm8`]); values clamp to `[0, 1]`, NaN gives 0. What an `R8G8B8A8_SRGB` target
+/// stores and what texel's PNGs hold.
+#[inline(always)]
+pub fn rgba_to_srgb8(c: [f32; 4]) -> [u8; 4] {
+    [
+        linear_to_srgb8(c[0]),
+        linear_to_srgb8(c[1]),
+        linear_to_srgb8(c[2]),
+        unorm8(c[3]),
+    ]
+}
+
+/// One RGBA colour as 8-bit unorm bytes, every channel [`unorm8`] (clamped, NaN gives 0), no
+/// transfer function: what an `R8G8B8A8_UNORM` target stores.
+#[inline(always)]
+pub fn rgba_to_unorm8(c: [f32; 4]) -> [u8; 4] {
+    [unorm8(c[0]), unorm8(c[1]), unorm8(c[2]), unorm8(c[3])]
+}
+
 /// The definition [`linear_to_srgb8`] is built from and tested against: `unorm8` of the sRGB OETF
 /// of the clamped value, one `powf` per call.
 pub fn linear_to_srgb8_exact(l: f32) -> u8 {
