@@ -53,6 +53,13 @@ pub enum Command {
     ///
     /// Example: texel mips brick.png --out mips/
     Mips(MipsArgs),
+    /// Bake a mesh's ambient occlusion into a texture of its uv layout (rays through a BVH,
+    /// cosine-weighted), for a material's `occlusion` or glTF's occlusionTexture.
+    ///
+    /// Example: texel bake-ao model.glb --size 1024 --rays 256 -o ao.png
+    ///
+    /// Example: texel bake-ao builtin:knot --max-distance 1.5 -o knot-ao.png
+    BakeAo(BakeAoArgs),
     /// The embedded demo: compare every filter on the built-in scenes, with an index page.
     ///
     /// Example: texel demo --out demo/   (then open demo/index.html)
@@ -560,4 +567,44 @@ pub struct MipsArgs {
     /// Output directory: created, or replaced as a whole if texel wrote it before.
     #[arg(long)]
     pub out: PathBuf,
+}
+
+/// `texel bake-ao`.
+#[derive(Debug, Args)]
+pub struct BakeAoArgs {
+    /// The mesh: an OBJ or glTF (.gltf, .glb) file, or a scene (TOML file or builtin:NAME) whose
+    /// meshes all bake into the one map. Its uvs must not overlap where they are to differ.
+    #[arg(default_value = "builtin:knot")]
+    pub mesh: String,
+    /// Side of the square map in texels, 1 to 16384.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::ao::MAX_AO_SIZE)))]
+    pub size: u32,
+    /// Rays per texel, 1 to 65536 (the first floor(sqrt(N))^2 stratified).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::ao::MAX_AO_RAYS)))]
+    pub rays: u32,
+    /// Occluders farther than D (world units) do not count (default: any distance).
+    #[arg(long, value_name = "D", value_parser = positive_f32)]
+    pub max_distance: Option<f32>,
+    /// Rings of texels filled around the uv islands. A margin of M keeps the islands' values
+    /// alone in mip levels 0 to log2(M) - 1 (16 protects 4 levels). Default: the whole map (every
+    /// level protected).
+    #[arg(long, value_name = "PX")]
+    pub margin: Option<u32>,
+    /// Seed of the ray directions (the map is the same for a seed on any number of threads).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Worker threads, 1 to 1024 (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Output PNG: 8-bit grey, linear (1 = unoccluded; read it with color = "linear").
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// A finite number above 0.
+fn positive_f32(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("{s:?} is not a finite number above 0")),
+    }
 }

@@ -6,6 +6,7 @@
 
 mod budget;
 mod cli;
+mod cmd_bake_ao;
 mod cmd_bench;
 mod cmd_compare;
 mod cmd_demo;
@@ -55,6 +56,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => cmd_demo::run(&args, &mut input),
         Command::Warp(args) => cmd_warp::run(&args, &mut input),
         Command::Mips(args) => cmd_mips::run(&args, &mut input),
+        Command::BakeAo(args) => cmd_bake_ao::run(&args, &mut input),
         Command::View(args) => view::run(&args, input),
         Command::GpuInfo => cmd_render::gpu_info(),
     };

@@ -31,6 +31,23 @@ fn demo_compares_every_builtin_scene_with_an_index() {
             assert_eq!(load(dir.join(&row.image)).size(), (64, 36));
         }
     }
+    // The ambient occlusion page: the knot without and with its baked map, and the map (64 x 64
+    // for a 64-pixel-wide demo), linked from the index.
+    assert!(index.contains("Baked ambient occlusion"), "{index}");
+    for img in ["plain.png", "with-ao.png", "ao-map.png"] {
+        assert!(index.contains(&format!("src=\"ao/{img}\"")), "{img}");
+    }
+    assert_eq!(load(d.join("demo/ao/plain.png")).size(), (64, 36));
+    assert_eq!(load(d.join("demo/ao/ao-map.png")).size(), (64, 64));
+    // Occlusion only darkens: no pixel of the occluded render is brighter than the plain one.
+    let plain = load(d.join("demo/ao/plain.png"));
+    let with = load(d.join("demo/ao/with-ao.png"));
+    let mut darker = 0;
+    for (a, b) in plain.pixels().iter().zip(with.pixels()) {
+        assert!((0..3).all(|c| b[c] <= a[c]), "{a:?} {b:?}");
+        darker += usize::from(b[..3] != a[..3]);
+    }
+    assert!(darker > 100, "{darker}");
     assert!(temp_files(&d.join("demo")).is_empty());
 }
 

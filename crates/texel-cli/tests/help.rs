@@ -12,6 +12,7 @@ fn every_command_has_help_with_an_example() {
         "mips",
         "demo",
         "bench",
+        "bake-ao",
     ];
     let top = stdout(&ok(&["--help"]));
     for c in commands {

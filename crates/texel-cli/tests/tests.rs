@@ -1,6 +1,7 @@
 //! The `texel` binary's integration tests, one test binary (as ripgrep's `tests/tests.rs`):
 //! [`util`] holds the shared helpers and fixtures, each other module one command or concern.
 
+mod bake_ao;
 mod compare;
 mod demo_bench;
 mod errors;

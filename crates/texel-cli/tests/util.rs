@@ -14,7 +14,7 @@ use texel_quality::Image8;
 pub(crate) const FILTERS: [&str; 12] = texel::Filter::NAMES;
 
 /// The built-in scenes the demo covers.
-pub(crate) const BUILTINS: [&str; 9] = [
+pub(crate) const BUILTINS: [&str; 10] = [
     "ground",
     "ground-rotated",
     "zoneplate",
@@ -24,6 +24,7 @@ pub(crate) const BUILTINS: [&str; 9] = [
     "glossy",
     "bricks",
     "terrain",
+    "knot",
 ];
 
 /// Run `texel` with `args`.

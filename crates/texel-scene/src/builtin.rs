@@ -56,9 +56,11 @@ pub fn builtin_names() -> &'static [&'static str] {
 /// - `bricks`: a brick wall with mortar joints as a height map (parallax occlusion mapping),
 ///   seen along its length, from 50 degrees to grazing;
 /// - `terrain`: ground receding to 200 m with four layers (grass, rock, sand, snow) blended by a
-///   mask and their heights, bump-mapped from the blended heights.
+///   mask and their heights, bump-mapped from the blended heights;
+/// - `knot`: a clay torus knot resting on a square of ground under a sky and a sun, its uvs one
+///   non-overlapping atlas ([`knot_mesh`]): the model `texel bake-ao` bakes in the demo.
 pub fn shaded_builtin_names() -> &'static [&'static str] {
-    &["glossy", "bricks", "terrain"]
+    &["glossy", "bricks", "terrain", "knot"]
 }
 
 fn from_toml(name: &str, text: &str) -> Result<Scene, SceneError> {
@@ -89,6 +91,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "terrain" => from_toml(name, TERRAIN_TOML),
         "cube" => Ok(cube()),
         "sphere" => Ok(sphere()),
+        "knot" => Ok(knot()),
         _ => Err(SceneError::UnknownBuiltin {
             name: name.to_string(),
         }),
@@ -103,6 +106,23 @@ fn one_texture(name: &str, p: Procedural) -> std::collections::BTreeMap<String, 
     .into()
 }
 
+/// A mesh with no vertices yet (normals to come), `texture`, clamped, no material.
+fn empty_mesh(texture: &str) -> Mesh {
+    Mesh {
+        positions: Vec::new(),
+        uvs: Vec::new(),
+        normals: Some(Vec::new()),
+        colors: None,
+        triangles: Vec::new(),
+        texture: texture.into(),
+        address_mode_u: AddressMode::ClampToEdge,
+        address_mode_v: AddressMode::ClampToEdge,
+        filters: None,
+        material: None,
+        tangents: None,
+    }
+}
+
 /// A cube of side 2 centred at the origin; each face maps the whole texture (uv (0, 0) at the
 /// face's top-left seen from outside), triangles counter-clockwise from outside, face normals.
 fn cube() -> Scene {
@@ -115,19 +135,7 @@ fn cube() -> Scene {
         (Vec3::Z, Vec3::X, Vec3::Y),
         (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
     ];
-    let mut mesh = Mesh {
-        positions: Vec::new(),
-        uvs: Vec::new(),
-        normals: Some(Vec::new()),
-        colors: None,
-        triangles: Vec::new(),
-        texture: "grid".into(),
-        address_mode_u: AddressMode::ClampToEdge,
-        address_mode_v: AddressMode::ClampToEdge,
-        filters: None,
-        material: None,
-        tangents: None,
-    };
+    let mut mesh = empty_mesh("grid");
     for (n, r, u) in faces {
         let base = mesh.positions.len() as u32;
         // Bottom-left, bottom-right, top-right, top-left.
@@ -258,6 +266,135 @@ fn sphere() -> Scene {
     }
 }
 
+/// Radius of the knot's tube ([`knot_mesh`]).
+pub const KNOT_RADIUS: f32 = 0.2;
+
+/// Segments along the built-in knot's tube and around it ([`knot_mesh`]): 25 600 triangles.
+pub const KNOT_SEGMENTS: (u32, u32) = (400, 32);
+
+/// A (2, 3) torus knot tube resting on a square of ground, as one mesh whose uvs form a
+/// non-overlapping atlas (for baking: every surface point has its own texel):
+/// - the tube: the centre line `c(t) = 0.5 ((2 + cos 3t) cos 2t, -sin 3t, (2 + cos 3t) sin 2t)`
+///   lifted so its lowest point touches `y = 0`, radius [`KNOT_RADIUS`], `segments` steps along it and
+///   `sides` around; its first half maps to `u` in `[0.01, 0.99]`, `v` in `[0.01, 0.24]` and its
+///   second half to `v` in `[0.26, 0.49]` (`u` along, `v` around: about as many texels per unit
+///   along as around);
+/// - the ground: a 4.5 x 4.5 square at `y = 0` under it, `uv` in `[0.26, 0.74] x [0.51, 0.99]`.
+///
+/// Triangles are counter-clockwise from outside; the tube has smooth normals (the tube frame
+/// holds `+y` as its reference, which the tangent never meets: the centre line's horizontal speed
+/// is at least 1). `segments` is rounded up to an even number, at least 4; `sides` at least 3.
+pub fn knot_mesh(segments: u32, sides: u32) -> Mesh {
+    let segments = segments.max(4).next_multiple_of(2);
+    let sides = sides.max(3);
+    let centre = |t: f32| {
+        let r = 2.0 + (3.0 * t).cos();
+        Vec3::new(r * (2.0 * t).cos(), -(3.0 * t).sin(), r * (2.0 * t).sin()) * 0.5
+    };
+    let radius = KNOT_RADIUS;
+    let lift = Vec3::new(0.0, 0.5 + radius, 0.0);
+    let mut mesh = Mesh {
+        material: Some("clay".into()),
+        ..empty_mesh("clay")
+    };
+    let half = segments / 2;
+    for strip in 0..2u32 {
+        let base = mesh.positions.len() as u32;
+        for i in 0..=half {
+            let t = 2.0 * PI * (strip * half + i) as f32 / segments as f32;
+            let h = 1e-3;
+            let tangent = (centre(t + h) - centre(t - h)).normalize();
+            let side = tangent.cross(Vec3::Y).normalize();
+            let up = side.cross(tangent);
+            for j in 0..=sides {
+                let a = 2.0 * PI * j as f32 / sides as f32;
+                let n = side * a.cos() + up * a.sin();
+                mesh.positions.push(centre(t) + lift + n * radius);
+                if let Some(ns) = &mut mesh.normals {
+                    ns.push(n);
+                }
+                mesh.uvs.push(Vec2::new(
+                    0.01 + 0.98 * i as f32 / half as f32,
+                    0.01 + 0.25 * strip as f32 + 0.23 * j as f32 / sides as f32,
+                ));
+            }
+        }
+        let row = sides + 1;
+        for i in 0..half {
+            for j in 0..sides {
+                let a = base + i * row + j;
+                let b = a + row;
+                mesh.triangles.extend([[a, b, b + 1], [a, b + 1, a + 1]]);
+            }
+        }
+    }
+    let base = mesh.positions.len() as u32;
+    for (x, z, uv) in [
+        (-2.25, -2.25, Vec2::new(0.26, 0.51)),
+        (-2.25, 2.25, Vec2::new(0.26, 0.99)),
+        (2.25, 2.25, Vec2::new(0.74, 0.99)),
+        (2.25, -2.25, Vec2::new(0.74, 0.51)),
+    ] {
+        mesh.positions.push(Vec3::new(x, 0.0, z));
+        mesh.uvs.push(uv);
+        if let Some(ns) = &mut mesh.normals {
+            ns.push(Vec3::Y);
+        }
+    }
+    mesh.triangles
+        .extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+    mesh
+}
+
+/// The `knot` scene: [`knot_mesh`] at [`KNOT_SEGMENTS`], a clay material, a sky-blue ambient
+/// light and a sun from the upper left.
+fn knot() -> Scene {
+    let (segments, sides) = KNOT_SEGMENTS;
+    let clay = crate::model::MaterialSpec {
+        base_color: crate::model::ColorInput::Rgb(Vec3::new(0.8, 0.72, 0.62)),
+        roughness: crate::model::ScalarInput::Value(0.7),
+        ..Default::default()
+    };
+    Scene {
+        output: Output {
+            width: 960,
+            height: 540,
+            background: [180, 200, 225, 255],
+        },
+        camera: Camera {
+            eye: Vec3::new(0.0, 3.6, 4.6),
+            target: Vec3::new(0.0, 0.45, 0.0),
+            up: Vec3::Y,
+            fovy_deg: 40.0,
+            near: 0.1,
+            far: 100.0,
+        },
+        textures: [(
+            "clay".to_string(),
+            TextureSpec::new(
+                TextureSource::Procedural(Procedural::Solid {
+                    width: 4,
+                    height: 4,
+                    rgba: [255, 255, 255, 255],
+                }),
+                ColorSpace::Srgb,
+            ),
+        )]
+        .into(),
+        meshes: vec![knot_mesh(segments, sides)],
+        lights: vec![
+            crate::model::LightSpec::Ambient {
+                intensity: Vec3::new(0.5, 0.55, 0.65),
+            },
+            crate::model::LightSpec::Directional {
+                direction: Vec3::new(-0.5, 1.0, 0.3),
+                intensity: Vec3::new(1.3, 1.2, 1.1),
+            },
+        ],
+        materials: [("clay".to_string(), clay)].into(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -309,6 +446,54 @@ mod tests {
             .position(|(p, n)| *p == Vec3::new(-1.0, 1.0, 1.0) && *n == Vec3::Z)
             .unwrap();
         assert_eq!(m.uvs[i], Vec2::ZERO);
+    }
+
+    #[test]
+    fn knot_is_outward_and_does_not_touch_itself() {
+        let m = knot_mesh(200, 16);
+        assert_eq!(m.triangles.len(), 200 * 16 * 2 + 2);
+        assert_eq!(m.uvs.len(), m.positions.len());
+        let normals = m.normals.as_ref().unwrap();
+        // Each triangle faces the way its vertices' normals point.
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            let n: Vec3 = t.iter().map(|&i| normals[i as usize]).sum();
+            assert!((b - a).cross(c - a).dot(n) > 0.0, "{t:?}");
+        }
+        // It rests on the ground: its lowest point is at y = 0 (to the ring's sampling).
+        let low = m
+            .positions
+            .iter()
+            .map(|p| p.y)
+            .fold(f32::INFINITY, f32::min);
+        assert!(low.abs() < 1e-3, "{low}");
+        // Strands more than a tube's width apart along the knot stay more than a diameter apart
+        // (centre line: vertex rings' means).
+        let rings: Vec<Vec3> = m.positions[..(101 * 17)]
+            .chunks(17)
+            .chain(m.positions[101 * 17..2 * 101 * 17].chunks(17))
+            .map(|r| r[..16].iter().sum::<Vec3>() / 16.0)
+            .collect();
+        for (i, a) in rings.iter().enumerate() {
+            for (j, b) in rings.iter().enumerate() {
+                let along = (i as i32 - j as i32)
+                    .rem_euclid(202)
+                    .min((j as i32 - i as i32).rem_euclid(202));
+                if along > 20 {
+                    assert!(
+                        a.distance(*b) > 2.0 * KNOT_RADIUS,
+                        "{i} {j} {}",
+                        a.distance(*b)
+                    );
+                }
+            }
+        }
+        // The uv islands lie inside the map and do not overlap: the tube's two strips and the
+        // ground are in separate rectangles.
+        assert!(m
+            .uvs
+            .iter()
+            .all(|uv| uv.min_element() > 0.0 && uv.max_element() < 1.0));
     }
 
     #[test]

@@ -44,8 +44,8 @@ mod texture;
 mod validate;
 
 pub use builtin::{
-    builtin, builtin_names, shaded_builtin_names, GLOSSY_TOML, GROUND_ROTATION_DEG, GROUND_TOML,
-    TRIANGLE_TOML, ZONEPLATE_TOML,
+    builtin, builtin_names, knot_mesh, shaded_builtin_names, GLOSSY_TOML, GROUND_ROTATION_DEG,
+    GROUND_TOML, KNOT_RADIUS, KNOT_SEGMENTS, TRIANGLE_TOML, ZONEPLATE_TOML,
 };
 pub use camera::Camera;
 pub use error::SceneError;

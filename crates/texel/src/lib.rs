@@ -26,7 +26,9 @@
 //! For more control (several filters on one loaded scene, debug views, threads, timing), use
 //! [`PreparedScene`] with [`raster::render`] as `examples/render_scene.rs` does.
 
+pub mod ao;
 pub mod bake;
+pub mod bvh;
 mod error;
 mod filter;
 pub mod memory;

@@ -1,0 +1,161 @@
+//! `texel bake-ao`: a mesh's ambient occlusion baked into its uv layout ([`texel::ao`]), written
+//! as an 8-bit linear grey PNG.
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use texel::ao::{bake_ao, protected_levels, AoMesh, AoSettings};
+use texel_scene::{load_gltf_with, load_obj_with, Mesh, Scene};
+
+use crate::cli::{BakeAoArgs, ColorArg};
+use crate::input::{scene_limits, Input};
+use crate::output::write_png;
+use crate::progress;
+use crate::threads::{thread_count, with_threads};
+
+/// Run `texel bake-ao`.
+pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
+    let meshes = load_meshes(&args.mesh, input)?;
+    let mesh = AoMesh::from_meshes(&meshes);
+    drop(meshes);
+    let settings = AoSettings {
+        size: args.size,
+        rays: args.rays,
+        max_distance: args.max_distance,
+        margin: args.margin,
+        seed: args.seed,
+    };
+    let started = Instant::now();
+    let bar = progress::bar(u64::from(args.size), "baking");
+    let never = AtomicBool::new(false);
+    let map = with_threads(args.threads, || {
+        bake_ao(
+            &mesh,
+            &settings,
+            &mut input.budget,
+            &|rows| bar.inc(rows),
+            &never,
+        )
+    })?
+    .with_context(|| format!("cannot bake {}", args.mesh))?;
+    bar.finish_and_clear();
+    let seconds = started.elapsed().as_secs_f64();
+    let pixels: Vec<[f32; 4]> = map.values.iter().map(|&v| [v, v, v, 1.0]).collect();
+    write_png(&args.output, map.size, map.size, &pixels, ColorArg::Raw)?;
+    let texels = u64::from(map.size) * u64::from(map.size);
+    let margin = match args.margin {
+        None => "the whole map (every mip level protected)".to_string(),
+        Some(m) => format!(
+            "{m} texels (mip levels 0 to {} protected)",
+            i64::from(protected_levels(m)) - 1
+        ),
+    };
+    eprintln!(
+        "texel bake-ao: {} triangles, {size}x{size}: {} texels sampled ({:.1} %), {} filled by the margin, {:.1} M rays in {seconds:.1} s on {} threads ({:.2} M rays/s); margin: {margin}",
+        mesh.triangles.len(),
+        map.sampled,
+        100.0 * map.sampled as f64 / texels as f64,
+        map.filled,
+        map.rays as f64 / 1e6,
+        thread_count(args.threads),
+        map.rays as f64 / 1e6 / seconds.max(1e-9),
+        size = map.size,
+    );
+    if map.skipped_triangles > 0 {
+        eprintln!(
+            "texel bake-ao: warning: {} triangles not baked (zero area in uv or in space, or outside the map's [0, 1] uv square); they still occlude",
+            map.skipped_triangles
+        );
+    }
+    Ok(())
+}
+
+/// The meshes of `arg`: an OBJ or glTF file by its extension, else a scene (a TOML file or
+/// `builtin:NAME`).
+fn load_meshes(arg: &str, input: &Input) -> Result<Vec<Mesh>> {
+    let limits = scene_limits(input.budget.remaining());
+    let path = Path::new(arg);
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let meshes = match ext.as_deref() {
+        Some("obj") => load_obj_with(path, "", &limits).map(|m| vec![m]),
+        Some("gltf" | "glb") => load_gltf_with(path, "", &limits),
+        _ => Scene::load_with(arg, &limits).map(|s| s.meshes),
+    };
+    meshes.with_context(|| format!("cannot load the mesh {arg}"))
+}
+
+/// Side of the demo's map; its rays per texel.
+const DEMO_MAP: u32 = 512;
+const DEMO_RAYS: u32 = 128;
+
+/// What the demo's ambient occlusion page shows: the lecture's three pictures.
+pub struct DemoAo {
+    /// The knot without its occlusion map, with it, and the map (file names in the page's directory).
+    pub images: [&'static str; 3],
+    /// One line on the bake.
+    pub summary: String,
+}
+
+/// The demo's ambient occlusion page in `dir`: `builtin:knot` baked (a `DEMO_MAP` map, or the
+/// frame's width rounded up to a power of two when `size` is smaller, `DEMO_RAYS` rays), then
+/// rendered (trilinear) without and with the map as its material's `occlusion`, and the map.
+pub fn demo_page(dir: &Path, size: (u32, u32), input: &mut Input) -> Result<DemoAo> {
+    use texel::quality::{Encoding, Image8};
+    use texel_scene::{EncodedImage, TextureSource, TextureSpec};
+
+    let mut scene = Scene::load("builtin:knot")?;
+    let side = DEMO_MAP.min(size.0.next_power_of_two().max(32));
+    let settings = AoSettings {
+        size: side,
+        rays: DEMO_RAYS,
+        ..AoSettings::default()
+    };
+    let started = Instant::now();
+    let map = bake_ao(
+        &AoMesh::from_meshes(&scene.meshes),
+        &settings,
+        &mut input.budget,
+        &|_| {},
+        &AtomicBool::new(false),
+    )?;
+    let seconds = started.elapsed().as_secs_f64();
+    let pixels: Vec<[f32; 4]> = map.values.iter().map(|&v| [v, v, v, 1.0]).collect();
+    let ao = Image8::from_linear(side, side, &pixels, Encoding::Linear)?;
+    ao.write_png(dir.join("ao-map.png"))?;
+    let options = texel::RenderOptions {
+        filter: Some(texel::Filter::Trilinear),
+        size: Some(size),
+        max_memory: Some(input.budget.remaining()),
+        ..Default::default()
+    };
+    let plain = texel::render_scene(&scene, &options)?;
+    texel::frame_image(&plain, Encoding::Srgb)?.write_png(dir.join("plain.png"))?;
+    scene.textures.insert(
+        "ao".into(),
+        TextureSpec::new(
+            TextureSource::Encoded(EncodedImage {
+                bytes: ao.to_png()?.into(),
+                origin: "the baked ambient occlusion".into(),
+            }),
+            texel::texture::ColorSpace::Linear,
+        ),
+    );
+    for m in scene.materials.values_mut() {
+        m.occlusion = Some("ao".into());
+    }
+    let lit = texel::render_scene(&scene, &options)?;
+    texel::frame_image(&lit, Encoding::Srgb)?.write_png(dir.join("with-ao.png"))?;
+    Ok(DemoAo {
+        images: ["plain.png", "with-ao.png", "ao-map.png"],
+        summary: format!(
+            "builtin:knot, {} triangles, baked at {side}x{side} with {DEMO_RAYS} rays per texel ({:.1} M rays) in {seconds:.1} s",
+            scene.meshes.iter().map(|m| m.triangles.len()).sum::<usize>(),
+            map.rays as f64 / 1e6
+        ),
+    })
+}
