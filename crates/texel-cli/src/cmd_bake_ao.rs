@@ -6,12 +6,13 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use texel::ao::{bake_ao, protected_levels, AoMesh, AoSettings};
+use texel::ao::{bake_ao, protected_levels, AoMap, AoMesh, AoSettings};
+use texel::quality::{Encoding, Image8};
 use texel_scene::{load_gltf_with, load_obj_with, Mesh, Scene};
 
-use crate::cli::{BakeAoArgs, ColorArg};
+use crate::cli::BakeAoArgs;
 use crate::input::{scene_limits, Input};
-use crate::output::write_png;
+use crate::output::write_image;
 use crate::progress;
 use crate::threads::{thread_count, with_threads};
 
@@ -42,8 +43,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
     .with_context(|| format!("cannot bake {}", args.mesh))?;
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
-    let pixels: Vec<[f32; 4]> = map.values.iter().map(|&v| [v, v, v, 1.0]).collect();
-    write_png(&args.output, map.size, map.size, &pixels, ColorArg::Raw)?;
+    write_image(&args.output, &map_image(&map)?)?;
     let texels = u64::from(map.size) * u64::from(map.size);
     let margin = match args.margin {
         None => "the whole map (every mip level protected)".to_string(),
@@ -70,6 +70,17 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// A baked map as the image `bake-ao` writes: grey, linear (`round(255 a)`), opaque.
+fn map_image(map: &AoMap) -> Result<Image8> {
+    let pixels: Vec<[f32; 4]> = map.values.iter().map(|&v| [v, v, v, 1.0]).collect();
+    Ok(Image8::from_linear(
+        map.size,
+        map.size,
+        &pixels,
+        Encoding::Linear,
+    )?)
 }
 
 /// The meshes of `arg`: an OBJ or glTF file by its extension, else a scene (a TOML file or
@@ -105,7 +116,6 @@ pub struct DemoAo {
 /// frame's width rounded up to a power of two when `size` is smaller, `DEMO_RAYS` rays), then
 /// rendered (trilinear) without and with the map as its material's `occlusion`, and the map.
 pub fn demo_page(dir: &Path, size: (u32, u32), input: &mut Input) -> Result<DemoAo> {
-    use texel::quality::{Encoding, Image8};
     use texel_scene::{EncodedImage, TextureSource, TextureSpec};
 
     let mut scene = Scene::load("builtin:knot")?;
@@ -124,8 +134,7 @@ pub fn demo_page(dir: &Path, size: (u32, u32), input: &mut Input) -> Result<Demo
         &AtomicBool::new(false),
     )?;
     let seconds = started.elapsed().as_secs_f64();
-    let pixels: Vec<[f32; 4]> = map.values.iter().map(|&v| [v, v, v, 1.0]).collect();
-    let ao = Image8::from_linear(side, side, &pixels, Encoding::Linear)?;
+    let ao = map_image(&map)?;
     ao.write_png(dir.join("ao-map.png"))?;
     let options = texel::RenderOptions {
         filter: Some(texel::Filter::Trilinear),

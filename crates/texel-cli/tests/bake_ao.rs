@@ -13,16 +13,15 @@ f 1/1 2/2 3/3\nf 1/1 3/3 4/4\nf 5/5 6/5 7/5\nf 5/5 7/5 8/5\n";
 fn bakes_obj_gltf_and_scenes() {
     let d = Dir::new("bake-ao");
     d.write("fw.obj", FLOOR_AND_WALL_OBJ);
-    let out = ok(&[
-        "bake-ao",
-        &d.arg("fw.obj"),
-        "--size",
-        "32",
-        "--rays",
-        "64",
-        "-o",
-        &d.arg("fw.png"),
-    ]);
+    // The floor and wall at 32 x 32 with 64 rays, plus `extra` arguments, into `out`.
+    let fw = |extra: &[&str], out: &str| {
+        let mut args = vec!["bake-ao".to_string(), d.arg("fw.obj")];
+        args.extend(["--size", "32", "--rays", "64", "-o"].map(String::from));
+        args.push(d.arg(out));
+        args.extend(extra.iter().map(|s| s.to_string()));
+        ok(&args)
+    };
+    let out = fw(&[], "fw.png");
     let err = stderr(&out);
     assert!(
         err.contains("32x32") && err.contains("1024 texels sampled"),
@@ -44,18 +43,7 @@ fn bakes_obj_gltf_and_scenes() {
     );
     assert!(px(0, 16)[0] > 200 && px(31, 16)[0] > 200, "{:?}", px(0, 16));
     // The same seed on one thread: the same bytes.
-    ok(&[
-        "bake-ao",
-        &d.arg("fw.obj"),
-        "--size",
-        "32",
-        "--rays",
-        "64",
-        "--threads",
-        "1",
-        "-o",
-        &d.arg("fw1.png"),
-    ]);
+    fw(&["--threads", "1"], "fw1.png");
     assert_eq!(file_bytes(d.join("fw.png")), file_bytes(d.join("fw1.png")));
     // A glTF quad and a built-in scene.
     d.write("quad.bin", quad_buffer());

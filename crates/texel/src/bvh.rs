@@ -15,7 +15,8 @@
 //! - **Query**: [`Bvh::occluded`] stops at the first hit in `(0, t_max)`, visiting the nearer child
 //!   first.
 //!
-//! Measured against the `bvh` crate in `ARCHITECTURE.md` ("Ambient occlusion bake").
+//! Measured against the `bvh` crate: README ("Baked ambient occlusion") and `ARCHITECTURE.md`
+//! ("Decisions (ambient occlusion bake)").
 
 use glam::Vec3;
 
@@ -91,13 +92,10 @@ impl Bvh {
         let mut tris = Vec::with_capacity(triangles.len());
         let mut boxes = Vec::with_capacity(triangles.len());
         for (id, t) in triangles.iter().enumerate() {
-            let Some(p) = t
-                .iter()
-                .map(|&k| positions.get(k as usize).copied().filter(|p| p.is_finite()))
-                .collect::<Option<Vec<Vec3>>>()
-            else {
+            let p = t.map(|k| positions.get(k as usize).copied().unwrap_or(Vec3::NAN));
+            if !p.iter().all(|q| q.is_finite()) {
                 continue;
-            };
+            }
             let mut b = Bounds::EMPTY;
             p.iter().for_each(|&q| b.grow(q));
             boxes.push(b);
@@ -172,12 +170,6 @@ impl Bvh {
         self.tris.is_empty()
     }
 
-    /// Bytes the hierarchy holds (nodes and triangles).
-    pub fn bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<Node>()
-            + self.tris.len() * std::mem::size_of::<Tri>()
-    }
-
     /// Whether the ray `origin + t dir` hits some triangle other than `skip` (an index of the
     /// list the hierarchy was built from; `u32::MAX` skips none) at `0 < t < t_max`. `dir` need
     /// not be normalised (`t` is in its units); `t_max` may be infinite. A ray with a non-finite
@@ -250,10 +242,7 @@ fn sah_split(
         if extent[axis].is_nan() || extent[axis] <= 0.0 {
             continue;
         }
-        let scale = BINS as f32 / extent[axis];
-        let bin_of = |r: u32| {
-            (((centroids[r as usize][axis] - cb.min[axis]) * scale) as usize).min(BINS - 1)
-        };
+        let bin_of = |r: u32| bin(centroids[r as usize][axis], cb.min[axis], extent[axis]);
         let mut count = [0usize; BINS];
         let mut bounds = [Bounds::EMPTY; BINS];
         for &r in refs.iter() {
@@ -292,11 +281,15 @@ fn sah_split(
     if split_cost >= refs.len() as f32 && refs.len() <= 4 * MAX_LEAF {
         return None;
     }
-    let scale = BINS as f32 / extent[axis];
     let mid = partition(refs, |r| {
-        ((((centroids[r as usize][axis] - cb.min[axis]) * scale) as usize).min(BINS - 1)) < k
+        bin(centroids[r as usize][axis], cb.min[axis], extent[axis]) < k
     });
     Some(mid)
+}
+
+/// The bin of centroid coordinate `c` over `[lo, lo + extent]` (`extent > 0`).
+fn bin(c: f32, lo: f32, extent: f32) -> usize {
+    (((c - lo) * (BINS as f32 / extent)) as usize).min(BINS - 1)
 }
 
 /// Split `refs` at its median along the centroids' longest axis (by count: equal centroids too).
