@@ -112,7 +112,7 @@ fn time_gpu(
         };
         let samplers = scene.samplers(*filter)?;
         let draws = scene.draws(&samplers);
-        let mut settings = scene.settings();
+        let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
         settings.derivatives = texel_raster::Derivatives::Quad;
         if args.target == TargetArg::Float {
             settings.target = texel::ColorTarget::Float;
@@ -167,7 +167,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
                 let samplers = scene.samplers(*filter)?;
                 scene.build_structures_within(&samplers, budget)?;
                 let draws = scene.draws(&samplers);
-                let mut settings = scene.settings();
+                let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
                 if args.target == TargetArg::Float {
                     settings.target = texel::ColorTarget::Float;
                 }

@@ -13,7 +13,7 @@ use texel_quality::{
     crop_enlarge, default_band_rows, excess_change, heat_map, horizon_crop_rect, mean_abs_change,
     psnr, publish_dir, FilterRow, Image8, Mask, Orbit, Report, Scores,
 };
-use texel_raster::{render, Frame};
+use texel_raster::{render, Frame, RenderSettings};
 
 use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
@@ -172,6 +172,10 @@ fn gpu_rows(
         let samplers = scene.samplers(filter)?;
         let draws = scene.draws(&samplers);
         let prepared = gpu.prepare(&draws, gpu_filter)?;
+        let settings = RenderSettings {
+            environment: scene.environment(&samplers, &scene.scene.camera),
+            ..settings
+        };
         let mut times = Vec::new();
         let mut frame = prepared.render(&settings)?;
         for _ in 0..TIMED_FRAMES {
@@ -242,7 +246,7 @@ pub fn compare(
         let samplers = scene.samplers(filter)?;
         let bytes = scene.build_structures_within(&samplers, budget)?;
         let draws = scene.draws(&samplers);
-        let settings = scene.settings();
+        let settings = scene.settings_for(&samplers, &scene.scene.camera);
         let mut times = time_frames(&settings, &draws, 1, Duration::ZERO, TIMED_FRAMES)?;
         let mut counting = settings;
         counting.count_texels = true;
@@ -332,8 +336,7 @@ fn orbit_scores(
     rows: &mut [FilterRow],
 ) -> Result<Orbit> {
     let enc = encoding(scene.color);
-    let settings = scene.settings();
-    let (w, h) = (settings.width, settings.height);
+    let (w, h) = (scene.width, scene.height);
     let mut prev_ref = scoring.reference.clone();
     let mut prev_cov = scoring.coverage.clone();
     let mut prev = images;
@@ -349,6 +352,7 @@ fn orbit_scores(
         ref_change += mean_abs_change(&prev_ref, &ref_image, &prev_cov, &coverage)?;
         for (i, &filter) in filters.iter().enumerate() {
             let samplers = scene.samplers(filter)?;
+            let settings = scene.settings_for(&samplers, &camera);
             let frame = render(&settings, &scene.draws_from(&samplers, &camera))?;
             let image = texel::frame_image(&frame, enc)?;
             change[i] += excess_change(

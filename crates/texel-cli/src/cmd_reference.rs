@@ -38,7 +38,7 @@ pub fn reference_frame_from(
     // supplies those.
     let samplers = scene.samplers(Filter::Bilinear)?;
     let draws = scene.reference_draws_from(&samplers, camera)?;
-    let settings = scene.settings();
+    let settings = scene.settings_for(&samplers, camera);
     let (n, m) = strata(spp);
     let pb = progress::bar(1000, "reference");
     let report = |done: u64, total: u64| pb.set_position(done * 1000 / total.max(1));

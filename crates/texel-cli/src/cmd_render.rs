@@ -22,7 +22,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         None => scene.default_samplers()?,
     };
     scene.build_structures_within(&samplers, &mut input.budget)?;
-    let mut settings = scene.settings();
+    let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
     settings.derivatives = match args.derivatives {
         DerivativesArg::Analytic => Derivatives::Analytic,
         DerivativesArg::Quad => Derivatives::Quad,

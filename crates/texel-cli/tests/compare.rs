@@ -171,16 +171,7 @@ fn ground_plane_filter_ranking_against_a_16x16_reference() {
         "--out",
         &out,
     ]);
-    let report =
-        Report::from_json(&std::fs::read_to_string(d.join("report/report.json")).unwrap()).unwrap();
-    let psnr = |name: &str| {
-        report
-            .rows
-            .iter()
-            .find(|r| r.name == name)
-            .unwrap()
-            .psnr_all
-    };
+    let psnr = psnr_of(&d.join("report/report.json"));
     let (n, b, t, a, e) = (
         psnr("nearest"),
         psnr("bilinear"),
@@ -191,4 +182,45 @@ fn ground_plane_filter_ranking_against_a_16x16_reference() {
     assert!(e > t && a > t, "ewa {e} aniso16 {a} trilinear {t}");
     assert!(t > b, "trilinear {t} bilinear {b}");
     assert!(b > n, "bilinear {b} nearest {n}");
+}
+
+#[test]
+fn footprint_aware_environment_lookups_beat_level_zero_on_the_rippled_mirror() {
+    let d = Dir::new("mirror-plane");
+    let out = d.arg("report");
+    ok(&[
+        "compare",
+        "builtin:mirror-plane",
+        "--size",
+        "320x180",
+        "--spp",
+        "64",
+        "--filters",
+        "bilinear,trilinear,aniso16,ewa",
+        "--out",
+        &out,
+    ]);
+    let psnr = psnr_of(&d.join("report/report.json"));
+    let (b, t, a, e) = (
+        psnr("bilinear"),
+        psnr("trilinear"),
+        psnr("aniso16"),
+        psnr("ewa"),
+    );
+    // Every filter reads the reflection through its own footprint; bilinear reads level 0.
+    assert!(t > b + 2.0, "trilinear {t} bilinear {b}");
+    assert!(a > t && e > t, "aniso16 {a} ewa {e} trilinear {t}");
+}
+
+/// The whole-image PSNR of each row of the report at `path`, by filter name.
+fn psnr_of(path: &std::path::Path) -> impl Fn(&str) -> f64 {
+    let report = Report::from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
+    move |name| {
+        report
+            .rows
+            .iter()
+            .find(|r| r.name == name)
+            .unwrap()
+            .psnr_all
+    }
 }

@@ -14,7 +14,7 @@ use texel_quality::Image8;
 pub(crate) const FILTERS: [&str; 12] = texel::Filter::NAMES;
 
 /// The built-in scenes the demo covers.
-pub(crate) const BUILTINS: [&str; 10] = [
+pub(crate) const BUILTINS: [&str; 12] = [
     "ground",
     "ground-rotated",
     "zoneplate",
@@ -25,6 +25,8 @@ pub(crate) const BUILTINS: [&str; 10] = [
     "bricks",
     "terrain",
     "knot",
+    "mirror-spheres",
+    "mirror-plane",
 ];
 
 /// Run `texel` with `args`.

@@ -44,6 +44,7 @@ pub mod camera;
 pub mod clip;
 mod dispatch;
 mod draw;
+pub mod environment;
 mod error;
 mod frame;
 pub mod interp;
@@ -59,6 +60,7 @@ pub mod views;
 
 pub use dispatch::{force_baseline, level as simd_level, SimdLevel};
 pub use draw::{DrawCall, Vertex};
+pub use environment::{Environment, EnvironmentMaps};
 pub use error::RasterError;
 pub use frame::Frame;
 pub use layers::{Layer, LayerBlend, Layers};

@@ -12,7 +12,8 @@
 //! border colour), and shades as [`crate::View::Color`] does (vertex colour; under lights the same
 //! material model, its maps read bilinearly at level 0 too and the normals used exactly, without
 //! specular antialiasing).
-//! Samples that hit nothing take the background colour. The pixel is the plain mean (box filter) in
+//! Samples that hit nothing take the background colour, or the environment's radiance along
+//! their own ray, read bilinearly at level 0, where the environment is the background. The pixel is the plain mean (box filter) in
 //! linear light.
 //!
 //! Design, for speed (it is asked for 256 spp at 1280 x 720): triangle setup and binning are the
@@ -36,6 +37,7 @@ use rayon::prelude::*;
 use texel_texture::{FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor};
 
 use crate::draw::DrawCall;
+use crate::environment::{Environment, ViewRays};
 use crate::error::RasterError;
 use crate::frame::Frame;
 use crate::material::{ChannelInput, Material, SpecularAa, TextureInput};
@@ -187,10 +189,12 @@ fn level0(sampler: &Sampler) -> Result<Sampler, RasterError> {
 }
 
 struct Context<'a> {
-    settings: &'a RenderSettings,
+    settings: &'a RenderSettings<'a>,
     setups: &'a [TriangleSetup],
     draws: Vec<DrawContext<'a>>,
-    lighting: Option<Lighting>,
+    lighting: Option<Lighting<'a>>,
+    /// The environment and its camera rays, when it is the background.
+    background: Option<(Environment<'a>, ViewRays)>,
     strata: [u32; 2],
     seed: u64,
 }
@@ -239,7 +243,11 @@ fn reference_frame(
         settings,
         setups: &setups,
         draws: ref_draws.iter().map(DrawContext::new).collect(),
-        lighting: Lighting::of(settings),
+        lighting: Lighting::of(settings, true),
+        background: settings
+            .environment
+            .filter(|e| e.background)
+            .and_then(|e| Some((e, e.view_rays(width, height)?))),
         strata,
         seed,
     };
@@ -353,7 +361,15 @@ fn reference_row(
         for k in p * spp..(p + 1) * spp {
             let id = s.winner[k];
             if id == u32::MAX {
-                sum += background;
+                sum += match &ctx.background {
+                    Some((env, rays)) => {
+                        let pos = s.pos[k];
+                        rays.direction(pos.x, pos.y).map_or(background, |d| {
+                            env.radiance(d, [DVec3::ZERO; 2], true, false).0.extend(1.0)
+                        })
+                    }
+                    None => background,
+                };
                 continue;
             }
             *nearest = nearest.min(s.depth[k]);

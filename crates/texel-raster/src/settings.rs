@@ -3,6 +3,7 @@
 
 use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8, srgb_table, unorm8_table};
 
+use crate::environment::Environment;
 use crate::error::RasterError;
 use crate::material::{Light, MAX_LIGHTS};
 
@@ -114,8 +115,8 @@ impl ColorTarget {
 }
 
 /// Everything that configures one frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderSettings {
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings<'a> {
     /// Frame width in pixels, `1..=MAX_DIMENSION`.
     pub width: u32,
     /// Frame height in pixels, `1..=MAX_DIMENSION`.
@@ -153,9 +154,13 @@ pub struct RenderSettings {
     /// into the 8-bit target its output encodes to). The reference renderer always renders into
     /// a float target.
     pub target: ColorTarget,
+    /// The environment map ([`crate::environment`]): light from every direction for lit
+    /// frames (it makes a frame lit on its own), reflected by materials, and the background
+    /// where [`Environment::background`] says so. `None` by default.
+    pub environment: Option<Environment<'a>>,
 }
 
-impl RenderSettings {
+impl RenderSettings<'_> {
     /// Defaults for a `width x height` frame: opaque black background, analytic derivatives,
     /// perspective-correct colour view, no culling, no lights, rayon's global pool, no counting,
     /// a float colour target.
@@ -174,6 +179,7 @@ impl RenderSettings {
             capture_footprints: false,
             scissor: None,
             target: ColorTarget::Float,
+            environment: None,
         }
     }
 
@@ -182,9 +188,9 @@ impl RenderSettings {
         self.scissor.unwrap_or([0, 0, self.width, self.height])
     }
 
-    /// Whether any light is set (the frame is shaded).
+    /// Whether any light or an environment is set (the frame is shaded).
     pub fn is_lit(&self) -> bool {
-        self.lights.iter().any(Option::is_some)
+        self.lights.iter().any(Option::is_some) || self.environment.is_some()
     }
 
     /// The lights that are set.
@@ -239,11 +245,17 @@ impl RenderSettings {
         if let Some(l) = self.active_lights().find(|l| !l.is_finite()) {
             return Err(RasterError::NonFiniteLight(format!("{l:?}")));
         }
+        if let Some(e) = self.environment.filter(|e| !e.is_valid()) {
+            return Err(RasterError::NonFiniteLight(format!(
+                "environment intensity {:?}",
+                e.intensity
+            )));
+        }
         Ok(())
     }
 }
 
-impl Default for RenderSettings {
+impl Default for RenderSettings<'_> {
     /// [`RenderSettings::new`] at 1280 x 720.
     fn default() -> Self {
         RenderSettings::new(1280, 720)

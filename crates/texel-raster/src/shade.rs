@@ -17,6 +17,7 @@ use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};
 use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
 use crate::draw::{DrawCall, Vertex};
+use crate::environment::{self, Environment};
 use crate::layers::Needs;
 use crate::material::{
     self, Displacement, Light, Material, SpecularAa, Surface, TextureInput, MIN_ROUGHNESS,
@@ -142,23 +143,106 @@ impl<'a> DrawContext<'a> {
     }
 }
 
-/// The frame's lights, gathered once.
+/// The frame's lights and environment, gathered once.
 #[derive(Clone, Debug)]
-pub(crate) struct Lighting {
+pub(crate) struct Lighting<'a> {
     lights: Vec<Light>,
-    /// Some light is ambient (only ambient light reads the occlusion map).
+    /// Some light is ambient, or there is an environment (only ambient light reads the
+    /// occlusion map).
     ambient: bool,
+    /// The environment's light ([`crate::environment`]).
+    environment: Option<Environment<'a>>,
+    /// The reference's point samples: the environment is read without footprints.
+    reference: bool,
 }
 
-impl Lighting {
-    /// The lights of `settings`, or `None` for an unlit frame.
-    pub fn of(settings: &RenderSettings) -> Option<Self> {
+impl<'a> Lighting<'a> {
+    /// The lights of `settings`, or `None` for an unlit frame; `reference` for the reference
+    /// renderer's samples.
+    pub fn of(settings: &RenderSettings<'a>, reference: bool) -> Option<Self> {
         settings.is_lit().then(|| {
             let lights: Vec<Light> = settings.active_lights().copied().collect();
-            let ambient = lights.iter().any(|l| matches!(l, Light::Ambient { .. }));
-            Lighting { lights, ambient }
+            let ambient = settings.environment.is_some()
+                || lights.iter().any(|l| matches!(l, Light::Ambient { .. }));
+            Lighting {
+                lights,
+                ambient,
+                environment: settings.environment,
+                reference,
+            }
         })
     }
+}
+
+/// The environment's light on `surface` (linear RGB) and the texels read: specular from the
+/// direction the view reflects to, with its screen derivatives differentiated as pbrt-v4 does
+/// (`dr = 2 ((dn.v + n.dv) n + (n.v) dn) - dv`, where `dp` and `dn` come from the barycentrics'
+/// derivatives `dlambda` and the interpolated vertex normals, and `dv` from `dp`), and diffuse
+/// from the irradiance along the diffuse normal (see [`crate::environment`]); `lambert` keeps
+/// only the diffuse part with the base colour itself. Scaled by the surface's occlusion.
+#[allow(clippy::too_many_arguments)]
+fn environment_light(
+    lighting: &Lighting,
+    verts: [&Vertex; 3],
+    lambda: DVec3,
+    dlambda: [DVec3; 2],
+    surface: &Surface,
+    eye: Vec3,
+    lambert: bool,
+    count: bool,
+    texels: &mut u32,
+) -> Vec3 {
+    let Some(env) = &lighting.environment else {
+        return Vec3::ZERO;
+    };
+    let c_diff = surface.base * if lambert { 1.0 } else { 1.0 - surface.metallic };
+    let nd = surface
+        .diffuse_normal
+        .as_dvec3()
+        .normalize_or(surface.normal.as_dvec3());
+    let (irr, k) = env.irradiance(nd, count);
+    *texels += k;
+    let mut out = c_diff * irr;
+    if !lambert {
+        let n = surface.normal.as_dvec3();
+        let p = surface.position.as_dvec3();
+        let to_eye = eye.as_dvec3() - p;
+        let dist = to_eye.length().max(1e-30);
+        let v = to_eye / dist;
+        let n_dot_v = n.dot(v);
+        let r = n * (2.0 * n_dot_v) - v;
+        let mut dr = [DVec3::ZERO; 2];
+        if !lighting.reference {
+            let m = lerp3(verts, lambda, |v| v.normal);
+            let len = m.length();
+            let ng = if len > 0.0 { m / len } else { DVec3::ZERO };
+            for (dr, dl) in dr.iter_mut().zip(dlambda) {
+                let dp = lerp3(verts, dl, |v| v.position);
+                let dm = lerp3(verts, dl, |v| v.normal);
+                let dn = if len > 0.0 {
+                    (dm - ng * ng.dot(dm)) / len
+                } else {
+                    DVec3::ZERO
+                };
+                let dv = -(dp - v * v.dot(dp)) / dist;
+                *dr = (n * (dn.dot(v) + n.dot(dv)) + dn * n_dot_v) * 2.0 - dv;
+            }
+        }
+        let (spec, k) = env.specular(r, dr, surface.roughness, lighting.reference, count);
+        *texels += k;
+        let f0 = Vec3::splat(0.04).lerp(surface.base, surface.metallic);
+        let (a, b) = environment::dfg(n_dot_v.max(1e-4) as f32, surface.roughness);
+        out += spec * (f0 * a + Vec3::splat(b));
+    }
+    out * surface.occlusion
+}
+
+/// `sum lambda_k f(vertex_k)` in `f64`.
+#[inline(always)]
+fn lerp3(verts: [&Vertex; 3], lambda: DVec3, f: impl Fn(&Vertex) -> Vec3) -> DVec3 {
+    f(verts[0]).as_dvec3() * lambda.x
+        + f(verts[1]).as_dvec3() * lambda.y
+        + f(verts[2]).as_dvec3() * lambda.z
 }
 
 /// The shaded colour of a fragment with base texture colour `tex` (linear RGBA), barycentrics
@@ -204,8 +288,20 @@ pub(crate) fn shade(
             position,
             occlusion: 1.0,
         };
-        let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, true);
-        return (rgb.extend(c.w).to_array(), 0);
+        let mut texels = 0;
+        let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, true)
+            + environment_light(
+                lighting,
+                verts,
+                lambda,
+                dlambda,
+                &surface,
+                ctx.eye,
+                true,
+                count,
+                &mut texels,
+            );
+        return (rgb.extend(c.w).to_array(), texels);
     };
     // Parallax occlusion mapping moves every read to where the view ray meets the relief.
     let mut fp = *fp;
@@ -308,7 +404,18 @@ pub(crate) fn shade(
         position,
         occlusion,
     };
-    let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, false);
+    let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, false)
+        + environment_light(
+            lighting,
+            verts,
+            lambda,
+            dlambda,
+            &surface,
+            ctx.eye,
+            false,
+            count,
+            &mut texels,
+        );
     (rgb.extend(c.w).to_array(), texels)
 }
 

@@ -43,6 +43,7 @@ use texel_texture::Footprint;
 
 use crate::dispatch::Kernel;
 use crate::draw::DrawCall;
+use crate::environment::{Environment, ViewRays};
 use crate::frame::Frame;
 use crate::interp::{self, quad_differences};
 use crate::settings::{ColorTarget, Derivatives, Perspective, RenderSettings, View};
@@ -132,11 +133,13 @@ impl TileTarget<'_> {
 
 /// Everything shared by the tiles of one frame.
 struct Context<'a> {
-    settings: &'a RenderSettings,
+    settings: &'a RenderSettings<'a>,
     draws: Vec<DrawContext<'a>>,
-    lighting: Option<Lighting>,
+    lighting: Option<Lighting<'a>>,
     counting: bool,
     capture: bool,
+    /// The environment's camera rays, when it is the background of a colour view.
+    background: Option<(Environment<'a>, ViewRays)>,
 }
 
 /// What the fragment stage needs besides the pixel: barycentrics and the footprint's inputs.
@@ -165,9 +168,13 @@ pub(crate) fn draw_frame(
     let ctx = Context {
         settings,
         draws: draws.iter().map(DrawContext::new).collect(),
-        lighting: Lighting::of(settings),
+        lighting: Lighting::of(settings, false),
         counting,
         capture,
+        background: settings
+            .environment
+            .filter(|e| e.background && settings.view == View::Color)
+            .and_then(|e| Some((e, e.view_rays(width, height)?))),
     };
     let (tx, _) = tile_counts(width, height);
     let mut color = split_rows(&mut frame.color, width, height).into_iter();
@@ -202,6 +209,39 @@ pub(crate) fn draw_frame(
 /// Rasterise one tile, on the best instruction set the CPU has ([`crate::dispatch`]).
 fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
     crate::dispatch::run(TileJob { ctx, tile, bin });
+    if let Some((env, rays)) = &ctx.background {
+        background_tile(ctx, env, rays, tile);
+    }
+}
+
+/// Show the environment in the tile's pixels (inside the scissor) that no fragment covers; their
+/// depth stays `+inf`. Texels are counted and footprints captured as for fragments.
+fn background_tile(ctx: &Context, env: &Environment, rays: &ViewRays, tile: &mut TileTarget) {
+    let [sx0, sy0, sx1, sy1] = ctx.settings.scissor_rect();
+    for j in tile.y0.max(sy0)..(tile.y0 + tile.h).min(sy1) {
+        for i in tile.x0.max(sx0)..(tile.x0 + tile.w).min(sx1) {
+            let (li, lj) = ((i - tile.x0) as usize, (j - tile.y0) as usize);
+            if tile.depth[lj][li] < f32::INFINITY {
+                continue;
+            }
+            let Some(fp) = rays.footprint(i, j) else {
+                continue;
+            };
+            let (c, n) = env.radiance_at(&fp, false, ctx.counting);
+            let color = [c.x, c.y, c.z, 1.0];
+            if tile.target.is_8bit() {
+                tile.color8[lj][li] = tile.target.encode(color);
+            } else {
+                tile.color[lj][li] = color;
+            }
+            if ctx.counting {
+                tile.texels[lj][li] = n;
+            }
+            if ctx.capture {
+                tile.footprints[lj][li] = fp;
+            }
+        }
+    }
 }
 
 /// [`raster_tile`]'s arguments, as the dispatcher's unit of work.

@@ -75,7 +75,7 @@ fn plane_draw<'a>(
     }
 }
 
-fn lit(light: Light) -> RenderSettings {
+fn lit(light: Light) -> RenderSettings<'static> {
     let mut lights = [None; MAX_LIGHTS];
     lights[0] = Some(light);
     RenderSettings {

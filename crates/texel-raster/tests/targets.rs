@@ -13,7 +13,7 @@ use texel_raster::{
 };
 use texel_texture::{Sampler, Texture};
 
-fn settings(w: u32, h: u32, target: ColorTarget) -> RenderSettings {
+fn settings(w: u32, h: u32, target: ColorTarget) -> RenderSettings<'static> {
     RenderSettings {
         target,
         threads: Some(2),

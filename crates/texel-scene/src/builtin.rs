@@ -58,9 +58,21 @@ pub fn builtin_names() -> &'static [&'static str] {
 /// - `terrain`: ground receding to 200 m with four layers (grass, rock, sand, snow) blended by a
 ///   mask and their heights, bump-mapped from the blended heights;
 /// - `knot`: a clay torus knot resting on a square of ground under a sky and a sun, its uvs one
-///   non-overlapping atlas ([`knot_mesh`]): the model `texel bake-ao` bakes in the demo.
+///   non-overlapping atlas ([`knot_mesh`]): the model `texel bake-ao` bakes in the demo;
+/// - `mirror-spheres`: a mirror sphere and a glossy one (rough metal) in the procedural sky,
+///   which is also the background: reflections of an environment map;
+/// - `mirror-plane`: a rippled mirror floor receding to the horizon under the procedural sky
+///   ([`mirror_plane_mesh`]): grazing reflections, whose footprints in the map grow long towards
+///   the horizon.
 pub fn shaded_builtin_names() -> &'static [&'static str] {
-    &["glossy", "bricks", "terrain", "knot"]
+    &[
+        "glossy",
+        "bricks",
+        "terrain",
+        "knot",
+        "mirror-spheres",
+        "mirror-plane",
+    ]
 }
 
 fn from_toml(name: &str, text: &str) -> Result<Scene, SceneError> {
@@ -92,6 +104,8 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "cube" => Ok(cube()),
         "sphere" => Ok(sphere()),
         "knot" => Ok(knot()),
+        "mirror-spheres" => Ok(mirror_spheres()),
+        "mirror-plane" => Ok(mirror_plane()),
         _ => Err(SceneError::UnknownBuiltin {
             name: name.to_string(),
         }),
@@ -104,6 +118,42 @@ fn one_texture(name: &str, p: Procedural) -> std::collections::BTreeMap<String, 
         TextureSpec::new(TextureSource::Procedural(p), ColorSpace::Srgb),
     )]
     .into()
+}
+
+/// A 4x4 opaque white texture named `white` (a draw's texture under a constant base colour).
+fn white_texture() -> std::collections::BTreeMap<String, TextureSpec> {
+    one_texture(
+        "white",
+        Procedural::Solid {
+            width: 4,
+            height: 4,
+            rgba: [255, 255, 255, 255],
+        },
+    )
+}
+
+/// A metal (`metallic = 1`) of linear colour `rgb` and perceptual `roughness`.
+fn metal(rgb: Vec3, roughness: f32) -> crate::model::MaterialSpec {
+    use crate::model::{ColorInput, MaterialSpec, ScalarInput};
+    MaterialSpec {
+        base_color: ColorInput::Rgb(rgb),
+        roughness: ScalarInput::Value(roughness),
+        metallic: ScalarInput::Value(1.0),
+        ..Default::default()
+    }
+}
+
+/// The procedural sky, `width` texels wide, as the only light and the background.
+fn sky_environment(width: u32) -> Option<crate::environment::EnvironmentSpec> {
+    use crate::environment::{EnvironmentSource, EnvironmentSpec, Sky};
+    Some(EnvironmentSpec {
+        source: EnvironmentSource::Sky(Sky {
+            width,
+            ..Sky::default()
+        }),
+        intensity: Vec3::ONE,
+        background: true,
+    })
 }
 
 /// A mesh with no vertices yet (normals to come), `texture`, clamped, no material.
@@ -180,6 +230,7 @@ fn cube() -> Scene {
         meshes: vec![mesh],
         lights: Vec::new(),
         materials: Default::default(),
+        environment: None,
     }
 }
 
@@ -190,7 +241,8 @@ const SPHERE_RINGS: u32 = 32;
 /// A unit UV sphere: vertex (s, r) at longitude `2 pi s / 64` and colatitude `pi r / 32`,
 /// uv = `(s / 64, r / 32)` (north pole at v = 0, the top row of the latitude-longitude map), with
 /// a duplicated seam column at u = 1; u repeats, v clamps.
-fn sphere() -> Scene {
+/// The built-in sphere's mesh (see [`sphere`]), with `texture`.
+fn sphere_mesh(texture: &str) -> Mesh {
     let mut positions = Vec::new();
     let mut uvs = Vec::new();
     for r in 0..=SPHERE_RINGS {
@@ -225,6 +277,25 @@ fn sphere() -> Scene {
         }
     }
     let normals = Some(positions.clone());
+    Mesh {
+        positions,
+        uvs,
+        normals,
+        colors: None::<Vec<Vec4>>,
+        triangles,
+        texture: texture.into(),
+        address_mode_u: AddressMode::Repeat,
+        address_mode_v: AddressMode::ClampToEdge,
+        filters: None,
+        material: None,
+        tangents: None,
+    }
+}
+
+/// A unit UV sphere: vertex (s, r) at longitude `2 pi s / 64` and colatitude `pi r / 32`,
+/// uv = `(s / 64, r / 32)` (north pole at v = 0, the top row of the latitude-longitude map), with
+/// a duplicated seam column at u = 1; u repeats, v clamps.
+fn sphere() -> Scene {
     Scene {
         output: Output {
             width: 960,
@@ -248,21 +319,138 @@ fn sphere() -> Scene {
                 line_width: 3.0,
             },
         ),
-        meshes: vec![Mesh {
-            positions,
-            uvs,
-            normals,
-            colors: None::<Vec<Vec4>>,
-            triangles,
-            texture: "latlong".into(),
-            address_mode_u: AddressMode::Repeat,
-            address_mode_v: AddressMode::ClampToEdge,
-            filters: None,
-            material: None,
-            tangents: None,
-        }],
+        meshes: vec![sphere_mesh("latlong")],
         lights: Vec::new(),
         materials: Default::default(),
+        environment: None,
+    }
+}
+
+/// The `mirror-spheres` scene: two spheres of radius 1 side by side in the procedural sky, a
+/// mirror (`metallic = 1`, `roughness = 0`) on the left and brushed copper (`roughness = 0.35`)
+/// on the right; no lights but the environment, which is also the background.
+fn mirror_spheres() -> Scene {
+    let placed = |x: f32, material: &str| {
+        let mut m = sphere_mesh("white");
+        for p in &mut m.positions {
+            *p += Vec3::new(x, 0.0, 0.0);
+        }
+        m.material = Some(material.into());
+        m
+    };
+    Scene {
+        output: Output {
+            width: 960,
+            height: 540,
+            background: [0, 0, 0, 255],
+        },
+        camera: Camera {
+            eye: Vec3::new(0.0, 0.6, 5.2),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_deg: 40.0,
+            near: 0.1,
+            far: 100.0,
+        },
+        textures: white_texture(),
+        meshes: vec![placed(-1.15, "mirror"), placed(1.15, "copper")],
+        lights: Vec::new(),
+        materials: [
+            (
+                "mirror".to_string(),
+                metal(Vec3::new(0.95, 0.93, 0.88), 0.0),
+            ),
+            (
+                "copper".to_string(),
+                metal(Vec3::new(0.95, 0.64, 0.54), 0.35),
+            ),
+        ]
+        .into(),
+        environment: sky_environment(1024),
+    }
+}
+
+/// The ripples of [`mirror_plane_mesh`]: (wave vector `(k_x, k_z)` in radians per unit,
+/// amplitude in units) of `h(x, z) = sum a sin(k_x x + k_z z)`.
+pub const RIPPLES: [(f32, f32, f32); 3] = [(0.35, 1.3, 0.1), (-0.9, 0.8, 0.06), (1.6, 0.5, 0.03)];
+
+/// The floor of `mirror-plane`: flat at `y = 0`, from `x = -60` to `60` and `z = 1` (behind the
+/// eye at the origin) to `z = -300`, whose normals are those of the ripples [`RIPPLES`]
+/// (`n = normalize(-dh/dx, 1, -dh/dz)`; the geometry stays flat, as a normal map would leave it).
+/// A flat mirror shows the environment as a virtual image at the pixel's own angular size, so
+/// its lookups are never minified; ripples make the reflected direction change faster than the
+/// view, most of all where the view grazes the floor. 161 columns by 400 rows whose spacing grows
+/// geometrically with distance (2.2 % per row, 0.05 units at the eye), so every row of
+/// triangles covers about the same number of screen rows and the ripples are resolved by the
+/// vertices (two a wavelength) to about 100 units away.
+pub fn mirror_plane_mesh() -> Mesh {
+    let mut mesh = empty_mesh("white");
+    mesh.address_mode_u = AddressMode::Repeat;
+    mesh.address_mode_v = AddressMode::Repeat;
+    let (cols, rows) = (161u32, 400u32);
+    let ratio = (301.0f32 / 0.05).powf(1.0 / (rows - 1) as f32);
+    for r in 0..rows {
+        // Distance from z = 1: 0 for the first row, then 0.05 ratio^(r - 1) ... 301.
+        let d = if r == 0 {
+            0.0
+        } else {
+            0.05 * ratio.powi(r as i32 - 1)
+        };
+        let z = 1.0 - d.min(301.0);
+        for c in 0..cols {
+            let x = -60.0 + 120.0 * c as f32 / (cols - 1) as f32;
+            let (mut hx, mut hz) = (0.0, 0.0);
+            for (kx, kz, a) in RIPPLES {
+                let s = (kx * x + kz * z).cos() * a;
+                hx += s * kx;
+                hz += s * kz;
+            }
+            mesh.positions.push(Vec3::new(x, 0.0, z));
+            mesh.uvs.push(Vec2::new(x, z));
+            if let Some(ns) = &mut mesh.normals {
+                ns.push(Vec3::new(-hx, 1.0, -hz).normalize());
+            }
+        }
+    }
+    for r in 0..rows - 1 {
+        for c in 0..cols - 1 {
+            let a = r * cols + c;
+            let b = a + cols; // one row further away (-z)
+                              // Counter-clockwise seen from above (+y): a, a + 1, b + 1 and a, b + 1, b.
+            mesh.triangles.extend([[a, a + 1, b + 1], [a, b + 1, b]]);
+        }
+    }
+    mesh.material = Some("mirror".into());
+    mesh
+}
+
+/// The `mirror-plane` scene: [`mirror_plane_mesh`], a silver mirror (`metallic = 1`,
+/// `roughness = 0`), the eye 1 unit above it looking just below the horizon (as `ground`), the
+/// procedural sky (2048 wide) as the only light and the background.
+fn mirror_plane() -> Scene {
+    Scene {
+        output: Output {
+            width: 1280,
+            height: 720,
+            background: [0, 0, 0, 255],
+        },
+        camera: Camera {
+            eye: Vec3::new(0.0, 1.0, 0.0),
+            target: Vec3::new(0.0, 0.75, -10.0),
+            up: Vec3::Y,
+            fovy_deg: 50.0,
+            near: 0.05,
+            far: 2000.0,
+        },
+        textures: white_texture(),
+        meshes: vec![mirror_plane_mesh()],
+        lights: Vec::new(),
+        materials: [(
+            "mirror".to_string(),
+            metal(Vec3::new(0.95, 0.93, 0.88), 0.0),
+        )]
+        .into(),
+        environment: sky_environment(2048),
     }
 }
 
@@ -392,6 +580,7 @@ fn knot() -> Scene {
             },
         ],
         materials: [("clay".to_string(), clay)].into(),
+        environment: None,
     }
 }
 

@@ -108,6 +108,9 @@ pub enum SceneError {
         /// What is wrong.
         reason: String,
     },
+    /// The `[environment]` table is invalid.
+    #[error("environment: {0}")]
+    Environment(String),
     /// A light is invalid, or there are too many.
     #[error("lights: {0}")]
     Light(String),

@@ -31,6 +31,10 @@
 //! type = "directional"          #   "point" (position) | "ambient"; intensity = [r, g, b]
 //! direction = [0.0, 0.25, -1.0] #   linear (glTF KHR_lights_punctual units); at most 8 lights
 //! intensity = [5.0, 5.0, 5.0]
+//! [environment]                 # path = "map.hdr" (equirectangular PNG, JPEG, EXR or HDR) or
+//! procedural = "sky"            #   procedural = "sky" (size = width, default 1024; sun =
+//! intensity = 1.0               #   [x, y, z] towards the sun; seed); mapping = "equirect";
+//! background = true             #   intensity = k or [r, g, b]; background (default true)
 //! [materials.glossy]            # base_color = "TEXTURE" or [r, g, b] (linear, default white);
 //! base_color = "checker"        # roughness, metallic = number in [0, 1] or "TEXTURE" (red);
 //! roughness = 0.25              # normal = "TEXTURE" (color = "linear"), normal_scale;
@@ -58,6 +62,7 @@ use serde::Deserialize;
 use texel_texture::{AddressMode, ColorSpace};
 
 use crate::camera::Camera;
+use crate::environment::{EnvironmentSource, EnvironmentSpec, Sky};
 use crate::error::SceneError;
 use crate::gltf_import::GltfScene;
 use crate::limits::SceneLimits;
@@ -80,6 +85,82 @@ struct RawScene {
     lights: Vec<RawLight>,
     #[serde(default)]
     materials: BTreeMap<String, RawMaterial>,
+    environment: Option<RawEnvironment>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawEnvironment {
+    path: Option<String>,
+    procedural: Option<SkyName>,
+    mapping: Option<MappingName>,
+    intensity: Option<RawIntensity>,
+    background: Option<bool>,
+    size: Option<u32>,
+    sun: Option<[f32; 3]>,
+    seed: Option<u32>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum SkyName {
+    Sky,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+enum MappingName {
+    Equirect,
+    Cube,
+    Octahedral,
+}
+
+/// One number for every channel, or `[r, g, b]`.
+#[derive(Deserialize, Clone, Copy)]
+#[serde(untagged)]
+enum RawIntensity {
+    Gray(f32),
+    Rgb([f32; 3]),
+}
+
+/// The `[environment]` table as the model's.
+fn environment_spec(raw: RawEnvironment, base: &Path) -> Result<EnvironmentSpec, SceneError> {
+    let bad = |s: &str| Err(SceneError::Environment(s.to_string()));
+    if matches!(
+        raw.mapping,
+        Some(MappingName::Cube | MappingName::Octahedral)
+    ) {
+        return bad(
+            "mapping: only \"equirect\" (latitude-longitude) maps are supported so far; \
+             convert cube and octahedral maps to equirectangular",
+        );
+    }
+    let source = match (raw.path, raw.procedural) {
+        (Some(path), None) => {
+            if raw.size.is_some() || raw.sun.is_some() || raw.seed.is_some() {
+                return bad("size, sun and seed are the procedural sky's; a file map takes none");
+            }
+            EnvironmentSource::File(base.join(path))
+        }
+        (None, Some(SkyName::Sky)) => {
+            let d = Sky::default();
+            EnvironmentSource::Sky(Sky {
+                width: raw.size.unwrap_or(d.width),
+                sun: raw.sun.map_or(d.sun, Vec3::from),
+                seed: raw.seed.unwrap_or(d.seed),
+            })
+        }
+        _ => return bad("give exactly one of path = \"FILE\" and procedural = \"sky\""),
+    };
+    Ok(EnvironmentSpec {
+        source,
+        intensity: match raw.intensity {
+            None => Vec3::ONE,
+            Some(RawIntensity::Gray(k)) => Vec3::splat(k),
+            Some(RawIntensity::Rgb(c)) => Vec3::from(c),
+        },
+        background: raw.background.unwrap_or(true),
+    })
 }
 
 #[derive(Deserialize)]
@@ -827,6 +908,10 @@ impl Scene {
             meshes: all,
             lights: raw.lights.into_iter().map(light_spec).collect(),
             materials,
+            environment: raw
+                .environment
+                .map(|e| environment_spec(e, &base))
+                .transpose()?,
         };
         scene.validate()?;
         Ok(scene)

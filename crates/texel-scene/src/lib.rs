@@ -32,6 +32,7 @@
 
 mod builtin;
 mod camera;
+mod environment;
 mod error;
 pub mod file;
 mod gltf_import;
@@ -48,6 +49,7 @@ pub use builtin::{
     GROUND_TOML, KNOT_RADIUS, KNOT_SEGMENTS, TRIANGLE_TOML, ZONEPLATE_TOML,
 };
 pub use camera::Camera;
+pub use environment::{EnvironmentSource, EnvironmentSpec, Sky, MAX_SKY_WIDTH};
 pub use error::SceneError;
 pub use gltf_import::{import_gltf, load_gltf, load_gltf_slice, load_gltf_with, GltfScene};
 pub use limits::SceneLimits;

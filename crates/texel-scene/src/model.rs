@@ -7,6 +7,7 @@ use glam::{Vec2, Vec3, Vec4};
 use texel_texture::{AddressMode, ColorSpace, FilterMode, MipmapFilterMode};
 
 use crate::camera::Camera;
+use crate::environment::EnvironmentSpec;
 use crate::procedural::Procedural;
 
 /// The largest output width or height accepted (16384, the common GPU limit).
@@ -27,6 +28,9 @@ pub struct Scene {
     pub lights: Vec<LightSpec>,
     /// Materials by name (`[materials.NAME]`; meshes refer to them by name).
     pub materials: BTreeMap<String, MaterialSpec>,
+    /// The environment map (`[environment]`), if any: it lights the scene (the frame is lit
+    /// even without lights), is reflected by materials and may be the background.
+    pub environment: Option<EnvironmentSpec>,
 }
 
 /// The most lights a scene has.

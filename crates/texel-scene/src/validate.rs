@@ -175,6 +175,9 @@ impl Scene {
             }
         }
         self.validate_lights()?;
+        if let Some(e) = &self.environment {
+            e.validate()?;
+        }
         for (name, m) in &self.materials {
             self.validate_material(name, m)?;
         }

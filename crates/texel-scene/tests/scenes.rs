@@ -652,3 +652,84 @@ fn gltf_accessors_and_chains_are_checked_before_reading() {
         "{e}"
     );
 }
+
+#[test]
+fn the_environment_table_parses_and_loads() {
+    use texel_scene::{EnvironmentSource, Sky};
+    // The procedural sky with its parameters.
+    let text = format!(
+        "{HEAD}{TRI}\n[environment]\nprocedural = \"sky\"\nsize = 64\nsun = [0.0, 1.0, 0.0]\n\
+         intensity = [1.0, 0.5, 0.25]\nbackground = false\nmapping = \"equirect\"\n"
+    );
+    let s = parse(&text).unwrap();
+    let e = s.environment.as_ref().unwrap();
+    assert_eq!(
+        e.source,
+        EnvironmentSource::Sky(Sky {
+            width: 64,
+            sun: Vec3::Y,
+            seed: 0
+        })
+    );
+    assert_eq!(e.intensity, Vec3::new(1.0, 0.5, 0.25));
+    assert!(!e.background);
+    let t = e.load(&Limits::default()).unwrap();
+    assert_eq!((t.width(), t.height()), (64, 32));
+    // A file map, relative to the scene, in Radiance HDR (float, linear).
+    let dir = scratch("env");
+    let mut hdr = Vec::new();
+    let pixels = vec![image::Rgb([2.5f32, 0.5, 0.125]); 8 * 4];
+    image::codecs::hdr::HdrEncoder::new(&mut hdr)
+        .encode(&pixels, 8, 4)
+        .unwrap();
+    fs::write(dir.join("sky.hdr"), &hdr).unwrap();
+    let scene_path = dir.join("scene.toml");
+    let text = format!("{HEAD}{TRI}\n[environment]\npath = \"sky.hdr\"\nintensity = 2.0\n");
+    fs::write(&scene_path, &text).unwrap();
+    let s = Scene::from_path(&scene_path).unwrap();
+    let e = s.environment.as_ref().unwrap();
+    assert_eq!(e.source, EnvironmentSource::File(dir.join("sky.hdr")));
+    assert_eq!(e.intensity, Vec3::splat(2.0));
+    assert!(e.background);
+    let t = e.load(&Limits::default()).unwrap();
+    let c = t.texel(0, 3, 2).unwrap();
+    assert!(
+        (c[0] - 2.5).abs() < 0.05 && (c[2] - 0.125).abs() < 0.01,
+        "{c:?}"
+    );
+    // A missing file is named when the map is loaded.
+    fs::remove_file(dir.join("sky.hdr")).unwrap();
+    let err = e.load(&Limits::default()).unwrap_err().to_string();
+    assert!(
+        err.contains("environment") && err.contains("sky.hdr"),
+        "{err}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_environment_tables_are_refused() {
+    for (table, expect) in [
+        ("procedural = \"sky\"\npath = \"a.hdr\"", "exactly one"),
+        ("intensity = 1.0", "exactly one"),
+        ("procedural = \"sky\"\nmapping = \"cube\"", "equirect"),
+        (
+            "procedural = \"sky\"\nmapping = \"sphere\"",
+            "unknown variant",
+        ),
+        ("procedural = \"sky\"\nintensity = -1.0", "negative"),
+        (
+            "procedural = \"sky\"\nintensity = [1.0, nan, 1.0]",
+            "finite",
+        ),
+        ("procedural = \"sky\"\nsize = 0", "size"),
+        ("procedural = \"sky\"\nsize = 100000", "size"),
+        ("procedural = \"sky\"\nsun = [0.0, 0.0, 0.0]", "sun"),
+        ("path = \"a.hdr\"\nsun = [0.0, 1.0, 0.0]", "procedural sky"),
+        ("procedural = \"sky\"\nbrightness = 2.0", "unknown field"),
+    ] {
+        let text = format!("{HEAD}{TRI}\n[environment]\n{table}\n");
+        let err = parse(&text).unwrap_err().to_string();
+        assert!(err.contains(expect), "{table}: {err}");
+    }
+}

@@ -319,15 +319,7 @@ impl Texture {
     ) -> Result<Self, TextureError> {
         limits.check(width, height, Format::Rgba32Float)?;
         check_len(width, height, texels.len())?;
-        if let Some(k) = texels.iter().position(|t| !t.iter().all(|c| c.is_finite())) {
-            let channel = texels[k].iter().position(|c| !c.is_finite()).unwrap_or(0);
-            return Err(TextureError::NonFiniteTexel {
-                x: (k % width as usize) as u32,
-                y: (k / width as usize) as u32,
-                channel: ["R", "G", "B", "A"][channel],
-                value: texels[k][channel],
-            });
-        }
+        check_finite(width, &texels)?;
         let level0 = Level {
             width,
             height,
@@ -341,6 +333,54 @@ impl Texture {
             Format::Rgba32Float,
             levels,
             Storage::F32(all),
+            limits,
+        ))
+    }
+
+    /// A float texture whose mip levels are given rather than built: `texels` holds every level of
+    /// a full `width x height` chain ([`crate::pyramid::level_size`], down to 1x1), level 0 first,
+    /// each row-major and the levels back to back ([`crate::pyramid::pyramid_texels`] in all).
+    /// For pyramids whose levels are not box reductions of level 0, such as an environment map's
+    /// GGX-prefiltered levels (each convolved with a wider specular lobe). Ripmaps and
+    /// summed-area tables, built from level 0, know nothing of the other levels.
+    ///
+    /// # Errors
+    /// As [`Texture::from_rgba32f`], with [`TextureError::DataLength`] against the whole chain
+    /// (reported as level 0's size).
+    pub fn from_rgba32f_levels(
+        width: u32,
+        height: u32,
+        texels: Vec<[f32; 4]>,
+        limits: &Limits,
+    ) -> Result<Self, TextureError> {
+        limits.check(width, height, Format::Rgba32Float)?;
+        let total = pyramid::pyramid_texels(width, height);
+        if texels.len() as u64 != total {
+            return Err(TextureError::DataLength {
+                width,
+                height,
+                expected: total as usize,
+                got: texels.len(),
+            });
+        }
+        check_finite(width, &texels)?;
+        let mut offset = 0;
+        let levels = (0..pyramid::level_count(width, height))
+            .map(|k| {
+                let (w, h) = pyramid::level_size(width, height, k);
+                let info = LevelInfo {
+                    width: w,
+                    height: h,
+                    offset,
+                };
+                offset += w as usize * h as usize;
+                info
+            })
+            .collect();
+        Ok(Texture::assemble(
+            Format::Rgba32Float,
+            levels,
+            Storage::F32(texels),
             limits,
         ))
     }
@@ -692,6 +732,21 @@ pub(crate) fn decode_rgba8(t: [u8; 4], srgb: bool) -> [f32; 4] {
         table[t[2] as usize],
         lin[t[3] as usize],
     ]
+}
+
+/// [`TextureError::NonFiniteTexel`] for the first non-finite value of row-major `texels` (rows
+/// of `width`; past level 0, the index counts on as if the level continued).
+fn check_finite(width: u32, texels: &[[f32; 4]]) -> Result<(), TextureError> {
+    if let Some(k) = texels.iter().position(|t| !t.iter().all(|c| c.is_finite())) {
+        let channel = texels[k].iter().position(|c| !c.is_finite()).unwrap_or(0);
+        return Err(TextureError::NonFiniteTexel {
+            x: (k % width as usize) as u32,
+            y: (k / width as usize) as u32,
+            channel: ["R", "G", "B", "A"][channel],
+            value: texels[k][channel],
+        });
+    }
+    Ok(())
 }
 
 fn check_len(width: u32, height: u32, got: usize) -> Result<(), TextureError> {

@@ -40,7 +40,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let structure_bytes = prepared.build_structures(&samplers)?;
     let started = std::time::Instant::now();
-    let frame = render(&prepared.settings(), &prepared.draws(&samplers))?;
+    let settings = prepared.settings_for(&samplers, &prepared.scene.camera);
+    let frame = render(&settings, &prepared.draws(&samplers))?;
     let ms = started.elapsed().as_secs_f64() * 1e3;
     texel::frame_image(&frame, Encoding::Srgb)?.write_png(&out)?;
     println!(

@@ -109,7 +109,7 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Err
         None => prepared.default_samplers()?,
     };
     prepared.build_structures_within(&samplers, &mut budget)?;
-    let mut settings = prepared.settings();
+    let mut settings = prepared.settings_for(&samplers, &prepared.scene.camera);
     settings.view = options.view;
     Ok(render(&settings, &prepared.draws(&samplers))?)
 }

@@ -5,6 +5,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::{Mutex, OnceLock};
 
+use texel_raster::environment::{self, Environment, EnvironmentMaps};
 use texel_raster::layers::{Layer, LayerBlend, Layers, MAX_LAYERS};
 use texel_raster::{
     ChannelInput, ColorTarget, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
@@ -106,6 +107,28 @@ pub struct PreparedScene {
     /// [`crate::tessellate::REFERENCE_EDGE_PX`] and displaced by level-0 heights (built on first
     /// use).
     reference_geometry: OnceLock<Vec<Option<Tessellated>>>,
+    /// The environment's maps ([`texel_raster::environment`]), when the scene has one.
+    environment: Option<EnvironmentMaps>,
+}
+
+/// Load the environment map of `spec` within what `budget` has left and prefilter it (its
+/// glossy pyramid and irradiance), charging both.
+fn environment_maps(
+    spec: &texel_scene::EnvironmentSpec,
+    budget: &mut MemoryBudget,
+) -> Result<EnvironmentMaps, Error> {
+    let limits = Limits {
+        max_bytes: budget.remaining(),
+        ..Limits::default()
+    };
+    let radiance = spec.load(&limits)?;
+    budget.take("the environment map", radiance.pyramid_bytes())?;
+    let (w, h) = (radiance.width(), radiance.height());
+    budget.take(
+        "the environment's prefiltered pyramid and irradiance",
+        EnvironmentMaps::extra_bytes(w, h),
+    )?;
+    Ok(EnvironmentMaps::new(radiance, &Limits::default())?)
 }
 
 impl PreparedScene {
@@ -159,6 +182,10 @@ impl PreparedScene {
             )?;
             textures.insert(u.name.to_string(), loaded.texture);
         }
+        let environment = match &scene.environment {
+            Some(spec) => Some(environment_maps(spec, budget)?),
+            None => None,
+        };
         let mut own_samplers: Vec<TextureSampler> = Vec::new();
         let mut own_sampler_of = BTreeMap::new();
         for u in scene.used_textures() {
@@ -325,6 +352,7 @@ impl PreparedScene {
             reference_geometry: OnceLock::new(),
             own_samplers,
             own_sampler_of,
+            environment,
         })
     }
 
@@ -345,10 +373,15 @@ impl PreparedScene {
             .own_samplers
             .iter()
             .map(|s| (s.address_mode_u, s.address_mode_v));
-        meshes
+        let mut out: Vec<Sampler> = meshes
             .chain(own)
             .map(|(u, v)| Ok(Sampler::new(filter.descriptor(u, v))?))
-            .collect()
+            .collect::<Result<_, Error>>()?;
+        if self.environment.is_some() {
+            let desc = filter.descriptor(AddressMode::Repeat, AddressMode::ClampToEdge);
+            out.push(Sampler::new(environment::equirect_descriptor(desc))?);
+        }
+        Ok(out)
     }
 
     /// The samplers of [`PreparedScene::samplers`] when no filter is named: a glTF mesh's or
@@ -367,7 +400,7 @@ impl PreparedScene {
             .own_samplers
             .iter()
             .map(|s| (s.address_mode_u, s.address_mode_v, Some(s.filters)));
-        meshes
+        let mut out: Vec<Sampler> = meshes
             .chain(own)
             .map(|(u, v, filters)| {
                 let mut desc = Filter::Trilinear.descriptor(u, v);
@@ -378,7 +411,47 @@ impl PreparedScene {
                 }
                 Ok(Sampler::new(desc)?)
             })
-            .collect()
+            .collect::<Result<_, Error>>()?;
+        if self.environment.is_some() {
+            let desc = Filter::Trilinear.descriptor(AddressMode::Repeat, AddressMode::ClampToEdge);
+            out.push(Sampler::new(environment::equirect_descriptor(desc))?);
+        }
+        Ok(out)
+    }
+
+    /// The scene's environment as a frame seen by `camera` reads it, through the last of
+    /// `samplers` (those of [`PreparedScene::samplers`], which end with the environment's when
+    /// there is one); `None` for a scene without one.
+    pub fn environment<'a>(
+        &'a self,
+        samplers: &'a [Sampler],
+        camera: &texel_scene::Camera,
+    ) -> Option<Environment<'a>> {
+        let aspect = self.width as f32 / self.height as f32;
+        self.environment_through(samplers, camera.clip_from_world(aspect))
+    }
+
+    /// [`PreparedScene::environment`] with the background seen through `clip_from_world` (the
+    /// viewer's fly camera at its own aspect).
+    pub fn environment_through<'a>(
+        &'a self,
+        samplers: &'a [Sampler],
+        clip_from_world: glam::Mat4,
+    ) -> Option<Environment<'a>> {
+        let maps = self.environment.as_ref()?;
+        let spec = self.scene.environment.as_ref()?;
+        Some(Environment {
+            maps,
+            sampler: samplers.last()?,
+            intensity: spec.intensity,
+            background: spec.background,
+            clip_from_world,
+        })
+    }
+
+    /// Whether the scene has an environment map.
+    pub fn has_environment(&self) -> bool {
+        self.environment.is_some()
     }
 
     /// Build the acceleration structures `samplers` need (ripmaps, summed-area tables) ahead of
@@ -637,7 +710,7 @@ impl PreparedScene {
     /// [`ColorHandling::Raw`]), so a frame holds the bytes a PNG of it holds. Set
     /// `target = ColorTarget::Float` for linear floats (accumulating, comparing before
     /// quantisation).
-    pub fn settings(&self) -> RenderSettings {
+    pub fn settings(&self) -> RenderSettings<'static> {
         let mut s = RenderSettings::new(self.width, self.height);
         s.target = match self.color {
             ColorHandling::Srgb => ColorTarget::Srgb8,
@@ -673,6 +746,19 @@ impl PreparedScene {
             decode(bg[2]),
             f32::from(bg[3]) / 255.0,
         ];
+        s
+    }
+
+    /// [`PreparedScene::settings`] with the scene's environment as `camera` sees it through the
+    /// last of `samplers` ([`PreparedScene::environment`]): what every frame of the scene
+    /// renders with.
+    pub fn settings_for<'a>(
+        &'a self,
+        samplers: &'a [Sampler],
+        camera: &texel_scene::Camera,
+    ) -> RenderSettings<'a> {
+        let mut s = self.settings();
+        s.environment = self.environment(samplers, camera);
         s
     }
 }

@@ -311,6 +311,22 @@ fn camera_draws<'a>(
     draws
 }
 
+/// `settings` with the environment of the scene loaded for `key` (if it has one) read through
+/// `key`'s samplers and seen through `clip`.
+fn with_environment<'a>(
+    settings: &RenderSettings,
+    scenes: &'a [Option<PreparedScene>; 2],
+    samplers: &'a HashMap<SamplerKey, Vec<Sampler>>,
+    key: SamplerKey,
+    clip: glam::Mat4,
+) -> RenderSettings<'a> {
+    let scene = scenes[key.2].as_ref().expect("loaded with its samplers");
+    RenderSettings {
+        environment: scene.environment_through(&samplers[&key], clip),
+        ..*settings
+    }
+}
+
 /// The pixel rectangles `[x0, y0, x1, y1]` of the modes on screen at `w x h`.
 pub fn part_rects(state: &ViewState, w: u32, h: u32) -> Vec<[u32; 4]> {
     if state.split && w >= 2 {
@@ -432,6 +448,8 @@ impl FrameContext<'_, '_> {
             };
             let key = self.samplers(filter, state)?;
             let draws = camera_draws(&self.worker.scenes, self.samplers, key, clip);
+            let settings =
+                with_environment(&settings, &self.worker.scenes, self.samplers, key, clip);
             match mode {
                 Mode::Filter(f) if gpu => {
                     let gpu_dev = self.gpu.expect("use_gpu checked");
@@ -579,12 +597,14 @@ impl FrameContext<'_, '_> {
             }
             let key = self.samplers(filter, state)?;
             let draws = camera_draws(&self.worker.scenes, self.samplers, key, clip);
+            let settings =
+                with_environment(settings, &self.worker.scenes, self.samplers, key, clip);
             let s = RenderSettings {
                 scissor: Some(rect),
                 view: View::Color,
                 count_texels: true,
                 capture_footprints: true,
-                ..*settings
+                ..settings
             };
             let counted = texel_raster::render(&s, &draws)?;
             let (mut texels, mut covered) = (0u64, 0u64);
