@@ -214,13 +214,6 @@ impl EnvironmentMaps {
         })
     }
 
-    /// Bytes the maps hold (the three pyramids).
-    pub fn bytes(&self) -> u64 {
-        self.radiance.pyramid_bytes()
-            + self.glossy.pyramid_bytes()
-            + self.irradiance.pyramid_bytes()
-    }
-
     /// Bytes [`EnvironmentMaps::new`] adds to a `width x height` map: the float glossy pyramid and
     /// the irradiance map.
     pub fn extra_bytes(width: u32, height: u32) -> u64 {
@@ -476,13 +469,14 @@ impl Environment<'_> {
         if lod_r <= 0.0 {
             return self.radiance(r, dr, reference, count);
         }
-        let lod = if reference {
-            lod_r
+        let (uv, lod) = if reference {
+            (equirect_uv(r), lod_r)
         } else {
             let fp = equirect_footprint(r, dr[0], dr[1]);
-            lod_r.max(self.sampler.lod(&maps.radiance, &fp))
+            let uv = DVec2::new(fp.u.into(), fp.v.into());
+            (uv, lod_r.max(self.sampler.lod(&maps.radiance, &fp)))
         };
-        let fp = footprint_at_lod(equirect_uv(r), lod, w, h);
+        let fp = footprint_at_lod(uv, lod, w, h);
         self.read(&maps.trilinear, &maps.glossy, &fp, count)
     }
 
@@ -497,11 +491,11 @@ impl Environment<'_> {
         self.read(&self.maps.trilinear, &self.maps.irradiance, &fp, count)
     }
 
-    /// The camera rays of the background for a `width x height` frame (`None` for a camera
-    /// without rays: a singular matrix).
-    pub fn view_rays(&self, width: u32, height: u32) -> Option<ViewRays> {
+    /// The camera rays of the background for a `width x height` frame: `None` where the
+    /// environment is not the background, or the camera has no rays (a singular matrix).
+    pub fn background_rays(&self, width: u32, height: u32) -> Option<ViewRays> {
         let m = DMat4::from_cols_array(&self.clip_from_world.to_cols_array().map(f64::from));
-        (m.determinant() != 0.0).then(|| ViewRays {
+        (self.background && m.determinant() != 0.0).then(|| ViewRays {
             world_from_clip: m.inverse(),
             width: f64::from(width),
             height: f64::from(height),
@@ -554,6 +548,7 @@ mod tests {
         let uv = equirect_uv(DVec3::NEG_Z);
         assert!((uv - DVec2::new(0.5, 0.5)).length() < 1e-12);
         assert!(equirect_uv(DVec3::Y).y.abs() < 1e-12);
+        assert!((equirect_uv(DVec3::NEG_Y).y - 1.0).abs() < 1e-12);
         assert!((equirect_uv(DVec3::X).x - 0.75).abs() < 1e-12);
         for k in 0..200 {
             let uv = DVec2::new(

@@ -246,8 +246,7 @@ fn reference_frame(
         lighting: Lighting::of(settings, true),
         background: settings
             .environment
-            .filter(|e| e.background)
-            .and_then(|e| Some((e, e.view_rays(width, height)?))),
+            .and_then(|e| Some((e, e.background_rays(width, height)?))),
         strata,
         seed,
     };

@@ -174,12 +174,10 @@ impl<'a> Lighting<'a> {
     }
 }
 
-/// The environment's light on `surface` (linear RGB) and the texels read: specular from the
-/// direction the view reflects to, with its screen derivatives differentiated as pbrt-v4 does
-/// (`dr = 2 ((dn.v + n.dv) n + (n.v) dn) - dv`, where `dp` and `dn` come from the barycentrics'
-/// derivatives `dlambda` and the interpolated vertex normals, and `dv` from `dp`), and diffuse
-/// from the irradiance along the diffuse normal (see [`crate::environment`]); `lambert` keeps
-/// only the diffuse part with the base colour itself. Scaled by the surface's occlusion.
+/// The environment's light on `surface` (linear RGB), adding the texels read to `texels`:
+/// diffuse from the irradiance along the diffuse normal and, unless `lambert`, specular from the
+/// direction the view reflects to ([`reflection`]) through the split sum (see
+/// [`crate::environment`]). Scaled by the surface's occlusion.
 #[allow(clippy::too_many_arguments)]
 fn environment_light(
     lighting: &Lighting,
@@ -195,39 +193,16 @@ fn environment_light(
     let Some(env) = &lighting.environment else {
         return Vec3::ZERO;
     };
-    let c_diff = surface.base * if lambert { 1.0 } else { 1.0 - surface.metallic };
     let nd = surface
         .diffuse_normal
         .as_dvec3()
         .normalize_or(surface.normal.as_dvec3());
     let (irr, k) = env.irradiance(nd, count);
     *texels += k;
-    let mut out = c_diff * irr;
+    let mut out = surface.base * (1.0 - surface.metallic) * irr;
     if !lambert {
-        let n = surface.normal.as_dvec3();
-        let p = surface.position.as_dvec3();
-        let to_eye = eye.as_dvec3() - p;
-        let dist = to_eye.length().max(1e-30);
-        let v = to_eye / dist;
-        let n_dot_v = n.dot(v);
-        let r = n * (2.0 * n_dot_v) - v;
-        let mut dr = [DVec3::ZERO; 2];
-        if !lighting.reference {
-            let m = lerp3(verts, lambda, |v| v.normal);
-            let len = m.length();
-            let ng = if len > 0.0 { m / len } else { DVec3::ZERO };
-            for (dr, dl) in dr.iter_mut().zip(dlambda) {
-                let dp = lerp3(verts, dl, |v| v.position);
-                let dm = lerp3(verts, dl, |v| v.normal);
-                let dn = if len > 0.0 {
-                    (dm - ng * ng.dot(dm)) / len
-                } else {
-                    DVec3::ZERO
-                };
-                let dv = -(dp - v * v.dot(dp)) / dist;
-                *dr = (n * (dn.dot(v) + n.dot(dv)) + dn * n_dot_v) * 2.0 - dv;
-            }
-        }
+        let derivatives = !lighting.reference;
+        let (r, dr, n_dot_v) = reflection(verts, lambda, dlambda, surface, eye, derivatives);
         let (spec, k) = env.specular(r, dr, surface.roughness, lighting.reference, count);
         *texels += k;
         let f0 = Vec3::splat(0.04).lerp(surface.base, surface.metallic);
@@ -235,6 +210,45 @@ fn environment_light(
         out += spec * (f0 * a + Vec3::splat(b));
     }
     out * surface.occlusion
+}
+
+/// The direction `r = 2 (n.v) n - v` the view reflects to about the surface's normal, its
+/// screen derivatives when `derivatives` (zero otherwise), and `n.v`. The derivatives are
+/// pbrt-v4's, `dr = 2 ((dn.v + n.dv) n + (n.v) dn) - dv`, with `dp` and `dn` (of the
+/// interpolated vertex normals) from the barycentrics' derivatives `dlambda`, and `dv` from `dp`.
+fn reflection(
+    verts: [&Vertex; 3],
+    lambda: DVec3,
+    dlambda: [DVec3; 2],
+    surface: &Surface,
+    eye: Vec3,
+    derivatives: bool,
+) -> (DVec3, [DVec3; 2], f64) {
+    let n = surface.normal.as_dvec3();
+    let to_eye = eye.as_dvec3() - surface.position.as_dvec3();
+    let dist = to_eye.length().max(1e-30);
+    let v = to_eye / dist;
+    let n_dot_v = n.dot(v);
+    let r = n * (2.0 * n_dot_v) - v;
+    if !derivatives {
+        return (r, [DVec3::ZERO; 2], n_dot_v);
+    }
+    let m = lerp3(verts, lambda, |v| v.normal);
+    let len = m.length();
+    let ng = if len > 0.0 { m / len } else { DVec3::ZERO };
+    let dr = dlambda.map(|dl| {
+        let dp = lerp3(verts, dl, |v| v.position);
+        let dm = lerp3(verts, dl, |v| v.normal);
+        // Without vertex normals the normal does not turn.
+        let dn = if len > 0.0 {
+            (dm - ng * ng.dot(dm)) / len
+        } else {
+            DVec3::ZERO
+        };
+        let dv = -(dp - v * v.dot(dp)) / dist;
+        (n * (dn.dot(v) + n.dot(dv)) + dn * n_dot_v) * 2.0 - dv
+    });
+    (r, dr, n_dot_v)
 }
 
 /// `sum lambda_k f(vertex_k)` in `f64`.
@@ -275,6 +289,13 @@ pub(crate) fn shade(
         }
         return (c.to_array(), texels);
     };
+    // The lights' and the environment's radiance; `lambert` drops the specular lobe.
+    let light = |surface: &Surface, lambert: bool, texels: &mut u32| {
+        material::radiance(surface, ctx.eye, &lighting.lights, lambert)
+            + environment_light(
+                lighting, verts, lambda, dlambda, surface, ctx.eye, lambert, count, texels,
+            )
+    };
     let mut position = relief::interpolate(verts, l, |v| v.position);
     let normal = relief::geometric_normal(verts, l);
     let Some(m) = &ctx.material else {
@@ -288,19 +309,7 @@ pub(crate) fn shade(
             position,
             occlusion: 1.0,
         };
-        let mut texels = 0;
-        let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, true)
-            + environment_light(
-                lighting,
-                verts,
-                lambda,
-                dlambda,
-                &surface,
-                ctx.eye,
-                true,
-                count,
-                &mut texels,
-            );
+        let rgb = light(&surface, true, &mut texels);
         return (rgb.extend(c.w).to_array(), texels);
     };
     // Parallax occlusion mapping moves every read to where the view ray meets the relief.
@@ -404,18 +413,7 @@ pub(crate) fn shade(
         position,
         occlusion,
     };
-    let rgb = material::radiance(&surface, ctx.eye, &lighting.lights, false)
-        + environment_light(
-            lighting,
-            verts,
-            lambda,
-            dlambda,
-            &surface,
-            ctx.eye,
-            false,
-            count,
-            &mut texels,
-        );
+    let rgb = light(&surface, false, &mut texels);
     (rgb.extend(c.w).to_array(), texels)
 }
 

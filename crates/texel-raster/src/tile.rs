@@ -173,8 +173,8 @@ pub(crate) fn draw_frame(
         capture,
         background: settings
             .environment
-            .filter(|e| e.background && settings.view == View::Color)
-            .and_then(|e| Some((e, e.view_rays(width, height)?))),
+            .filter(|_| settings.view == View::Color)
+            .and_then(|e| Some((e, e.background_rays(width, height)?))),
     };
     let (tx, _) = tile_counts(width, height);
     let mut color = split_rows(&mut frame.color, width, height).into_iter();

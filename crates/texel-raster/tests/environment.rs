@@ -2,7 +2,7 @@
 //! background and the light of a constant environment, and the seam's footprints.
 
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
-use texel_raster::environment::{equirect_descriptor, equirect_uv, roughness_lod};
+use texel_raster::environment::{equirect_descriptor, roughness_lod};
 use texel_raster::{
     render, render_reference, DrawCall, Environment, EnvironmentMaps, Material, RenderSettings,
     Vertex,
@@ -271,12 +271,6 @@ fn a_constant_environment_lights_by_the_split_sum() {
     };
     let c = shaded(Some(black));
     assert!((c[0] - 2.0 * l * 0.04).abs() < 0.01, "{c:?}");
-}
-
-#[test]
-fn equirect_coordinates_of_the_axes() {
-    assert!((equirect_uv(DVec3::NEG_Z).x - 0.5).abs() < 1e-12);
-    assert!((equirect_uv(DVec3::NEG_Y).y - 1.0).abs() < 1e-12);
 }
 
 /// The directional albedo `E(n.v = 1)` of a white metal of GGX `alpha` (F = 1), integrated on a

@@ -377,11 +377,22 @@ impl PreparedScene {
             .chain(own)
             .map(|(u, v)| Ok(Sampler::new(filter.descriptor(u, v))?))
             .collect::<Result<_, Error>>()?;
+        self.push_environment_sampler(&mut out, filter)?;
+        Ok(out)
+    }
+
+    /// Append the environment's sampler for `filter` (with the equirectangular map's address
+    /// modes) to `samplers`, when the scene has an environment.
+    fn push_environment_sampler(
+        &self,
+        samplers: &mut Vec<Sampler>,
+        filter: Filter,
+    ) -> Result<(), Error> {
         if self.environment.is_some() {
             let desc = filter.descriptor(AddressMode::Repeat, AddressMode::ClampToEdge);
-            out.push(Sampler::new(environment::equirect_descriptor(desc))?);
+            samplers.push(Sampler::new(environment::equirect_descriptor(desc))?);
         }
-        Ok(out)
+        Ok(())
     }
 
     /// The samplers of [`PreparedScene::samplers`] when no filter is named: a glTF mesh's or
@@ -412,10 +423,7 @@ impl PreparedScene {
                 Ok(Sampler::new(desc)?)
             })
             .collect::<Result<_, Error>>()?;
-        if self.environment.is_some() {
-            let desc = Filter::Trilinear.descriptor(AddressMode::Repeat, AddressMode::ClampToEdge);
-            out.push(Sampler::new(environment::equirect_descriptor(desc))?);
-        }
+        self.push_environment_sampler(&mut out, Filter::Trilinear)?;
         Ok(out)
     }
 
@@ -447,11 +455,6 @@ impl PreparedScene {
             background: spec.background,
             clip_from_world,
         })
-    }
-
-    /// Whether the scene has an environment map.
-    pub fn has_environment(&self) -> bool {
-        self.environment.is_some()
     }
 
     /// Build the acceleration structures `samplers` need (ripmaps, summed-area tables) ahead of
