@@ -152,6 +152,31 @@ pub struct SceneArgs {
     /// (e.g. builtin:terrain).
     #[arg(long, value_enum)]
     pub layer_order: Option<LayerOrderArg>,
+    /// Lay the scene's procedural sky out as this mapping, at about the same texel angle
+    /// (e.g. builtin:mirror-plane; a map from files keeps its own layout).
+    #[arg(long, value_enum, value_name = "MAPPING")]
+    pub environment_mapping: Option<EnvironmentMappingArg>,
+}
+
+/// An environment map's layout (see texel-texture's `sphere` module).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EnvironmentMappingArg {
+    /// Latitude-longitude, twice as wide as high.
+    Equirect,
+    /// Six faces with Vulkan's orientation, filtered across their edges.
+    Cube,
+    /// pbrt-v4's equal-area octahedral square.
+    Octahedral,
+}
+
+impl From<EnvironmentMappingArg> for texel_scene::Mapping {
+    fn from(a: EnvironmentMappingArg) -> Self {
+        match a {
+            EnvironmentMappingArg::Equirect => texel_scene::Mapping::Equirect,
+            EnvironmentMappingArg::Cube => texel_scene::Mapping::Cube,
+            EnvironmentMappingArg::Octahedral => texel_scene::Mapping::Octahedral,
+        }
+    }
 }
 
 /// Where a layered material blends (see texel-raster's `layers` module).

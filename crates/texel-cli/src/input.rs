@@ -111,6 +111,8 @@ pub struct MaterialOverrides {
     pub edge_px: Option<f32>,
     /// `--layer-order`.
     pub layer_order: Option<texel_scene::LayerOrder>,
+    /// `--environment-mapping`.
+    pub environment_mapping: Option<texel_scene::Mapping>,
 }
 
 impl MaterialOverrides {
@@ -121,6 +123,7 @@ impl MaterialOverrides {
             displacement: args.displacement.map(Into::into),
             edge_px: args.edge_px,
             layer_order: args.layer_order.map(Into::into),
+            environment_mapping: args.environment_mapping.map(Into::into),
         }
     }
 }
@@ -156,6 +159,7 @@ pub fn load_scene_with(
         displacement: overrides.displacement,
         edge_px: overrides.edge_px,
         layer_order: overrides.layer_order,
+        environment_mapping: overrides.environment_mapping,
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;

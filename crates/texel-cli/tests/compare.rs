@@ -186,30 +186,69 @@ fn ground_plane_filter_ranking_against_a_16x16_reference() {
 
 #[test]
 fn footprint_aware_environment_lookups_beat_level_zero_on_the_rippled_mirror() {
-    let d = Dir::new("mirror-plane");
-    let out = d.arg("report");
+    // The same sky laid out in each mapping: every one filters its reflections by footprint.
+    for mapping in ["equirect", "cube", "octahedral"] {
+        let d = Dir::new(&format!("mirror-plane-{mapping}"));
+        let out = d.arg("report");
+        ok(&[
+            "compare",
+            "builtin:mirror-plane",
+            "--environment-mapping",
+            mapping,
+            "--size",
+            "320x180",
+            "--spp",
+            "64",
+            "--filters",
+            "bilinear,trilinear,aniso16,ewa",
+            "--out",
+            &out,
+        ]);
+        let psnr = psnr_of(&d.join("report/report.json"));
+        let (b, t, a, e) = (
+            psnr("bilinear"),
+            psnr("trilinear"),
+            psnr("aniso16"),
+            psnr("ewa"),
+        );
+        // Every filter reads the reflection through its own footprint; bilinear reads level 0.
+        assert!(t > b + 2.0, "{mapping}: trilinear {t} bilinear {b}");
+        assert!(
+            a > t && e > t,
+            "{mapping}: aniso16 {a} ewa {e} trilinear {t}"
+        );
+    }
+}
+
+#[test]
+fn only_the_procedural_sky_is_laid_out_anew() {
+    let d = Dir::new("env-file-mapping");
+    let mut hdr = Vec::new();
+    let pixels = vec![image::Rgb([1.0f32, 0.5, 0.25]); 8 * 4];
+    image::codecs::hdr::HdrEncoder::new(&mut hdr)
+        .encode(&pixels, 8, 4)
+        .unwrap();
+    d.write("sky.hdr", &hdr);
+    let scene = d.write(
+        "scene.toml",
+        format!("{HEAD}{TRIANGLE}\n[environment]\npath = \"sky.hdr\"\n"),
+    );
+    let out = d.arg("a.png");
+    let scene = scene.to_str().unwrap();
+    ok(&["render", scene, "-o", &out]);
     ok(&[
-        "compare",
-        "builtin:mirror-plane",
-        "--size",
-        "320x180",
-        "--spp",
-        "64",
-        "--filters",
-        "bilinear,trilinear,aniso16,ewa",
-        "--out",
+        "render",
+        scene,
+        "--environment-mapping",
+        "equirect",
+        "-o",
         &out,
     ]);
-    let psnr = psnr_of(&d.join("report/report.json"));
-    let (b, t, a, e) = (
-        psnr("bilinear"),
-        psnr("trilinear"),
-        psnr("aniso16"),
-        psnr("ewa"),
+    fails(
+        &["render", scene, "--environment-mapping", "cube", "-o", &out],
+        1,
+        &["only the procedural sky", "equirect"],
     );
-    // Every filter reads the reflection through its own footprint; bilinear reads level 0.
-    assert!(t > b + 2.0, "trilinear {t} bilinear {b}");
-    assert!(a > t && e > t, "aniso16 {a} ewa {e} trilinear {t}");
 }
 
 /// The whole-image PSNR of each row of the report at `path`, by filter name.

@@ -1,40 +1,55 @@
-//! Environment maps: light from every direction, stored as an equirectangular (latitude-longitude)
-//! image, seen as the background and reflected by surfaces.
+//! Environment maps: light from every direction, stored equirectangular (latitude-longitude), as
+//! a cube or octahedral, seen as the background and reflected by surfaces.
 //!
-//! Directions to texture coordinates follow DESIGN.md: for a direction `d`,
-//! `u = 0.5 + atan2(d.x, -d.z) / (2 pi)` and `v = acos(d.y / |d|) / pi` (`v = 0` straight up, `-z`
-//! at the centre column). The seam `u = 0 = 1` lies along `+z`.
+//! Directions become texture coordinates through [`texel_texture::sphere`] (DESIGN.md's
+//! conventions: equirect `u = 0.5 + atan2(d.x, -d.z) / (2 pi)`, `v = acos(d.y / |d|) / pi`;
+//! Vulkan's cube faces; pbrt-v4's equal-area octahedral square).
 //!
-//! **Footprints come from analytic gradients** ([`equirect_duv`]): the screen derivatives of the
-//! direction (the camera ray's for the background; the reflected direction's, differentiated as
-//! pbrt-v4 does with `dn/dx` and `dp/dx`, for reflections) are mapped through the exact Jacobian of
-//! `(u, v)(d)`, `du = (x dz - z dx) / (2 pi (x^2 + z^2))`,
-//! `dv = -(dy - y (d.dd) / |d|^2) / (pi sqrt(x^2 + z^2))`. Differencing `u` itself would jump by
-//! about 1 across the seam and pick the coarsest level there (a visible line). Near the poles
-//! `du` grows as `1 / sin(theta)`: the footprint becomes long in `u`, which is exactly the
-//! stretch the anisotropic and EWA filters are for. Each derivative is clamped to 1 (one period;
-//! any more selects the coarsest level anyway).
+//! **Footprints come from analytic gradients** ([`MapLayout::footprint`]): the screen
+//! derivatives of the direction (the camera ray's for the background; the reflected
+//! direction's, differentiated as pbrt-v4 does with `dn/dx` and `dp/dx`, for reflections) are
+//! mapped through the exact Jacobian of the mapping ([`texel_texture::sphere::equirect_duv`],
+//! [`texel_texture::sphere::cube_dst`], [`texel_texture::sphere::octahedral_duv`]). Differencing
+//! `u` itself would jump by about 1 across a seam and pick the coarsest level there (a visible
+//! line). Near an equirect map's poles `du` grows as `1 / sin(theta)`: the footprint becomes long
+//! in `u`, which is exactly the stretch the anisotropic and EWA filters are for.
+//!
+//! **Seamless cube and octahedral maps.** Each cube face, and the octahedral square, is stored
+//! with a border of [`border`]`(N) = N / 8` texels (at least 1) on every side, filled from the
+//! neighbouring faces (the face's plane extended: a border texel holds the map's radiance along
+//! the direction through its centre, read bilinearly from the face that direction selects) or, for
+//! the octahedral square, from the square's own continuation ([`texel_texture::sphere::octahedral_wrap`],
+//! which maps border texel centres exactly onto texel centres). The box pyramid is built over the
+//! bordered image, so every level's border continues its face. Any filter then reads across an
+//! edge as if the neighbouring face were there: where Vulkan's seamless cube filtering fetches the
+//! neighbour's edge texels for the 2x2 bilinear footprint only, the border also serves the
+//! anisotropic probes, EWA's ellipse and the summed-area box, up to `N / 8` level-0 texels past the
+//! edge (`N / 2^(k+3)` at level `k`; footprints reaching further are clamped to the border's last
+//! texel). Each level's border halves with the face, so it covers the same angle at every level.
 //!
 //! **Glossy reflection** reads a GGX-prefiltered pyramid ([`EnvironmentMaps::glossy`], Karis 2013,
 //! "Real Shading in Unreal Engine 4"): level 0 is the map itself and level `k >= 1` is the map
-//! convolved with GGX of `alpha_k = min(1, 2 pi 2^k / W)` (`W` the map's width) under Karis's
-//! `n = v = r` assumption, weighted by `n.l`. The lobe's full width at half maximum is about
-//! `2.6 alpha` radians of reflected direction, so level `k`'s lobe spans about 2.6 of its own
-//! texels: it is sampled without aliasing at its resolution. A lookup with roughness `r` uses
-//! `lod_r = log2(r^2 W / (2 pi))` and reads at `max(lod_r, lod_footprint)` (trilinear), where
-//! `lod_footprint` is the frame filter's level for the reflected direction's footprint; below
-//! `lod_r = 0` (perceptual roughness under `sqrt(2 pi / W)`, 0.078 for a 1024-wide map) the
-//! surface is a mirror and the frame's filter reads the plain map with that footprint, like any
-//! texture. The convolution is importance-sampled (64 Hammersley directions per texel) from the
-//! plain map's box pyramid at the level whose texel matches each sample's share of the lobe
-//! (Colbert and Krivanek 2007, GPU Gems 3 ch. 20, with Karis's +1 bias).
+//! convolved with GGX of `alpha_k = min(1, theta_0 2^k)`, `theta_0` the angle of a level-0 texel
+//! ([`MapLayout::texel_angle`]: `2 pi / W` for an equirect map, `2 / N` at a cube face's centre,
+//! `sqrt(4 pi) / N` for the octahedral square), under Karis's `n = v = r` assumption, weighted by
+//! `n.l`. The lobe's full width at half maximum is about `2.6 alpha` radians of reflected
+//! direction, so level `k`'s lobe spans about 2.6 of its own texels: it is sampled without aliasing
+//! at its resolution. A lookup with roughness `r` uses `lod_r = log2(r^2 / theta_0)` and reads at
+//! `max(lod_r, lod_footprint)` (trilinear), where `lod_footprint` is the frame filter's level for
+//! the reflected direction's footprint; below `lod_r = 0` (perceptual roughness under
+//! `sqrt(theta_0)`, 0.078 for a 1024-wide equirect map) the surface is a mirror and the frame's
+//! filter reads the plain map with that footprint, like any texture. The convolution is
+//! importance-sampled (64 Hammersley directions per texel) from the plain map's box pyramid at the
+//! level whose texel matches each sample's share of the lobe (Colbert and Krivanek 2007, GPU Gems
+//! 3 ch. 20, with Karis's +1 bias).
 //!
 //! **Split sum**: specular `= prefiltered(r) (F0 A + B)` with `(A, B)` the integrated GGX/Smith BRDF
 //! for `(n.v, roughness)` ([`dfg`], a 32x32 table integrated at first use with the shading model's
 //! own `D` and visibility, 256 samples per entry); diffuse `= c_diff E(n) / pi` with `E` the
-//! irradiance of the map ([`EnvironmentMaps::irradiance`], 32x16 texels, each a brute-force
-//! cosine-weighted sum over the 64-wide level of the map). Both are scaled by the environment's
-//! intensity and the surface's ambient occlusion.
+//! irradiance of the map ([`EnvironmentMaps::irradiance`], an equirect map of 32x16 texels, each a
+//! brute-force cosine-weighted sum over a 64x32 grid of directions read from the map at the
+//! grid's resolution, whatever its layout). Both are scaled by the environment's intensity and
+//! the surface's ambient occlusion.
 //!
 //! **The reference** ([`crate::reference`]) reads the plain map bilinearly at level 0 for the
 //! background and mirrors, and the glossy pyramid trilinearly at exactly `lod_r` (the lobe is the
@@ -45,6 +60,11 @@ use std::sync::OnceLock;
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Mat4, Vec3};
 use rayon::prelude::*;
+use texel_texture::sphere::{
+    cube_direction, cube_dst, cube_face, octahedral_direction, octahedral_duv, octahedral_uv,
+    octahedral_wrap,
+};
+pub use texel_texture::sphere::{equirect_direction, equirect_duv, equirect_uv, Mapping};
 use texel_texture::{AddressMode, Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
 use crate::error::RasterError;
@@ -56,78 +76,145 @@ pub const IRRADIANCE_WIDTH: u32 = 32;
 /// Hammersley samples per texel of the glossy pyramid's levels.
 pub const PREFILTER_SAMPLES: u32 = 64;
 
-/// The address modes of an equirectangular map: `u` wraps around, `v` stops at the poles.
-pub fn equirect_descriptor(desc: SamplerDescriptor) -> SamplerDescriptor {
+/// Width of the grid of directions the irradiance is summed over (its height is half).
+const IRRADIANCE_SOURCES: u32 = 64;
+
+/// The border in texels around each stored cube face or octahedral square of side `side`
+/// (module docs): `side / 8`, at least 1.
+pub fn border(side: u32) -> u32 {
+    (side / 8).max(1)
+}
+
+/// The address modes of a mapping's stored layers: an equirect map wraps around in `u` and stops
+/// at the poles in `v`; bordered cube faces and octahedral squares clamp to their border.
+pub fn descriptor(mapping: Mapping, desc: SamplerDescriptor) -> SamplerDescriptor {
+    let u = match mapping {
+        Mapping::Equirect => AddressMode::Repeat,
+        Mapping::Cube | Mapping::Octahedral => AddressMode::ClampToEdge,
+    };
     SamplerDescriptor {
-        address_mode_u: AddressMode::Repeat,
+        address_mode_u: u,
         address_mode_v: AddressMode::ClampToEdge,
         ..desc
     }
 }
 
-/// The equirectangular coordinates of direction `d` (any length but 0; see the module docs).
-/// `u` is in `[0, 1]`, `v` in `[0, 1]`; a zero or non-finite `d` gives NaN.
-pub fn equirect_uv(d: DVec3) -> DVec2 {
-    let len = d.length();
-    DVec2::new(
-        0.5 + d.x.atan2(-d.z) / (2.0 * PI),
-        (d.y / len).clamp(-1.0, 1.0).acos() / PI,
-    )
+/// How directions land in an environment's stored layers: the mapping, the side of a face (the
+/// width of an equirect map) and the border around it (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapLayout {
+    /// The mapping.
+    pub mapping: Mapping,
+    /// Texels across a cube face or the octahedral square; an equirect map's width.
+    pub side: u32,
+    /// An equirect map's height (a cube face's and the octahedral square's are `side`).
+    pub height: u32,
+    /// Border texels on each side of a stored face (0 for an equirect map).
+    pub border: u32,
 }
 
-/// The unit direction at equirectangular coordinates `uv` (the inverse of [`equirect_uv`]):
-/// `theta = pi v`, `phi = 2 pi (u - 0.5)`, `d = (sin theta sin phi, cos theta, -sin theta cos phi)`.
-pub fn equirect_direction(uv: DVec2) -> DVec3 {
-    let theta = PI * uv.y;
-    let phi = 2.0 * PI * (uv.x - 0.5);
-    let s = theta.sin();
-    DVec3::new(s * phi.sin(), theta.cos(), -s * phi.cos())
-}
-
-/// The change of [`equirect_uv`] for a small change `dd` of the direction `d` (the Jacobian
-/// applied to `dd`, module docs), each component clamped to `[-1, 1]`. Continuous across the
-/// seam; at the poles, where `u` is undefined, `du` is the clamp.
-pub fn equirect_duv(d: DVec3, dd: DVec3) -> DVec2 {
-    let rho2 = d.x * d.x + d.z * d.z;
-    let len2 = d.length_squared();
-    if !(rho2 > 1e-300 && len2.is_finite()) {
-        return DVec2::ONE;
+impl MapLayout {
+    /// The layout of a map of `mapping` whose source faces are `width x height`.
+    pub fn new(mapping: Mapping, width: u32, height: u32) -> Self {
+        let border = match mapping {
+            Mapping::Equirect => 0,
+            Mapping::Cube | Mapping::Octahedral => border(width),
+        };
+        MapLayout {
+            mapping,
+            side: width,
+            height,
+            border,
+        }
     }
-    let du = (d.x * dd.z - d.z * dd.x) / (2.0 * PI * rho2);
-    let dv = -(dd.y - d.y * d.dot(dd) / len2) / (PI * rho2.sqrt());
-    let c = |x: f64| if x.is_nan() { 1.0 } else { x.clamp(-1.0, 1.0) };
-    DVec2::new(c(du), c(dv))
-}
 
-/// The footprint of direction `d` with screen derivatives `dd_dx`, `dd_dy` (zero derivatives
-/// give a zero footprint: level 0).
-pub fn equirect_footprint(d: DVec3, dd_dx: DVec3, dd_dy: DVec3) -> Footprint {
-    let uv = equirect_uv(d);
-    let dx = equirect_duv(d, dd_dx);
-    let dy = equirect_duv(d, dd_dy);
-    Footprint {
-        u: uv.x as f32,
-        v: uv.y as f32,
-        dudx: dx.x as f32,
-        dudy: dy.x as f32,
-        dvdx: dx.y as f32,
-        dvdy: dy.y as f32,
+    /// Stored layers: 6 for a cube, else 1.
+    pub fn layers(&self) -> usize {
+        match self.mapping {
+            Mapping::Cube => 6,
+            Mapping::Equirect | Mapping::Octahedral => 1,
+        }
     }
-}
 
-/// GGX's `alpha` that level `k` of the glossy pyramid of a `width`-wide map holds.
-pub fn level_alpha(k: u32, width: u32) -> f64 {
-    if k == 0 {
-        return 0.0;
+    /// A stored layer's size, border included.
+    pub fn stored_size(&self) -> (u32, u32) {
+        (self.side + 2 * self.border, self.height + 2 * self.border)
     }
-    (2.0 * PI * f64::from(1u32 << k.min(31)) / f64::from(width.max(1))).min(1.0)
-}
 
-/// The glossy pyramid's level for perceptual roughness `roughness` (`log2(r^2 W / (2 pi))`; `<= 0`
-/// is a mirror).
-pub fn roughness_lod(roughness: f32, width: u32) -> f32 {
-    let alpha = f64::from(roughness.clamp(MIN_ROUGHNESS, 1.0)).powi(2);
-    (alpha * f64::from(width) / (2.0 * PI)).log2() as f32
+    /// The angle in radians a level-0 texel spans (module docs: the glossy pyramid's scale).
+    pub fn texel_angle(&self) -> f64 {
+        let n = f64::from(self.side.max(1));
+        match self.mapping {
+            Mapping::Equirect => 2.0 * PI / n,
+            Mapping::Cube => 2.0 / n,
+            Mapping::Octahedral => (4.0 * PI).sqrt() / n,
+        }
+    }
+
+    /// The stored uv of a face's own uv (the border shifts and shrinks it), per axis.
+    fn scale_offset(&self) -> (DVec2, DVec2) {
+        let (w, h) = self.stored_size();
+        let (w, h) = (f64::from(w), f64::from(h));
+        let b = f64::from(self.border);
+        (
+            DVec2::new(f64::from(self.side) / w, f64::from(self.height) / h),
+            DVec2::new(b / w, b / h),
+        )
+    }
+
+    /// The layer direction `d` (any length but 0) lands in and its stored uv; a zero or
+    /// non-finite `d` gives layer 0 and NaN.
+    pub fn locate(&self, d: DVec3) -> (usize, DVec2) {
+        let (scale, offset) = self.scale_offset();
+        let (layer, uv) = match self.mapping {
+            Mapping::Equirect => (0, equirect_uv(d)),
+            Mapping::Cube => cube_face(d).unwrap_or((0, DVec2::NAN)),
+            Mapping::Octahedral => (0, octahedral_uv(d)),
+        };
+        (layer, uv * scale + offset)
+    }
+
+    /// The layer direction `d` lands in and its footprint there for screen derivatives `dd_dx`,
+    /// `dd_dy` of `d` (analytic, module docs; zero derivatives give a zero footprint, level 0).
+    pub fn footprint(&self, d: DVec3, dd_dx: DVec3, dd_dy: DVec3) -> (usize, Footprint) {
+        let (layer, uv) = self.locate(d);
+        let (scale, _) = self.scale_offset();
+        let duv = |dd: DVec3| {
+            scale
+                * match self.mapping {
+                    Mapping::Equirect => equirect_duv(d, dd),
+                    Mapping::Cube => cube_dst(layer, d, dd),
+                    Mapping::Octahedral => octahedral_duv(d, dd),
+                }
+        };
+        let (dx, dy) = (duv(dd_dx), duv(dd_dy));
+        let fp = Footprint {
+            u: uv.x as f32,
+            v: uv.y as f32,
+            dudx: dx.x as f32,
+            dudy: dy.x as f32,
+            dvdx: dx.y as f32,
+            dvdy: dy.y as f32,
+        };
+        (layer, fp)
+    }
+
+    /// The unit direction through the centre of texel `(i, j)` of a stored `lw x lh` level of
+    /// `layer` (border texels included: a cube face's plane extended, the octahedral square
+    /// continued).
+    pub fn texel_direction(&self, layer: usize, lw: u32, lh: u32, i: u32, j: u32) -> DVec3 {
+        let (scale, offset) = self.scale_offset();
+        let stored = DVec2::new(
+            (f64::from(i) + 0.5) / f64::from(lw),
+            (f64::from(j) + 0.5) / f64::from(lh),
+        );
+        let uv = (stored - offset) / scale;
+        match self.mapping {
+            Mapping::Equirect => equirect_direction(uv),
+            Mapping::Cube => cube_direction(layer, uv).normalize(),
+            Mapping::Octahedral => octahedral_direction(octahedral_wrap(uv)),
+        }
+    }
 }
 
 /// The `i`-th of `n` points of the Hammersley set in `[0, 1)^2`.
@@ -176,159 +263,275 @@ fn footprint_at_lod(uv: DVec2, lod: f32, w: u32, h: u32) -> Footprint {
     }
 }
 
+/// GGX's `alpha` that level `k` of the glossy pyramid holds, for level-0 texels of
+/// `texel_angle` radians ([`MapLayout::texel_angle`]).
+pub fn level_alpha(k: u32, texel_angle: f64) -> f64 {
+    if k == 0 {
+        return 0.0;
+    }
+    (texel_angle * f64::from(1u32 << k.min(31))).min(1.0)
+}
+
+/// The glossy pyramid's level for perceptual roughness `roughness` (`log2(r^2 / theta_0)`; `<= 0`
+/// is a mirror), for level-0 texels of `texel_angle` radians.
+pub fn roughness_lod(roughness: f32, texel_angle: f64) -> f32 {
+    let alpha = f64::from(roughness.clamp(MIN_ROUGHNESS, 1.0)).powi(2);
+    (alpha / texel_angle).log2() as f32
+}
+
 /// The maps an environment is read through: the plain map with its box pyramid, its GGX
 /// prefiltered pyramid and its irradiance (module docs), with the fixed samplers that read the
 /// last two.
 #[derive(Debug)]
 pub struct EnvironmentMaps {
-    /// The map as given (equirectangular, linear RGB), with its box pyramid: the background's
-    /// and mirrors' lookups, through the frame's filter.
-    pub radiance: Texture,
-    /// The GGX-prefiltered pyramid (module docs), the same size as `radiance`.
-    pub glossy: Texture,
+    /// Where directions land in the layers.
+    pub layout: MapLayout,
+    /// The stored layers ([`MapLayout::layers`]: the equirect map as given, else bordered
+    /// linear float faces), each with its box pyramid: the background's and mirrors' lookups,
+    /// through the frame's filter.
+    pub radiance: Vec<Texture>,
+    /// The GGX-prefiltered pyramids (module docs), one per layer, the same sizes as `radiance`.
+    pub glossy: Vec<Texture>,
     /// Irradiance over pi, `E(n) / pi`, by the normal's equirectangular coordinates.
     pub irradiance: Texture,
-    /// Trilinear, Repeat in `u`, clamped in `v`: reads `glossy` and `irradiance`.
+    /// Trilinear, with the layout's address modes: reads `glossy` and `radiance` for the
+    /// prefilter.
     trilinear: Sampler,
+    /// Trilinear, equirect address modes: reads `irradiance`.
+    irradiance_sampler: Sampler,
     /// Bilinear at level 0: the reference's reads of `radiance`.
     level0: Sampler,
 }
 
 impl EnvironmentMaps {
-    /// The prefiltered pyramid and the irradiance of `radiance` (an equirectangular map, any
-    /// format; it is read through its pyramid), computed on the current rayon pool.
+    /// The stored layers, prefiltered pyramid and irradiance of a map of `mapping` from its
+    /// `faces` (one equirect or octahedral image; six cube faces in the order `+x, -x, +y, -y,
+    /// +z, -z`, all square and of one size; any format, read through their pyramids), computed on
+    /// the current rayon pool.
     ///
     /// # Errors
-    /// [`RasterError::Texture`] when the float pyramid does not fit `limits`.
-    pub fn new(radiance: Texture, limits: &Limits) -> Result<Self, RasterError> {
-        let trilinear = Sampler::new(equirect_descriptor(SamplerDescriptor::lab_mode(4)?))?;
-        let level0 = Sampler::new(equirect_descriptor(SamplerDescriptor::lab_mode(2)?))?;
-        let glossy = prefilter_ggx(&radiance, &trilinear, limits)?;
-        let irradiance = irradiance_map(&radiance, limits)?;
+    /// [`RasterError::Texture`] when a float pyramid does not fit `limits`;
+    /// [`RasterError::InvalidEnvironment`] for the wrong number of faces or faces of the wrong shape.
+    pub fn new(
+        mapping: Mapping,
+        faces: Vec<Texture>,
+        limits: &Limits,
+    ) -> Result<Self, RasterError> {
+        let first = faces.first().ok_or(RasterError::InvalidEnvironment(
+            "an environment map needs an image",
+        ))?;
+        let layout = MapLayout::new(mapping, first.width(), first.height());
+        if faces.len() != layout.layers() {
+            return Err(RasterError::InvalidEnvironment(
+                "a cube map has six faces, other environment maps one image",
+            ));
+        }
+        if mapping != Mapping::Equirect
+            && faces
+                .iter()
+                .any(|f| f.width() != f.height() || f.width() != layout.side)
+        {
+            return Err(RasterError::InvalidEnvironment(
+                "cube faces and octahedral maps must be square, cube faces all of one size",
+            ));
+        }
+        let trilinear = Sampler::new(descriptor(mapping, SamplerDescriptor::lab_mode(4)?))?;
+        let level0 = Sampler::new(descriptor(mapping, SamplerDescriptor::lab_mode(2)?))?;
+        let irradiance_sampler = Sampler::new(descriptor(
+            Mapping::Equirect,
+            SamplerDescriptor::lab_mode(4)?,
+        ))?;
+        let radiance = match mapping {
+            Mapping::Equirect => faces,
+            Mapping::Cube | Mapping::Octahedral => {
+                let faces = MapFaces {
+                    layout: MapLayout {
+                        border: 0,
+                        ..layout
+                    },
+                    faces: &faces,
+                    sampler: &level0,
+                };
+                (0..layout.layers())
+                    .map(|layer| faces.bordered(layout, layer, limits))
+                    .collect::<Result<_, _>>()?
+            }
+        };
+        let source = MapFaces {
+            layout,
+            faces: &radiance,
+            sampler: &trilinear,
+        };
+        let glossy = (0..layout.layers())
+            .map(|layer| source.prefilter_ggx(layer, limits))
+            .collect::<Result<_, _>>()?;
+        let irradiance = source.irradiance_map(limits)?;
         Ok(EnvironmentMaps {
+            layout,
             radiance,
             glossy,
             irradiance,
             trilinear,
+            irradiance_sampler,
             level0,
         })
     }
 
-    /// Bytes [`EnvironmentMaps::new`] adds to a `width x height` map: the float glossy pyramid and
-    /// the irradiance map.
-    pub fn extra_bytes(width: u32, height: u32) -> u64 {
+    /// Bytes [`EnvironmentMaps::new`] adds to a map of `mapping` from faces of `width x height`:
+    /// the bordered float layers (cube and octahedral), the float glossy pyramids and the
+    /// irradiance map.
+    pub fn extra_bytes(mapping: Mapping, width: u32, height: u32) -> u64 {
         let f = Format::Rgba32Float.texel_bytes();
+        let layout = MapLayout::new(mapping, width, height);
+        let (w, h) = layout.stored_size();
+        let layer = texel_texture::pyramid::pyramid_texels(w, h);
+        let copies = if mapping == Mapping::Equirect { 1 } else { 2 };
         let irr = texel_texture::pyramid::pyramid_texels(IRRADIANCE_WIDTH, IRRADIANCE_WIDTH / 2);
-        (texel_texture::pyramid::pyramid_texels(width, height) + irr) * f
+        (layer * copies * layout.layers() as u64 + irr) * f
     }
 }
 
-/// The GGX-prefiltered pyramid of `radiance` (module docs), read through `trilinear`.
-fn prefilter_ggx(
-    radiance: &Texture,
-    trilinear: &Sampler,
-    limits: &Limits,
-) -> Result<Texture, RasterError> {
-    let (w, h) = (radiance.width(), radiance.height());
-    limits.check(w, h, Format::Rgba32Float)?;
-    // The solid angle of a level-0 texel on the equator.
-    let texel_solid_angle = (2.0 * PI / f64::from(w)) * (PI / f64::from(h));
-    let mut all: Vec<[f32; 4]> = Vec::new();
-    let levels = texel_texture::pyramid::level_count(w, h);
-    for k in 0..levels {
-        let (lw, lh) = texel_texture::pyramid::level_size(w, h, k);
-        if k == 0 {
-            all.extend(
-                (0..lh).flat_map(|j| {
+/// A map's layers with their layout and the sampler that reads them, while the maps are built.
+struct MapFaces<'a> {
+    layout: MapLayout,
+    faces: &'a [Texture],
+    sampler: &'a Sampler,
+}
+
+impl MapFaces<'_> {
+    /// The radiance along `d`, read at level `lod`.
+    fn read(&self, d: DVec3, lod: f32) -> DVec3 {
+        let (layer, uv) = self.layout.locate(d);
+        let tex = &self.faces[layer];
+        let fp = footprint_at_lod(uv, lod, tex.width(), tex.height());
+        let c = self.sampler.sample(tex, &fp);
+        DVec3::new(c[0].into(), c[1].into(), c[2].into())
+    }
+
+    /// Layer `layer` of `bordered` (a layout with a border) from these unbordered faces: the
+    /// face's own texels inside, the radiance along each border texel's direction outside
+    /// (module docs), as a linear float texture with its box pyramid.
+    fn bordered(
+        &self,
+        bordered: MapLayout,
+        layer: usize,
+        limits: &Limits,
+    ) -> Result<Texture, RasterError> {
+        let (w, h) = bordered.stored_size();
+        let b = bordered.border;
+        let face = &self.faces[layer];
+        Ok(Texture::from_fn(
+            w,
+            h,
+            Format::Rgba32Float,
+            limits,
+            |i, j| {
+                let (fi, fj) = (i.wrapping_sub(b), j.wrapping_sub(b));
+                if fi < bordered.side && fj < bordered.height {
+                    face.texel(0, fi, fj).unwrap_or([0.0; 4])
+                } else {
+                    let c = self.read(bordered.texel_direction(layer, w, h, i, j), 0.0);
+                    [c.x as f32, c.y as f32, c.z as f32, 1.0]
+                }
+            },
+        )?)
+    }
+
+    /// The GGX-prefiltered pyramid of layer `layer` (module docs).
+    fn prefilter_ggx(&self, layer: usize, limits: &Limits) -> Result<Texture, RasterError> {
+        let layout = self.layout;
+        let radiance = &self.faces[layer];
+        let (w, h) = (radiance.width(), radiance.height());
+        limits.check(w, h, Format::Rgba32Float)?;
+        let theta0 = layout.texel_angle();
+        let texel_solid_angle = theta0 * theta0;
+        let mut all: Vec<[f32; 4]> = Vec::new();
+        let levels = texel_texture::pyramid::level_count(w, h);
+        for k in 0..levels {
+            let (lw, lh) = texel_texture::pyramid::level_size(w, h, k);
+            if k == 0 {
+                all.extend((0..lh).flat_map(|j| {
                     (0..lw).map(move |i| radiance.texel(0, i, j).unwrap_or([0.0; 4]))
-                }),
-            );
-            continue;
+                }));
+                continue;
+            }
+            let alpha = level_alpha(k, theta0);
+            let n = PREFILTER_SAMPLES;
+            let level: Vec<[f32; 4]> = (0..lh)
+                .into_par_iter()
+                .flat_map_iter(|j| {
+                    (0..lw).map(move |i| {
+                        let r = layout.texel_direction(layer, lw, lh, i, j);
+                        let mut sum = DVec3::ZERO;
+                        let mut weight = 0.0;
+                        for s in 0..n {
+                            let (hv, n_dot_h) = ggx_half(r, alpha, hammersley(s, n));
+                            let l = hv * (2.0 * r.dot(hv)) - r;
+                            let n_dot_l = r.dot(l);
+                            if n_dot_l <= 0.0 {
+                                continue;
+                            }
+                            // pdf of l: D(n.h) n.h / (4 v.h), and v.h = n.h when v = n.
+                            let pdf = f64::from(ggx_d(n_dot_h as f32, alpha as f32)) / 4.0;
+                            let omega_s = 1.0 / (f64::from(n) * pdf.max(1e-30));
+                            let lod = (0.5 * (omega_s / texel_solid_angle).log2() + 1.0).max(0.0);
+                            sum += self.read(l, lod as f32) * n_dot_l;
+                            weight += n_dot_l;
+                        }
+                        let c = if weight > 0.0 { sum / weight } else { sum };
+                        [c.x as f32, c.y as f32, c.z as f32, 1.0]
+                    })
+                })
+                .collect();
+            all.extend(level);
         }
-        let alpha = level_alpha(k, w);
-        let n = PREFILTER_SAMPLES;
-        let level: Vec<[f32; 4]> = (0..lh)
+        Ok(Texture::from_rgba32f_levels(w, h, all, limits)?)
+    }
+
+    /// `E(n) / pi` over the map's directions (module docs), as an [`IRRADIANCE_WIDTH`]-wide
+    /// equirect map.
+    fn irradiance_map(&self, limits: &Limits) -> Result<Texture, RasterError> {
+        let (sw, sh) = (IRRADIANCE_SOURCES, IRRADIANCE_SOURCES / 2);
+        // The level whose texels match the grid's cells.
+        let lod = ((2.0 * PI / f64::from(sw)) / self.layout.texel_angle())
+            .log2()
+            .max(0.0) as f32;
+        let sources: Vec<(DVec3, DVec3)> = (0..sh)
             .into_par_iter()
             .flat_map_iter(|j| {
-                (0..lw).map(move |i| {
-                    let uv = DVec2::new(
-                        (f64::from(i) + 0.5) / f64::from(lw),
-                        (f64::from(j) + 0.5) / f64::from(lh),
-                    );
-                    let r = equirect_direction(uv);
-                    let mut sum = DVec3::ZERO;
-                    let mut weight = 0.0;
-                    for s in 0..n {
-                        let (hv, n_dot_h) = ggx_half(r, alpha, hammersley(s, n));
-                        let l = hv * (2.0 * r.dot(hv)) - r;
-                        let n_dot_l = r.dot(l);
-                        if n_dot_l <= 0.0 {
-                            continue;
-                        }
-                        // pdf of l: D(n.h) n.h / (4 v.h), and v.h = n.h when v = n.
-                        let pdf = f64::from(ggx_d(n_dot_h as f32, alpha as f32)) / 4.0;
-                        let omega_s = 1.0 / (f64::from(n) * pdf.max(1e-30));
-                        let lod = (0.5 * (omega_s / texel_solid_angle).log2() + 1.0).max(0.0);
-                        let fp = footprint_at_lod(equirect_uv(l), lod as f32, w, h);
-                        let c = trilinear.sample(radiance, &fp);
-                        sum += DVec3::new(c[0].into(), c[1].into(), c[2].into()) * n_dot_l;
-                        weight += n_dot_l;
-                    }
-                    let c = if weight > 0.0 { sum / weight } else { sum };
-                    [c.x as f32, c.y as f32, c.z as f32, 1.0]
+                let theta0 = PI * f64::from(j) / f64::from(sh);
+                let theta1 = PI * f64::from(j + 1) / f64::from(sh);
+                // The exact solid angle of the cell's share of its latitude band.
+                let omega = (theta0.cos() - theta1.cos()) * 2.0 * PI / f64::from(sw);
+                (0..sw).map(move |i| {
+                    let d = equirect_direction(DVec2::new(
+                        (f64::from(i) + 0.5) / f64::from(sw),
+                        (f64::from(j) + 0.5) / f64::from(sh),
+                    ));
+                    (d, self.read(d, lod) * omega)
                 })
             })
             .collect();
-        all.extend(level);
+        let (w, h) = (IRRADIANCE_WIDTH, IRRADIANCE_WIDTH / 2);
+        Ok(Texture::from_fn(
+            w,
+            h,
+            Format::Rgba32Float,
+            limits,
+            |i, j| {
+                let n = equirect_direction(DVec2::new(
+                    (f64::from(i) + 0.5) / f64::from(w),
+                    (f64::from(j) + 0.5) / f64::from(h),
+                ));
+                let e: DVec3 = sources
+                    .iter()
+                    .map(|(d, l)| *l * n.dot(*d).max(0.0))
+                    .sum::<DVec3>()
+                    / PI;
+                [e.x as f32, e.y as f32, e.z as f32, 1.0]
+            },
+        )?)
     }
-    Ok(Texture::from_rgba32f_levels(w, h, all, limits)?)
-}
-
-/// `E(n) / pi` over the map's directions (module docs), as an [`IRRADIANCE_WIDTH`]-wide map.
-fn irradiance_map(radiance: &Texture, limits: &Limits) -> Result<Texture, RasterError> {
-    // The finest level at most 64 texels wide: the cosine lobe is smooth, so it loses nothing.
-    let level = radiance
-        .levels()
-        .iter()
-        .position(|l| l.width <= 64)
-        .unwrap_or(radiance.levels().len() - 1);
-    let info = radiance.levels()[level];
-    let (sw, sh) = (info.width, info.height);
-    let mut sources = Vec::with_capacity((sw * sh) as usize);
-    for j in 0..sh {
-        let theta0 = PI * f64::from(j) / f64::from(sh);
-        let theta1 = PI * f64::from(j + 1) / f64::from(sh);
-        // The exact solid angle of the texel's latitude band share.
-        let omega = (theta0.cos() - theta1.cos()) * 2.0 * PI / f64::from(sw);
-        for i in 0..sw {
-            let uv = DVec2::new(
-                (f64::from(i) + 0.5) / f64::from(sw),
-                (f64::from(j) + 0.5) / f64::from(sh),
-            );
-            let c = radiance.texel(level, i, j).unwrap_or([0.0; 4]);
-            let l = DVec3::new(c[0].into(), c[1].into(), c[2].into());
-            sources.push((equirect_direction(uv), l * omega));
-        }
-    }
-    let (w, h) = (IRRADIANCE_WIDTH, IRRADIANCE_WIDTH / 2);
-    Ok(Texture::from_fn(
-        w,
-        h,
-        Format::Rgba32Float,
-        limits,
-        |i, j| {
-            let n = equirect_direction(DVec2::new(
-                (f64::from(i) + 0.5) / f64::from(w),
-                (f64::from(j) + 0.5) / f64::from(h),
-            ));
-            let e: DVec3 = sources
-                .iter()
-                .map(|(d, l)| *l * n.dot(*d).max(0.0))
-                .sum::<DVec3>()
-                / PI;
-            [e.x as f32, e.y as f32, e.z as f32, 1.0]
-        },
-    )?)
 }
 
 /// Side of the [`dfg`] table.
@@ -402,8 +605,8 @@ pub fn integrate_dfg(n_dot_v: f64, roughness: f64) -> (f32, f32) {
 pub struct Environment<'a> {
     /// The maps.
     pub maps: &'a EnvironmentMaps,
-    /// The frame's filter with [`equirect_descriptor`]'s address modes: the background's and
-    /// mirrors' lookups.
+    /// The frame's filter with [`descriptor`]'s address modes for the maps' mapping: the
+    /// background's and mirrors' lookups.
     pub sampler: &'a Sampler,
     /// Linear RGB scale of the map's radiance.
     pub intensity: Vec3,
@@ -434,22 +637,29 @@ impl Environment<'_> {
         (Vec3::new(c[0], c[1], c[2]) * self.intensity, n)
     }
 
+    /// The layer direction `d` lands in and its footprint for screen derivatives `dd`
+    /// ([`MapLayout::footprint`]).
+    pub fn footprint(&self, d: DVec3, dd: [DVec3; 2]) -> (usize, Footprint) {
+        self.maps.layout.footprint(d, dd[0], dd[1])
+    }
+
     /// The radiance arriving from direction `d` whose screen derivatives are `dd` (zero for the
     /// reference's point samples, which read level 0 bilinearly), as the background and mirrors
     /// see it.
     pub fn radiance(&self, d: DVec3, dd: [DVec3; 2], reference: bool, count: bool) -> Read {
-        self.radiance_at(&equirect_footprint(d, dd[0], dd[1]), reference, count)
+        let (layer, fp) = self.footprint(d, dd);
+        self.radiance_at(layer, &fp, reference, count)
     }
 
-    /// The plain map's radiance over footprint `fp` (the frame's filter; bilinear at level 0 for
-    /// the `reference`).
-    pub fn radiance_at(&self, fp: &Footprint, reference: bool, count: bool) -> Read {
+    /// The plain map's radiance over footprint `fp` in layer `layer` (the frame's filter;
+    /// bilinear at level 0 for the `reference`).
+    pub fn radiance_at(&self, layer: usize, fp: &Footprint, reference: bool, count: bool) -> Read {
         let sampler = if reference {
             &self.maps.level0
         } else {
             self.sampler
         };
-        self.read(sampler, &self.maps.radiance, fp, count)
+        self.read(sampler, &self.maps.radiance[layer], fp, count)
     }
 
     /// The prefiltered radiance reflected about direction `r` (derivatives `dr`) for perceptual
@@ -464,20 +674,20 @@ impl Environment<'_> {
         count: bool,
     ) -> Read {
         let maps = self.maps;
-        let (w, h) = (maps.radiance.width(), maps.radiance.height());
-        let lod_r = roughness_lod(roughness, w);
+        let lod_r = roughness_lod(roughness, maps.layout.texel_angle());
         if lod_r <= 0.0 {
             return self.radiance(r, dr, reference, count);
         }
-        let (uv, lod) = if reference {
-            (equirect_uv(r), lod_r)
+        let (layer, fp) = self.footprint(r, if reference { [DVec3::ZERO; 2] } else { dr });
+        let lod = if reference {
+            lod_r
         } else {
-            let fp = equirect_footprint(r, dr[0], dr[1]);
-            let uv = DVec2::new(fp.u.into(), fp.v.into());
-            (uv, lod_r.max(self.sampler.lod(&maps.radiance, &fp)))
+            lod_r.max(self.sampler.lod(&maps.radiance[layer], &fp))
         };
-        let fp = footprint_at_lod(uv, lod, w, h);
-        self.read(&maps.trilinear, &maps.glossy, &fp, count)
+        let glossy = &maps.glossy[layer];
+        let uv = DVec2::new(fp.u.into(), fp.v.into());
+        let fp = footprint_at_lod(uv, lod, glossy.width(), glossy.height());
+        self.read(&maps.trilinear, glossy, &fp, count)
     }
 
     /// Irradiance over pi for unit normal `n` (bilinear).
@@ -488,7 +698,12 @@ impl Environment<'_> {
             v: uv.y as f32,
             ..Footprint::default()
         };
-        self.read(&self.maps.trilinear, &self.maps.irradiance, &fp, count)
+        self.read(
+            &self.maps.irradiance_sampler,
+            &self.maps.irradiance,
+            &fp,
+            count,
+        )
     }
 
     /// The camera rays of the background for a `width x height` frame: `None` where the
@@ -526,72 +741,21 @@ impl ViewRays {
         (d.is_finite() && d != DVec3::ZERO).then_some(d)
     }
 
-    /// The background's footprint at the centre of pixel `(i, j)`: the ray's direction with the
-    /// differences to the rays one pixel right and one down (unit directions, so the differences
-    /// are angles) through [`equirect_duv`].
-    pub fn footprint(&self, i: u32, j: u32) -> Option<Footprint> {
+    /// The ray through the centre of pixel `(i, j)` and its differences to the rays one pixel
+    /// right and one down (unit directions, so the differences are angles): the background's
+    /// direction and screen derivatives.
+    pub fn differentials(&self, i: u32, j: u32) -> Option<(DVec3, [DVec3; 2])> {
         let (x, y) = (f64::from(i) + 0.5, f64::from(j) + 0.5);
         let d = self.direction(x, y)?;
         let dx = self.direction(x + 1.0, y)?;
         let dy = self.direction(x, y + 1.0)?;
-        Some(equirect_footprint(d, dx - d, dy - d))
+        Some((d, [dx - d, dy - d]))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn equirect_round_trips_and_follows_the_design_axes() {
-        // -z is the centre column, +y the top row, +x a quarter turn right of -z.
-        let uv = equirect_uv(DVec3::NEG_Z);
-        assert!((uv - DVec2::new(0.5, 0.5)).length() < 1e-12);
-        assert!(equirect_uv(DVec3::Y).y.abs() < 1e-12);
-        assert!((equirect_uv(DVec3::NEG_Y).y - 1.0).abs() < 1e-12);
-        assert!((equirect_uv(DVec3::X).x - 0.75).abs() < 1e-12);
-        for k in 0..200 {
-            let uv = DVec2::new(
-                (k as f64 * 0.137) % 1.0,
-                0.01 + 0.98 * (k as f64 * 0.291) % 0.98,
-            );
-            let back = equirect_uv(equirect_direction(uv) * 3.0);
-            assert!((back - uv).length() < 1e-9, "{uv} -> {back}");
-        }
-    }
-
-    #[test]
-    fn the_jacobian_matches_differences_away_from_the_seam() {
-        for k in 0..100 {
-            let uv = DVec2::new(
-                0.1 + 0.8 * ((k as f64 * 0.37) % 1.0),
-                0.05 + 0.9 * ((k as f64 * 0.61) % 1.0),
-            );
-            let d = equirect_direction(uv) * (1.0 + k as f64 * 0.1);
-            let dd = DVec3::new(0.3, -0.2, 0.5) * 1e-6;
-            let num = (equirect_uv(d + dd) - equirect_uv(d - dd)) / 2.0;
-            let ana = equirect_duv(d, dd);
-            assert!(
-                (num - ana).length() < 1e-9 * (1.0 + num.length() * 1e6),
-                "{num} {ana}"
-            );
-        }
-    }
-
-    #[test]
-    fn the_jacobian_is_continuous_across_the_seam() {
-        // Either side of +z (u = 0 and u = 1): the same du, where differencing u jumps by 1.
-        let dd = DVec3::new(1e-3, 0.0, 0.0);
-        let a = equirect_duv(DVec3::new(-1e-9, 0.0, 1.0), dd);
-        let b = equirect_duv(DVec3::new(1e-9, 0.0, 1.0), dd);
-        assert!((a - b).length() < 1e-9);
-        assert!((a.x - (-1e-3 / (2.0 * PI))).abs() < 1e-9, "{a}");
-        let jump =
-            equirect_uv(DVec3::new(1e-9, 0.0, 1.0)).x - equirect_uv(DVec3::new(-1e-9, 0.0, 1.0)).x;
-        assert!(jump.abs() > 0.99);
-        // At a pole u is undefined: the clamp.
-        assert_eq!(equirect_duv(DVec3::Y, dd), DVec2::ONE);
-    }
 
     #[test]
     fn dfg_of_a_smooth_surface_at_normal_incidence_is_f0() {

@@ -92,6 +92,10 @@ pub enum RasterError {
         /// The largest allowed.
         max: u32,
     },
+    /// An environment map's faces do not fit its mapping (six square faces of one size for a
+    /// cube, one square image for an octahedral map).
+    #[error("environment map: {0}")]
+    InvalidEnvironment(&'static str),
     /// A texture could not be created (the reference renderer builds its own sampler).
     #[error(transparent)]
     Texture(#[from] texel_texture::TextureError),

@@ -224,10 +224,11 @@ fn background_tile(ctx: &Context, env: &Environment, rays: &ViewRays, tile: &mut
             if tile.depth[lj][li] < f32::INFINITY {
                 continue;
             }
-            let Some(fp) = rays.footprint(i, j) else {
+            let Some((d, dd)) = rays.differentials(i, j) else {
                 continue;
             };
-            let (c, n) = env.radiance_at(&fp, false, ctx.counting);
+            let (layer, fp) = env.footprint(d, dd);
+            let (c, n) = env.radiance_at(layer, &fp, false, ctx.counting);
             let color = [c.x, c.y, c.z, 1.0];
             if tile.target.is_8bit() {
                 tile.color8[lj][li] = tile.target.encode(color);

@@ -147,6 +147,7 @@ fn metal(rgb: Vec3, roughness: f32) -> crate::model::MaterialSpec {
 fn sky_environment(width: u32) -> Option<crate::environment::EnvironmentSpec> {
     use crate::environment::{EnvironmentSource, EnvironmentSpec, Sky};
     Some(EnvironmentSpec {
+        mapping: texel_texture::sphere::Mapping::Equirect,
         source: EnvironmentSource::Sky(Sky {
             width,
             ..Sky::default()

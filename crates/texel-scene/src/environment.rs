@@ -1,6 +1,13 @@
-//! The scene's environment map (`[environment]`): an equirectangular image from a file (PNG,
-//! JPEG, OpenEXR or Radiance HDR) or the built-in procedural sky, with an intensity and whether
-//! it is seen as the background.
+//! The scene's environment map (`[environment]`): an equirectangular, cube or octahedral map
+//! ([`Mapping`]) from image files (PNG, JPEG, OpenEXR or Radiance HDR) or the built-in procedural
+//! sky, with an intensity and whether it is seen as the background.
+//!
+//! A cube map comes as six files (`faces`, in Vulkan's layer order `+x, -x, +y, -y, +z, -z`, each
+//! oriented as Vulkan's face table says, [`texel_texture::sphere`]) or as one cross image
+//! ([`CubeCross`]): a horizontal cross 4 faces wide and 3 high (`+y` above `+z`; `-x, +z, +x, -z`
+//! left to right; `-y` below `+z`), or a vertical cross 3 wide and 4 high (the same, with `-z`
+//! below `-y`, turned 180 degrees so that its edge meets `-y`'s). Both layouts unfold the cube
+//! without a cut between neighbours in a row or column.
 //!
 //! The procedural sky ([`Sky`]) is what tests and the demo light with (nothing is downloaded):
 //! - above the horizon a gradient from a pale horizon to a blue zenith, with clouds: four
@@ -11,14 +18,14 @@
 //!   fading to the horizon colour over the last few degrees (haze).
 //!
 //! Each texel is the mean of 3 x 3 stratified directions inside it, so the map's own level 0 is
-//! not aliased. Directions follow DESIGN.md's equirectangular convention (`v = 0` up, the
-//! centre column looks along `-z`).
+//! not aliased. The sky can be made in any mapping (`size` is then an equirect map's width, or a
+//! cube face's or the octahedral square's side), so the three can be compared on one scene.
 
-use std::f64::consts::PI;
 use std::path::PathBuf;
 
-use glam::{DVec3, Vec3};
-use texel_texture::{ColorSpace, Limits, Texture};
+use glam::{DVec2, DVec3, Vec3};
+use texel_texture::sphere::{cube_direction, equirect_direction, octahedral_direction, Mapping};
+use texel_texture::{ColorSpace, Format, Limits, Texture};
 
 use crate::error::SceneError;
 
@@ -29,12 +36,25 @@ pub const SUN_RADIUS: f64 = 0.02;
 /// The sun disc's radiance (linear, per channel, times the sky's warm tint).
 pub const SUN_RADIANCE: f64 = 30.0;
 
-/// The largest sky width (its height is half).
+/// The largest sky width (its height is half), face side or square side.
 pub const MAX_SKY_WIDTH: u32 = 8192;
+
+/// The procedural sky's default size per mapping: a 1024-wide equirect map, 256-texel cube faces
+/// (a 1024 x 768 cross) and a 512-texel octahedral square, within a factor 1.3 of one another in
+/// texel angle (`2 pi / 1024`, `2 / 256`, `sqrt(4 pi) / 512` radians).
+pub fn default_sky_size(mapping: Mapping) -> u32 {
+    match mapping {
+        Mapping::Equirect => 1024,
+        Mapping::Cube => 256,
+        Mapping::Octahedral => 512,
+    }
+}
 
 /// The scene's environment (`[environment]`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvironmentSpec {
+    /// How directions map to the image (`mapping`, default `equirect`).
+    pub mapping: Mapping,
     /// Where the map comes from.
     pub source: EnvironmentSource,
     /// Linear RGB scale of the map's radiance (finite, not negative; default 1).
@@ -47,9 +67,13 @@ pub struct EnvironmentSpec {
 /// Where an environment map comes from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum EnvironmentSource {
-    /// `path = "file"` (relative to the scene file): an equirectangular image. 8-bit images are
-    /// decoded as sRGB; float images (EXR, HDR) are linear.
+    /// `path = "file"` (relative to the scene file): the equirect or octahedral image, or a cube
+    /// map's cross ([`CubeCross`]). 8-bit images are decoded as sRGB; float images (EXR, HDR) are
+    /// linear.
     File(PathBuf),
+    /// `faces = ["+x", "-x", "+y", "-y", "+z", "-z"]` (files, relative to the scene file): a cube
+    /// map's six square faces of one size.
+    Faces(Box<[PathBuf; 6]>),
     /// `procedural = "sky"`.
     Sky(Sky),
 }
@@ -57,7 +81,8 @@ pub enum EnvironmentSource {
 /// The procedural sky's parameters (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sky {
-    /// Width in texels, `2..=MAX_SKY_WIDTH` (`size`, default 1024); the height is half.
+    /// An equirect map's width (its height is half), a cube face's or the octahedral square's
+    /// side, `2..=MAX_SKY_WIDTH` (`size`, default [`default_sky_size`]).
     pub width: u32,
     /// Direction towards the sun (`sun`, any length but 0; default `[-0.5, 0.7, -0.5]`).
     pub sun: Vec3,
@@ -136,19 +161,32 @@ impl Sky {
         }
     }
 
-    /// The map's texels, `width x width / 2`, row-major, linear RGBA (module docs).
-    pub fn texels(&self) -> Vec<[f32; 4]> {
-        let (w, h) = (self.width, (self.width / 2).max(1));
+    /// The size of each of the sky's layers in `mapping`.
+    pub fn layer_size(&self, mapping: Mapping) -> (u32, u32) {
+        match mapping {
+            Mapping::Equirect => (self.width, (self.width / 2).max(1)),
+            Mapping::Cube | Mapping::Octahedral => (self.width, self.width),
+        }
+    }
+
+    /// The texels of layer `layer` (a cube face `0..6`; else 0) of the sky in `mapping`,
+    /// [`Sky::layer_size`], row-major, linear RGBA (module docs).
+    pub fn texels(&self, mapping: Mapping, layer: usize) -> Vec<[f32; 4]> {
+        let (w, h) = self.layer_size(mapping);
         let mut out = Vec::with_capacity(w as usize * h as usize);
         for j in 0..h {
             for i in 0..w {
                 let mut sum = DVec3::ZERO;
                 for s in 0..9 {
-                    let u = (f64::from(i) + (f64::from(s % 3) + 0.5) / 3.0) / f64::from(w);
-                    let v = (f64::from(j) + (f64::from(s / 3) + 0.5) / 3.0) / f64::from(h);
-                    let (theta, phi) = (PI * v, 2.0 * PI * (u - 0.5));
-                    let st = theta.sin();
-                    let d = DVec3::new(st * phi.sin(), theta.cos(), -st * phi.cos());
+                    let uv = DVec2::new(
+                        (f64::from(i) + (f64::from(s % 3) + 0.5) / 3.0) / f64::from(w),
+                        (f64::from(j) + (f64::from(s / 3) + 0.5) / 3.0) / f64::from(h),
+                    );
+                    let d = match mapping {
+                        Mapping::Equirect => equirect_direction(uv),
+                        Mapping::Cube => cube_direction(layer, uv).normalize(),
+                        Mapping::Octahedral => octahedral_direction(uv),
+                    };
                     sum += self.radiance(d);
                 }
                 let c = sum / 9.0;
@@ -159,13 +197,81 @@ impl Sky {
     }
 }
 
-impl EnvironmentSpec {
-    /// The map as a texture (with its box pyramid) within `limits`.
+/// The two cube-map cross layouts (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CubeCross {
+    /// 4 faces wide, 3 high.
+    Horizontal,
+    /// 3 faces wide, 4 high, `-z` turned 180 degrees.
+    Vertical,
+}
+
+impl CubeCross {
+    /// The layout of a `width x height` image and its face side; `None` unless the image is 4 x 3
+    /// or 3 x 4 square faces.
+    pub fn of(width: u32, height: u32) -> Option<(CubeCross, u32)> {
+        let (w, h) = (u64::from(width), u64::from(height));
+        if width > 0 && width.is_multiple_of(4) && 3 * w == 4 * h {
+            Some((CubeCross::Horizontal, width / 4))
+        } else if width > 0 && width.is_multiple_of(3) && 4 * w == 3 * h {
+            Some((CubeCross::Vertical, width / 3))
+        } else {
+            None
+        }
+    }
+
+    /// Where face `face` (`+x, -x, +y, -y, +z, -z`) lies: its column and row in faces, and
+    /// whether it is turned 180 degrees.
+    pub fn cell(self, face: usize) -> (u32, u32, bool) {
+        match (self, face) {
+            (_, 0) => (2, 1, false),
+            (_, 1) => (0, 1, false),
+            (_, 2) => (1, 0, false),
+            (_, 3) => (1, 2, false),
+            (_, 4) => (1, 1, false),
+            (CubeCross::Horizontal, _) => (3, 1, false),
+            (CubeCross::Vertical, _) => (1, 3, true),
+        }
+    }
+
+    /// The six faces of `cross` (laid out as `self`, faces of side `n`), each in the cross's
+    /// format.
     ///
     /// # Errors
-    /// [`SceneError::Texture`] (named `environment`) when the file cannot be read or decoded, or
-    /// the map does not fit `limits`.
-    pub fn load(&self, limits: &Limits) -> Result<Texture, SceneError> {
+    /// A face does not fit `limits`.
+    pub fn split(
+        self,
+        cross: &Texture,
+        n: u32,
+        limits: &Limits,
+    ) -> Result<Vec<Texture>, texel_texture::TextureError> {
+        (0..6)
+            .map(|face| {
+                let (col, row, turned) = self.cell(face);
+                let (x0, y0) = (col * n, row * n);
+                Texture::from_fn(n, n, cross.format(), limits, |i, j| {
+                    let (i, j) = if turned {
+                        (n - 1 - i, n - 1 - j)
+                    } else {
+                        (i, j)
+                    };
+                    cross.texel(0, x0 + i, y0 + j).unwrap_or([0.0; 4])
+                })
+            })
+            .collect()
+    }
+}
+
+impl EnvironmentSpec {
+    /// The map's layers (the equirect or octahedral image; a cube map's six faces in the order
+    /// `+x, -x, +y, -y, +z, -z`), each with its box pyramid, within `limits`.
+    ///
+    /// # Errors
+    /// [`SceneError::Texture`] (named `environment`) when a file cannot be read or decoded, or
+    /// the map does not fit `limits`; [`SceneError::Environment`] when the images do not have
+    /// the mapping's shape (a 2:1 equirect map is not required; a square octahedral map, a 4:3
+    /// or 3:4 cross, six square faces of one size are).
+    pub fn load(&self, limits: &Limits) -> Result<Vec<Texture>, SceneError> {
         let err = |path: Option<PathBuf>| {
             move |source| SceneError::Texture {
                 name: "environment".into(),
@@ -173,18 +279,66 @@ impl EnvironmentSpec {
                 source,
             }
         };
-        match &self.source {
+        let load = |path: &PathBuf| {
+            Texture::load(path, ColorSpace::Srgb, limits).map_err(err(Some(path.clone())))
+        };
+        let bad = |s: String| Err(SceneError::Environment(s));
+        let faces = match &self.source {
             EnvironmentSource::File(path) => {
-                Texture::load(path, ColorSpace::Srgb, limits).map_err(err(Some(path.clone())))
+                let image = load(path)?;
+                let (w, h) = (image.width(), image.height());
+                match self.mapping {
+                    Mapping::Equirect => vec![image],
+                    Mapping::Octahedral if w == h => vec![image],
+                    Mapping::Octahedral => {
+                        return bad(format!(
+                            "{}: an octahedral map is square, this image is {w}x{h}",
+                            path.display()
+                        ))
+                    }
+                    Mapping::Cube => {
+                        let Some((cross, n)) = CubeCross::of(w, h) else {
+                            return bad(format!(
+                                "{}: a cube map in one image is a cross of 4x3 or 3x4 square                                  faces; this image is {w}x{h} (or give faces = [six files])",
+                                path.display()
+                            ));
+                        };
+                        cross
+                            .split(&image, n, limits)
+                            .map_err(err(Some(path.clone())))?
+                    }
+                }
+            }
+            EnvironmentSource::Faces(paths) => {
+                let faces = paths.iter().map(load).collect::<Result<Vec<_>, _>>()?;
+                let n = faces[0].width();
+                if let Some((p, f)) = paths
+                    .iter()
+                    .zip(&faces)
+                    .find(|(_, f)| f.width() != n || f.height() != n)
+                {
+                    return bad(format!(
+                        "{}: cube faces are square and of one size ({n}x{n}, as the first);                          this one is {}x{}",
+                        p.display(),
+                        f.width(),
+                        f.height()
+                    ));
+                }
+                faces
             }
             EnvironmentSource::Sky(sky) => {
-                let (w, h) = (sky.width, (sky.width / 2).max(1));
-                limits
-                    .check(w, h, texel_texture::Format::Rgba32Float)
-                    .map_err(err(None))?;
-                Texture::from_rgba32f(w, h, sky.texels(), limits).map_err(err(None))
+                let (w, h) = sky.layer_size(self.mapping);
+                let layers = if self.mapping == Mapping::Cube { 6 } else { 1 };
+                (0..layers)
+                    .map(|layer| {
+                        limits.check(w, h, Format::Rgba32Float)?;
+                        Texture::from_rgba32f(w, h, sky.texels(self.mapping, layer), limits)
+                    })
+                    .collect::<Result<_, _>>()
+                    .map_err(err(None))?
             }
-        }
+        };
+        Ok(faces)
     }
 
     /// Check the numbers: a finite, non-negative intensity; a sky of a valid width and a non-zero,
@@ -236,16 +390,30 @@ mod tests {
         let a = sky.radiance(DVec3::new(0.5, -1.0, 0.5).normalize());
         let b = sky.radiance(DVec3::new(1.5, -1.0, 0.5).normalize());
         assert!((a - b).length() > 0.2, "{a} {b}");
-        let texels = Sky { width: 64, ..sky }.texels();
-        assert_eq!(texels.len(), 64 * 32);
-        assert!(texels
-            .iter()
-            .all(|t| t.iter().all(|c| c.is_finite() && *c >= 0.0)));
+        let small = Sky { width: 64, ..sky };
+        for (mapping, len) in [
+            (Mapping::Equirect, 64 * 32),
+            (Mapping::Cube, 64 * 64),
+            (Mapping::Octahedral, 64 * 64),
+        ] {
+            let texels = small.texels(mapping, 5);
+            assert_eq!(texels.len(), len);
+            assert!(texels
+                .iter()
+                .all(|t| t.iter().all(|c| c.is_finite() && *c >= 0.0)));
+        }
+        // The cube's -y face (layer 3) is ground; its +y face (2) is sky.
+        let mean = |layer| {
+            let t = small.texels(Mapping::Cube, layer);
+            t.iter().map(|c| f64::from(c[2])).sum::<f64>() / t.len() as f64
+        };
+        assert!(mean(2) > 0.5 && mean(3) < 0.4, "{} {}", mean(2), mean(3));
     }
 
     #[test]
     fn validation_refuses_bad_numbers() {
         let ok = EnvironmentSpec {
+            mapping: Mapping::Equirect,
             source: EnvironmentSource::Sky(Sky::default()),
             intensity: Vec3::ONE,
             background: true,
@@ -269,5 +437,87 @@ mod tests {
             ..Sky::default()
         };
         assert!(with(&sky(huge)).contains("size"));
+    }
+}
+
+#[cfg(test)]
+mod cross_tests {
+    use super::*;
+
+    #[test]
+    fn crosses_are_recognised_by_shape_and_split_into_faces() {
+        assert_eq!(CubeCross::of(400, 300), Some((CubeCross::Horizontal, 100)));
+        assert_eq!(CubeCross::of(300, 400), Some((CubeCross::Vertical, 100)));
+        for (w, h) in [(400, 301), (0, 0), (401, 300), (100, 100), (200, 100)] {
+            assert_eq!(CubeCross::of(w, h), None, "{w}x{h}");
+        }
+        // Each cell of a 3x4 cross holds its face's index; -z comes back turned upright.
+        let n = 4;
+        let cross = Texture::from_fn(
+            3 * n,
+            4 * n,
+            Format::Rgba32Float,
+            &Limits::default(),
+            |i, j| {
+                [
+                    (i / n) as f32,
+                    (j / n) as f32,
+                    (i % n) as f32,
+                    (j % n) as f32,
+                ]
+            },
+        )
+        .unwrap();
+        let faces = CubeCross::Vertical
+            .split(&cross, n, &Limits::default())
+            .unwrap();
+        assert_eq!(faces[4].texel(0, 1, 2).unwrap(), [1.0, 1.0, 1.0, 2.0]);
+        assert_eq!(faces[0].texel(0, 0, 0).unwrap(), [2.0, 1.0, 0.0, 0.0]);
+        assert_eq!(faces[5].texel(0, 0, 0).unwrap(), [1.0, 3.0, 3.0, 3.0]);
+    }
+
+    #[test]
+    fn both_crosses_are_continuous_across_their_cuts() {
+        // Neighbouring cells meet without a jump: the texels either side of every internal edge
+        // hold nearby directions.
+        let n = 32;
+        for cross in [CubeCross::Horizontal, CubeCross::Vertical] {
+            let at = |x: u32, y: u32| {
+                (0..6).find_map(|face| {
+                    let (c, r, turned) = cross.cell(face);
+                    let (i, j) = (x % n, y % n);
+                    let (i, j) = if turned {
+                        (n - 1 - i, n - 1 - j)
+                    } else {
+                        (i, j)
+                    };
+                    let uv = DVec2::new(
+                        (f64::from(i) + 0.5) / f64::from(n),
+                        (f64::from(j) + 0.5) / f64::from(n),
+                    );
+                    (x / n == c && y / n == r).then(|| cube_direction(face, uv).normalize())
+                })
+            };
+            let (cols, rows) = match cross {
+                CubeCross::Horizontal => (4, 3),
+                CubeCross::Vertical => (3, 4),
+            };
+            let mut edges = 0;
+            for y in 0..rows * n {
+                for x in 0..cols * n {
+                    for (x1, y1) in [(x + 1, y), (x, y + 1)] {
+                        if let (Some(a), Some(b)) = (at(x, y), at(x1, y1)) {
+                            assert!(
+                                (a - b).length() < 3.0 / f64::from(n),
+                                "{cross:?} ({x}, {y})"
+                            );
+                            edges += 1;
+                        }
+                    }
+                }
+            }
+            // The pairs inside the six cells, and more across the cuts.
+            assert!(edges > 6 * 2 * n * (n - 1), "{edges}");
+        }
     }
 }

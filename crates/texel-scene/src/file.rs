@@ -31,10 +31,12 @@
 //! type = "directional"          #   "point" (position) | "ambient"; intensity = [r, g, b]
 //! direction = [0.0, 0.25, -1.0] #   linear (glTF KHR_lights_punctual units); at most 8 lights
 //! intensity = [5.0, 5.0, 5.0]
-//! [environment]                 # path = "map.hdr" (equirectangular PNG, JPEG, EXR or HDR) or
-//! procedural = "sky"            #   procedural = "sky" (size = width, default 1024; sun =
-//! intensity = 1.0               #   [x, y, z] towards the sun; seed); mapping = "equirect";
-//! background = true             #   intensity = k or [r, g, b]; background (default true)
+//! [environment]                 # path = "map.hdr" (PNG, JPEG, EXR or HDR), faces = [six files
+//! procedural = "sky"            #   +x -x +y -y +z -z] or procedural = "sky" (size: equirect
+//! intensity = 1.0               #   width 1024, cube face 256, octahedral side 512; sun = [x, y,
+//! background = true             #   z] towards the sun; seed); mapping = "equirect" | "cube"
+//!                               #   (path: a 4x3 or 3x4 cross) | "octahedral" (square);
+//!                               #   intensity = k or [r, g, b]; background (default true)
 //! [materials.glossy]            # base_color = "TEXTURE" or [r, g, b] (linear, default white);
 //! base_color = "checker"        # roughness, metallic = number in [0, 1] or "TEXTURE" (red);
 //! roughness = 0.25              # normal = "TEXTURE" (color = "linear"), normal_scale;
@@ -62,7 +64,7 @@ use serde::Deserialize;
 use texel_texture::{AddressMode, ColorSpace};
 
 use crate::camera::Camera;
-use crate::environment::{EnvironmentSource, EnvironmentSpec, Sky};
+use crate::environment::{default_sky_size, EnvironmentSource, EnvironmentSpec, Sky};
 use crate::error::SceneError;
 use crate::gltf_import::GltfScene;
 use crate::limits::SceneLimits;
@@ -71,6 +73,7 @@ use crate::model::{
     Output, ScalarInput, Scene, SpecularAaSpec, TextureSource, TextureSpec,
 };
 use crate::procedural::{NoiseKind, Procedural};
+use texel_texture::sphere::Mapping;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -92,6 +95,7 @@ struct RawScene {
 #[serde(deny_unknown_fields)]
 struct RawEnvironment {
     path: Option<String>,
+    faces: Option<[String; 6]>,
     procedural: Option<SkyName>,
     mapping: Option<MappingName>,
     intensity: Option<RawIntensity>,
@@ -126,33 +130,45 @@ enum RawIntensity {
 /// The `[environment]` table as the model's.
 fn environment_spec(raw: RawEnvironment, base: &Path) -> Result<EnvironmentSpec, SceneError> {
     let bad = |s: &str| Err(SceneError::Environment(s.to_string()));
-    if matches!(
-        raw.mapping,
-        Some(MappingName::Cube | MappingName::Octahedral)
-    ) {
-        return bad(
-            "mapping: only \"equirect\" (latitude-longitude) maps are supported so far; \
-             convert cube and octahedral maps to equirectangular",
-        );
-    }
-    let source = match (raw.path, raw.procedural) {
-        (Some(path), None) => {
-            if raw.size.is_some() || raw.sun.is_some() || raw.seed.is_some() {
+    let mapping = match (raw.mapping, &raw.faces) {
+        (None | Some(MappingName::Cube), Some(_)) => Mapping::Cube,
+        (Some(_), Some(_)) => {
+            return bad("faces = [six files] is a cube map's (mapping = \"cube\")")
+        }
+        (None | Some(MappingName::Equirect), None) => Mapping::Equirect,
+        (Some(MappingName::Cube), None) => Mapping::Cube,
+        (Some(MappingName::Octahedral), None) => Mapping::Octahedral,
+    };
+    let sky_keys = raw.size.is_some() || raw.sun.is_some() || raw.seed.is_some();
+    let source = match (raw.path, raw.faces, raw.procedural) {
+        (Some(path), None, None) => {
+            if sky_keys {
                 return bad("size, sun and seed are the procedural sky's; a file map takes none");
             }
             EnvironmentSource::File(base.join(path))
         }
-        (None, Some(SkyName::Sky)) => {
+        (None, Some(faces), None) => {
+            if sky_keys {
+                return bad("size, sun and seed are the procedural sky's; a file map takes none");
+            }
+            EnvironmentSource::Faces(Box::new(faces.map(|f| base.join(f))))
+        }
+        (None, None, Some(SkyName::Sky)) => {
             let d = Sky::default();
             EnvironmentSource::Sky(Sky {
-                width: raw.size.unwrap_or(d.width),
+                width: raw.size.unwrap_or(default_sky_size(mapping)),
                 sun: raw.sun.map_or(d.sun, Vec3::from),
                 seed: raw.seed.unwrap_or(d.seed),
             })
         }
-        _ => return bad("give exactly one of path = \"FILE\" and procedural = \"sky\""),
+        _ => {
+            return bad(
+                "give exactly one of path = \"FILE\", faces = [six files] and procedural = \"sky\"",
+            )
+        }
     };
     Ok(EnvironmentSpec {
+        mapping,
         source,
         intensity: match raw.intensity {
             None => Vec3::ONE,

@@ -49,7 +49,9 @@ pub use builtin::{
     GROUND_TOML, KNOT_RADIUS, KNOT_SEGMENTS, TRIANGLE_TOML, ZONEPLATE_TOML,
 };
 pub use camera::Camera;
-pub use environment::{EnvironmentSource, EnvironmentSpec, Sky, MAX_SKY_WIDTH};
+pub use environment::{
+    default_sky_size, CubeCross, EnvironmentSource, EnvironmentSpec, Sky, MAX_SKY_WIDTH,
+};
 pub use error::SceneError;
 pub use gltf_import::{import_gltf, load_gltf, load_gltf_slice, load_gltf_with, GltfScene};
 pub use limits::SceneLimits;
@@ -60,4 +62,5 @@ pub use model::{
 };
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::{NoiseKind, Procedural};
+pub use texel_texture::sphere::Mapping;
 pub use texture::TextureUse;

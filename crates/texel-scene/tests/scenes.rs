@@ -674,7 +674,8 @@ fn the_environment_table_parses_and_loads() {
     assert_eq!(e.intensity, Vec3::new(1.0, 0.5, 0.25));
     assert!(!e.background);
     let t = e.load(&Limits::default()).unwrap();
-    assert_eq!((t.width(), t.height()), (64, 32));
+    assert_eq!(t.len(), 1);
+    assert_eq!((t[0].width(), t[0].height()), (64, 32));
     // A file map, relative to the scene, in Radiance HDR (float, linear).
     let dir = scratch("env");
     let mut hdr = Vec::new();
@@ -692,7 +693,7 @@ fn the_environment_table_parses_and_loads() {
     assert_eq!(e.intensity, Vec3::splat(2.0));
     assert!(e.background);
     let t = e.load(&Limits::default()).unwrap();
-    let c = t.texel(0, 3, 2).unwrap();
+    let c = t[0].texel(0, 3, 2).unwrap();
     assert!(
         (c[0] - 2.5).abs() < 0.05 && (c[2] - 0.125).abs() < 0.01,
         "{c:?}"
@@ -708,11 +709,106 @@ fn the_environment_table_parses_and_loads() {
 }
 
 #[test]
+fn cube_and_octahedral_maps_load_from_crosses_faces_and_the_sky() {
+    use texel_scene::{EnvironmentSource, Mapping, Sky};
+    let dir = scratch("env-cube");
+    // A horizontal cross of 4x3 faces of 4 texels: each face a grey of its own.
+    let grey = |face: usize| (face as u8 + 1) * 40;
+    let cell = |x: u32, y: u32| match (x / 4, y / 4) {
+        (2, 1) => Some(0),
+        (0, 1) => Some(1),
+        (1, 0) => Some(2),
+        (1, 2) => Some(3),
+        (1, 1) => Some(4),
+        (3, 1) => Some(5),
+        _ => None,
+    };
+    let cross =
+        image::RgbImage::from_fn(16, 12, |x, y| image::Rgb([cell(x, y).map_or(0, grey); 3]));
+    cross.save(dir.join("cross.png")).unwrap();
+    image::RgbImage::new(16, 13)
+        .save(dir.join("odd.png"))
+        .unwrap();
+    for (f, size) in ["px", "nx", "py", "ny", "pz", "nz"]
+        .iter()
+        .zip([4, 4, 4, 4, 4, 5])
+    {
+        image::RgbImage::new(size, size)
+            .save(dir.join(format!("{f}.png")))
+            .unwrap();
+    }
+    let load = |table: &str| {
+        let path = dir.join("scene.toml");
+        fs::write(&path, format!("{HEAD}{TRI}\n[environment]\n{table}\n")).unwrap();
+        let s = Scene::from_path(&path)?;
+        let e = s.environment.clone().unwrap();
+        e.load(&Limits::default()).map(|t| (e, t))
+    };
+    let (e, faces) = load("path = \"cross.png\"\nmapping = \"cube\"").unwrap();
+    assert_eq!(e.mapping, Mapping::Cube);
+    assert_eq!(faces.len(), 6);
+    for (face, t) in faces.iter().enumerate() {
+        assert_eq!((t.width(), t.height()), (4, 4));
+        let want = texel_texture::color::srgb_to_linear(f32::from(grey(face)) / 255.0);
+        assert!(
+            (t.texel(0, 1, 2).unwrap()[0] - want).abs() < 1e-4,
+            "face {face}"
+        );
+    }
+    let err = load("path = \"odd.png\"\nmapping = \"cube\"")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("cross") && err.contains("16x13"), "{err}");
+    let err = load("path = \"odd.png\"\nmapping = \"octahedral\"")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("square"), "{err}");
+    // Six files, one of the wrong size: named.
+    let (e, _) =
+        load("faces = [\"px.png\", \"nx.png\", \"py.png\", \"ny.png\", \"pz.png\", \"px.png\"]")
+            .unwrap();
+    assert_eq!(e.mapping, Mapping::Cube);
+    assert!(matches!(e.source, EnvironmentSource::Faces(_)));
+    let err =
+        load("faces = [\"px.png\", \"nx.png\", \"py.png\", \"ny.png\", \"pz.png\", \"nz.png\"]")
+            .unwrap_err()
+            .to_string();
+    assert!(err.contains("nz.png") && err.contains("5x5"), "{err}");
+    // The sky in each mapping, at its default size.
+    for (mapping, layers, size) in [("cube", 6, 256), ("octahedral", 1, 512)] {
+        let text =
+            format!("{HEAD}{TRI}\n[environment]\nprocedural = \"sky\"\nmapping = \"{mapping}\"\n");
+        let s = parse(&text).unwrap();
+        let e = s.environment.as_ref().unwrap();
+        assert!(matches!(e.source, EnvironmentSource::Sky(Sky { width, .. }) if width == size));
+        let t = e.load(&Limits::default()).unwrap();
+        assert_eq!(t.len(), layers);
+        assert_eq!((t[0].width(), t[0].height()), (size, size));
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn bad_environment_tables_are_refused() {
     for (table, expect) in [
         ("procedural = \"sky\"\npath = \"a.hdr\"", "exactly one"),
         ("intensity = 1.0", "exactly one"),
-        ("procedural = \"sky\"\nmapping = \"cube\"", "equirect"),
+        (
+            "faces = [\"a\", \"b\", \"c\", \"d\", \"e\", \"f\"]\nmapping = \"octahedral\"",
+            "cube map's",
+        ),
+        (
+            "faces = [\"a\", \"b\", \"c\", \"d\", \"e\"]",
+            "invalid length",
+        ),
+        (
+            "faces = [\"a\", \"b\", \"c\", \"d\", \"e\", \"f\"]\npath = \"a.hdr\"",
+            "exactly one",
+        ),
+        (
+            "faces = [\"a\", \"b\", \"c\", \"d\", \"e\", \"f\"]\nsize = 4",
+            "procedural sky",
+        ),
         (
             "procedural = \"sky\"\nmapping = \"sphere\"",
             "unknown variant",

@@ -49,6 +49,7 @@ pub mod ripmap;
 pub mod rng;
 pub mod sampler;
 pub mod sat;
+pub mod sphere;
 pub mod texture;
 pub mod warp;
 

@@ -55,6 +55,47 @@ pub struct SceneOptions {
     /// Where every layered material blends, overriding each one's `layer_order` (the CLI's
     /// `--layer-order`).
     pub layer_order: Option<LayerOrder>,
+    /// The mapping the scene's procedural sky is laid out in, overriding its `mapping` (the
+    /// CLI's `--environment-mapping`; [`relay_sky`]).
+    pub environment_mapping: Option<texel_scene::Mapping>,
+}
+
+/// `spec` with its procedural sky laid out in `mapping` at about the same texel angle: an
+/// equirect map `W` wide becomes cube faces of `W / 4` or an octahedral square of `W / 2` (texel
+/// angles `2 pi / W`, `8 / W` and `7.1 / W` radians), and back. `None` keeps `spec`.
+///
+/// # Errors
+/// [`texel_scene::SceneError::Environment`] for a map from files in another mapping: their
+/// layout is their own.
+pub fn relay_sky(
+    spec: &texel_scene::EnvironmentSpec,
+    mapping: Option<texel_scene::Mapping>,
+) -> Result<texel_scene::EnvironmentSpec, texel_scene::SceneError> {
+    use texel_scene::{EnvironmentSource, Mapping};
+    let Some(mapping) = mapping.filter(|m| *m != spec.mapping) else {
+        return Ok(spec.clone());
+    };
+    let EnvironmentSource::Sky(sky) = &spec.source else {
+        return Err(texel_scene::SceneError::Environment(format!(
+            "the environment map is read from files laid out {:?}; only the procedural sky \
+             can be laid out {:?} instead",
+            spec.mapping.name(),
+            mapping.name()
+        )));
+    };
+    // Texels per equirect width.
+    let per_width = |m: Mapping| match m {
+        Mapping::Equirect => 1,
+        Mapping::Cube => 4,
+        Mapping::Octahedral => 2,
+    };
+    let width = (sky.width * per_width(spec.mapping) / per_width(mapping))
+        .clamp(2, texel_scene::MAX_SKY_WIDTH);
+    Ok(texel_scene::EnvironmentSpec {
+        mapping,
+        source: EnvironmentSource::Sky(texel_scene::Sky { width, ..*sky }),
+        ..spec.clone()
+    })
 }
 
 /// A loaded scene, ready to render with any filter.
@@ -121,14 +162,21 @@ fn environment_maps(
         max_bytes: budget.remaining(),
         ..Limits::default()
     };
-    let radiance = spec.load(&limits)?;
-    budget.take("the environment map", radiance.pyramid_bytes())?;
-    let (w, h) = (radiance.width(), radiance.height());
+    let faces = spec.load(&limits)?;
+    budget.take(
+        "the environment map",
+        faces.iter().map(Texture::pyramid_bytes).sum(),
+    )?;
+    let (w, h) = (faces[0].width(), faces[0].height());
     budget.take(
         "the environment's prefiltered pyramid and irradiance",
-        EnvironmentMaps::extra_bytes(w, h),
+        EnvironmentMaps::extra_bytes(spec.mapping, w, h),
     )?;
-    Ok(EnvironmentMaps::new(radiance, &Limits::default())?)
+    Ok(EnvironmentMaps::new(
+        spec.mapping,
+        faces,
+        &Limits::default(),
+    )?)
 }
 
 impl PreparedScene {
@@ -140,7 +188,7 @@ impl PreparedScene {
     /// [`Error::OverBudget`]; [`Error::Scene`] for a texture that cannot be loaded (its own memory
     /// limit is what the budget has left).
     pub fn new(
-        scene: Scene,
+        mut scene: Scene,
         options: &SceneOptions,
         budget: &mut MemoryBudget,
     ) -> Result<Self, Error> {
@@ -181,6 +229,9 @@ impl PreparedScene {
                 loaded.texture.pyramid_bytes(),
             )?;
             textures.insert(u.name.to_string(), loaded.texture);
+        }
+        if let Some(spec) = &scene.environment {
+            scene.environment = Some(relay_sky(spec, options.environment_mapping)?);
         }
         let environment = match &scene.environment {
             Some(spec) => Some(environment_maps(spec, budget)?),
@@ -292,7 +343,6 @@ impl PreparedScene {
             composites.insert(material.clone(), baked);
         }
         // Normal maps need tangents: MikkTSpace where the mesh brings none.
-        let mut scene = scene;
         for m in &mut scene.meshes {
             let mapped = m
                 .material
@@ -381,16 +431,19 @@ impl PreparedScene {
         Ok(out)
     }
 
-    /// Append the environment's sampler for `filter` (with the equirectangular map's address
-    /// modes) to `samplers`, when the scene has an environment.
+    /// Append the environment's sampler for `filter` (with its mapping's address modes) to
+    /// `samplers`, when the scene has an environment.
     fn push_environment_sampler(
         &self,
         samplers: &mut Vec<Sampler>,
         filter: Filter,
     ) -> Result<(), Error> {
-        if self.environment.is_some() {
-            let desc = filter.descriptor(AddressMode::Repeat, AddressMode::ClampToEdge);
-            samplers.push(Sampler::new(environment::equirect_descriptor(desc))?);
+        if let Some(maps) = &self.environment {
+            let desc = filter.descriptor(AddressMode::ClampToEdge, AddressMode::ClampToEdge);
+            samplers.push(Sampler::new(environment::descriptor(
+                maps.layout.mapping,
+                desc,
+            ))?);
         }
         Ok(())
     }
