@@ -60,10 +60,6 @@ use std::sync::OnceLock;
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Mat4, Vec3};
 use rayon::prelude::*;
-use texel_texture::sphere::{
-    cube_direction, cube_dst, cube_face, octahedral_direction, octahedral_duv, octahedral_uv,
-    octahedral_wrap,
-};
 pub use texel_texture::sphere::{equirect_direction, equirect_duv, equirect_uv, Mapping};
 use texel_texture::{AddressMode, Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
@@ -130,10 +126,7 @@ impl MapLayout {
 
     /// Stored layers: 6 for a cube, else 1.
     pub fn layers(&self) -> usize {
-        match self.mapping {
-            Mapping::Cube => 6,
-            Mapping::Equirect | Mapping::Octahedral => 1,
-        }
+        self.mapping.layers()
     }
 
     /// A stored layer's size, border included.
@@ -166,11 +159,7 @@ impl MapLayout {
     /// non-finite `d` gives layer 0 and NaN.
     pub fn locate(&self, d: DVec3) -> (usize, DVec2) {
         let (scale, offset) = self.scale_offset();
-        let (layer, uv) = match self.mapping {
-            Mapping::Equirect => (0, equirect_uv(d)),
-            Mapping::Cube => cube_face(d).unwrap_or((0, DVec2::NAN)),
-            Mapping::Octahedral => (0, octahedral_uv(d)),
-        };
+        let (layer, uv) = self.mapping.uv(d);
         (layer, uv * scale + offset)
     }
 
@@ -179,14 +168,7 @@ impl MapLayout {
     pub fn footprint(&self, d: DVec3, dd_dx: DVec3, dd_dy: DVec3) -> (usize, Footprint) {
         let (layer, uv) = self.locate(d);
         let (scale, _) = self.scale_offset();
-        let duv = |dd: DVec3| {
-            scale
-                * match self.mapping {
-                    Mapping::Equirect => equirect_duv(d, dd),
-                    Mapping::Cube => cube_dst(layer, d, dd),
-                    Mapping::Octahedral => octahedral_duv(d, dd),
-                }
-        };
+        let duv = |dd: DVec3| scale * self.mapping.duv(layer, d, dd);
         let (dx, dy) = (duv(dd_dx), duv(dd_dy));
         let fp = Footprint {
             u: uv.x as f32,
@@ -208,12 +190,7 @@ impl MapLayout {
             (f64::from(i) + 0.5) / f64::from(lw),
             (f64::from(j) + 0.5) / f64::from(lh),
         );
-        let uv = (stored - offset) / scale;
-        match self.mapping {
-            Mapping::Equirect => equirect_direction(uv),
-            Mapping::Cube => cube_direction(layer, uv).normalize(),
-            Mapping::Octahedral => octahedral_direction(octahedral_wrap(uv)),
-        }
+        self.mapping.direction(layer, (stored - offset) / scale)
     }
 }
 

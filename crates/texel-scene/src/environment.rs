@@ -24,7 +24,7 @@
 use std::path::PathBuf;
 
 use glam::{DVec2, DVec3, Vec3};
-use texel_texture::sphere::{cube_direction, equirect_direction, octahedral_direction, Mapping};
+use texel_texture::sphere::Mapping;
 use texel_texture::{ColorSpace, Format, Limits, Texture};
 
 use crate::error::SceneError;
@@ -182,12 +182,7 @@ impl Sky {
                         (f64::from(i) + (f64::from(s % 3) + 0.5) / 3.0) / f64::from(w),
                         (f64::from(j) + (f64::from(s / 3) + 0.5) / 3.0) / f64::from(h),
                     );
-                    let d = match mapping {
-                        Mapping::Equirect => equirect_direction(uv),
-                        Mapping::Cube => cube_direction(layer, uv).normalize(),
-                        Mapping::Octahedral => octahedral_direction(uv),
-                    };
-                    sum += self.radiance(d);
+                    sum += self.radiance(mapping.direction(layer, uv));
                 }
                 let c = sum / 9.0;
                 out.push([c.x as f32, c.y as f32, c.z as f32, 1.0]);
@@ -328,8 +323,7 @@ impl EnvironmentSpec {
             }
             EnvironmentSource::Sky(sky) => {
                 let (w, h) = sky.layer_size(self.mapping);
-                let layers = if self.mapping == Mapping::Cube { 6 } else { 1 };
-                (0..layers)
+                (0..self.mapping.layers())
                     .map(|layer| {
                         limits.check(w, h, Format::Rgba32Float)?;
                         Texture::from_rgba32f(w, h, sky.texels(self.mapping, layer), limits)
@@ -443,6 +437,7 @@ mod tests {
 #[cfg(test)]
 mod cross_tests {
     use super::*;
+    use texel_texture::sphere::cube_direction;
 
     #[test]
     fn crosses_are_recognised_by_shape_and_split_into_faces() {

@@ -140,17 +140,13 @@ fn environment_spec(raw: RawEnvironment, base: &Path) -> Result<EnvironmentSpec,
         (Some(MappingName::Octahedral), None) => Mapping::Octahedral,
     };
     let sky_keys = raw.size.is_some() || raw.sun.is_some() || raw.seed.is_some();
+    if sky_keys && raw.procedural.is_none() {
+        return bad("size, sun and seed are the procedural sky's; a file map takes none");
+    }
+    let one = "give exactly one of path = \"FILE\", faces = [six files] and procedural = \"sky\"";
     let source = match (raw.path, raw.faces, raw.procedural) {
-        (Some(path), None, None) => {
-            if sky_keys {
-                return bad("size, sun and seed are the procedural sky's; a file map takes none");
-            }
-            EnvironmentSource::File(base.join(path))
-        }
+        (Some(path), None, None) => EnvironmentSource::File(base.join(path)),
         (None, Some(faces), None) => {
-            if sky_keys {
-                return bad("size, sun and seed are the procedural sky's; a file map takes none");
-            }
             EnvironmentSource::Faces(Box::new(faces.map(|f| base.join(f))))
         }
         (None, None, Some(SkyName::Sky)) => {
@@ -161,11 +157,7 @@ fn environment_spec(raw: RawEnvironment, base: &Path) -> Result<EnvironmentSpec,
                 seed: raw.seed.unwrap_or(d.seed),
             })
         }
-        _ => {
-            return bad(
-                "give exactly one of path = \"FILE\", faces = [six files] and procedural = \"sky\"",
-            )
-        }
+        _ => return bad(one),
     };
     Ok(EnvironmentSpec {
         mapping,

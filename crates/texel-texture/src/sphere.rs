@@ -44,6 +44,46 @@ impl Mapping {
             Mapping::Octahedral => "octahedral",
         }
     }
+
+    /// Images the mapping stores: 6 cube faces (in [`CUBE_FACES`]' order), else 1.
+    pub fn layers(self) -> usize {
+        match self {
+            Mapping::Cube => 6,
+            Mapping::Equirect | Mapping::Octahedral => 1,
+        }
+    }
+
+    /// The layer direction `d` (any length but 0) lands in and its coordinates there
+    /// ([`equirect_uv`], [`cube_face`], [`octahedral_uv`]); a zero or non-finite `d` gives NaN
+    /// (in layer 0).
+    pub fn uv(self, d: DVec3) -> (usize, DVec2) {
+        match self {
+            Mapping::Equirect => (0, equirect_uv(d)),
+            Mapping::Cube => cube_face(d).unwrap_or((0, DVec2::NAN)),
+            Mapping::Octahedral => (0, octahedral_uv(d)),
+        }
+    }
+
+    /// The change of the coordinates in `layer` (where `d` lands, [`Mapping::uv`]) for a small
+    /// change `dd` of `d`: [`equirect_duv`], [`cube_dst`] or [`octahedral_duv`].
+    pub fn duv(self, layer: usize, d: DVec3, dd: DVec3) -> DVec2 {
+        match self {
+            Mapping::Equirect => equirect_duv(d, dd),
+            Mapping::Cube => cube_dst(layer, d, dd),
+            Mapping::Octahedral => octahedral_duv(d, dd),
+        }
+    }
+
+    /// The unit direction at coordinates `uv` of layer `layer` (the inverse of [`Mapping::uv`]).
+    /// Past `[0, 1]^2` a cube face's plane extends and the octahedral square continues
+    /// ([`octahedral_wrap`]), so border texels have directions too.
+    pub fn direction(self, layer: usize, uv: DVec2) -> DVec3 {
+        match self {
+            Mapping::Equirect => equirect_direction(uv),
+            Mapping::Cube => cube_direction(layer, uv).normalize(),
+            Mapping::Octahedral => octahedral_direction(octahedral_wrap(uv)),
+        }
+    }
 }
 
 /// The equirectangular coordinates of direction `d` (any length but 0; see the module docs).
