@@ -82,6 +82,7 @@ fuzz_target!(|input: Input| {
             sampler: &sampler,
             clip_from_world,
             material: None,
+            uv_mapping: None,
         };
         render(&settings, &[call]).expect("valid draw").coverage
     };

@@ -156,6 +156,28 @@ pub struct SceneArgs {
     /// (e.g. builtin:mirror-plane; a map from files keeps its own layout).
     #[arg(long, value_enum, value_name = "MAPPING")]
     pub environment_mapping: Option<EnvironmentMappingArg>,
+    /// Where meshes with a sphere mapping (builtin:sphere, builtin:globe, `sphere_uv` in a scene)
+    /// get their uv: exactly at every pixel (the default), or at the vertices, interpolated.
+    #[arg(long, value_enum, value_name = "AT")]
+    pub surface_uv: Option<SurfaceUvArg>,
+}
+
+/// Where a sphere mapping is evaluated (see texel-raster's `UvMapping`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SurfaceUvArg {
+    /// The projection of each pixel's position, with its analytic derivatives.
+    Pixel,
+    /// The vertices' uv, interpolated across each triangle.
+    Vertex,
+}
+
+impl From<SurfaceUvArg> for texel::raster::UvEvaluation {
+    fn from(a: SurfaceUvArg) -> Self {
+        match a {
+            SurfaceUvArg::Pixel => texel::raster::UvEvaluation::PerPixel,
+            SurfaceUvArg::Vertex => texel::raster::UvEvaluation::PerVertex,
+        }
+    }
 }
 
 /// An environment map's layout (see texel-texture's `sphere` module).

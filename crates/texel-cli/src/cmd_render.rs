@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Result};
 use texel_gpu::{Gpu, GpuFilter};
-use texel_raster::{render, ColorTarget, Derivatives, Perspective, View};
+use texel_raster::{render, ColorTarget, Derivatives, Perspective, UvEvaluation, View};
 
 use crate::cli::{ColorArg, DerivativesArg, PerspectiveArg, RenderArgs, ViewArg};
 use crate::filters::Filter;
@@ -16,7 +16,14 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         Some(m) => Some(Filter::from_lab_mode(m)?),
         None => args.filter,
     };
-    let scene = load_scene(&args.scene, input)?;
+    let mut scene = load_scene(&args.scene, input)?;
+    if args.gpu && args.scene.surface_uv.is_none() && scene.maps_uv_per_pixel() {
+        // The shader interpolates the vertices' uv: say so rather than refuse the scene.
+        eprintln!(
+            "texel: --gpu interpolates sphere mappings from the vertices (--surface-uv vertex)"
+        );
+        scene.set_surface_uv(UvEvaluation::PerVertex);
+    }
     let samplers = match filter {
         Some(f) => scene.samplers(f)?,
         None => scene.default_samplers()?,

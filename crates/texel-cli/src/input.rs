@@ -113,6 +113,8 @@ pub struct MaterialOverrides {
     pub layer_order: Option<texel_scene::LayerOrder>,
     /// `--environment-mapping`.
     pub environment_mapping: Option<texel_scene::Mapping>,
+    /// `--surface-uv`.
+    pub surface_uv: Option<texel::raster::UvEvaluation>,
 }
 
 impl MaterialOverrides {
@@ -124,6 +126,7 @@ impl MaterialOverrides {
             edge_px: args.edge_px,
             layer_order: args.layer_order.map(Into::into),
             environment_mapping: args.environment_mapping.map(Into::into),
+            surface_uv: args.surface_uv.map(Into::into),
         }
     }
 }
@@ -160,6 +163,7 @@ pub fn load_scene_with(
         edge_px: overrides.edge_px,
         layer_order: overrides.layer_order,
         environment_mapping: overrides.environment_mapping,
+        surface_uv: overrides.surface_uv.unwrap_or_default(),
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;

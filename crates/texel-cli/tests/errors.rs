@@ -126,6 +126,36 @@ fn error_mesh_index_out_of_range() {
     );
 }
 
+#[test]
+fn error_sphere_mapping_past_the_pole_and_valid_ones_render() {
+    let d = Dir::new("err-sphere-uv");
+    let scene = d.write(
+        "s.toml",
+        format!("{HEAD}{TRIANGLE}sphere_uv = \"mercator\"\nmercator_cut_deg = 90.0\n"),
+    );
+    fails(
+        &["render", &scene.to_string_lossy(), "-o", &d.arg("x.png")],
+        1,
+        &["meshes[0]", "mercator_cut_deg 90", "outside (0, 89.9]"],
+    );
+    assert!(!d.join("x.png").exists());
+    // A valid mapping on a file mesh renders per pixel and per vertex.
+    let scene = d.write(
+        "t.toml",
+        format!("{HEAD}{TRIANGLE}sphere_uv = \"equirect\"\nsphere_centre = [0.0, 0.0, -1.0]\n"),
+    );
+    for at in ["pixel", "vertex"] {
+        ok(&[
+            "render",
+            &scene.to_string_lossy(),
+            "--surface-uv",
+            at,
+            "-o",
+            &d.arg("y.png"),
+        ]);
+    }
+}
+
 /// Bytes that are neither OBJ, glTF JSON, GLB nor PNG.
 fn garbage() -> Vec<u8> {
     (0u32..512)

@@ -534,12 +534,22 @@ impl Gpu {
     /// Upload `draws` for rendering with `filter`.
     ///
     /// # Errors
-    /// [`GpuError::Unsupported`] for draws with a material;
+    /// [`GpuError::Unsupported`] for draws with a material or a per-pixel sphere mapping (the
+    /// shader interpolates the vertices' uv; `UvEvaluation::PerVertex` draws are accepted);
     /// [`GpuError::TooLarge`] for a texture over the device's limit; [`GpuError::Failed`] when
     /// the device reports an error.
     pub fn prepare(&self, draws: &[DrawCall], filter: GpuFilter) -> Result<GpuDraws<'_>, GpuError> {
         if draws.iter().any(|d| d.material.is_some()) {
             return Err(GpuError::Unsupported("materials"));
+        }
+        let per_pixel = |d: &DrawCall| {
+            d.uv_mapping
+                .is_some_and(|m| m.evaluation == texel_raster::UvEvaluation::PerPixel)
+        };
+        if draws.iter().any(per_pixel) {
+            return Err(GpuError::Unsupported(
+                "per-pixel sphere mappings (--surface-uv vertex draws them)",
+            ));
         }
         let device = &self.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);

@@ -65,6 +65,7 @@ fn mesh(c: &mut Criterion) {
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
         material: None,
+        uv_mapping: None,
     };
     let mut group = c.benchmark_group("mesh_100k_64x64_trilinear");
     group

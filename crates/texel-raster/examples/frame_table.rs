@@ -77,6 +77,7 @@ fn main() {
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
         material: None,
+        uv_mapping: None,
     };
     let cells: Vec<String> = per_thread_count(runs, w, h, draw)
         .iter()

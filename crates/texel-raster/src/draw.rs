@@ -1,6 +1,7 @@
 //! What is drawn: vertices, indexed triangles and the texture/sampler pair of one draw call.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
+use texel_texture::sphere::SurfaceProjection;
 use texel_texture::{Sampler, Texture};
 
 use crate::material::Material;
@@ -59,4 +60,49 @@ pub struct DrawCall<'a> {
     /// Shading parameters and maps when the frame has lights ([`crate::RenderSettings::lights`]);
     /// `None` is Lambertian (see [`crate::material`]).
     pub material: Option<Material<'a>>,
+    /// Texture coordinates as a sphere mapping of the surface position, if the mesh has one
+    /// ([`UvMapping`]); `None`: the vertices' `uv`, interpolated.
+    pub uv_mapping: Option<UvMapping>,
+}
+
+/// A mesh whose texture coordinates are a projection ([`SurfaceProjection`]: equirect or
+/// Mercator) of its points' directions from a centre: the lecture's spherical mappings.
+///
+/// With [`UvEvaluation::PerPixel`] the rasterizer evaluates the projection at each pixel's
+/// interpolated world position `p` (its direction `p - centre`; points of a flat triangle are
+/// projected radially), and `uv`'s screen derivatives are the projection's Jacobian applied to
+/// `dp/dx` and `dp/dy` ([`SurfaceProjection::duv`]), never differences of `u`: no seam, and in
+/// the 2x2-quad mode the quad's position differences go through the same Jacobian. With
+/// [`UvEvaluation::PerVertex`] it interpolates the vertices' `uv` (which should be the projection
+/// at each vertex), the classic approximation whose error grows with the projection's curvature
+/// across a triangle. The supersampled reference evaluates the projection at every sample in
+/// both cases: it is the ground truth both approximate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvMapping {
+    /// The projection.
+    pub projection: SurfaceProjection,
+    /// The sphere's centre, world space.
+    pub centre: Vec3,
+    /// Where the rasterizer evaluates it.
+    pub evaluation: UvEvaluation,
+}
+
+/// Where a [`UvMapping`] is evaluated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UvEvaluation {
+    /// At the vertices (the mesh's `uv`), interpolated across each triangle.
+    PerVertex,
+    /// Exactly, at every pixel (the default).
+    #[default]
+    PerPixel,
+}
+
+impl UvEvaluation {
+    /// The name the command line uses: `vertex` or `pixel`.
+    pub fn name(self) -> &'static str {
+        match self {
+            UvEvaluation::PerVertex => "vertex",
+            UvEvaluation::PerPixel => "pixel",
+        }
+    }
 }

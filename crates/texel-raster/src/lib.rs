@@ -30,6 +30,7 @@
 //!     sampler: &sampler,
 //!     clip_from_world: Mat4::IDENTITY,
 //!     material: None,
+//!     uv_mapping: None,
 //! };
 //! let frame = render(&RenderSettings::new(8, 8), &[draw])?;
 //! // The lower-left half is white. The 8 diagonal pixel centres lie exactly on the hypotenuse, a
@@ -59,7 +60,7 @@ pub mod tile;
 pub mod views;
 
 pub use dispatch::{force_baseline, level as simd_level, SimdLevel};
-pub use draw::{DrawCall, Vertex};
+pub use draw::{DrawCall, UvEvaluation, UvMapping, Vertex};
 pub use environment::{Environment, EnvironmentMaps};
 pub use error::RasterError;
 pub use frame::Frame;

@@ -36,7 +36,7 @@ use glam::{DVec2, DVec3, Vec4};
 use rayon::prelude::*;
 use texel_texture::{FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor};
 
-use crate::draw::DrawCall;
+use crate::draw::{DrawCall, UvEvaluation, UvMapping};
 use crate::environment::{Environment, ViewRays};
 use crate::error::RasterError;
 use crate::frame::Frame;
@@ -236,6 +236,12 @@ fn reference_frame(
         .map(|((d, s), m)| DrawCall {
             sampler: s,
             material: *m,
+            // The reference evaluates a sphere mapping at every sample, whichever way the
+            // rasterizer does: the ground truth both evaluations approximate.
+            uv_mapping: d.uv_mapping.map(|m| UvMapping {
+                evaluation: UvEvaluation::PerPixel,
+                ..m
+            }),
             ..*d
         })
         .collect();
@@ -376,8 +382,13 @@ fn reference_row(
             let dc = &ctx.draws[t.draw as usize];
             let pos = s.pos[k];
             let lambda = t.lambda_at(pos.x, pos.y, Perspective::Correct);
-            let uvs = dc.uvs(t);
-            let uv = uvs[0] * lambda.x + uvs[1] * lambda.y + uvs[2] * lambda.z;
+            let uv = match dc.mapped_uv(t, lambda, [DVec3::ZERO; 2]) {
+                Some((uv, _, _)) => uv,
+                None => {
+                    let uvs = dc.uvs(t);
+                    uvs[0] * lambda.x + uvs[1] * lambda.y + uvs[2] * lambda.z
+                }
+            };
             let fp = dc.footprint(uv, DVec2::ZERO, DVec2::ZERO);
             let tex = dc.sampler.sample(dc.texture, &fp);
             let lit = ctx.lighting.as_ref();

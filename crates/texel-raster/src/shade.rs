@@ -14,9 +14,10 @@
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3, Vec4};
 use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};
+use texel_texture::sphere::SurfaceProjection;
 use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
-use crate::draw::{DrawCall, Vertex};
+use crate::draw::{DrawCall, UvEvaluation, Vertex};
 use crate::environment::{self, Environment};
 use crate::layers::Needs;
 use crate::material::{
@@ -42,6 +43,9 @@ pub(crate) struct DrawContext<'a> {
     pub material: Option<Material<'a>>,
     /// The eye's world position (the centre of projection of `clip_from_world`).
     pub eye: Vec3,
+    /// The sphere mapping evaluated per pixel, with its centre ([`crate::UvMapping`]); `None`
+    /// when the vertices' `uv` is interpolated.
+    surface: Option<(SurfaceProjection, DVec3)>,
 }
 
 fn period(mode: AddressMode) -> f64 {
@@ -114,7 +118,39 @@ impl<'a> DrawContext<'a> {
             colored: draw.vertices.iter().any(|v| v.color != Vec4::ONE),
             material: draw.material,
             eye: eye_of(draw),
+            surface: draw
+                .uv_mapping
+                .filter(|m| m.evaluation == UvEvaluation::PerPixel)
+                .map(|m| (m.projection, m.centre.as_dvec3())),
         }
+    }
+
+    /// Whether `uv` comes from a per-pixel sphere mapping ([`DrawContext::mapped_uv`]).
+    #[inline(always)]
+    pub fn maps_uv(&self) -> bool {
+        self.surface.is_some()
+    }
+
+    /// The per-pixel sphere mapping's `uv` and its screen derivatives at barycentrics `lambda`
+    /// (derivatives `dlambda`, per pixel right and down) of triangle `t`: the projection of the
+    /// interpolated position's direction from the centre, and its Jacobian applied to the
+    /// position's derivatives. `None` when the draw has no per-pixel mapping.
+    #[inline(always)]
+    pub fn mapped_uv(
+        &self,
+        t: &TriangleSetup,
+        lambda: DVec3,
+        dlambda: [DVec3; 2],
+    ) -> Option<(DVec2, DVec2, DVec2)> {
+        let (projection, centre) = self.surface?;
+        let p = self.vertices(t).map(|v| v.position.as_dvec3() - centre);
+        let at = |l: DVec3| p[0] * l.x + p[1] * l.y + p[2] * l.z;
+        let d = at(lambda);
+        Some((
+            projection.uv(d),
+            projection.duv(d, at(dlambda[0])),
+            projection.duv(d, at(dlambda[1])),
+        ))
     }
 
     /// The triangle's vertices.

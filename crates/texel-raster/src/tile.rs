@@ -311,11 +311,17 @@ fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range:
                 let z = t.depth_at(x, y) as f32;
                 if z < tile.depth[lj][li] {
                     let b = t.barycentrics(x, y, perspective);
-                    let (duv_dx, duv_dy) = b.derivatives2(uvs);
+                    let (uv, duv_dx, duv_dy) = match dc.mapped_uv(t, b.lambda, [b.dx, b.dy]) {
+                        Some(m) => m,
+                        None => {
+                            let (dx, dy) = b.derivatives2(uvs);
+                            (b.interpolate2(uvs), dx, dy)
+                        }
+                    };
                     let f = Fragment {
                         lambda: b.lambda,
                         dlambda: [b.dx, b.dy],
-                        uv: b.interpolate2(uvs),
+                        uv,
                         duv_dx,
                         duv_dy,
                         z,
@@ -427,13 +433,33 @@ impl Span {
 
     /// The footprints of the span's fragments from their barycentrics: `uv` and (when `deriv`)
     /// its derivatives as [`crate::interp::Barycentrics::interpolate2`] and `derivatives2` compute
-    /// them, reduced by [`DrawContext::footprint`].
+    /// them (or a per-pixel sphere mapping, [`DrawContext::mapped_uv`]), reduced by
+    /// [`DrawContext::footprint`].
     #[inline(always)]
-    fn footprints(&mut self, dc: &DrawContext, uvs: [DVec2; 3], deriv: bool) {
+    fn footprints(&mut self, dc: &DrawContext, t: &TriangleSetup, deriv: bool) {
         let n = self.n;
         let [l0, l1, l2] = &self.l;
         let [x0, x1, x2] = &self.ldx;
         let [y0, y1, y2] = &self.ldy;
+        if dc.maps_uv() {
+            // A per-pixel sphere mapping: not a linear combination, one fragment at a time.
+            for k in 0..n {
+                let lambda = DVec3::new(l0[k], l1[k], l2[k]);
+                let dlambda = if deriv {
+                    [
+                        DVec3::new(x0[k], x1[k], x2[k]),
+                        DVec3::new(y0[k], y1[k], y2[k]),
+                    ]
+                } else {
+                    [DVec3::ZERO; 2]
+                };
+                if let Some((uv, dx, dy)) = dc.mapped_uv(t, lambda, dlambda) {
+                    self.fps[k] = dc.footprint(uv, dx, dy);
+                }
+            }
+            return;
+        }
+        let uvs = dc.uvs(t);
         let dot = |a: [DVec2; 3], l: [f64; 3]| a[0] * l[0] + a[1] * l[1] + a[2] * l[2];
         for k in 0..n {
             let uv = dot(uvs, [l0[k], l1[k], l2[k]]);
@@ -527,7 +553,7 @@ fn flush_span(
     // material's maps may need them.
     let deriv = ctx.capture || dc.sampler.uses_derivatives() || dc.material.is_some();
     span.barycentrics(t, ctx.settings.perspective, deriv);
-    span.footprints(dc, dc.uvs(t), deriv);
+    span.footprints(dc, t, deriv);
     dc.sampler
         .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
     let verts = dc.vertices(t);
@@ -613,13 +639,22 @@ fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: 
                 let y = f64::from(qj + (k as u32 >> 1)) + 0.5;
                 t.lambda_at(x, y, perspective)
             });
-            let uv = lambda.map(|l| uvs[0] * l.x + uvs[1] * l.y + uvs[2] * l.z);
-            let d = quad_differences(uv);
+            let mut uv = lambda.map(|l| uvs[0] * l.x + uvs[1] * l.y + uvs[2] * l.z);
+            let mut d = quad_differences(uv);
             // The barycentrics' differences across the quad, as the uv's.
             let dl = quad_differences(lambda.map(|l| l.truncate())).map(|(dx, dy)| {
                 let third = |d: DVec2| DVec3::new(d.x, d.y, -d.x - d.y);
                 [third(dx), third(dy)]
             });
+            // A per-pixel sphere mapping differences the positions (continuous) and maps the
+            // differences through the projection's Jacobian, never differencing u.
+            if dc.maps_uv() {
+                for k in 0..4 {
+                    if let Some((m, dx, dy)) = dc.mapped_uv(t, lambda[k], dl[k]) {
+                        (uv[k], d[k]) = (m, (dx, dy));
+                    }
+                }
+            }
             for k in 0..4usize {
                 if mask & (1 << k) != 0 {
                     let (i, j) = (qi + (k as u32 & 1), qj + (k as u32 >> 1));

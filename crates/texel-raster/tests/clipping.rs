@@ -19,6 +19,7 @@ fn draw<'a>(
         sampler: &tex.1,
         clip_from_world: m,
         material: None,
+        uv_mapping: None,
     }
 }
 

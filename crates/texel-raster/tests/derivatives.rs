@@ -83,6 +83,7 @@ fn analytic_derivatives_match_finite_differences_on_random_triangles() {
             sampler: &sampler,
             clip_from_world: proj * view,
             material: None,
+            uv_mapping: None,
         };
         let setups = setup_draws(&RenderSettings::new(w, h), &[draw]).unwrap();
         checked += check_against_finite_differences(&setups, &vertices, w, h);

@@ -287,6 +287,7 @@ fn a_constant_environment_lights_by_the_split_sum() {
             sampler: &s,
             clip_from_world: clip,
             material,
+            uv_mapping: None,
         };
         let f = render(&settings, &[draw]).unwrap();
         f.color[f.index(8, 8)]

@@ -203,6 +203,7 @@ fn vertex_colours_barycentrics_and_lambert() {
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
         material: None,
+        uv_mapping: None,
     };
     let color = render(&RenderSettings::new(w, h), &[draw]).unwrap();
     let bary = render(

@@ -78,6 +78,7 @@ proptest! {
             sampler: &sampler,
             clip_from_world: Mat4::IDENTITY,
             material: None,
+            uv_mapping: None,
         };
         let setups = setup_draws(&RenderSettings::new(64, 48), &[draw]).unwrap();
         let uvs = [0, 1, 2].map(|k| vertices[k].uv.as_dvec2());

@@ -162,6 +162,7 @@ fn reference_covers_tile_seams_and_subpixel_triangles() {
         sampler: &sampler,
         clip_from_world: glam::Mat4::IDENTITY,
         material: None,
+        uv_mapping: None,
     };
     let s = RenderSettings::new(w, h);
     let f = render_reference(&s, &[draw], 4, 7, None).unwrap();
@@ -179,6 +180,7 @@ fn reference_covers_tile_seams_and_subpixel_triangles() {
         sampler: &sampler,
         clip_from_world: glam::Mat4::IDENTITY,
         material: None,
+        uv_mapping: None,
     };
     assert_eq!(render(&s, &[draw]).unwrap().covered_pixels(), 0);
     let f = render_reference(&s, &[draw], 8, 7, None).unwrap();

@@ -72,6 +72,7 @@ fn plane_draw<'a>(
         sampler,
         clip_from_world,
         material: Some(material),
+        uv_mapping: None,
     }
 }
 

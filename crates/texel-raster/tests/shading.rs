@@ -74,6 +74,7 @@ fn a_normal_map_tilts_the_shading_normal_in_gltf_tangent_space() {
             sampler: &sampler,
             clip_from_world: m,
             material: Some(material),
+            uv_mapping: None,
         };
         let frame = render(&settings, &[draw]).unwrap();
         // Tangent +x, bitangent +y, normal +z: the world normal is the scaled map normal.
@@ -113,6 +114,7 @@ fn lights_without_a_material_are_lambertian_and_unlit_frames_ignore_normals() {
         sampler: &sampler,
         clip_from_world: m,
         material: None,
+        uv_mapping: None,
     };
     // 0.5 stored as the 8-bit code 128.
     let c = white.texel(0, 0, 0).unwrap()[0];

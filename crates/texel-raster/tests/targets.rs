@@ -51,6 +51,7 @@ fn screen_draw<'a>(
         sampler,
         clip_from_world: Mat4::IDENTITY,
         material: None,
+        uv_mapping: None,
     }
 }
 

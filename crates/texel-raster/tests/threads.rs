@@ -109,6 +109,7 @@ fn batched_small_triangles_equal_per_pixel() {
                 sampler: &sampler,
                 clip_from_world,
                 material: None,
+                uv_mapping: None,
             };
             let label = format!("{name} grid, lab mode {mode}");
             assert_batched_equals_per_pixel(w, h, draw, &label);

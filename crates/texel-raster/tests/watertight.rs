@@ -17,6 +17,7 @@ fn coverage_counts(vertices: &[Vertex], triangles: &[[u32; 3]], w: u32, h: u32) 
         sampler: &sampler,
         clip_from_world: Mat4::IDENTITY,
         material: None,
+        uv_mapping: None,
     };
     let settings = RenderSettings::new(w, h);
     let setups = setup_draws(&settings, &[draw]).unwrap();

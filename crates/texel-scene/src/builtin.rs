@@ -1,18 +1,19 @@
 //! Built-in scenes, available as `builtin:NAME`.
 //!
 //! `ground`, `zoneplate` and `triangle` are TOML files compiled into the crate (`src/builtin/`;
-//! `ground` is byte for byte `shared/scenes/ground.toml`); `ground-rotated`, `cube` and `sphere`
-//! are built in code.
+//! `ground` is byte for byte `shared/scenes/ground.toml`); `ground-rotated`, `cube`, `sphere`,
+//! the globes and the lit scenes but `glossy`, `bricks` and `terrain` are built in code.
 
 use std::f32::consts::PI;
 use std::path::Path;
 
 use glam::{Vec2, Vec3, Vec4};
+use texel_texture::sphere::SurfaceProjection;
 use texel_texture::{AddressMode, ColorSpace};
 
 use crate::camera::Camera;
 use crate::error::SceneError;
-use crate::model::{Mesh, Output, Scene, TextureSource, TextureSpec};
+use crate::model::{Mesh, Output, Scene, SphereUv, TextureSource, TextureSpec};
 use crate::procedural::Procedural;
 
 /// The ground plane TOML (identical to `shared/scenes/ground.toml`).
@@ -37,7 +38,11 @@ pub const GROUND_ROTATION_DEG: f32 = 30.0;
 ///   run diagonally to the view (anisotropy off the screen axes);
 /// - `zoneplate`: a zone plate on a square seen at a grazing angle;
 /// - `cube`: a cube with a grid texture on each face, seen from above a corner;
-/// - `sphere`: a UV sphere with a latitude-longitude grid (15 degree cells), u wrapping;
+/// - `sphere`: a UV sphere with a latitude-longitude grid (15 degree cells), u wrapping, its uvs
+///   the equirect mapping (evaluated per pixel unless asked per vertex);
+/// - `globe`: the sphere wearing a Mercator map (cut at 85.05 degrees) of parallels, meridians
+///   and Tissot's discs, seen from above so the polar cap shows;
+/// - `globe-equirect`: the same globe from an equirect map;
 /// - `triangle`: the barycentric colour triangle (red, green, blue vertices, white texture).
 pub fn builtin_names() -> &'static [&'static str] {
     &[
@@ -46,6 +51,8 @@ pub fn builtin_names() -> &'static [&'static str] {
         "zoneplate",
         "cube",
         "sphere",
+        "globe",
+        "globe-equirect",
         "triangle",
     ]
 }
@@ -103,6 +110,8 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "terrain" => from_toml(name, TERRAIN_TOML),
         "cube" => Ok(cube()),
         "sphere" => Ok(sphere()),
+        "globe" => Ok(globe(true)),
+        "globe-equirect" => Ok(globe(false)),
         "knot" => Ok(knot()),
         "mirror-spheres" => Ok(mirror_spheres()),
         "mirror-plane" => Ok(mirror_plane()),
@@ -171,6 +180,7 @@ fn empty_mesh(texture: &str) -> Mesh {
         filters: None,
         material: None,
         tangents: None,
+        uv_mapping: None,
     }
 }
 
@@ -239,11 +249,17 @@ fn cube() -> Scene {
 const SPHERE_SEGMENTS: u32 = 64;
 const SPHERE_RINGS: u32 = 32;
 
-/// A unit UV sphere: vertex (s, r) at longitude `2 pi s / 64` and colatitude `pi r / 32`,
-/// uv = `(s / 64, r / 32)` (north pole at v = 0, the top row of the latitude-longitude map), with
-/// a duplicated seam column at u = 1; u repeats, v clamps.
-/// The built-in sphere's mesh (see [`sphere`]), with `texture`.
+/// The built-in sphere's mesh (see [`sphere`]), with `texture`, its uvs the equirect mapping.
 fn sphere_mesh(texture: &str) -> Mesh {
+    sphere_mesh_mapped(texture, SurfaceProjection::Equirect)
+}
+
+/// A unit UV sphere centred at the origin: vertex (s, r) at longitude `2 pi s / 64` (0 facing
+/// `+z`, increasing towards `+x`) and colatitude `pi r / 32`, with uv = `projection`'s at the
+/// vertex ([`SurfaceProjection::uv`]: `u = s / 64`, equirect `v = r / 32`, Mercator's `v` clamped
+/// at its cut) and the mapping recorded for per-pixel evaluation. The seam column is duplicated at
+/// `u = 1` and each pole triangle has its own pole vertex at its column's `u`; u repeats, v clamps.
+fn sphere_mesh_mapped(texture: &str, projection: SurfaceProjection) -> Mesh {
     let mut positions = Vec::new();
     let mut uvs = Vec::new();
     for r in 0..=SPHERE_RINGS {
@@ -256,10 +272,15 @@ fn sphere_mesh(texture: &str) -> Mesh {
                 theta.cos(),
                 theta.sin() * phi.cos(),
             ));
-            uvs.push(Vec2::new(
-                s as f32 / SPHERE_SEGMENTS as f32,
-                r as f32 / SPHERE_RINGS as f32,
-            ));
+            let v = match projection {
+                SurfaceProjection::Equirect => r as f32 / SPHERE_RINGS as f32,
+                SurfaceProjection::Mercator { .. } => {
+                    let lat = std::f64::consts::FRAC_PI_2 - f64::from(theta);
+                    let d = glam::DVec3::new(lat.cos(), lat.sin(), 0.0);
+                    projection.uv(d).y as f32
+                }
+            };
+            uvs.push(Vec2::new(s as f32 / SPHERE_SEGMENTS as f32, v));
         }
     }
     let row = SPHERE_SEGMENTS + 1;
@@ -290,6 +311,10 @@ fn sphere_mesh(texture: &str) -> Mesh {
         filters: None,
         material: None,
         tangents: None,
+        uv_mapping: Some(SphereUv {
+            projection,
+            centre: Vec3::ZERO,
+        }),
     }
 }
 
@@ -327,6 +352,41 @@ fn sphere() -> Scene {
     }
 }
 
+/// The `globe` (Mercator, `mercator = true`) and `globe-equirect` scenes: the built-in sphere
+/// wearing [`Procedural::Globe`]'s map in that projection, seen from 35 degrees above the
+/// equator so the north polar cap (past Mercator's cut) shows, with the seam (the red prime
+/// meridian) facing the camera. Unlit.
+fn globe(mercator: bool) -> Scene {
+    let map = Procedural::Globe {
+        width: 2048,
+        height: if mercator { 2048 } else { 1024 },
+        mercator,
+    };
+    let projection = map
+        .globe_projection()
+        .unwrap_or(SurfaceProjection::Equirect);
+    Scene {
+        output: Output {
+            width: 960,
+            height: 540,
+            background: [0, 0, 0, 255],
+        },
+        camera: Camera {
+            eye: Vec3::new(0.0, 1.8, 2.6),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_deg: 45.0,
+            near: 0.1,
+            far: 100.0,
+        },
+        textures: one_texture("globe", map),
+        meshes: vec![sphere_mesh_mapped("globe", projection)],
+        lights: Vec::new(),
+        materials: Default::default(),
+        environment: None,
+    }
+}
+
 /// The `mirror-spheres` scene: two spheres of radius 1 side by side in the procedural sky, a
 /// mirror (`metallic = 1`, `roughness = 0`) on the left and brushed copper (`roughness = 0.35`)
 /// on the right; no lights but the environment, which is also the background.
@@ -336,6 +396,8 @@ fn mirror_spheres() -> Scene {
         for p in &mut m.positions {
             *p += Vec3::new(x, 0.0, 0.0);
         }
+        // A white texture: nothing to gain from evaluating the mapping per pixel.
+        m.uv_mapping = None;
         m.material = Some(material.into());
         m
     };

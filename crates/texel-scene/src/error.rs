@@ -92,6 +92,14 @@ pub enum SceneError {
         /// What is wrong.
         reason: &'static str,
     },
+    /// A mesh's sphere mapping (`sphere_uv` and its keys) is invalid.
+    #[error("meshes[{mesh}]: {reason}")]
+    MeshMapping {
+        /// Mesh index.
+        mesh: usize,
+        /// What is wrong.
+        reason: String,
+    },
     /// A mesh's texture or material is missing or contradicts itself.
     #[error("meshes[{mesh}]: {reason}")]
     MeshMaterial {

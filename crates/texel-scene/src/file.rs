@@ -13,7 +13,8 @@
 //! [textures.checker]            # path = "file.png" (relative to the scene file) or
 //! procedural = "checker"        # procedural = checker | zoneplate | grid | uv | solid | bumps |
 //! size = 1024                   # waves | wave-heights | bricks | brick-heights | noise |
-//! checks = 8                    # noise-heights | splat; color = "srgb" (default) | "linear";
+//! checks = 8                    # noise-heights | splat | globe | globe-mercator;
+//!                               # color = "srgb" (default) | "linear";
 //! color = "srgb"                # see `Procedural` for each kind's parameters (size or width +
 //!                               # height, checks, cells, line_width, rgba, slope, waves, seed,
 //!                               # rows, columns, mortar, bevel, layers)
@@ -27,6 +28,10 @@
 //! # material = "NAME" (optional; `texture` may then be left out if the material's base_color
 //! # is a texture; a glTF mesh without one uses the file's own materials and textures, named
 //! # "FILE#materialN" and "FILE#textureN.srgb" / ".linear", and `texture` may be left out)
+//! # sphere_uv = "equirect" | "mercator" (optional): the uvs are that projection of each point's
+//! # direction from sphere_centre = [x, y, z] (default origin), Mercator cut at
+//! # mercator_cut_deg (default 85.0511, Web Mercator's square); drawn exactly per pixel
+//! # (the CLI's --surface-uv vertex interpolates the uvs instead)
 //! [[lights]]                    # type = "directional" (direction towards the light) |
 //! type = "directional"          #   "point" (position) | "ambient"; intensity = [r, g, b]
 //! direction = [0.0, 0.25, -1.0] #   linear (glTF KHR_lights_punctual units); at most 8 lights
@@ -70,7 +75,7 @@ use crate::gltf_import::GltfScene;
 use crate::limits::SceneLimits;
 use crate::model::{
     ColorInput, Displacement, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec, MaterialSpec, Mesh,
-    Output, ScalarInput, Scene, SpecularAaSpec, TextureSource, TextureSpec,
+    Output, ScalarInput, Scene, SpecularAaSpec, SphereUv, TextureSource, TextureSpec,
 };
 use crate::procedural::{NoiseKind, Procedural};
 use texel_texture::sphere::Mapping;
@@ -399,6 +404,8 @@ enum Kind {
     Noise,
     NoiseHeights,
     Splat,
+    Globe,
+    GlobeMercator,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -448,6 +455,8 @@ impl Kind {
             Kind::Noise => "noise",
             Kind::NoiseHeights => "noise-heights",
             Kind::Splat => "splat",
+            Kind::Globe => "globe",
+            Kind::GlobeMercator => "globe-mercator",
         }
     }
 }
@@ -490,6 +499,50 @@ struct RawMesh {
     triangles: Option<Vec<[u32; 3]>>,
     obj: Option<String>,
     gltf: Option<String>,
+    sphere_uv: Option<SphereUvName>,
+    sphere_centre: Option<[f32; 3]>,
+    mercator_cut_deg: Option<f64>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+enum SphereUvName {
+    Equirect,
+    Mercator,
+}
+
+/// The sphere mapping of `[[meshes]]` entry `m`, checked: a finite centre, a cut latitude in
+/// `(0, 89.9]` degrees and only for Mercator, neither without `sphere_uv`.
+fn sphere_uv(m: &RawMesh) -> Result<Option<SphereUv>, String> {
+    use texel_texture::sphere::SurfaceProjection;
+    let Some(name) = m.sphere_uv else {
+        if m.sphere_centre.is_some() || m.mercator_cut_deg.is_some() {
+            return Err("sphere_centre and mercator_cut_deg need sphere_uv".into());
+        }
+        return Ok(None);
+    };
+    let centre = Vec3::from(m.sphere_centre.unwrap_or_default());
+    if !centre.is_finite() {
+        return Err(format!("sphere_centre {centre} is not finite"));
+    }
+    let projection = match (name, m.mercator_cut_deg) {
+        (SphereUvName::Equirect, None) => SurfaceProjection::Equirect,
+        (SphereUvName::Equirect, Some(_)) => {
+            return Err("mercator_cut_deg is for sphere_uv = \"mercator\"".into())
+        }
+        (SphereUvName::Mercator, None) => SurfaceProjection::MERCATOR,
+        (SphereUvName::Mercator, Some(cut)) => {
+            if !(cut > 0.0 && cut <= 89.9) {
+                return Err(format!(
+                    "mercator_cut_deg {cut} is outside (0, 89.9] (Mercator reaches infinity at the poles)"
+                ));
+            }
+            SurfaceProjection::Mercator {
+                cut: cut.to_radians(),
+            }
+        }
+    };
+    Ok(Some(SphereUv { projection, centre }))
 }
 
 /// 1-based line and column (in characters) of byte offset `at` in `text`.
@@ -557,6 +610,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Noise => &["size", "cells", "seed", "rgba"],
                 Kind::NoiseHeights => &["size", "cells", "seed"],
                 Kind::Splat => &["size", "cells", "seed", "layers"],
+                Kind::Globe | Kind::GlobeMercator => &["size", "width", "height"],
             };
             if let Some(k) = given.iter().find(|k| !allowed.contains(k)) {
                 return Err(bad(format!(
@@ -571,7 +625,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Kind::Solid => 1,
                 Kind::Bumps | Kind::Waves | Kind::WaveHeights => 512,
                 Kind::Noise | Kind::NoiseHeights | Kind::Splat => 512,
-                Kind::Bricks | Kind::BrickHeights => 0,
+                Kind::Bricks | Kind::BrickHeights | Kind::Globe | Kind::GlobeMercator => 0,
             };
             let (width, height) = match (t.size, t.width, t.height) {
                 (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
@@ -582,6 +636,8 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 (None, None, None) if matches!(kind, Kind::Bricks | Kind::BrickHeights) => {
                     (1024, 512)
                 }
+                (None, None, None) if matches!(kind, Kind::Globe) => (2048, 1024),
+                (None, None, None) if matches!(kind, Kind::GlobeMercator) => (2048, 2048),
                 (None, None, None) => (default_size, default_size),
                 _ => return Err(bad("width and height go together".into())),
             };
@@ -645,6 +701,11 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                         heights: matches!(kind, Kind::BrickHeights),
                     }
                 }
+                Kind::Globe | Kind::GlobeMercator => Procedural::Globe {
+                    width,
+                    height,
+                    mercator: matches!(kind, Kind::GlobeMercator),
+                },
                 Kind::Solid => Procedural::Solid {
                     width,
                     height,
@@ -749,6 +810,10 @@ fn meshes(
             "give exactly one geometry source: inline positions, obj = \"FILE\" or gltf = \"FILE\"",
         ));
     }
+    let uv_mapping = sphere_uv(&m).map_err(|reason| SceneError::MeshMapping {
+        mesh: index,
+        reason,
+    })?;
     let both = m.address_mode.map(AddressMode::from);
     let mode_u = m.address_mode_u.map(AddressMode::from).or(both);
     let mode_v = m.address_mode_v.map(AddressMode::from).or(both);
@@ -768,6 +833,7 @@ fn meshes(
             filters: None,
             material: None,
             tangents: None,
+            uv_mapping: None,
         }])
     } else {
         if m.uvs.is_some() || m.triangles.is_some() || m.normals.is_some() || m.colors.is_some() {
@@ -803,6 +869,9 @@ fn meshes(
         }
         if let Some(v) = mode_v {
             mesh.address_mode_v = v;
+        }
+        if uv_mapping.is_some() {
+            mesh.uv_mapping = uv_mapping;
         }
     }
     Ok(out)

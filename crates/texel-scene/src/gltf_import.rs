@@ -230,6 +230,7 @@ impl Ctx<'_> {
                 filters,
                 material: imported,
                 tangents,
+                uv_mapping: None,
             });
         }
         Ok(())

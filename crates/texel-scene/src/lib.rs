@@ -57,8 +57,8 @@ pub use gltf_import::{import_gltf, load_gltf, load_gltf_slice, load_gltf_with, G
 pub use limits::SceneLimits;
 pub use model::{
     ColorInput, Displacement, EncodedImage, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec,
-    MaterialSpec, Mesh, MeshFilters, Output, ScalarInput, Scene, SpecularAaSpec, TextureSampler,
-    TextureSource, TextureSpec, MAX_LAYERS, MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
+    MaterialSpec, Mesh, MeshFilters, Output, ScalarInput, Scene, SpecularAaSpec, SphereUv,
+    TextureSampler, TextureSource, TextureSpec, MAX_LAYERS, MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
 };
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::{NoiseKind, Procedural};

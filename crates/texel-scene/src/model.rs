@@ -437,6 +437,20 @@ pub struct Mesh {
     /// Tangents (`xyz` along increasing u, `w = +-1` handedness as glTF's `TANGENT`), one per
     /// position, if given or generated ([`Mesh::generate_tangents`]).
     pub tangents: Option<Vec<Vec4>>,
+    /// Whether `uvs` are a sphere mapping of the positions' directions from a centre (scene
+    /// key `sphere_uv`); the renderer may then evaluate it exactly per pixel.
+    pub uv_mapping: Option<SphereUv>,
+}
+
+/// A mesh's texture coordinates as a projection of its points' directions from `centre`: the
+/// lecture's spherical mappings (`texel_texture::sphere::SurfaceProjection`). The mesh's own
+/// `uvs` should hold the projection at each vertex (what per-vertex evaluation interpolates).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereUv {
+    /// Equirect or Mercator (with its cut latitude).
+    pub projection: texel_texture::sphere::SurfaceProjection,
+    /// The sphere's centre, world units.
+    pub centre: Vec3,
 }
 
 /// Texture filters a glTF sampler asks for (glTF 2.0 spec, 5.26 "Sampler"); `None` = not specified.

@@ -207,6 +207,7 @@ pub fn load_obj_bytes(
         filters: None,
         material: None,
         tangents: None,
+        uv_mapping: None,
     };
     for model in &models {
         let m = &model.mesh;

@@ -1,5 +1,5 @@
-//! Procedural textures: checker, zone plate, grid, uv, solid, and the bump and wave normal and
-//! height maps.
+//! Procedural textures: checker, zone plate, grid, uv, solid, a globe's map, and the bump and
+//! wave normal and height maps.
 //!
 //! Each generator gives the 8-bit code of every texel (`code(i, j)`, row 0 at the top); the texture
 //! is then made with `Texture::from_rgba8` and the spec's colour space, so `color = "srgb"` decodes
@@ -142,6 +142,28 @@ pub enum Procedural {
         /// What is made of the noise.
         kind: NoiseKind,
     },
+    /// A globe's map for the spherical mappings ([`texel_texture::sphere::SurfaceProjection`]):
+    /// texel `(i, j)` is coloured by the point of the sphere it shows, `d = direction(u, v)` at its
+    /// centre, latitude `phi`, longitude `lambda` (east from `+z`). Ocean `[28, 64, 128]`;
+    /// Tissot's indicatrix, discs of [`GLOBE_DISC_DEG`] radius on the sphere centred every 30
+    /// degrees of longitude at latitudes -60 to 60, in `[240, 150, 40]`; parallels and meridians
+    /// every 15 degrees ([`GLOBE_LINE_DEG`] wide on the sphere; meridians end at 75 degrees of
+    /// latitude except every 90th) in white; the prime meridian (the seam `u = 0 = 1`) in
+    /// `[220, 40, 40]`. Every line and disc has the same size on the sphere, so on a correctly
+    /// mapped globe they all look alike. Edges are antialiased with the texel's own angular size
+    /// (coverage `clamp((r - dist) / s + 1/2, 0, 1)`, `s` the texel's extent on the sphere across
+    /// the edge). `mercator = false` (`"globe"`): equirect, `2048 x 1024` by default;
+    /// `mercator = true` (`"globe-mercator"`): Mercator whose cut follows the aspect
+    /// (`ln tan(pi/4 + cut/2) = pi height / width`; a square, the default `2048 x 2048`, is Web
+    /// Mercator).
+    Globe {
+        /// Width in texels.
+        width: u32,
+        /// Height in texels.
+        height: u32,
+        /// Mercator instead of equirect.
+        mercator: bool,
+    },
     /// One colour everywhere (8-bit codes, `rgba = [255, 255, 255, 255]` and `size = 1` by default).
     Solid {
         /// Width in texels.
@@ -161,6 +183,7 @@ impl Procedural {
             | Procedural::Grid { width, height, .. }
             | Procedural::Uv { width, height }
             | Procedural::Bricks { width, height, .. }
+            | Procedural::Globe { width, height, .. }
             | Procedural::Solid { width, height, .. } => (width, height),
             Procedural::ZonePlate { size }
             | Procedural::Bumps { size, .. }
@@ -198,6 +221,11 @@ impl Procedural {
                 let on = f64::from(i) % p < lw || f64::from(j) % p < lw;
                 grey(if on { 0 } else { 255 })
             }
+            Procedural::Globe {
+                width,
+                height,
+                mercator,
+            } => globe(width, height, mercator, i, j),
             Procedural::Uv { width, height } => {
                 let r = (255.0 * (f64::from(i) + 0.5) / f64::from(width)).round() as u8;
                 let g = (255.0 * (f64::from(j) + 0.5) / f64::from(height)).round() as u8;
@@ -346,6 +374,95 @@ impl Procedural {
             .collect();
         Texture::from_rgba8(w, h, texels, color, limits)
     }
+}
+
+/// Radius, degrees on the sphere, of [`Procedural::Globe`]'s discs.
+pub const GLOBE_DISC_DEG: f64 = 6.0;
+/// Width, degrees on the sphere, of [`Procedural::Globe`]'s lines.
+pub const GLOBE_LINE_DEG: f64 = 0.5;
+
+impl Procedural {
+    /// The projection a [`Procedural::Globe`] map is drawn in (`None` for other kinds): equirect,
+    /// or Mercator cut where `ln tan(pi/4 + cut/2) = pi height / width`.
+    pub fn globe_projection(&self) -> Option<texel_texture::sphere::SurfaceProjection> {
+        use texel_texture::sphere::SurfaceProjection;
+        let Procedural::Globe {
+            width,
+            height,
+            mercator,
+        } = *self
+        else {
+            return None;
+        };
+        Some(if mercator && width == height {
+            SurfaceProjection::MERCATOR
+        } else if mercator {
+            let y = std::f64::consts::PI * f64::from(height) / f64::from(width.max(1));
+            SurfaceProjection::Mercator {
+                cut: y.tanh().asin(),
+            }
+        } else {
+            SurfaceProjection::Equirect
+        })
+    }
+}
+
+/// [`Procedural::Globe`]'s texel `(i, j)`.
+fn globe(width: u32, height: u32, mercator: bool, i: u32, j: u32) -> [u8; 4] {
+    use glam::{DVec2, DVec3};
+    use std::f64::consts::PI;
+    use texel_texture::sphere::SurfaceProjection;
+    let projection = Procedural::Globe {
+        width,
+        height,
+        mercator,
+    }
+    .globe_projection()
+    .unwrap_or(SurfaceProjection::Equirect);
+    let (w, h) = (f64::from(width.max(1)), f64::from(height.max(1)));
+    let uv = DVec2::new((f64::from(i) + 0.5) / w, (f64::from(j) + 0.5) / h);
+    let d = projection.direction(uv);
+    let lat = d.y.clamp(-1.0, 1.0).asin();
+    let lon = 2.0 * PI * uv.x;
+    let cos = lat.cos().max(1e-9);
+    // A texel's extent on the sphere, radians: east-west, and north-south (equirect pi / H;
+    // Mercator 2 Y cos(lat) / H, the same as east-west for a square map: conformal).
+    let s_east = 2.0 * PI * cos / w;
+    let s_north = match projection {
+        SurfaceProjection::Equirect => PI / h,
+        SurfaceProjection::Mercator { .. } => 2.0 * PI * cos / w,
+    };
+    let cover = |r: f64, dist: f64, s: f64| ((r - dist) / s + 0.5).clamp(0.0, 1.0);
+    let deg = PI / 180.0;
+    let nearest = |x: f64, step: f64| x - (x / step).round() * step;
+    let half = 0.5 * GLOBE_LINE_DEG * deg;
+    let parallel = cover(half, nearest(lat, 15.0 * deg).abs(), s_north);
+    // Meridians: the distance on the sphere is |delta lon| cos(lat).
+    let dlon = nearest(lon, 15.0 * deg).abs();
+    let every_90th = ((lon / (15.0 * deg)).round() as i64).rem_euclid(6) == 0;
+    let meridian = if lat.abs() > 75.0 * deg && !every_90th {
+        0.0
+    } else {
+        cover(half, dlon * cos, s_east)
+    };
+    let prime = cover(half, nearest(lon, 2.0 * PI).abs() * cos, s_east);
+    // Tissot's disc nearest the texel: its great-circle distance.
+    let lat_c = ((lat / (30.0 * deg)).round().clamp(-2.0, 2.0)) * 30.0 * deg;
+    let lon_c = (lon / (30.0 * deg)).round() * 30.0 * deg;
+    let centre = DVec3::new(
+        lat_c.cos() * lon_c.sin(),
+        lat_c.sin(),
+        lat_c.cos() * lon_c.cos(),
+    );
+    let here = DVec3::new(cos * lon.sin(), lat.sin(), cos * lon.cos());
+    let dist = here.cross(centre).length().atan2(here.dot(centre));
+    let disc = cover(GLOBE_DISC_DEG * deg, dist, (s_east * s_north).sqrt());
+    let mix = |a: [f64; 3], b: [f64; 3], t: f64| std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t);
+    let mut c = mix([28.0, 64.0, 128.0], [240.0, 150.0, 40.0], disc);
+    c = mix(c, [255.0; 3], parallel.max(meridian));
+    c = mix(c, [220.0, 40.0, 40.0], prime);
+    let code = |x: f64| x.round().clamp(0.0, 255.0) as u8;
+    [code(c[0]), code(c[1]), code(c[2]), 255]
 }
 
 /// What [`Procedural::Noise`] makes of its noise.

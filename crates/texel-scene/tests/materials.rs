@@ -362,6 +362,7 @@ fn generated_tangents_point_along_u_and_up_the_image() {
             filters: None,
             material: None,
             tangents: None,
+            uv_mapping: None,
         };
         mesh.generate_tangents();
         for t in mesh.tangents.as_ref().unwrap() {

@@ -829,3 +829,130 @@ fn bad_environment_tables_are_refused() {
         assert!(err.contains(expect), "{table}: {err}");
     }
 }
+
+#[test]
+fn sphere_uv_keys_parse_and_bad_ones_are_refused() {
+    use texel_texture::sphere::SurfaceProjection;
+    let with = |keys: &str| parse(&format!("{HEAD}{TRI}{keys}\n"));
+    let m = with("sphere_uv = \"mercator\"\nsphere_centre = [1.0, 2.0, 3.0]").unwrap();
+    let u = m.meshes[0].uv_mapping.unwrap();
+    assert_eq!(u.projection, SurfaceProjection::MERCATOR);
+    assert_eq!(u.centre, Vec3::new(1.0, 2.0, 3.0));
+    let m = with("sphere_uv = \"mercator\"\nmercator_cut_deg = 60.0").unwrap();
+    match m.meshes[0].uv_mapping.unwrap().projection {
+        SurfaceProjection::Mercator { cut } => assert!((cut - 60f64.to_radians()).abs() < 1e-12),
+        other => panic!("{other:?}"),
+    }
+    let m = with("sphere_uv = \"equirect\"").unwrap();
+    assert_eq!(
+        m.meshes[0].uv_mapping.unwrap().projection,
+        SurfaceProjection::Equirect
+    );
+    assert_eq!(
+        parse(&format!("{HEAD}{TRI}")).unwrap().meshes[0].uv_mapping,
+        None
+    );
+    for (keys, needle) in [
+        (
+            "sphere_uv = \"equirect\"\nmercator_cut_deg = 80.0",
+            "mercator_cut_deg is for",
+        ),
+        (
+            "sphere_uv = \"mercator\"\nmercator_cut_deg = 90.0",
+            "outside (0, 89.9]",
+        ),
+        (
+            "sphere_uv = \"mercator\"\nmercator_cut_deg = -5.0",
+            "outside (0, 89.9]",
+        ),
+        (
+            "sphere_uv = \"mercator\"\nmercator_cut_deg = nan",
+            "outside (0, 89.9]",
+        ),
+        ("sphere_centre = [0.0, 0.0, 0.0]", "need sphere_uv"),
+        (
+            "sphere_uv = \"mercator\"\nsphere_centre = [inf, 0.0, 0.0]",
+            "not finite",
+        ),
+        ("sphere_uv = \"sinusoidal\"", "unknown variant"),
+    ] {
+        let e = with(keys).unwrap_err().to_string();
+        assert!(e.contains(needle), "{keys}: {e}");
+    }
+}
+
+#[test]
+fn the_globes_carry_their_projection_at_every_vertex() {
+    use texel_texture::sphere::SurfaceProjection;
+    for (name, want) in [
+        ("sphere", SurfaceProjection::Equirect),
+        ("globe-equirect", SurfaceProjection::Equirect),
+        ("globe", SurfaceProjection::MERCATOR),
+    ] {
+        let s = builtin(name).unwrap();
+        let m = &s.meshes[0];
+        let u = m.uv_mapping.unwrap();
+        assert_eq!(u.projection, want, "{name}");
+        // Each vertex's uv is the projection of its direction (u = 1 on the duplicated seam
+        // column, and at the poles any u: the column's).
+        for (p, uv) in m.positions.iter().zip(&m.uvs) {
+            let d = (*p - u.centre).as_dvec3();
+            let want = u.projection.uv(d);
+            assert!(
+                (f64::from(uv.y) - want.y).abs() < 1e-6,
+                "{name} {p}: {uv} {want}"
+            );
+            let pole = d.normalize().y.abs() > 1.0 - 1e-6;
+            let du = (f64::from(uv.x) - want.x).rem_euclid(1.0);
+            assert!(pole || du.min(1.0 - du) < 1e-6, "{name} {p}: {uv} {want}");
+        }
+    }
+}
+
+#[test]
+fn both_globe_maps_draw_the_same_globe() {
+    // Sample each map at the texel a sphere point lands in: away from edges (where the texels'
+    // different sizes antialias differently) the two maps agree, and the discs are where
+    // Tissot's indicatrix puts them.
+    use glam::DVec3;
+    let maps = [false, true].map(|mercator| Procedural::Globe {
+        width: 2048,
+        height: if mercator { 2048 } else { 1024 },
+        mercator,
+    });
+    let colour_at = |p: &Procedural, d: DVec3| {
+        let uv = p.globe_projection().unwrap().uv(d);
+        let (w, h) = p.size();
+        let i = ((uv.x * f64::from(w)) as u32).min(w - 1);
+        let j = ((uv.y * f64::from(h)) as u32).min(h - 1);
+        p.code(i, j)
+    };
+    let at = |lat: f64, lon: f64| {
+        let (lat, lon) = (lat.to_radians(), lon.to_radians());
+        DVec3::new(lat.cos() * lon.sin(), lat.sin(), lat.cos() * lon.cos())
+    };
+    let (ocean, disc, line) = (
+        [28, 64, 128, 255],
+        [240, 150, 40, 255],
+        [255, 255, 255, 255],
+    );
+    for (lat, lon, want) in [
+        (3.0, 33.0, disc),
+        (58.0, 93.0, disc),
+        (-33.0, 207.0, disc),
+        (62.0, 92.0, disc),
+        (7.5, 22.5, ocean),
+        (80.0, 7.0, ocean),
+        (45.0, 37.5, line),
+        (-22.5, 75.0, line),
+    ] {
+        for p in &maps {
+            assert_eq!(colour_at(p, at(lat, lon)), want, "{p:?} at ({lat}, {lon})");
+        }
+    }
+    // The prime meridian (the seam) is red in both.
+    for p in &maps {
+        let c = colour_at(p, at(20.0, 359.99));
+        assert!(c[0] > 150 && c[1] < 100, "{c:?}");
+    }
+}

@@ -330,6 +330,120 @@ pub fn octahedral_duv(d: DVec3, dd: DVec3) -> DVec2 {
     DVec2::new(c(0.5 * sx * du), c(0.5 * sy * dv))
 }
 
+/// The latitude, in radians, at which Web Mercator cuts a square map: `2 atan(e^pi) - pi / 2`
+/// (about 85.0511 degrees), where `ln tan(pi / 4 + phi / 2) = pi`, so the square spans
+/// `y` in `[-pi, pi]` like `x`.
+pub const MERCATOR_WEB_CUT: f64 = 1.484_422_229_745_332_4;
+
+/// How a texture wraps a sphere seen from outside (a globe): the projections of the lecture's
+/// "spherical mappings", applied to the direction `d` of a surface point from the sphere's centre.
+///
+/// Both share `u`: longitude 0 faces `+z` at `u = 0` (and 1), longitudes increase eastwards
+/// towards `+x` (`u = 1/4`), so `u = atan2(d.x, d.z) / (2 pi)` reduced to `[0, 1)`; the seam
+/// `u = 0 = 1` is the meridian through `+z`. `v = 0` is the north (`+y`) edge of the image.
+/// - **Equirect**: `v = acos(d.y / |d|) / pi`, the colatitude; the poles are the image's top and
+///   bottom rows, where `u` is undefined.
+/// - **Mercator**: `v = 1/2 - ln tan(pi/4 + phi/2) / (2 Y)`, `Y = ln tan(pi/4 + cut/2)`, with
+///   `phi` the latitude (`ln tan(pi/4 + phi/2) = atanh(sin phi)`; Snyder 1987, "Map Projections:
+///   A Working Manual", eq. 7-2). The projection is conformal and reaches infinity at the poles,
+///   so it is cut at latitude `cut` (Web Mercator's [`MERCATOR_WEB_CUT`] for a square map): past
+///   it `v` clamps to the edge row (the polar caps take that row's colour) and stops changing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SurfaceProjection {
+    /// Latitude-longitude.
+    Equirect,
+    /// Mercator, cut at latitude `cut` radians, in `(0, pi/2)`.
+    Mercator {
+        /// The latitude (radians) mapped to the image's top edge; `-cut` maps to the bottom.
+        cut: f64,
+    },
+}
+
+/// `d` mirrored in `x`: the surface mappings' `u` runs the other way round from the environment's
+/// (a globe is seen from outside, an environment from inside).
+fn mirror_x(d: DVec3) -> DVec3 {
+    DVec3::new(-d.x, d.y, d.z)
+}
+
+impl SurfaceProjection {
+    /// Mercator with Web Mercator's cut ([`MERCATOR_WEB_CUT`]).
+    pub const MERCATOR: SurfaceProjection = SurfaceProjection::Mercator {
+        cut: MERCATOR_WEB_CUT,
+    };
+
+    /// The name a scene file uses: `equirect` or `mercator`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SurfaceProjection::Equirect => "equirect",
+            SurfaceProjection::Mercator { .. } => "mercator",
+        }
+    }
+
+    /// `Y`: Mercator's `ln tan(pi/4 + cut/2)`, the half-height of the map in `x`'s units (1 for
+    /// Equirect, where it is not used).
+    fn half_height(self) -> f64 {
+        match self {
+            SurfaceProjection::Equirect => 1.0,
+            SurfaceProjection::Mercator { cut } => cut.sin().atanh(),
+        }
+    }
+
+    /// The texture coordinates of surface direction `d` (any length but 0): `u` in `[0, 1]`,
+    /// `v` in `[0, 1]` (see the type's docs). A zero or non-finite `d` gives NaN.
+    pub fn uv(self, d: DVec3) -> DVec2 {
+        let uv = equirect_uv(mirror_x(d));
+        match self {
+            SurfaceProjection::Equirect => uv,
+            SurfaceProjection::Mercator { .. } => {
+                let s = (d.y / d.length()).clamp(-1.0, 1.0);
+                let y = s.atanh();
+                DVec2::new(uv.x, (0.5 - y / (2.0 * self.half_height())).clamp(0.0, 1.0))
+            }
+        }
+    }
+
+    /// The change of [`SurfaceProjection::uv`] for a small change `dd` of `d`, in closed form, so
+    /// continuous across the seam (DESIGN.md: `u` is never differenced). `du` is
+    /// [`equirect_duv`]'s, mirrored; Mercator's `dv = -(dy - y (d.dd) / |d|^2) |d| / (2 Y rho^2)`
+    /// with `rho^2 = x^2 + z^2` (the derivative of `atanh(y / |d|)`), and 0 past the cut, where
+    /// `v` is clamped. Each component is clamped to `[-1, 1]`; at the poles `du` is the clamp.
+    pub fn duv(self, d: DVec3, dd: DVec3) -> DVec2 {
+        let duv = equirect_duv(mirror_x(d), mirror_x(dd));
+        match self {
+            SurfaceProjection::Equirect => duv,
+            SurfaceProjection::Mercator { .. } => {
+                let (len2, rho2) = (d.length_squared(), d.x * d.x + d.z * d.z);
+                let big_y = self.half_height();
+                let y = (d.y / len2.sqrt()).clamp(-1.0, 1.0).atanh();
+                let dv = if !(rho2 > 1e-300 && len2.is_finite()) || y.abs() >= big_y {
+                    0.0
+                } else {
+                    -(dd.y - d.y * d.dot(dd) / len2) * len2.sqrt() / (2.0 * big_y * rho2)
+                };
+                let dv = if dv.is_nan() {
+                    0.0
+                } else {
+                    dv.clamp(-1.0, 1.0)
+                };
+                DVec2::new(duv.x, dv)
+            }
+        }
+    }
+
+    /// The unit direction at texture coordinates `uv` (the inverse of
+    /// [`SurfaceProjection::uv`] inside the cut).
+    pub fn direction(self, uv: DVec2) -> DVec3 {
+        let v = match self {
+            SurfaceProjection::Equirect => uv.y,
+            SurfaceProjection::Mercator { .. } => {
+                let lat = ((1.0 - 2.0 * uv.y) * self.half_height()).tanh().asin();
+                0.5 - lat / PI
+            }
+        };
+        mirror_x(equirect_direction(DVec2::new(uv.x, v)))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -543,5 +657,98 @@ mod tests {
         let n = 8.0;
         let w = octahedral_wrap(DVec2::new(-0.5 / n, 2.5 / n));
         assert!((w * n - DVec2::new(0.5, 5.5)).length() < 1e-12, "{w}");
+    }
+
+    #[test]
+    fn surface_projections_follow_the_globe_axes_and_round_trip() {
+        for proj in [SurfaceProjection::Equirect, SurfaceProjection::MERCATOR] {
+            // Longitude 0 faces +z, +x is a quarter turn east, -z half a turn; the equator is
+            // the middle row.
+            let at = |d: DVec3| proj.uv(d);
+            assert!((at(DVec3::X) - DVec2::new(0.25, 0.5)).length() < 1e-12);
+            assert!((at(DVec3::NEG_Z) - DVec2::new(0.5, 0.5)).length() < 1e-12);
+            assert!((at(DVec3::NEG_X) - DVec2::new(0.75, 0.5)).length() < 1e-12);
+            assert!(at(DVec3::new(0.0, 1.0, 0.5)).y < 0.5, "north is up");
+            for k in 0..300 {
+                let uv = DVec2::new(
+                    (k as f64 * 0.137) % 1.0,
+                    0.01 + 0.98 * ((k as f64 * 0.291) % 1.0),
+                );
+                let back = proj.uv(proj.direction(uv) * (0.5 + k as f64 * 0.01));
+                let du = (back.x - uv.x).abs();
+                assert!(
+                    du.min(1.0 - du) < 1e-9 && (back.y - uv.y).abs() < 1e-9,
+                    "{uv} {back}"
+                );
+            }
+        }
+        // Web Mercator's cut makes the square map's height equal its width: y = +-pi.
+        assert!((MERCATOR_WEB_CUT.sin().atanh() - PI).abs() < 1e-12);
+        assert!((MERCATOR_WEB_CUT.to_degrees() - 85.051_128_78).abs() < 1e-8);
+    }
+
+    #[test]
+    fn mercator_is_cut_at_its_latitude_and_conformal_inside() {
+        let cut = 60f64.to_radians();
+        let m = SurfaceProjection::Mercator { cut };
+        let at_lat = |lat: f64, lon: f64| {
+            DVec3::new(lat.cos() * lon.sin(), lat.sin(), lat.cos() * lon.cos())
+        };
+        // The cut latitude is the top edge; past it v stays there and stops changing.
+        assert!(m.uv(at_lat(cut, 1.0)).y.abs() < 1e-12);
+        assert!((m.uv(at_lat(-cut, 1.0)).y - 1.0).abs() < 1e-12);
+        for lat in [61f64, 75.0, 89.0, 90.0] {
+            let d = at_lat(lat.to_radians(), 0.3);
+            assert_eq!(m.uv(d).y, 0.0);
+            assert_eq!(m.duv(d, DVec3::new(0.0, 1e-3, -1e-3)).y, 0.0);
+            assert_eq!(m.uv(-d).y, 1.0);
+        }
+        // Conformal: with Web Mercator's cut a small step north moves v (down the image, so
+        // negative) by as much as the same step east moves u, at every latitude inside the cut.
+        let w = SurfaceProjection::MERCATOR;
+        for lat in [-80.0f64, -45.0, 0.0, 30.0, 70.0, 85.0] {
+            let (lat, lon) = (lat.to_radians(), 0.7);
+            let d = at_lat(lat, lon);
+            let east = DVec3::new(lon.cos(), 0.0, -lon.sin()) * 1e-4;
+            let north =
+                DVec3::new(-lat.sin() * lon.sin(), lat.cos(), -lat.sin() * lon.cos()) * 1e-4;
+            let (e, n) = (w.duv(d, east), w.duv(d, north));
+            assert!(e.y.abs() < 1e-15 && n.x.abs() < 1e-15, "{e} {n}");
+            assert!((e.x + n.y).abs() < 1e-9 * e.x.abs(), "{lat}: {e} {n}");
+            // And equirect stretches east by 1 / cos(lat) against north, halved by the 2:1 image.
+            let q = SurfaceProjection::Equirect;
+            let (e, n) = (q.duv(d, east), q.duv(d, north));
+            assert!((e.x * lat.cos() * 2.0 + n.y).abs() < 1e-9, "{lat}: {e} {n}");
+        }
+    }
+
+    #[test]
+    fn surface_jacobians_match_differences_and_cross_the_seam() {
+        for proj in [
+            SurfaceProjection::Equirect,
+            SurfaceProjection::MERCATOR,
+            SurfaceProjection::Mercator { cut: 1.0 },
+        ] {
+            for d in directions(400) {
+                let n = d.normalize();
+                let uv = proj.uv(d);
+                // Away from the seam, the poles and the cut (where v has a kink).
+                let near_cut = matches!(proj, SurfaceProjection::Mercator { cut }
+                    if (n.y.asin().abs() - cut).abs() < 1e-3);
+                if !(0.01..0.99).contains(&uv.x) || n.y.abs() > 0.999 || near_cut {
+                    continue;
+                }
+                let dd = DVec3::new(0.3, -0.2, 0.5) * 1e-6 * d.length();
+                let num = (proj.uv(d + dd) - proj.uv(d - dd)) / 2.0;
+                let ana = proj.duv(d, dd);
+                assert!((num - ana).length() < 1e-9, "{proj:?} {d}: {num} {ana}");
+            }
+            // Either side of +z: u jumps by 1, its derivative does not.
+            let dd = DVec3::new(1e-3, 0.0, 0.0);
+            let (a, b) = (DVec3::new(-1e-9, 0.2, 1.0), DVec3::new(1e-9, 0.2, 1.0));
+            assert!((proj.uv(a).x - proj.uv(b).x).abs() > 0.99);
+            assert!((proj.duv(a, dd) - proj.duv(b, dd)).length() < 1e-9);
+            assert!(proj.duv(a, dd).x > 0.0, "east is +u");
+        }
     }
 }

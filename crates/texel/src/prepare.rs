@@ -9,7 +9,7 @@ use texel_raster::environment::{self, Environment, EnvironmentMaps};
 use texel_raster::layers::{Layer, LayerBlend, Layers, MAX_LAYERS};
 use texel_raster::{
     ChannelInput, ColorTarget, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
-    TextureInput, Vertex,
+    TextureInput, UvEvaluation, UvMapping, Vertex,
 };
 use texel_scene::{
     ColorInput, LayerBlendSpec, LayerOrder, LightSpec, MaterialSpec, ScalarInput, Scene,
@@ -58,6 +58,9 @@ pub struct SceneOptions {
     /// The mapping the scene's procedural sky is laid out in, overriding its `mapping` (the
     /// CLI's `--environment-mapping`; [`relay_sky`]).
     pub environment_mapping: Option<texel_scene::Mapping>,
+    /// Where meshes with a sphere mapping (`sphere_uv`) get their uv: exactly per pixel (the
+    /// default) or interpolated from the vertices (the CLI's `--surface-uv`).
+    pub surface_uv: UvEvaluation,
 }
 
 /// `spec` with its procedural sky laid out in `mapping` at about the same texel angle: an
@@ -130,6 +133,8 @@ pub struct PreparedScene {
     height_moments: BTreeMap<String, Texture>,
     /// [`SceneOptions::layer_order`].
     layer_order: Option<LayerOrder>,
+    /// [`SceneOptions::surface_uv`]; [`PreparedScene::set_surface_uv`] changes it.
+    surface_uv: UvEvaluation,
     /// Baked layered materials ([`crate::bake`]), by material name: those that blend then
     /// filter, and those whose heights displace.
     composites: BTreeMap<String, Baked>,
@@ -390,6 +395,7 @@ impl PreparedScene {
             lean_maps,
             height_moments,
             layer_order: options.layer_order,
+            surface_uv: options.surface_uv,
             composites,
             white: Texture::from_fn(
                 1,
@@ -557,6 +563,17 @@ impl PreparedScene {
         self.build_structures(samplers)
     }
 
+    /// Where meshes with a sphere mapping get their uv from now on ([`SceneOptions::surface_uv`]).
+    pub fn set_surface_uv(&mut self, evaluation: UvEvaluation) {
+        self.surface_uv = evaluation;
+    }
+
+    /// Whether some mesh has a sphere mapping that its draws evaluate per pixel.
+    pub fn maps_uv_per_pixel(&self) -> bool {
+        self.surface_uv == UvEvaluation::PerPixel
+            && self.scene.meshes.iter().any(|m| m.uv_mapping.is_some())
+    }
+
     /// The draw calls of the whole scene with `samplers` (one per mesh), seen by the scene's
     /// camera.
     pub fn draws<'a>(&'a self, samplers: &'a [Sampler]) -> Vec<DrawCall<'a>> {
@@ -648,6 +665,16 @@ impl PreparedScene {
                     sampler,
                     clip_from_world,
                     material,
+                    // Tessellated (displaced) geometry keeps the mapping at its vertices only:
+                    // its points are no longer on the sphere.
+                    uv_mapping: mesh
+                        .uv_mapping
+                        .filter(|_| own.is_none())
+                        .map(|m| UvMapping {
+                            projection: m.projection,
+                            centre: m.centre,
+                            evaluation: self.surface_uv,
+                        }),
                 }
             })
             .collect()

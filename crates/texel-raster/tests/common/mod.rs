@@ -88,6 +88,7 @@ impl Ground {
             sampler,
             clip_from_world: self.clip_from_world,
             material: None,
+            uv_mapping: None,
         }
     }
 
