@@ -14,7 +14,9 @@ use crate::cli::{ColorArg, DemoArgs};
 use crate::cmd_bake_ao::{demo_page, DemoAo};
 use crate::cmd_compare::{compare, Extras, COMPARE_BYTES_PER_PIXEL};
 use crate::filters::Filter;
-use crate::input::{load_scene_with, Input};
+use crate::input::{load_scene_with, Input, MaterialOverrides};
+use texel::quality::Encoding;
+use texel_raster::{render, ColorTarget, UvEvaluation, View};
 
 /// Run `texel demo`: every scene's report is written into one staging directory, published as a
 /// whole at `--out` when all are done.
@@ -64,6 +66,8 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
             )?;
             reports.push((name.to_string(), report));
         }
+        eprintln!("texel demo: spherical mappings per vertex ...");
+        let mappings = mapping_rows(dir, args, input, &reports)?;
         eprintln!("texel demo: baked ambient occlusion ...");
         let sub = dir.join("ao");
         std::fs::create_dir(&sub).with_context(|| format!("cannot create {}", sub.display()))?;
@@ -77,7 +81,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
         };
         let ao = demo_page(&sub, (size.width, size.height), &mut ao_input)
             .context("cannot bake the ambient occlusion page")?;
-        let html = index_html(&reports, &ao, started.elapsed().as_secs_f64());
+        let html = index_html(&reports, &mappings, &ao, started.elapsed().as_secs_f64());
         write_atomic(&dir.join("index.html"), html.as_bytes())?;
         Ok(reports)
     })
@@ -92,6 +96,159 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     Ok(())
 }
 
+/// The globes the demo compares evaluated per pixel (their reports from the scene loop) and
+/// per vertex.
+const GLOBES: [&str; 2] = ["globe", "globe-equirect"];
+
+/// The filters of the per-vertex reports.
+const MAPPING_FILTERS: [Filter; 3] = [Filter::Trilinear, Filter::Aniso16, Filter::Ewa];
+
+/// One row of the demo's spherical-mapping table: a globe, where its uv is evaluated, its report
+/// directory and report, and its level-of-detail view.
+struct MappingRow {
+    scene: &'static str,
+    evaluation: UvEvaluation,
+    dir: String,
+    report: Report,
+    lod_image: String,
+}
+
+/// The spherical-mapping page's rows: each globe's per-pixel report (already in `reports`) and a
+/// per-vertex one compared here (into `GLOBE-per-vertex/`), with a `--view lod` image of each
+/// (trilinear) in `mapping/`.
+fn mapping_rows(
+    dir: &std::path::Path,
+    args: &DemoArgs,
+    input: &Input,
+    reports: &[(String, Report)],
+) -> Result<Vec<MappingRow>> {
+    let views = dir.join("mapping");
+    std::fs::create_dir(&views).with_context(|| format!("cannot create {}", views.display()))?;
+    let mut rows = Vec::new();
+    for scene_name in GLOBES {
+        let label = format!("builtin:{scene_name}");
+        for evaluation in [UvEvaluation::PerPixel, UvEvaluation::PerVertex] {
+            let mut scene_input = Input {
+                budget: input.budget.clone(),
+                sanitize: input.sanitize,
+            };
+            let overrides = MaterialOverrides {
+                surface_uv: Some(evaluation),
+                ..Default::default()
+            };
+            let scene = load_scene_with(
+                &label,
+                ColorArg::Srgb,
+                args.size,
+                overrides,
+                &mut scene_input,
+            )?;
+            let (sub, report) = match evaluation {
+                UvEvaluation::PerPixel => {
+                    let Some((_, r)) = reports.iter().find(|(n, _)| n == scene_name) else {
+                        continue;
+                    };
+                    (scene_name.to_string(), r.clone())
+                }
+                UvEvaluation::PerVertex => {
+                    let sub = format!("{scene_name}-per-vertex");
+                    let path = dir.join(&sub);
+                    std::fs::create_dir(&path)
+                        .with_context(|| format!("cannot create {}", path.display()))?;
+                    scene_input.budget.take(
+                        "the comparison's reference and images",
+                        u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
+                    )?;
+                    let report = compare(
+                        &scene,
+                        &format!("{label} --surface-uv vertex"),
+                        &MAPPING_FILTERS,
+                        args.spp,
+                        &Extras::default(),
+                        None,
+                        &path,
+                        &mut scene_input.budget,
+                    )?;
+                    (sub, report)
+                }
+            };
+            let samplers = scene.samplers(Filter::Trilinear)?;
+            scene.build_structures_within(&samplers, &mut scene_input.budget)?;
+            let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
+            settings.view = View::Lod;
+            settings.target = ColorTarget::Srgb8;
+            let frame = render(&settings, &scene.draws(&samplers))?;
+            let lod_image = format!("{scene_name}-lod-{}.png", evaluation.name());
+            texel::frame_image(&frame, Encoding::Srgb)?.write_png(views.join(&lod_image))?;
+            rows.push(MappingRow {
+                scene: scene_name,
+                evaluation,
+                dir: sub,
+                report,
+                lod_image: format!("mapping/{lod_image}"),
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// The index page's spherical-mapping section.
+fn mapping_html(rows: &[MappingRow]) -> String {
+    let mut s = String::from(
+        "<h2>Spherical mappings</h2>\n<p>The built-in sphere wearing a globe's map (parallels and meridians every 15 \
+         degrees, Tissot's discs of 6 degrees, the seam as the red meridian facing the camera) in two projections: \
+         Mercator (cut at 85.05 degrees; the polar cap takes the map's edge row) and equirect. <em>Per pixel</em> \
+         evaluates the projection at every pixel's surface point with its exact derivatives; <em>per vertex</em> \
+         interpolates the uv given at the vertices (5.6-degree rings). Every row is scored against the same \
+         reference, which evaluates the projection at every sample; the level-of-detail views (trilinear) show no \
+         seam line.</p>\n<table>\n<tr><th>scene</th><th>uv</th><th>trilinear</th><th>aniso16</th><th>ewa</th></tr>\n",
+    );
+    let psnr = |r: &Report, name: &str| {
+        r.rows
+            .iter()
+            .find(|row| row.name == name)
+            .map_or("-".to_string(), |row| format!("{:.2}", row.psnr_all))
+    };
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "<tr><td><a href=\"{d}/index.html\">{scene}</a></td><td>per {e}</td><td>{t}</td><td>{a}</td><td>{w}</td></tr>",
+            d = escape(&r.dir),
+            scene = escape(r.scene),
+            e = r.evaluation.name(),
+            t = psnr(&r.report, "trilinear"),
+            a = psnr(&r.report, "aniso16"),
+            w = psnr(&r.report, "ewa"),
+        );
+    }
+    s += "</table>\n<div class=\"cards\">\n";
+    for r in rows {
+        let image = r
+            .report
+            .rows
+            .iter()
+            .find(|row| row.name == "aniso16")
+            .map(|row| format!("{}/{}", r.dir, row.image));
+        let caption = format!("{}, per {}", r.scene, r.evaluation.name());
+        if let Some(image) = image {
+            let _ = writeln!(
+                s,
+                "<div class=\"card\"><a href=\"{i}\"><img src=\"{i}\" alt=\"{c}\"></a><br>{c}, aniso16</div>",
+                i = escape(&image),
+                c = escape(&caption)
+            );
+        }
+        let _ = writeln!(
+            s,
+            "<div class=\"card\"><a href=\"{i}\"><img src=\"{i}\" alt=\"{c}\"></a><br>{c}, level of detail</div>",
+            i = escape(&r.lod_image),
+            c = escape(&caption)
+        );
+    }
+    s += "</div>\n";
+    s
+}
+
 /// Half the output size of built-in scene `name`.
 fn half_size(name: &str) -> Result<crate::cli::Size> {
     let o = texel_scene::builtin(name)?.output;
@@ -102,7 +259,12 @@ fn half_size(name: &str) -> Result<crate::cli::Size> {
 }
 
 /// The index page: one row per scene with the best filter and a few reference points, and links.
-fn index_html(reports: &[(String, Report)], ao: &DemoAo, seconds: f64) -> String {
+fn index_html(
+    reports: &[(String, Report)],
+    mappings: &[MappingRow],
+    ao: &DemoAo,
+    seconds: f64,
+) -> String {
     let mut s = String::from(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>texel demo</title>\n<style>\n\
          body { font-family: sans-serif; margin: 1.5em; color: #222; }\n\
@@ -155,7 +317,9 @@ fn index_html(reports: &[(String, Report)], ao: &DemoAo, seconds: f64) -> String
             spp = r.spp
         );
     }
-    s += "</div>\n<h2>Baked ambient occlusion</h2>\n<p>The lecture's three pictures: a model under ambient \
+    s += "</div>\n";
+    s += &mapping_html(mappings);
+    s += "<h2>Baked ambient occlusion</h2>\n<p>The lecture's three pictures: a model under ambient \
           light and a sun, the same model with its ambient occlusion (the map dims the ambient light only), \
           and the occlusion map baked from it by <code>texel bake-ao</code> (its uv layout: the tube's two \
           halves above, the ground below).</p>\n<div class=\"cards\">\n";

@@ -31,6 +31,24 @@ fn demo_compares_every_builtin_scene_with_an_index() {
             assert_eq!(load(dir.join(&row.image)).size(), (64, 36));
         }
     }
+    // The spherical-mapping section: each globe per pixel (its own report) and per vertex, with
+    // a level-of-detail view of each.
+    assert!(index.contains("Spherical mappings"), "{index}");
+    for globe in ["globe", "globe-equirect"] {
+        assert!(index.contains(&format!("href=\"{globe}-per-vertex/index.html\"")));
+        let report = Report::from_json(
+            &std::fs::read_to_string(d.join(&format!("demo/{globe}-per-vertex/report.json")))
+                .unwrap(),
+        )
+        .unwrap();
+        let names: Vec<&str> = report.rows.iter().map(|r| r.name.as_str()).collect();
+        assert_eq!(names, ["trilinear", "aniso16", "ewa"]);
+        for at in ["pixel", "vertex"] {
+            let lod = format!("mapping/{globe}-lod-{at}.png");
+            assert!(index.contains(&format!("src=\"{lod}\"")), "{lod}");
+            assert_eq!(load(d.join(&format!("demo/{lod}"))).size(), (64, 36));
+        }
+    }
     // The ambient occlusion page: the knot without and with its baked map, and the map (64 x 64
     // for a 64-pixel-wide demo), linked from the index.
     assert!(index.contains("Baked ambient occlusion"), "{index}");

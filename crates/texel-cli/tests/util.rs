@@ -14,12 +14,14 @@ use texel_quality::Image8;
 pub(crate) const FILTERS: [&str; 12] = texel::Filter::NAMES;
 
 /// The built-in scenes the demo covers.
-pub(crate) const BUILTINS: [&str; 12] = [
+pub(crate) const BUILTINS: [&str; 14] = [
     "ground",
     "ground-rotated",
     "zoneplate",
     "cube",
     "sphere",
+    "globe",
+    "globe-equirect",
     "triangle",
     "glossy",
     "bricks",

@@ -387,11 +387,14 @@ impl FrameContext<'_, '_> {
             };
         }
         let modes = state.modes();
-        // The GPU path has no lighting or materials: lit scenes stay on the CPU.
+        // The GPU path has no lighting, materials or per-pixel sphere mappings: such scenes
+        // stay on the CPU.
         let lit = self.worker.scenes[state.color as usize]
             .as_ref()
             .or(self.worker.scenes.iter().flatten().next())
-            .is_some_and(|s| !s.scene.lights.is_empty() || !s.scene.materials.is_empty());
+            .is_some_and(|s| {
+                !s.scene.lights.is_empty() || !s.scene.materials.is_empty() || s.maps_uv_per_pixel()
+            });
         let has_gpu = self.gpu.is_some() && !lit;
         let use_gpu = |m: Mode| {
             has_gpu
