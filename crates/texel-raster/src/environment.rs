@@ -35,8 +35,12 @@
 //! `n.l`. The lobe's full width at half maximum is about `2.6 alpha` radians of reflected
 //! direction, so level `k`'s lobe spans about 2.6 of its own texels: it is sampled without aliasing
 //! at its resolution. A lookup with roughness `r` uses `lod_r = log2(r^2 / theta_0)` and reads at
-//! `max(lod_r, lod_footprint)` (trilinear), where `lod_footprint` is the frame filter's level for
-//! the reflected direction's footprint; below `lod_r = 0` (perceptual roughness under
+//! `max(lod_r, lod_footprint)` (trilinear), where `lod_footprint` is the reflected direction's
+//! footprint measured in angle ([`angular_lod`]: `log2` of the unit direction's larger change per
+//! pixel over `theta_0`), the same for every mapping and every part of the sphere; the map's `uv`
+//! footprint would pick levels far too coarse where the mapping stretches (the equirect poles,
+//! where `du` grows as `1 / sin theta`), and the glossy pyramid is read isotropically anyway;
+//! below `lod_r = 0` (perceptual roughness under
 //! `sqrt(theta_0)`, 0.078 for a 1024-wide equirect map) the surface is a mirror and the frame's
 //! filter reads the plain map with that footprint, like any texture. The convolution is
 //! importance-sampled (64 Hammersley directions per texel) from the plain map's box pyramid at the
@@ -254,6 +258,30 @@ pub fn level_alpha(k: u32, texel_angle: f64) -> f64 {
 pub fn roughness_lod(roughness: f32, texel_angle: f64) -> f32 {
     let alpha = f64::from(roughness.clamp(MIN_ROUGHNESS, 1.0)).powi(2);
     (alpha / texel_angle).log2() as f32
+}
+
+/// The glossy pyramid's level for a footprint of direction `d` (any length but 0) changing by
+/// `dd[0]` and `dd[1]` per pixel: `log2(max(|dn/dx|, |dn/dy|) / theta_0)` with `dn` the change of
+/// the unit direction (radians per pixel) and `theta_0 = texel_angle`, clamped to `[0, 64]`
+/// (0 for a zero, NaN or degenerate footprint). At the equator of an equirect map it equals the
+/// isotropic `uv` footprint's level; unlike that level it does not depend on where the mapping
+/// stretches.
+pub fn angular_lod(d: DVec3, dd: [DVec3; 2], texel_angle: f64) -> f32 {
+    let len = d.length();
+    if !(len > 0.0 && len.is_finite() && texel_angle > 0.0) {
+        return 0.0;
+    }
+    let n = d / len;
+    let rate = dd
+        .iter()
+        .map(|&v| ((v - n * n.dot(v)) / len).length())
+        .fold(0.0, f64::max);
+    let lod = (rate / texel_angle).log2();
+    if lod.is_nan() {
+        0.0
+    } else {
+        lod.clamp(0.0, 64.0) as f32
+    }
 }
 
 /// The maps an environment is read through: the plain map with its box pyramid, its GGX
@@ -659,7 +687,7 @@ impl Environment<'_> {
         let lod = if reference {
             lod_r
         } else {
-            lod_r.max(self.sampler.lod(&maps.radiance[layer], &fp))
+            lod_r.max(angular_lod(r, dr, maps.layout.texel_angle()))
         };
         let glossy = &maps.glossy[layer];
         let uv = DVec2::new(fp.u.into(), fp.v.into());
@@ -770,5 +798,45 @@ mod tests {
             .sum::<f64>()
             * (PI / 2.0 / steps as f64);
         assert!((mean - exact).abs() < 2e-3, "{mean} {exact}");
+    }
+
+    #[test]
+    fn the_angular_level_matches_the_uv_level_at_the_equator_and_not_the_poles_stretch() {
+        // An equirect map 2048 x 1024: theta_0 = 2 pi / 2048, square texels at the equator.
+        let (w, h) = (2048.0, 1024.0);
+        let theta0 = 2.0 * PI / w;
+        let uv_lod = |d: DVec3, dd: [DVec3; 2]| {
+            let rho = dd
+                .iter()
+                .map(|&v| {
+                    let duv = texel_texture::sphere::equirect_duv(d, v);
+                    DVec2::new(duv.x * w, duv.y * h).length()
+                })
+                .fold(0.0, f64::max);
+            rho.log2() as f32
+        };
+        // Two degrees per pixel (11.4 texels), east and down, at the equator.
+        let step = 2f64.to_radians();
+        let d = DVec3::new(1.0, 0.0, 0.0) * 3.0;
+        let dd = [
+            DVec3::new(0.0, 0.0, step * 3.0),
+            DVec3::new(0.0, -step * 3.0, 0.0),
+        ];
+        let (a, u) = (angular_lod(d, dd, theta0), uv_lod(d, dd));
+        assert!((a - u).abs() < 1e-3, "{a} {u}");
+        assert!((a - (step / theta0).log2() as f32).abs() < 1e-4);
+        // A degree from the pole, the same change of angle east: the same angular level, where
+        // the uv footprint stretches by 1 / sin(1 degree) (almost 6 levels coarser).
+        let t = 1f64.to_radians();
+        let d = DVec3::new(t.sin(), t.cos(), 0.0);
+        let east = [DVec3::new(0.0, 0.0, step), DVec3::ZERO];
+        let (a, u) = (angular_lod(d, east, theta0), uv_lod(d, east));
+        assert!((a - (step / theta0).log2() as f32).abs() < 1e-4, "{a}");
+        assert!(u > a + 5.5, "{u} {a}");
+        // Degenerate footprints read level 0; huge ones clamp.
+        assert_eq!(angular_lod(DVec3::ZERO, east, theta0), 0.0);
+        assert_eq!(angular_lod(d, [DVec3::ZERO; 2], theta0), 0.0);
+        assert_eq!(angular_lod(d, [DVec3::splat(f64::NAN); 2], theta0), 0.0);
+        assert_eq!(angular_lod(d, [DVec3::splat(1e300); 2], theta0), 64.0);
     }
 }
