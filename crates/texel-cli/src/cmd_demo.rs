@@ -14,7 +14,7 @@ use crate::cli::{ColorArg, DemoArgs};
 use crate::cmd_bake_ao::{demo_page, DemoAo};
 use crate::cmd_compare::{compare, Extras, COMPARE_BYTES_PER_PIXEL};
 use crate::filters::Filter;
-use crate::input::{load_scene_with, Input, MaterialOverrides};
+use crate::input::{load_scene_with, Input};
 use texel::quality::Encoding;
 use texel_raster::{render, ColorTarget, UvEvaluation, View};
 
@@ -47,22 +47,13 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
                 Default::default(),
                 &mut scene_input,
             )?;
-            scene_input.budget.take(
-                "the comparison's reference and images",
-                u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
-            )?;
-            let sub = dir.join(name);
-            std::fs::create_dir(&sub)
-                .with_context(|| format!("cannot create {}", sub.display()))?;
-            let report = compare(
+            let report = report_in(
+                &dir.join(name),
                 &scene,
                 &label,
                 &Filter::ALL,
                 args.spp,
-                &Extras::default(),
-                None,
-                &sub,
-                &mut scene_input.budget,
+                &mut scene_input,
             )?;
             reports.push((name.to_string(), report));
         }
@@ -96,6 +87,33 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     Ok(())
 }
 
+/// Compare `filters` on `scene` against a `spp`-sample reference into the new directory `sub`,
+/// charging the comparison's images to `input`'s account.
+fn report_in(
+    sub: &std::path::Path,
+    scene: &texel::PreparedScene,
+    label: &str,
+    filters: &[Filter],
+    spp: u32,
+    input: &mut Input,
+) -> Result<Report> {
+    input.budget.take(
+        "the comparison's reference and images",
+        u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
+    )?;
+    std::fs::create_dir(sub).with_context(|| format!("cannot create {}", sub.display()))?;
+    compare(
+        scene,
+        label,
+        filters,
+        spp,
+        &Extras::default(),
+        None,
+        sub,
+        &mut input.budget,
+    )
+}
+
 /// The globes the demo compares evaluated per pixel (their reports from the scene loop) and
 /// per vertex.
 const GLOBES: [&str; 2] = ["globe", "globe-equirect"];
@@ -114,8 +132,8 @@ struct MappingRow {
 }
 
 /// The spherical-mapping page's rows: each globe's per-pixel report (already in `reports`) and a
-/// per-vertex one compared here (into `GLOBE-per-vertex/`), with a `--view lod` image of each
-/// (trilinear) in `mapping/`.
+/// per-vertex one compared here (into `GLOBE-per-vertex/`) on the same prepared scene, with a
+/// `--view lod` image of each (trilinear) in `mapping/`.
 fn mapping_rows(
     dir: &std::path::Path,
     args: &DemoArgs,
@@ -126,48 +144,34 @@ fn mapping_rows(
     std::fs::create_dir(&views).with_context(|| format!("cannot create {}", views.display()))?;
     let mut rows = Vec::new();
     for scene_name in GLOBES {
+        let Some((_, per_pixel)) = reports.iter().find(|(n, _)| n == scene_name) else {
+            continue;
+        };
         let label = format!("builtin:{scene_name}");
+        let mut scene_input = Input {
+            budget: input.budget.clone(),
+            sanitize: input.sanitize,
+        };
+        let mut scene = load_scene_with(
+            &label,
+            ColorArg::Srgb,
+            args.size,
+            Default::default(),
+            &mut scene_input,
+        )?;
         for evaluation in [UvEvaluation::PerPixel, UvEvaluation::PerVertex] {
-            let mut scene_input = Input {
-                budget: input.budget.clone(),
-                sanitize: input.sanitize,
-            };
-            let overrides = MaterialOverrides {
-                surface_uv: Some(evaluation),
-                ..Default::default()
-            };
-            let scene = load_scene_with(
-                &label,
-                ColorArg::Srgb,
-                args.size,
-                overrides,
-                &mut scene_input,
-            )?;
+            scene.set_surface_uv(evaluation);
             let (sub, report) = match evaluation {
-                UvEvaluation::PerPixel => {
-                    let Some((_, r)) = reports.iter().find(|(n, _)| n == scene_name) else {
-                        continue;
-                    };
-                    (scene_name.to_string(), r.clone())
-                }
+                UvEvaluation::PerPixel => (scene_name.to_string(), per_pixel.clone()),
                 UvEvaluation::PerVertex => {
                     let sub = format!("{scene_name}-per-vertex");
-                    let path = dir.join(&sub);
-                    std::fs::create_dir(&path)
-                        .with_context(|| format!("cannot create {}", path.display()))?;
-                    scene_input.budget.take(
-                        "the comparison's reference and images",
-                        u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
-                    )?;
-                    let report = compare(
+                    let report = report_in(
+                        &dir.join(&sub),
                         &scene,
                         &format!("{label} --surface-uv vertex"),
                         &MAPPING_FILTERS,
                         args.spp,
-                        &Extras::default(),
-                        None,
-                        &path,
-                        &mut scene_input.budget,
+                        &mut scene_input,
                     )?;
                     (sub, report)
                 }

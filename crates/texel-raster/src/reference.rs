@@ -382,8 +382,8 @@ fn reference_row(
             let dc = &ctx.draws[t.draw as usize];
             let pos = s.pos[k];
             let lambda = t.lambda_at(pos.x, pos.y, Perspective::Correct);
-            let uv = match dc.mapped_uv(t, lambda, [DVec3::ZERO; 2]) {
-                Some((uv, _, _)) => uv,
+            let uv = match dc.mapped(t) {
+                Some(m) => m.uv(lambda, None).0,
                 None => {
                     let uvs = dc.uvs(t);
                     uvs[0] * lambda.x + uvs[1] * lambda.y + uvs[2] * lambda.z

@@ -125,32 +125,15 @@ impl<'a> DrawContext<'a> {
         }
     }
 
-    /// Whether `uv` comes from a per-pixel sphere mapping ([`DrawContext::mapped_uv`]).
+    /// Triangle `t` ready for its per-pixel sphere mapping ([`MappedTriangle`]); `None` when
+    /// the draw interpolates the vertices' `uv`.
     #[inline(always)]
-    pub fn maps_uv(&self) -> bool {
-        self.surface.is_some()
-    }
-
-    /// The per-pixel sphere mapping's `uv` and its screen derivatives at barycentrics `lambda`
-    /// (derivatives `dlambda`, per pixel right and down) of triangle `t`: the projection of the
-    /// interpolated position's direction from the centre, and its Jacobian applied to the
-    /// position's derivatives. `None` when the draw has no per-pixel mapping.
-    #[inline(always)]
-    pub fn mapped_uv(
-        &self,
-        t: &TriangleSetup,
-        lambda: DVec3,
-        dlambda: [DVec3; 2],
-    ) -> Option<(DVec2, DVec2, DVec2)> {
+    pub fn mapped(&self, t: &TriangleSetup) -> Option<MappedTriangle> {
         let (projection, centre) = self.surface?;
-        let p = self.vertices(t).map(|v| v.position.as_dvec3() - centre);
-        let at = |l: DVec3| p[0] * l.x + p[1] * l.y + p[2] * l.z;
-        let d = at(lambda);
-        Some((
-            projection.uv(d),
-            projection.duv(d, at(dlambda[0])),
-            projection.duv(d, at(dlambda[1])),
-        ))
+        Some(MappedTriangle {
+            projection,
+            p: self.vertices(t).map(|v| v.position.as_dvec3() - centre),
+        })
     }
 
     /// The triangle's vertices.
@@ -176,6 +159,32 @@ impl<'a> DrawContext<'a> {
             dvdx: duv_dx.y as f32,
             dvdy: duv_dy.y as f32,
         }
+    }
+}
+
+/// One triangle of a draw with a per-pixel sphere mapping ([`crate::UvMapping`]): its vertices
+/// relative to the sphere's centre, gathered once per triangle.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MappedTriangle {
+    projection: SurfaceProjection,
+    p: [DVec3; 3],
+}
+
+impl MappedTriangle {
+    /// `uv` at barycentrics `lambda`, the projection of the interpolated position's direction
+    /// from the centre, and with `dlambda` (the barycentrics' derivatives per pixel right and
+    /// down) its screen derivatives: the projection's Jacobian applied to the position's (zero
+    /// without).
+    #[inline(always)]
+    pub fn uv(&self, lambda: DVec3, dlambda: Option<[DVec3; 2]>) -> (DVec2, DVec2, DVec2) {
+        let p = &self.p;
+        let at = |l: DVec3| p[0] * l.x + p[1] * l.y + p[2] * l.z;
+        let d = at(lambda);
+        let (dx, dy) = match dlambda {
+            Some([x, y]) => (self.projection.duv(d, at(x)), self.projection.duv(d, at(y))),
+            None => (DVec2::ZERO, DVec2::ZERO),
+        };
+        (self.projection.uv(d), dx, dy)
     }
 }
 

@@ -296,6 +296,7 @@ fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range:
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];
     let uvs = dc.uvs(t);
+    let mapped = dc.mapped(t);
     let step = t.edges.map(|e| e.a * SUBPIXEL);
     let x_start = pixel_center_fixed(i_lo);
     let perspective = ctx.settings.perspective;
@@ -311,8 +312,8 @@ fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range:
                 let z = t.depth_at(x, y) as f32;
                 if z < tile.depth[lj][li] {
                     let b = t.barycentrics(x, y, perspective);
-                    let (uv, duv_dx, duv_dy) = match dc.mapped_uv(t, b.lambda, [b.dx, b.dy]) {
-                        Some(m) => m,
+                    let (uv, duv_dx, duv_dy) = match &mapped {
+                        Some(m) => m.uv(b.lambda, Some([b.dx, b.dy])),
                         None => {
                             let (dx, dy) = b.derivatives2(uvs);
                             (b.interpolate2(uvs), dx, dy)
@@ -433,7 +434,7 @@ impl Span {
 
     /// The footprints of the span's fragments from their barycentrics: `uv` and (when `deriv`)
     /// its derivatives as [`crate::interp::Barycentrics::interpolate2`] and `derivatives2` compute
-    /// them (or a per-pixel sphere mapping, [`DrawContext::mapped_uv`]), reduced by
+    /// them (or a per-pixel sphere mapping, [`DrawContext::mapped`]), reduced by
     /// [`DrawContext::footprint`].
     #[inline(always)]
     fn footprints(&mut self, dc: &DrawContext, t: &TriangleSetup, deriv: bool) {
@@ -441,21 +442,18 @@ impl Span {
         let [l0, l1, l2] = &self.l;
         let [x0, x1, x2] = &self.ldx;
         let [y0, y1, y2] = &self.ldy;
-        if dc.maps_uv() {
+        if let Some(m) = dc.mapped(t) {
             // A per-pixel sphere mapping: not a linear combination, one fragment at a time.
             for k in 0..n {
                 let lambda = DVec3::new(l0[k], l1[k], l2[k]);
-                let dlambda = if deriv {
+                let dlambda = deriv.then(|| {
                     [
                         DVec3::new(x0[k], x1[k], x2[k]),
                         DVec3::new(y0[k], y1[k], y2[k]),
                     ]
-                } else {
-                    [DVec3::ZERO; 2]
-                };
-                if let Some((uv, dx, dy)) = dc.mapped_uv(t, lambda, dlambda) {
-                    self.fps[k] = dc.footprint(uv, dx, dy);
-                }
+                });
+                let (uv, dx, dy) = m.uv(lambda, dlambda);
+                self.fps[k] = dc.footprint(uv, dx, dy);
             }
             return;
         }
@@ -611,6 +609,7 @@ fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: 
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];
     let uvs = dc.uvs(t);
+    let mapped = dc.mapped(t);
     let perspective = ctx.settings.perspective;
     for qj in (j_lo & !1..=j_hi).step_by(2) {
         for qi in (i_lo & !1..=i_hi).step_by(2) {
@@ -639,22 +638,23 @@ fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: 
                 let y = f64::from(qj + (k as u32 >> 1)) + 0.5;
                 t.lambda_at(x, y, perspective)
             });
-            let mut uv = lambda.map(|l| uvs[0] * l.x + uvs[1] * l.y + uvs[2] * l.z);
-            let mut d = quad_differences(uv);
             // The barycentrics' differences across the quad, as the uv's.
             let dl = quad_differences(lambda.map(|l| l.truncate())).map(|(dx, dy)| {
                 let third = |d: DVec2| DVec3::new(d.x, d.y, -d.x - d.y);
                 [third(dx), third(dy)]
             });
-            // A per-pixel sphere mapping differences the positions (continuous) and maps the
-            // differences through the projection's Jacobian, never differencing u.
-            if dc.maps_uv() {
-                for k in 0..4 {
-                    if let Some((m, dx, dy)) = dc.mapped_uv(t, lambda[k], dl[k]) {
-                        (uv[k], d[k]) = (m, (dx, dy));
-                    }
+            let (uv, d) = match &mapped {
+                // A per-pixel sphere mapping differences the positions (continuous) and maps the
+                // differences through the projection's Jacobian, never differencing u.
+                Some(m) => {
+                    let eval = std::array::from_fn(|k| m.uv(lambda[k], Some(dl[k])));
+                    (eval.map(|e| e.0), eval.map(|e| (e.1, e.2)))
                 }
-            }
+                None => {
+                    let uv = lambda.map(|l| uvs[0] * l.x + uvs[1] * l.y + uvs[2] * l.z);
+                    (uv, quad_differences(uv))
+                }
+            };
             for k in 0..4usize {
                 if mask & (1 << k) != 0 {
                     let (i, j) = (qi + (k as u32 & 1), qj + (k as u32 >> 1));

@@ -318,38 +318,20 @@ fn sphere_mesh_mapped(texture: &str, projection: SurfaceProjection) -> Mesh {
     }
 }
 
-/// A unit UV sphere: vertex (s, r) at longitude `2 pi s / 64` and colatitude `pi r / 32`,
-/// uv = `(s / 64, r / 32)` (north pole at v = 0, the top row of the latitude-longitude map), with
-/// a duplicated seam column at u = 1; u repeats, v clamps.
+/// The `sphere` scene: the built-in sphere with its equirect uv ([`sphere_mesh_mapped`]) wearing
+/// a latitude-longitude grid of 15-degree cells.
 fn sphere() -> Scene {
-    Scene {
-        output: Output {
-            width: 960,
-            height: 540,
-            background: [0, 0, 0, 255],
-        },
-        camera: Camera {
-            eye: Vec3::new(0.0, 0.9, 3.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fovy_deg: 45.0,
-            near: 0.1,
-            far: 100.0,
-        },
-        textures: one_texture(
-            "latlong",
-            Procedural::Grid {
-                width: 1024,
-                height: 512,
-                cells: 24,
-                line_width: 3.0,
-            },
-        ),
-        meshes: vec![sphere_mesh("latlong")],
-        lights: Vec::new(),
-        materials: Default::default(),
-        environment: None,
-    }
+    let grid = Procedural::Grid {
+        width: 1024,
+        height: 512,
+        cells: 24,
+        line_width: 3.0,
+    };
+    sphere_scene(
+        Vec3::new(0.0, 0.9, 3.0),
+        ("latlong", grid),
+        SurfaceProjection::Equirect,
+    )
 }
 
 /// The `globe` (Mercator, `mercator = true`) and `globe-equirect` scenes: the built-in sphere
@@ -365,6 +347,17 @@ fn globe(mercator: bool) -> Scene {
     let projection = map
         .globe_projection()
         .unwrap_or(SurfaceProjection::Equirect);
+    sphere_scene(Vec3::new(0.0, 1.8, 2.6), ("globe", map), projection)
+}
+
+/// The built-in sphere ([`sphere_mesh_mapped`] in `projection`) wearing texture `map` (name and
+/// generator), unlit, at 960 x 540 on black, seen from `eye` towards its centre (the origin)
+/// with a 45-degree field of view.
+fn sphere_scene(
+    eye: Vec3,
+    (name, map): (&str, Procedural),
+    projection: SurfaceProjection,
+) -> Scene {
     Scene {
         output: Output {
             width: 960,
@@ -372,15 +365,15 @@ fn globe(mercator: bool) -> Scene {
             background: [0, 0, 0, 255],
         },
         camera: Camera {
-            eye: Vec3::new(0.0, 1.8, 2.6),
+            eye,
             target: Vec3::ZERO,
             up: Vec3::Y,
             fovy_deg: 45.0,
             near: 0.1,
             far: 100.0,
         },
-        textures: one_texture("globe", map),
-        meshes: vec![sphere_mesh_mapped("globe", projection)],
+        textures: one_texture(name, map),
+        meshes: vec![sphere_mesh_mapped(name, projection)],
         lights: Vec::new(),
         materials: Default::default(),
         environment: None,

@@ -225,7 +225,13 @@ impl Procedural {
                 width,
                 height,
                 mercator,
-            } => globe(width, height, mercator, i, j),
+            } => globe(
+                globe_projection(width, height, mercator),
+                width,
+                height,
+                i,
+                j,
+            ),
             Procedural::Uv { width, height } => {
                 let r = (255.0 * (f64::from(i) + 0.5) / f64::from(width)).round() as u8;
                 let g = (255.0 * (f64::from(j) + 0.5) / f64::from(height)).round() as u8;
@@ -306,6 +312,16 @@ impl Procedural {
     /// The code of every texel as a function: [`Procedural::code`], with the wave set of
     /// [`Procedural::Waves`] drawn once instead of per texel.
     fn coder(&self) -> Box<dyn Fn(u32, u32) -> [u8; 4] + '_> {
+        if let Procedural::Globe {
+            width,
+            height,
+            mercator,
+        } = *self
+        {
+            // The projection once, not per texel.
+            let projection = globe_projection(width, height, mercator);
+            return Box::new(move |i, j| globe(projection, width, height, i, j));
+        }
         let Procedural::Waves {
             size,
             waves,
@@ -385,40 +401,47 @@ impl Procedural {
     /// The projection a [`Procedural::Globe`] map is drawn in (`None` for other kinds): equirect,
     /// or Mercator cut where `ln tan(pi/4 + cut/2) = pi height / width`.
     pub fn globe_projection(&self) -> Option<texel_texture::sphere::SurfaceProjection> {
-        use texel_texture::sphere::SurfaceProjection;
-        let Procedural::Globe {
-            width,
-            height,
-            mercator,
-        } = *self
-        else {
-            return None;
-        };
-        Some(if mercator && width == height {
-            SurfaceProjection::MERCATOR
-        } else if mercator {
-            let y = std::f64::consts::PI * f64::from(height) / f64::from(width.max(1));
-            SurfaceProjection::Mercator {
-                cut: y.tanh().asin(),
-            }
-        } else {
-            SurfaceProjection::Equirect
-        })
+        match *self {
+            Procedural::Globe {
+                width,
+                height,
+                mercator,
+            } => Some(globe_projection(width, height, mercator)),
+            _ => None,
+        }
     }
 }
 
-/// [`Procedural::Globe`]'s texel `(i, j)`.
-fn globe(width: u32, height: u32, mercator: bool, i: u32, j: u32) -> [u8; 4] {
+/// [`Procedural::globe_projection`] of a globe map `width x height`.
+fn globe_projection(
+    width: u32,
+    height: u32,
+    mercator: bool,
+) -> texel_texture::sphere::SurfaceProjection {
+    use texel_texture::sphere::SurfaceProjection;
+    if mercator && width == height {
+        SurfaceProjection::MERCATOR
+    } else if mercator {
+        let y = std::f64::consts::PI * f64::from(height) / f64::from(width.max(1));
+        SurfaceProjection::Mercator {
+            cut: y.tanh().asin(),
+        }
+    } else {
+        SurfaceProjection::Equirect
+    }
+}
+
+/// [`Procedural::Globe`]'s texel `(i, j)` of a `width x height` map in `projection`.
+fn globe(
+    projection: texel_texture::sphere::SurfaceProjection,
+    width: u32,
+    height: u32,
+    i: u32,
+    j: u32,
+) -> [u8; 4] {
     use glam::{DVec2, DVec3};
     use std::f64::consts::PI;
     use texel_texture::sphere::SurfaceProjection;
-    let projection = Procedural::Globe {
-        width,
-        height,
-        mercator,
-    }
-    .globe_projection()
-    .unwrap_or(SurfaceProjection::Equirect);
     let (w, h) = (f64::from(width.max(1)), f64::from(height.max(1)));
     let uv = DVec2::new((f64::from(i) + 0.5) / w, (f64::from(j) + 0.5) / h);
     let d = projection.direction(uv);

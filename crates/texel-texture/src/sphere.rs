@@ -391,13 +391,13 @@ impl SurfaceProjection {
     /// The texture coordinates of surface direction `d` (any length but 0): `u` in `[0, 1]`,
     /// `v` in `[0, 1]` (see the type's docs). A zero or non-finite `d` gives NaN.
     pub fn uv(self, d: DVec3) -> DVec2 {
-        let uv = equirect_uv(mirror_x(d));
         match self {
-            SurfaceProjection::Equirect => uv,
+            SurfaceProjection::Equirect => equirect_uv(mirror_x(d)),
             SurfaceProjection::Mercator { .. } => {
-                let s = (d.y / d.length()).clamp(-1.0, 1.0);
-                let y = s.atanh();
-                DVec2::new(uv.x, (0.5 - y / (2.0 * self.half_height())).clamp(0.0, 1.0))
+                // equirect_uv's u of the mirrored direction, without its acos.
+                let u = 0.5 + (-d.x).atan2(-d.z) / (2.0 * PI);
+                let y = (d.y / d.length()).clamp(-1.0, 1.0).atanh();
+                DVec2::new(u, (0.5 - y / (2.0 * self.half_height())).clamp(0.0, 1.0))
             }
         }
     }
