@@ -320,7 +320,8 @@ pub struct RenderArgs {
     /// TEXEL_ADAPTER environment variable, else the first, real GPUs first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
-    /// Output PNG (`-` writes it to standard output).
+    /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
+    /// instead: the linear colour as 32-bit floats, unclamped.
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -367,7 +368,8 @@ pub struct ReferenceArgs {
     /// side at most 64 (256 = 16x16, 512 = 16x32).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub spp: u32,
-    /// Output PNG (`-` writes it to standard output).
+    /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
+    /// instead: the linear colour as 32-bit floats, unclamped.
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -598,7 +600,8 @@ pub struct WarpArgs {
     /// Colour handling.
     #[arg(long, value_enum, default_value_t)]
     pub color: ColorArg,
-    /// Output PNG (`-` writes it to standard output).
+    /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
+    /// instead: the linear colour as 32-bit floats, unclamped.
     #[arg(short, long)]
     pub output: PathBuf,
 }

@@ -6,7 +6,7 @@ use texel_raster::render_reference_strata;
 use crate::cli::ReferenceArgs;
 use crate::filters::Filter;
 use crate::input::{load_scene, Input};
-use crate::output::write_png;
+use crate::output::{encoding, write_frame};
 use crate::progress;
 use texel::PreparedScene;
 
@@ -56,13 +56,7 @@ pub fn reference_frame_from(
 pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     let scene = load_scene(&args.scene, input)?;
     let frame = reference_frame(&scene, args.spp)?;
-    write_png(
-        &args.output,
-        frame.width,
-        frame.height,
-        &frame.color,
-        args.scene.color,
-    )
+    write_frame(&args.output, &frame, encoding(args.scene.color))
 }
 
 #[cfg(test)]

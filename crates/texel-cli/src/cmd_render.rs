@@ -7,7 +7,7 @@ use texel_raster::{render, ColorTarget, Derivatives, Perspective, UvEvaluation, 
 use crate::cli::{ColorArg, DerivativesArg, PerspectiveArg, RenderArgs, ViewArg};
 use crate::filters::Filter;
 use crate::input::{load_scene, Input};
-use crate::output::{encoding, write_image};
+use crate::output::{encoding, is_exr, write_frame};
 use crate::threads::with_threads;
 
 /// Run `texel render`.
@@ -55,6 +55,10 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         settings.target = ColorTarget::Srgb8;
         ColorArg::Srgb
     };
+    if is_exr(&args.output) {
+        // OpenEXR keeps the colour in float, unclamped.
+        settings.target = ColorTarget::Float;
+    }
     let draws = scene.draws(&samplers);
     let frame = if args.gpu {
         let filter = filter.unwrap_or(Filter::Trilinear);
@@ -72,7 +76,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     } else {
         with_threads(args.threads, || render(&settings, &draws))??
     };
-    write_image(&args.output, &texel::frame_image(&frame, encoding(color))?)
+    write_frame(&args.output, &frame, encoding(color))
 }
 
 /// Run `texel gpu-info`: every adapter, and which one `--gpu` would pick.

@@ -1,5 +1,6 @@
-//! Writing images: linear RGBA frames encoded to 8-bit PNG, written atomically (through
-//! texel-quality's `Image8` and `write_atomic`, so images and reports share one encoder).
+//! Writing images: linear RGBA frames encoded to 8-bit PNG, or kept as linear float OpenEXR where
+//! the output path ends in `.exr`, written atomically (through texel-quality's `Image8`,
+//! `encode_exr` and `write_atomic`, so images and reports share one encoder).
 
 use std::io::Write;
 use std::path::Path;
@@ -8,6 +9,7 @@ use anyhow::{Context, Result};
 use texel_quality::{Encoding, Image8};
 
 use texel::ColorHandling;
+use texel_raster::Frame;
 
 use crate::cli::ColorArg;
 
@@ -19,7 +21,25 @@ pub fn encoding(color: impl Into<ColorHandling>) -> Encoding {
     }
 }
 
-/// Encode a linear RGBA frame as PNG and publish it at `path` ([`texel_quality::write_atomic`]:
+/// Whether `path` names an OpenEXR file (extension `exr`, in any case). Such outputs hold the
+/// frame's linear colour as 32-bit floats, unclamped (radiance above 1 is kept), whatever
+/// `--color` says about encoding.
+pub fn is_exr(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+/// Publish `frame` at `path`: OpenEXR of its linear colour ([`is_exr`]; a float frame is
+/// written as it is, an 8-bit one decoded), else PNG encoded as `encoding` ([`write_image`]).
+pub fn write_frame(path: &Path, frame: &Frame, encoding: Encoding) -> Result<()> {
+    if is_exr(path) {
+        return texel_quality::write_exr_atomic(path, frame.width, frame.height, &frame.linear())
+            .with_context(|| format!("cannot write {}", path.display()));
+    }
+    write_image(path, &texel::frame_image(frame, encoding)?)
+}
+
+/// Encode a linear RGBA frame as PNG (OpenEXR for a `.exr` path, [`is_exr`]) and publish it at `path` ([`texel_quality::write_atomic`]:
 /// atomically over a regular file or a new path, through to a device or FIFO), or stream it to
 /// standard output when `path` is `-`.
 pub fn write_png(
@@ -29,6 +49,10 @@ pub fn write_png(
     pixels: &[[f32; 4]],
     color: ColorArg,
 ) -> Result<()> {
+    if is_exr(path) {
+        return texel_quality::write_exr_atomic(path, width, height, pixels)
+            .with_context(|| format!("cannot write {}", path.display()));
+    }
     let image = Image8::from_linear(width, height, pixels, encoding(color))?;
     write_image(path, &image)
 }

@@ -52,3 +52,49 @@ fn failed_writes_leave_no_temporary_files() {
     ok(&["render", "--size", "32x18", "-o", &d.arg("out/ok.png")]);
     assert!(temp_files(d.path()).is_empty());
 }
+
+/// The linear float colour of an OpenEXR file.
+fn load_exr(path: &std::path::Path) -> (u32, u32, Vec<[f32; 4]>) {
+    let img = image::open(path)
+        .unwrap_or_else(|e| panic!("cannot load {}: {e}", path.display()))
+        .to_rgba32f();
+    let px = img.pixels().map(|p| p.0).collect();
+    (img.width(), img.height(), px)
+}
+
+/// An output named `.exr` (any case) is OpenEXR holding the frame's linear colour unclamped: the
+/// glossy plane's highlight is above 1, and encoding the floats gives the PNG's bytes exactly.
+#[test]
+fn exr_outputs_keep_the_linear_colour_unclamped() {
+    let d = Dir::new("exr");
+    let scene = ["builtin:glossy", "--size", "96x54"];
+    for (cmd, extra) in [
+        ("render", ["--filter", "aniso16"]),
+        ("reference", ["--spp", "4"]),
+    ] {
+        let exr = d.arg(&format!("{cmd}.EXR"));
+        let png = d.arg(&format!("{cmd}.png"));
+        for out in [&exr, &png] {
+            let mut args = vec![cmd];
+            args.extend_from_slice(&scene);
+            args.extend_from_slice(&extra);
+            args.extend_from_slice(&["-o", out]);
+            ok(&args);
+        }
+        assert_eq!(
+            &file_bytes(&exr)[..4],
+            &[0x76, 0x2f, 0x31, 0x01],
+            "OpenEXR magic"
+        );
+        let (w, h, px) = load_exr(std::path::Path::new(&exr));
+        assert_eq!((w, h), (96, 54));
+        let brightest = px
+            .iter()
+            .map(|p| p[0].max(p[1]).max(p[2]))
+            .fold(0.0, f32::max);
+        assert!(brightest > 1.5, "{cmd}: highlight {brightest}");
+        let encoded =
+            texel_quality::Image8::from_linear(w, h, &px, texel_quality::Encoding::Srgb).unwrap();
+        assert_eq!(encoded.pixels(), load(&png).pixels(), "{cmd}");
+    }
+}

@@ -411,9 +411,71 @@ pub fn write_png_atomic(
     write_atomic(path, &encode_png(width, height, rgba8)?)
 }
 
+/// Encode `width x height` linear RGBA floats (row 0 at the top) as OpenEXR (32-bit float
+/// channels R, G, B, A) in memory.
+///
+/// # Errors
+/// Size errors ([`QualityError::DataLength`], ...) and [`QualityError::Image`] from the encoder.
+pub fn encode_exr(width: u32, height: u32, rgba: &[[f32; 4]]) -> Result<Vec<u8>, QualityError> {
+    let n = checked_len(width, height)?;
+    if rgba.len() != n {
+        return Err(QualityError::DataLength {
+            width,
+            height,
+            expected: n,
+            got: rgba.len(),
+        });
+    }
+    let bytes: Vec<u8> = rgba
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    let mut out = std::io::Cursor::new(Vec::new());
+    image::codecs::openexr::OpenExrEncoder::new(&mut out)
+        .write_image(&bytes, width, height, image::ExtendedColorType::Rgba32F)
+        .map_err(|source| QualityError::Image {
+            path: PathBuf::new(),
+            source,
+        })?;
+    Ok(out.into_inner())
+}
+
+/// Encode linear RGBA floats as OpenEXR ([`encode_exr`]) and write them with [`write_atomic`].
+///
+/// # Errors
+/// As [`encode_exr`] and [`write_atomic`].
+pub fn write_exr_atomic(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgba: &[[f32; 4]],
+) -> Result<(), QualityError> {
+    write_atomic(path, &encode_exr(width, height, rgba)?)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn exr_round_trips_floats_exactly() {
+        let px: Vec<[f32; 4]> = (0..6)
+            .map(|k| [k as f32 * 0.25, 3.5e3, -1.0 / 3.0, 1.0])
+            .collect();
+        let bytes = encode_exr(3, 2, &px).unwrap();
+        let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::OpenExr)
+            .unwrap()
+            .to_rgba32f();
+        assert_eq!((img.width(), img.height()), (3, 2));
+        for (got, want) in img.pixels().zip(&px) {
+            assert_eq!(&got.0, want);
+        }
+        assert!(matches!(
+            encode_exr(3, 2, &px[..5]),
+            Err(QualityError::DataLength { .. })
+        ));
+    }
 
     fn scratch(tag: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("texel-quality-{tag}-{}", std::process::id()));

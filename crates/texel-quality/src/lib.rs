@@ -53,7 +53,8 @@ pub mod ssim;
 pub const MAX_SIDE: u32 = 16384;
 
 pub use atomic::{
-    publish_dir, remove_pending_and_exit, write_atomic, write_png_atomic, OUTPUT_MARKER,
+    encode_exr, publish_dir, remove_pending_and_exit, write_atomic, write_exr_atomic,
+    write_png_atomic, OUTPUT_MARKER,
 };
 pub use band::{default_band_rows, horizon_band};
 pub use crop::{crop_enlarge, horizon_crop_rect, Rect};
