@@ -269,8 +269,8 @@ pub enum SpecularAaArg {
     None,
     /// Toksvig (2005): roughness widened by how much the filtered normal shortened.
     Toksvig,
-    /// LEAN mapping (Olano & Baker 2010): slope moments filtered with the normals; roughness
-    /// widened by their variance.
+    /// LEAN mapping (Olano & Baker 2010): slope moments filtered with the normals; the lobe
+    /// convolved with their covariance (anisotropic).
     Lean,
     /// Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021): roughness widened by the
     /// normal's change to the neighbouring pixels, as GPUs ship it.

@@ -5,8 +5,10 @@ use texel_quality::psnr;
 use crate::util::*;
 
 /// Toksvig's and LEAN's specular antialiasing are closer to the reference (which shades every
-/// sub-sample with exact level-0 normals) than plain filtered normals, for trilinear and aniso16
-/// (measured 3.5-4.7 dB closer at this size).
+/// sub-sample with exact level-0 normals) than plain filtered normals, for trilinear and aniso16;
+/// LEAN with aniso16 by the 6 dB (measured at this size: trilinear none 14.79, Toksvig
+/// 19.37, LEAN 20.12 dB; aniso16 15.44, 21.63, 22.96 dB; LEAN was 4.7 dB above none before its
+/// lobe took the slopes' covariance and the GGX-Gaussian mixture shape).
 #[test]
 fn toksvig_beats_plain_filtered_normals_against_the_reference() {
     let d = Dir::new("glossy");
@@ -48,6 +50,9 @@ fn toksvig_beats_plain_filtered_normals_against_the_reference() {
             db[1] >= db[0] + 2.0 && db[2] >= db[0] + 2.0,
             "{filter}: {db:?}"
         );
+        if filter == "aniso16" {
+            assert!(db[2] >= db[0] + 6.0, "{filter}: {db:?}");
+        }
     }
 }
 

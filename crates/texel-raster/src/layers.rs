@@ -24,9 +24,9 @@
 //! `prepare`), then filters those.
 
 use glam::{Vec3, Vec4};
-use texel_texture::{Footprint, Format, Sampler, Texture};
+use texel_texture::{Footprint, Format, Sampler};
 
-use crate::material::{read, read_channel, ChannelInput, TextureInput};
+use crate::material::{read, read_channel, ChannelInput, MomentMap, TextureInput};
 
 /// The most layers a material has (one per mask channel).
 pub const MAX_LAYERS: usize = 4;
@@ -56,7 +56,7 @@ pub struct Layer<'a> {
     pub normal_scale: f32,
     /// The LEAN moment map of `normal_map` ([`crate::material::lean_map`]), read through the
     /// normal map's sampler; without it LEAN falls back to Toksvig's rule for this material.
-    pub lean: Option<&'a Texture>,
+    pub lean: Option<&'a MomentMap>,
     /// Height in `[0, 1]` where there is no `height_map` (and the factor multiplying it where
     /// there is one).
     pub height: f32,
@@ -118,9 +118,9 @@ pub struct MapNormal {
     pub raw: Vec3,
     /// The mean normal after each layer's `normal_scale`.
     pub mean: Vec3,
-    /// LEAN's moments `[b_x, b_y, b_x^2, b_y^2]` after scaling, where every normal-mapped layer
-    /// has its moment map and they were asked for.
-    pub moments: Option<[f32; 4]>,
+    /// LEAN's moments `[b_x, b_y, b_x^2, b_y^2, b_x b_y]` after scaling, where every
+    /// normal-mapped layer has its moment map and they were asked for.
+    pub moments: Option<[f32; 5]>,
     /// How far `raw` may fall short of unit length by quantisation ([`UNORM8_NORMAL_SLACK`] if
     /// any map is 8-bit, else 0).
     pub slack: f32,
@@ -297,7 +297,7 @@ impl<'a> Layers<'a> {
         let mut normal = MapNormal {
             raw: Vec3::ZERO,
             mean: Vec3::ZERO,
-            moments: needs.moments.then_some([0.0; 4]),
+            moments: needs.moments.then_some([0.0; 5]),
             slack: 0.0,
         };
         for (l, &wk) in self.used().iter().zip(&w) {
@@ -345,21 +345,17 @@ impl<'a> Layers<'a> {
 pub(crate) fn read_normal(
     map: &TextureInput,
     scale: f32,
-    lean: Option<&Texture>,
+    lean: Option<&MomentMap>,
     fp: &Footprint,
     count: bool,
     texels: &mut u32,
 ) -> MapNormal {
     let t = read(map, fp, count, texels);
     let raw = Vec3::new(t[0], t[1], t[2]) * 2.0 - Vec3::ONE;
-    let moments = lean.map(|texture| {
-        let input = TextureInput {
-            texture,
-            sampler: map.sampler,
-        };
-        let e = read(&input, fp, count, texels);
+    let moments = lean.map(|lean| {
+        let e = lean.read(map.sampler, fp, count, texels);
         let s2 = scale * scale;
-        [e[0] * scale, e[1] * scale, e[2] * s2, e[3] * s2]
+        [e[0] * scale, e[1] * scale, e[2] * s2, e[3] * s2, e[4] * s2]
     });
     MapNormal {
         raw,
@@ -388,7 +384,7 @@ fn normalise(m: &mut [f32; MAX_LAYERS]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use texel_texture::{ColorSpace, Limits, SamplerDescriptor};
+    use texel_texture::{ColorSpace, Limits, SamplerDescriptor, Texture};
 
     fn solid(rgba: [f32; 4]) -> Texture {
         Texture::from_fn(4, 4, Format::Rgba32Float, &Limits::default(), |_, _| rgba).unwrap()

@@ -14,6 +14,9 @@
 //!   alpha^2))`, the height-correlated Smith masking-shadowing term divided by `4 n.l n.v` (Heitz
 //!   2014, eq. 99);
 //! - `f = (1 - F) c_diff / pi + F D Vis` with `c_diff = c (1 - m)`;
+//! - where specular antialiasing measured a spread of normals under the pixel
+//!   ([`SlopeSpread`]), `D` is the GGX lobe convolved with that spread ([`SlopeSpread::d`]) and the
+//!   diffuse `n.l` the mean clamped cosine over it ([`SlopeSpread::clamped_cosine`]);
 //! - outgoing radiance `L = sum over lights of f E (n.l)` for `n.l > 0`, plus `A (c_diff + F0)` for
 //!   ambient light `A`, times the ambient visibility [`Surface::occlusion`] (glTF's occlusion
 //!   texture applies to ambient light only). The diffuse part's `n.l` uses [`Surface::diffuse_normal`] (the mean normal
@@ -92,17 +95,20 @@ pub enum SpecularAa {
     /// Toksvig (2005): the filtered (averaged) tangent-space normal is shorter than 1 where the
     /// normals under the footprint disagree. With `|n|` its length and the Blinn-Phong exponent
     /// `s = 2 / alpha^2 - 2` equivalent to GGX's `alpha` (Walter et al. 2007), the exponent becomes
-    /// `s' = s |n| / (|n| + s (1 - |n|))`, i.e. `alpha'^2 = 2 / (s' + 2)`.
+    /// `s' = s |n| / (|n| + s (1 - |n|))`, i.e. `alpha'^2 = 2 / (s' + 2)`. The widening is taken
+    /// as an isotropic slope variance `(alpha'^2 - alpha^2) / 2` about the mean normal and shaped
+    /// by [`SlopeSpread::d`].
     Toksvig,
     /// LEAN mapping (Olano & Baker 2010): the map's slopes `b = (n_x, n_y) / n_z` and their second
-    /// moments `(b_x^2, b_y^2)` are stored in a float texture ([`lean_map`]) and filtered by the
-    /// same filter, which is exact for them because they are linear. The mean slope gives the
-    /// normal `normalize(b_x, b_y, 1)`; `E[b^2] - E[b]^2` per axis is the slope variance under the
-    /// footprint. Its mean over both axes `sigma^2` widens the isotropic lobe as a Beckmann lobe of
-    /// that variance would (`alpha^2 = 2 sigma^2` for Beckmann): `alpha'^2 = alpha^2 + 2 sigma^2`.
-    /// (LEAN's cross moment `b_x b_y` would orient an anisotropic lobe; the lobe here is
-    /// isotropic, so it is not stored.) Needs [`Material::lean`] for a normal map, or
-    /// [`Material::height_moments`] for a height map (whose slopes are the height's gradient).
+    /// moments `(b_x^2, b_y^2, b_x b_y)` are stored in float textures ([`lean_map`]) and filtered
+    /// by the same filter, which is exact for them because they are linear. The mean slope gives
+    /// the normal `normalize(b_x, b_y, 1)`; `E[b b^T] - E[b] E[b]^T` is the slopes' covariance
+    /// under the footprint. The lobe is the material's GGX lobe convolved with the Gaussian of
+    /// that covariance ([`SlopeSpread::d`]: anisotropic, oriented by the cross moment), with the
+    /// isotropic `alpha'^2 = alpha^2 + tr(cov)` for the masking term; the diffuse term takes the
+    /// mean of the clamped cosine over the spread ([`SlopeSpread::clamped_cosine`]). Needs
+    /// [`Material::lean`] for a normal map, or [`Material::height_moments`] for a height map
+    /// (whose slopes are the height's gradient).
     Lean,
     /// Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021, "Stable Geometric Specular
     /// Antialiasing with Projected-Space NDF Filtering", JCGT 10(2), eq. 14 and listing 5), what
@@ -111,7 +117,7 @@ pub enum SpecularAa {
     /// variance of the normal under a Gaussian pixel filter of variance `sigma^2 = 1 / (2 pi)`:
     /// `alpha'^2 = min(1, alpha^2 + min(sigma^2 (|dn/dx|^2 + |dn/dy|^2), kappa))` with the paper's
     /// clamp `kappa = 0.18`. Covers normal maps, bump maps and curved geometry alike, at the price
-    /// of two more normal evaluations.
+    /// of two more normal evaluations. The lobe stays the widened GGX, as the paper ships it.
     Projected,
 }
 
@@ -174,7 +180,7 @@ pub struct Material<'a> {
     pub specular_aa: SpecularAa,
     /// The LEAN moment map of `normal_map` ([`lean_map`]), read through the normal map's
     /// sampler; required by [`SpecularAa::Lean`] on a normal map.
-    pub lean: Option<&'a Texture>,
+    pub lean: Option<&'a MomentMap>,
     /// Height map, one channel in `[0, 1]` (see [`Displacement`]); used when `displacement` is
     /// not [`Displacement::None`]. A normal map, when there is one, still gives the normal.
     pub height_map: Option<ChannelInput<'a>>,
@@ -185,7 +191,7 @@ pub struct Material<'a> {
     /// The slope moment map of `height_map` ([`height_moments`]), read through the height map's
     /// sampler; used by [`SpecularAa::Lean`] and [`SpecularAa::Toksvig`] on bump-mapped
     /// surfaces without a normal map.
-    pub height_moments: Option<&'a Texture>,
+    pub height_moments: Option<&'a MomentMap>,
     /// Layers blended by a mask ([`crate::layers`]), filtered then blended. Their blended base
     /// colour multiplies the draw's texture and `base_color`, their roughness multiplies
     /// `roughness`; their normals (where some layer has a normal map) replace `normal_map`, and
@@ -301,6 +307,109 @@ pub struct Surface {
     /// Ambient visibility in `[0, 1]` (baked ambient occlusion; 1 unoccluded): multiplies the
     /// ambient lights only.
     pub occlusion: f32,
+    /// The spread of the normals under the pixel that specular antialiasing measured, or `None`
+    /// (exact normals, or no antialiasing): the lobe is then [`SlopeSpread::d`] instead of GGX
+    /// at `roughness`.
+    pub spread: Option<SlopeSpread>,
+}
+
+/// The normals under a pixel as specular antialiasing sees them: slopes (`b = (x, y) / z` of a
+/// normal in `frame`) with mean `mean` and covariance `cov`, under the material's own GGX lobe of
+/// perceptual roughness `base_roughness`. The reflectance of such a pixel is the convolution of
+/// the GGX slope distribution `P_a(m) = 1 / (pi a^2 (1 + |m|^2 / a^2)^2)` with the Gaussian of the
+/// slopes (Olano & Baker 2010 use Beckmann for both, so their convolution is Beckmann again; GGX
+/// has no closed form). [`SlopeSpread::d`] approximates it by a mixture that is exact at both
+/// ends and has the right tail.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlopeSpread {
+    /// `[tangent, bitangent, normal]`, orthonormal, world space: the slopes' frame.
+    pub frame: [Vec3; 3],
+    /// Mean slope along tangent and bitangent.
+    pub mean: glam::Vec2,
+    /// Covariance of the slopes `[xx, yy, xy]` (positive semi-definite; rounding is clamped).
+    pub cov: [f32; 3],
+    /// The material's perceptual roughness before antialiasing widened it.
+    pub base_roughness: f32,
+}
+
+impl SlopeSpread {
+    /// An isotropic spread about the unit `normal` (no mean slope) of variance `var` per axis.
+    pub fn isotropic(normal: Vec3, var: f32, base_roughness: f32) -> SlopeSpread {
+        let (t, b) = normal.any_orthonormal_pair();
+        SlopeSpread {
+            frame: [t, b, normal],
+            mean: glam::Vec2::ZERO,
+            cov: [var.max(0.0), var.max(0.0), 0.0],
+            base_roughness,
+        }
+    }
+
+    /// `E[max(0, n.l)]` over the pixel's normals, for the unit light direction `l` and
+    /// `mean = E[n].l`: to first order in the slopes, `n.l` is Gaussian with that mean and the
+    /// variance `l_t^T cov l_t` (`l_t` the light's components along the frame's tangent and
+    /// bitangent), and the mean of a clamped Gaussian is `m Phi(m / s) + s phi(m / s)`.
+    pub fn clamped_cosine(&self, mean: f32, l: Vec3) -> f32 {
+        let [t, b, _] = self.frame;
+        let (x, y) = (l.dot(t), l.dot(b));
+        let var = self.cov[0] * x * x + self.cov[1] * y * y + 2.0 * self.cov[2] * x * y;
+        if var <= 1e-12 {
+            return mean.max(0.0);
+        }
+        let sd = var.sqrt();
+        let z = mean / sd;
+        let phi = (-0.5 * z * z).exp() / (2.0 * std::f32::consts::PI).sqrt();
+        let cdf = 0.5 * (1.0 + erf(z / std::f32::consts::SQRT_2));
+        (mean * cdf + sd * phi).max(0.0)
+    }
+
+    /// The microfacet distribution `D(h)` of the pixel for the half vector `h` (unit), with
+    /// `alpha` the widened GGX alpha (`alpha^2 = alpha_0^2 + tr(cov)`, as
+    /// [`slope_variance_roughness`] gives): with `w = alpha_0^2 / alpha^2`,
+    ///
+    /// `D = w D_GGX(n'.h; alpha) + (1 - w) N(m_h - mean; cov + alpha_0^2 / 2 I) / (h.n)^4`,
+    ///
+    /// where `n'` is the normal of the mean slope, `m_h` the slope of `h` in `frame` and `N` the
+    /// bivariate Gaussian. Both parts integrate to 1 over projected area. Without spread
+    /// (`cov = 0`, `w = 1`) it is the material's GGX lobe exactly; for a spread much wider than
+    /// the lobe it is the Gaussian of the slopes widened by the lobe's own variance
+    /// (`alpha_0^2 / 2` per axis, Beckmann's); and far from the mean its tail is
+    /// `alpha_0^2 / (pi |m|^4)`, the base lobe's own (GGX's tail scales as `alpha^2`, and
+    /// `w alpha^2 = alpha_0^2`), where a widened GGX alone (what Toksvig's and LEAN's GGX
+    /// adaptations use) carries `alpha^2`: a highlight too wide and too bright in its tails.
+    pub fn d(&self, h: Vec3, alpha: f32) -> f32 {
+        let [t, b, n] = self.frame;
+        let c = h.dot(n);
+        if c <= 0.0 {
+            return 0.0;
+        }
+        let a0 = self.base_roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
+        let w = (a0 * a0 / (alpha * alpha).max(1e-12)).min(1.0);
+        let mean_normal = (t * self.mean.x + b * self.mean.y + n).normalize();
+        let ggx = ggx_d(mean_normal.dot(h).max(0.0), alpha);
+        if w >= 1.0 {
+            return ggx;
+        }
+        let m = glam::Vec2::new(h.dot(t), h.dot(b)) / c - self.mean;
+        let lobe = 0.5 * a0 * a0;
+        let (sxx, syy) = (self.cov[0].max(0.0) + lobe, self.cov[1].max(0.0) + lobe);
+        // Keep the matrix positive definite whatever rounding did to the cross term.
+        let sxy = self.cov[2].clamp(-0.999 * (sxx * syy).sqrt(), 0.999 * (sxx * syy).sqrt());
+        let det = sxx * syy - sxy * sxy;
+        let q = (syy * m.x * m.x - 2.0 * sxy * m.x * m.y + sxx * m.y * m.y) / det;
+        let gauss = (-0.5 * q).exp() / (2.0 * std::f32::consts::PI * det.sqrt());
+        w * ggx + (1.0 - w) * gauss / (c * c * c * c)
+    }
+}
+
+/// The error function, Abramowitz & Stegun 7.1.26 (absolute error below `1.5e-7` in exact
+/// arithmetic, `1e-6` in `f32`).
+pub fn erf(x: f32) -> f32 {
+    let t = 1.0 / (1.0 + 0.327_591_1 * x.abs());
+    let poly = t
+        * (0.254_829_6
+            + t * (-0.284_496_74 + t * (1.421_413_7 + t * (-1.453_152_1 + t * 1.061_405_4))));
+    let y = 1.0 - poly * (-x * x).exp();
+    y.copysign(x)
 }
 
 /// GGX's normal distribution `D(n.h)` for `alpha` (see the module docs).
@@ -373,7 +482,11 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
             }
         };
         let n_dot_l = n.dot(l);
-        let diffuse = c_diff * std::f32::consts::FRAC_1_PI * surface.diffuse_normal.dot(l).max(0.0);
+        let cosine = match &surface.spread {
+            Some(spread) => spread.clamped_cosine(surface.diffuse_normal.dot(l), l),
+            _ => surface.diffuse_normal.dot(l).max(0.0),
+        };
+        let diffuse = c_diff * std::f32::consts::FRAC_1_PI * cosine;
         if lambert {
             out += diffuse * e;
             continue;
@@ -384,8 +497,11 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
         }
         let h = (l + v).normalize_or_zero();
         let fr = fresnel(f0, v.dot(h));
-        let spec =
-            fr * (ggx_d(n.dot(h).max(0.0), alpha) * smith_visibility(n_dot_l, n_dot_v, alpha));
+        let d = match &surface.spread {
+            Some(spread) => spread.d(h, alpha),
+            None => ggx_d(n.dot(h).max(0.0), alpha),
+        };
+        let spec = fr * (d * smith_visibility(n_dot_l, n_dot_v, alpha));
         out += ((Vec3::ONE - fr) * diffuse + spec * n_dot_l) * e;
     }
     out
@@ -395,43 +511,112 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
 /// surface normal): grazing map normals would make the moments explode.
 pub const LEAN_MAX_SLOPE: f32 = 16.0;
 
-/// The LEAN moment map of a tangent-space normal map (Olano & Baker 2010), `Rgba32Float` with its
-/// own pyramid: `[b_x, b_y, b_x^2, b_y^2]`, where `b = (n_x, n_y) / n_z` for each level-0 texel's
-/// normal `n = normalize(2 rgb - 1)` (slopes clamped to [`LEAN_MAX_SLOPE`]). Averaging it over any
-/// footprint gives the mean slope and the second moments of the normals under it.
+/// A slope moment map ([`lean_map`], [`height_moments`]): the first and second moments of a
+/// normal or height map's slopes `m`, in two float textures with their own pyramids, read through
+/// the map's sampler. Every filter is linear in its texels, so averaged over a footprint they
+/// give the mean slope and the slopes' covariance under it (Olano & Baker 2010).
+#[derive(Debug)]
+pub struct MomentMap {
+    /// `[m_x, m_y, m_x^2, m_y^2]`.
+    pub moments: Texture,
+    /// `[m_x m_y, 0, 0, 0]`: the cross moment, which orients the covariance.
+    pub cross: Texture,
+}
+
+impl MomentMap {
+    /// The moment map of level-0 slopes `slope(i, j)` over a `w x h` map.
+    ///
+    /// # Errors
+    /// The size errors of `Texture::from_fn` for a float texture of that size.
+    pub fn from_slopes(
+        w: u32,
+        h: u32,
+        limits: &texel_texture::Limits,
+        slope: impl Fn(u32, u32) -> glam::Vec2,
+    ) -> Result<MomentMap, texel_texture::TextureError> {
+        let format = texel_texture::Format::Rgba32Float;
+        let moments = Texture::from_fn(w, h, format, limits, |i, j| {
+            let b = slope(i, j);
+            [b.x, b.y, b.x * b.x, b.y * b.y]
+        })?;
+        let cross = Texture::from_fn(w, h, format, limits, |i, j| {
+            let b = slope(i, j);
+            [b.x * b.y, 0.0, 0.0, 0.0]
+        })?;
+        Ok(MomentMap { moments, cross })
+    }
+
+    /// Bytes the texels of both pyramids occupy.
+    pub fn pyramid_bytes(&self) -> u64 {
+        self.moments.pyramid_bytes() + self.cross.pyramid_bytes()
+    }
+
+    /// The filtered moments `[m_x, m_y, m_x^2, m_y^2, m_x m_y]` at `fp` through `sampler`, adding
+    /// the texels read to `texels` when `count`.
+    pub(crate) fn read(
+        &self,
+        sampler: &Sampler,
+        fp: &Footprint,
+        count: bool,
+        texels: &mut u32,
+    ) -> [f32; 5] {
+        let at =
+            |texture, texels: &mut u32| read(&TextureInput { texture, sampler }, fp, count, texels);
+        let e = at(&self.moments, texels);
+        let c = at(&self.cross, texels);
+        [e[0], e[1], e[2], e[3], c[0]]
+    }
+}
+
+/// The LEAN moment map of a tangent-space normal map (Olano & Baker 2010): the moments of
+/// `b = (n_x, n_y) / n_z` for each level-0 texel's normal `n = normalize(2 rgb - 1)` (slopes
+/// clamped to [`LEAN_MAX_SLOPE`]).
 ///
 /// # Errors
 /// The size errors of `Texture::from_fn` for a float texture of the map's size.
 pub fn lean_map(
     normal_map: &Texture,
     limits: &texel_texture::Limits,
-) -> Result<Texture, texel_texture::TextureError> {
+) -> Result<MomentMap, texel_texture::TextureError> {
     let (w, h) = (normal_map.width(), normal_map.height());
-    let slope = |i: u32, j: u32| {
+    MomentMap::from_slopes(w, h, limits, |i, j| {
         let c = normal_map.texel(0, i, j).unwrap_or([0.5, 0.5, 1.0, 1.0]);
         let n = (Vec3::new(c[0], c[1], c[2]) * 2.0 - Vec3::ONE).normalize_or(Vec3::Z);
         let z =
             n.z.max(1.0 / (1.0 + LEAN_MAX_SLOPE * LEAN_MAX_SLOPE).sqrt());
         (n.truncate() / z).clamp_length_max(LEAN_MAX_SLOPE)
-    };
-    Texture::from_fn(w, h, texel_texture::Format::Rgba32Float, limits, |i, j| {
-        let b = slope(i, j);
-        [b.x, b.y, b.x * b.x, b.y * b.y]
     })
 }
 
 /// LEAN's tangent-space normal (unit) and widened roughness from the filtered moments
-/// `[b_x, b_y, b_x^2, b_y^2]`, for a normal map scaled by `scale` and base `roughness`. See
-/// [`SpecularAa::Lean`].
-pub fn lean_normal_roughness(moments: [f32; 4], scale: f32, roughness: f32) -> (Vec3, f32) {
-    let b = glam::Vec2::new(moments[0], moments[1]) * scale;
-    let s2 = scale * scale;
-    let var_x = moments[2] * s2 - b.x * b.x;
-    let var_y = moments[3] * s2 - b.y * b.y;
+/// `[b_x, b_y, b_x^2, b_y^2, b_x b_y]` ([`MomentMap`]), for a normal map scaled by `scale` and
+/// base `roughness`. See [`SpecularAa::Lean`].
+pub fn lean_normal_roughness(moments: [f32; 5], scale: f32, roughness: f32) -> (Vec3, f32) {
+    let (b, cov) = lean_mean_covariance(moments, scale);
     (
         b.extend(1.0).normalize(),
-        slope_variance_roughness(roughness, var_x, var_y),
+        slope_variance_roughness(roughness, cov[0], cov[1]),
     )
+}
+
+/// LEAN's mean slope and slope covariance `[xx, yy, xy]` from the filtered moments
+/// `[b_x, b_y, b_x^2, b_y^2, b_x b_y]` of a normal map scaled by `scale` (variances below 0,
+/// from rounding, are 0).
+pub fn lean_mean_covariance(moments: [f32; 5], scale: f32) -> (glam::Vec2, [f32; 3]) {
+    let b = glam::Vec2::new(moments[0], moments[1]) * scale;
+    let s2 = scale * scale;
+    let var_x = (moments[2] * s2 - b.x * b.x).max(0.0);
+    let var_y = (moments[3] * s2 - b.y * b.y).max(0.0);
+    (b, [var_x, var_y, moments[4] * s2 - b.x * b.y])
+}
+
+/// The isotropic [`SlopeSpread`] about the unit shading `normal` that turns perceptual roughness
+/// `base` into `widened` (`alpha^2 = alpha_0^2 + 2 sigma^2`, so `sigma^2 = (alpha^2 -
+/// alpha_0^2) / 2` per axis): how Toksvig's widening is shaped.
+pub fn isotropic_spread(normal: Vec3, base: f32, widened: f32) -> SlopeSpread {
+    let a0 = base.clamp(MIN_ROUGHNESS, 1.0).powi(4);
+    let a1 = widened.clamp(MIN_ROUGHNESS, 1.0).powi(4);
+    SlopeSpread::isotropic(normal, 0.5 * (a1 - a0), base)
 }
 
 /// The perceptual roughness whose lobe also covers normals with slope variances `var_x` and
@@ -459,12 +644,12 @@ pub fn projected_roughness(roughness: f32, dn_dx: Vec3, dn_dy: Vec3) -> f32 {
     alpha2.sqrt().sqrt()
 }
 
-/// The slope moment map of a height map (one channel, `channel`): `Rgba32Float` with its own
-/// pyramid holding `[g_u, g_v, g_u^2, g_v^2]`, where `g` is the height's gradient per unit of `u`
-/// and `v` from forward differences between level-0 texels (wrapping at the edges, as height maps
-/// tile): `g_u = (h(i + 1, j) - h(i, j)) w`, `g_v = (h(i, j + 1) - h(i, j)) h_px`. Averaged over a
-/// footprint it gives the variance of the gradient under it, which [`SpecularAa::Lean`] turns into
-/// roughness after scaling by `height_scale` and the surface's size per unit of `u` and `v`.
+/// The slope moment map of a height map (one channel, `channel`): the moments of `g`, the
+/// height's gradient per unit of `u` and `v` from forward differences between level-0 texels
+/// (wrapping at the edges, as height maps tile): `g_u = (h(i + 1, j) - h(i, j)) w`,
+/// `g_v = (h(i, j + 1) - h(i, j)) h_px`. Averaged over a footprint they give the covariance of
+/// the gradient under it, which [`SpecularAa::Lean`] turns into roughness after scaling by
+/// `height_scale` and the surface's size per unit of `u` and `v`.
 ///
 /// # Errors
 /// The size errors of `Texture::from_fn` for a float texture of the map's size.
@@ -472,18 +657,19 @@ pub fn height_moments(
     height_map: &Texture,
     channel: usize,
     limits: &texel_texture::Limits,
-) -> Result<Texture, texel_texture::TextureError> {
+) -> Result<MomentMap, texel_texture::TextureError> {
     let (w, h) = (height_map.width(), height_map.height());
     let at = |i: u32, j: u32| {
         height_map
             .texel(0, i % w, j % h)
             .map_or(0.0, |t| t[channel.min(3)])
     };
-    Texture::from_fn(w, h, texel_texture::Format::Rgba32Float, limits, |i, j| {
+    MomentMap::from_slopes(w, h, limits, |i, j| {
         let h0 = at(i, j);
-        let gu = (at(i + 1, j) - h0) * w as f32;
-        let gv = (at(i, j + 1) - h0) * h as f32;
-        [gu, gv, gu * gu, gv * gv]
+        glam::Vec2::new(
+            (at(i + 1, j) - h0) * w as f32,
+            (at(i, j + 1) - h0) * h as f32,
+        )
     })
 }
 
@@ -562,6 +748,7 @@ mod tests {
             diffuse_normal: Vec3::Y,
             position: Vec3::ZERO,
             occlusion: 1.0,
+            spread: None,
         };
         let sun = [Light::Directional {
             direction: Vec3::Y,
@@ -610,6 +797,7 @@ mod tests {
                 diffuse_normal: Vec3::Z,
                 position: Vec3::ZERO,
                 occlusion: 1.0,
+                spread: None,
             };
             let eye = Vec3::new(0.5, 0.0, 1.0) * 10.0;
             let (nt, np) = (400, 400);
@@ -642,45 +830,88 @@ mod tests {
     #[test]
     fn lean_moments_give_the_mean_normal_and_the_slope_variance() {
         // One flat texel: the normal is z and nothing widens.
-        let flat = lean_normal_roughness([0.0, 0.0, 0.0, 0.0], 1.0, 0.3);
+        let flat = lean_normal_roughness([0.0; 5], 1.0, 0.3);
         assert!((flat.0 - Vec3::Z).length() < 1e-6 && (flat.1 - 0.3).abs() < 1e-6);
         // Two slopes (+0.5, 0) and (-0.5, 0) averaged: mean 0, variance 0.25 along x, 0 along y:
         // sigma^2 = 0.125, alpha'^2 = alpha^2 + 0.25.
-        let (n, r) = lean_normal_roughness([0.0, 0.0, 0.25, 0.0], 1.0, 0.3);
+        let (n, r) = lean_normal_roughness([0.0, 0.0, 0.25, 0.0, 0.0], 1.0, 0.3);
         assert!((n - Vec3::Z).length() < 1e-6);
         let want = (0.3f32.powi(4) + 0.25).sqrt().sqrt();
         assert!((r - want).abs() < 1e-6, "{r} vs {want}");
         // A constant slope (0.5, 0.25): the normal tilts, no variance. Scale 2 doubles the slope.
-        let (n, r) = lean_normal_roughness([0.5, 0.25, 0.25, 0.0625], 2.0, 0.3);
+        let m = [0.5, 0.25, 0.25, 0.0625, 0.125];
+        let (n, r) = lean_normal_roughness(m, 2.0, 0.3);
         assert!(
             (n - Vec3::new(1.0, 0.5, 1.0).normalize()).length() < 1e-6,
             "{n}"
         );
         assert!((r - 0.3).abs() < 1e-5, "{r}");
+        let (mean, cov) = lean_mean_covariance(m, 2.0);
+        assert_eq!(mean, glam::Vec2::new(1.0, 0.5));
+        assert!(cov.iter().all(|c| c.abs() < 1e-6), "{cov:?}");
+        // Slopes (0.5, 0.5) and (-0.5, -0.5): the variance lies along the diagonal, which only
+        // the cross moment tells from (0.5, -0.5) and (-0.5, 0.5).
+        let (_, cov) = lean_mean_covariance([0.0, 0.0, 0.25, 0.25, 0.25], 1.0);
+        assert_eq!(cov, [0.25, 0.25, 0.25]);
+        let (_, cov) = lean_mean_covariance([0.0, 0.0, 0.25, 0.25, -0.25], 1.0);
+        assert_eq!(cov, [0.25, 0.25, -0.25]);
     }
 
     #[test]
-    fn the_lean_map_holds_slopes_and_their_squares() {
-        let n = Vec3::new(0.3, -0.2, 0.9).normalize();
+    fn the_lean_map_holds_the_slope_moments_and_its_pyramid_their_covariance() {
+        let normals = [
+            Vec3::new(0.3, -0.2, 0.9),
+            Vec3::new(-0.4, 0.1, 0.8),
+            Vec3::new(0.1, 0.5, 0.85),
+            Vec3::new(0.0, 0.0, 1.0),
+        ]
+        .map(Vec3::normalize);
         let code = |c: f32| ((c + 1.0) / 2.0 * 255.0).round() as u8;
         let t = Texture::from_rgba8(
             2,
             2,
-            vec![[code(n.x), code(n.y), code(n.z), 255]; 4],
+            normals
+                .iter()
+                .map(|n| [code(n.x), code(n.y), code(n.z), 255])
+                .collect(),
             texel_texture::ColorSpace::Linear,
             &texel_texture::Limits::default(),
         )
         .unwrap();
         let a = lean_map(&t, &texel_texture::Limits::default()).unwrap();
-        let c = t.texel(0, 0, 0).unwrap();
-        let d = (Vec3::new(c[0], c[1], c[2]) * 2.0 - Vec3::ONE).normalize();
-        let (bx, by) = (d.x / d.z, d.y / d.z);
-        let got = a.texel(0, 1, 1).unwrap();
-        for (g, w) in got.iter().zip([bx, by, bx * bx, by * by]) {
-            assert!((g - w).abs() < 1e-6, "{got:?}");
+        let slope = |k: usize| {
+            let (i, j) = (k as u32 % 2, k as u32 / 2);
+            let c = t.texel(0, i, j).unwrap();
+            let d = (Vec3::new(c[0], c[1], c[2]) * 2.0 - Vec3::ONE).normalize();
+            glam::Vec2::new(d.x / d.z, d.y / d.z)
+        };
+        let moments = |level: usize, i: u32, j: u32| {
+            let m = a.moments.texel(level, i, j).unwrap();
+            let c = a.cross.texel(level, i, j).unwrap();
+            [m[0], m[1], m[2], m[3], c[0]]
+        };
+        for k in 0..4 {
+            let b = slope(k);
+            let got = moments(0, k as u32 % 2, k as u32 / 2);
+            for (g, w) in got.iter().zip([b.x, b.y, b.x * b.x, b.y * b.y, b.x * b.y]) {
+                assert!((g - w).abs() < 1e-6, "{k}: {got:?}");
+            }
         }
-        // The coarsest level averages them (a constant map: the same values).
-        assert!((a.texel(1, 0, 0).unwrap()[2] - bx * bx).abs() < 1e-6);
+        // Level 1 averages the four texels: its moments give their mean and covariance exactly.
+        let (mean, cov) = lean_mean_covariance(moments(1, 0, 0), 1.0);
+        let bs: Vec<glam::Vec2> = (0..4).map(slope).collect();
+        let want_mean = bs.iter().copied().sum::<glam::Vec2>() / 4.0;
+        let d: Vec<glam::Vec2> = bs.iter().map(|b| *b - want_mean).collect();
+        let want = [
+            d.iter().map(|d| d.x * d.x).sum::<f32>() / 4.0,
+            d.iter().map(|d| d.y * d.y).sum::<f32>() / 4.0,
+            d.iter().map(|d| d.x * d.y).sum::<f32>() / 4.0,
+        ];
+        assert!((mean - want_mean).length() < 1e-6, "{mean} vs {want_mean}");
+        for (g, w) in cov.iter().zip(want) {
+            assert!((g - w).abs() < 1e-5, "{cov:?} vs {want:?}");
+        }
+        assert!(want[2].abs() > 0.01, "the cross term is exercised");
     }
 
     #[test]
@@ -714,20 +945,139 @@ mod tests {
     }
 
     #[test]
-    fn height_moments_hold_forward_differences_and_their_squares() {
+    fn height_moments_hold_forward_differences_and_their_products() {
         let limits = texel_texture::Limits::default();
-        // h = (i^2) / 64 along u over 8 texels, constant along v.
-        let t = Texture::from_fn(8, 4, texel_texture::Format::Rgba32Float, &limits, |i, _| {
-            let h = (i * i) as f32 / 64.0;
+        // h = (i^2 + 3 j) / 64 over 8 x 4 texels.
+        let t = Texture::from_fn(8, 4, texel_texture::Format::Rgba32Float, &limits, |i, j| {
+            let h = (i * i + 3 * j) as f32 / 64.0;
             [h, 0.0, 0.0, 1.0]
         })
         .unwrap();
         let m = height_moments(&t, 0, &limits).unwrap();
-        let got = m.texel(0, 2, 1).unwrap();
+        let got = m.moments.texel(0, 2, 1).unwrap();
         let gu = (9.0 - 4.0) / 64.0 * 8.0;
-        assert_eq!(got, [gu, 0.0, gu * gu, 0.0]);
+        let gv = 3.0 / 64.0 * 4.0;
+        assert_eq!(got, [gu, gv, gu * gu, gv * gv]);
+        assert_eq!(m.cross.texel(0, 2, 1).unwrap()[0], gu * gv);
         // The last column wraps to the first.
-        let got = m.texel(0, 7, 0).unwrap();
+        let got = m.moments.texel(0, 7, 0).unwrap();
         assert_eq!(got[0], (0.0 - 49.0 / 64.0) * 8.0);
+    }
+
+    /// `int D(h) (h.n) dw` over the hemisphere, by the midpoint rule in `(theta, phi)`.
+    fn projected_integral(d: impl Fn(Vec3) -> f32) -> f64 {
+        let (nt, np) = (2000, 256);
+        let mut sum = 0.0f64;
+        for i in 0..nt {
+            let theta = (i as f64 + 0.5) / nt as f64 * std::f64::consts::FRAC_PI_2;
+            for j in 0..np {
+                let phi = (j as f64 + 0.5) / np as f64 * std::f64::consts::TAU;
+                let h = Vec3::new(
+                    (theta.sin() * phi.cos()) as f32,
+                    (theta.sin() * phi.sin()) as f32,
+                    theta.cos() as f32,
+                );
+                let dw = theta.sin()
+                    * (std::f64::consts::FRAC_PI_2 / nt as f64)
+                    * (std::f64::consts::TAU / np as f64);
+                sum += f64::from(d(h)) * theta.cos() * dw;
+            }
+        }
+        sum
+    }
+
+    fn spread(cov: [f32; 3], mean: glam::Vec2, base: f32) -> SlopeSpread {
+        SlopeSpread {
+            frame: [Vec3::X, Vec3::Y, Vec3::Z],
+            mean,
+            cov,
+            base_roughness: base,
+        }
+    }
+
+    #[test]
+    fn the_spread_lobe_is_ggx_without_spread_and_normalised_with_it() {
+        // No spread: the material's own GGX lobe about the mean slope's normal, exactly.
+        let s = spread([0.0; 3], glam::Vec2::new(0.2, -0.1), 0.4);
+        let n = Vec3::new(0.2, -0.1, 1.0).normalize();
+        for h in [Vec3::Z, Vec3::new(0.3, 0.1, 1.0), Vec3::new(-0.5, 0.4, 0.6)] {
+            let h = h.normalize();
+            assert_eq!(s.d(h, 0.16), ggx_d(n.dot(h), 0.16));
+        }
+        // With spread (anisotropic, correlated), both parts keep unit projected area.
+        for (cov, base) in [
+            ([0.02f32, 0.005, 0.004], 0.3f32),
+            ([0.09, 0.09, 0.0], 0.25),
+            ([0.01, 0.04, -0.015], 0.5),
+        ] {
+            let s = spread(cov, glam::Vec2::ZERO, base);
+            let a0 = base * base;
+            let alpha = (a0 * a0 + cov[0] + cov[1]).sqrt();
+            let total = projected_integral(|h| s.d(h, alpha));
+            assert!((total - 1.0).abs() < 5e-3, "{cov:?}: {total}");
+        }
+    }
+
+    #[test]
+    fn a_wide_spread_is_the_slopes_gaussian_with_the_base_lobes_tail() {
+        let base = 0.2f32;
+        let a0 = base * base;
+        let cov = [0.09f32, 0.04, 0.02];
+        let alpha = (a0 * a0 + cov[0] + cov[1]).sqrt();
+        let s = spread(cov, glam::Vec2::ZERO, base);
+        // Near the mean: the bivariate Gaussian of covariance cov + a0^2 / 2, over cos^4.
+        let (sxx, syy, sxy) = (cov[0] + a0 * a0 / 2.0, cov[1] + a0 * a0 / 2.0, cov[2]);
+        let det = sxx * syy - sxy * sxy;
+        for m in [
+            glam::Vec2::ZERO,
+            glam::Vec2::new(0.2, 0.1),
+            glam::Vec2::new(-0.1, 0.3),
+        ] {
+            let h = m.extend(1.0).normalize();
+            let q = (syy * m.x * m.x - 2.0 * sxy * m.x * m.y + sxx * m.y * m.y) / det;
+            let c = h.z;
+            let gauss = (-0.5 * q).exp() / (std::f32::consts::TAU * det.sqrt()) / c.powi(4);
+            let got = s.d(h, alpha);
+            assert!((got / gauss - 1.0).abs() < 0.01, "{m}: {got} vs {gauss}");
+        }
+        // Far out (|m| = 12): the base lobe's tail a0^2 / (pi |m|^4), not the widened GGX's.
+        let m = glam::Vec2::new(12.0, 0.0);
+        let h = m.extend(1.0).normalize();
+        let tail = a0 * a0 / (std::f32::consts::PI * m.length().powi(4)) / h.z.powi(4);
+        let got = s.d(h, alpha);
+        assert!((got / tail - 1.0).abs() < 0.05, "{got} vs {tail}");
+        assert!(
+            ggx_d(h.z, alpha) > 10.0 * tail,
+            "the widened GGX alone is far brighter"
+        );
+    }
+
+    #[test]
+    fn the_clamped_cosine_is_the_mean_of_a_clamped_gaussian() {
+        assert!((erf(0.5) - 0.520_499_9).abs() < 1e-6);
+        assert!((erf(1.0) - 0.842_700_8).abs() < 1e-6);
+        assert!((erf(-2.0) + 0.995_322_3).abs() < 1e-6);
+        let s = spread([0.04, 0.01, 0.01], glam::Vec2::ZERO, 0.3);
+        let l = Vec3::new(0.6, 0.3, 0.2).normalize();
+        // n.l's variance to first order: l_t^T cov l_t.
+        let var = 0.04 * l.x * l.x + 0.01 * l.y * l.y + 2.0 * 0.01 * l.x * l.y;
+        for mean in [-0.3f32, -0.05, 0.0, 0.1, 0.5] {
+            // E[max(0, X)], X ~ N(mean, var), by the midpoint rule over +-8 sd.
+            let sd = var.sqrt() as f64;
+            let k = 20_000;
+            let mut want = 0.0f64;
+            for i in 0..k {
+                let z = -8.0 + 16.0 * (i as f64 + 0.5) / k as f64;
+                let x = f64::from(mean) + sd * z;
+                want += x.max(0.0) * (-0.5 * z * z).exp() / (std::f64::consts::TAU).sqrt()
+                    * (16.0 / k as f64);
+            }
+            let got = f64::from(s.clamped_cosine(mean, l));
+            assert!((got - want).abs() < 1e-5, "{mean}: {got} vs {want}");
+        }
+        // No spread: the plain clamped cosine.
+        let flat = spread([0.0; 3], glam::Vec2::ZERO, 0.3);
+        assert_eq!(flat.clamped_cosine(0.4, l), 0.4);
+        assert_eq!(flat.clamped_cosine(-0.4, l), 0.0);
     }
 }

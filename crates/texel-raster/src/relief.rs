@@ -14,7 +14,7 @@ use texel_texture::Footprint;
 
 use crate::draw::Vertex;
 use crate::layers::{read_normal, LayerSample};
-use crate::material::{self, Material, SpecularAa, TextureInput};
+use crate::material::{self, Material, SlopeSpread, SpecularAa};
 
 /// The fewest and the most linear steps of the parallax march (at normal incidence and at
 /// grazing angles; Tatarchuk 2006 interpolates between them by `n.v`).
@@ -29,6 +29,9 @@ pub(crate) struct Shading {
     pub diffuse_normal: Option<Vec3>,
     /// Perceptual roughness after antialiasing.
     pub roughness: f32,
+    /// The spread of the normals that antialiasing measured (the lobe's shape, see
+    /// [`SlopeSpread::d`]); `None` without antialiasing.
+    pub spread: Option<SlopeSpread>,
 }
 
 /// The barycentric interpolation of `f` over the triangle's vertices.
@@ -124,6 +127,7 @@ pub(crate) fn shading_normal(
         normal: n,
         diffuse_normal: None,
         roughness,
+        spread: None,
     };
     let layer_normal = layered.and_then(|s| s.normal);
     if layer_normal.is_some() || m.normal_map.is_some() {
@@ -140,11 +144,20 @@ pub(crate) fn shading_normal(
             }
             (None, None) => return plain,
         };
+        let base = roughness;
         let mut roughness = roughness;
+        let mut spread = None;
         let antialiased = match (aa, mapped.moments) {
             (SpecularAa::Lean, Some(moments)) => {
                 let (nt, r) = material::lean_normal_roughness(moments, 1.0, roughness);
+                let (mean, cov) = material::lean_mean_covariance(moments, 1.0);
                 roughness = r;
+                spread = Some(SlopeSpread {
+                    frame: [t, b, n],
+                    mean,
+                    cov,
+                    base_roughness: base,
+                });
                 Some(nt)
             }
             // Toksvig's rule, also LEAN's fallback where a layer has no moment map.
@@ -155,12 +168,17 @@ pub(crate) fn shading_normal(
             }
             _ => None,
         };
+        let normal = to_world(antialiased.unwrap_or(mapped.mean)).normalize_or(n);
+        if antialiased.is_some() && spread.is_none() {
+            spread = Some(material::isotropic_spread(normal, base, roughness));
+        }
         return Shading {
-            normal: to_world(antialiased.unwrap_or(mapped.mean)).normalize_or(n),
+            normal,
             // Antialiased methods light the diffuse term with the mean normal (no longer than 1:
             // scaling by `normal_scale` can lengthen it).
             diffuse_normal: antialiased.map(|_| to_world(mapped.mean).clamp_length_max(1.0)),
             roughness,
+            spread,
         };
     }
     if !m.bumped() {
@@ -187,27 +205,39 @@ pub(crate) fn shading_normal(
     let s = m.height_scale;
     let g = Vec2::new((hu1 - hu0) / du, (hv1 - hv0) / dv) * s;
     let normal = normal_from_gradient(a, b, n, g);
+    let base = roughness;
     let mut roughness = roughness;
+    let mut spread = None;
     let moments = m
         .height_moments
         .zip(m.height_map.filter(|_| m.layers.is_none()));
     if let (SpecularAa::Lean | SpecularAa::Toksvig, Some((moments, height))) = (aa, moments) {
         // Toksvig measures an averaged normal's length, which a height map does not have; its
         // moments carry the same information (the spread of the normals), so both use them.
-        let input = TextureInput {
-            texture: moments,
-            sampler: height.input.sampler,
-        };
-        let e = material::read(&input, fp, count, texels);
+        let e = moments.read(height.input.sampler, fp, count, texels);
+        // Gradients per unit of u and v become slopes along dp/du and dp/dv by dividing by
+        // their lengths (the axes are orthogonal for the usual, unsheared, uv).
+        let (la, lb) = (a.length(), b.length());
         let s2 = s * s;
-        let var_u = (e[2] - e[0] * e[0]) * s2 / a.length_squared();
-        let var_v = (e[3] - e[1] * e[1]) * s2 / b.length_squared();
+        let var_u = (e[2] - e[0] * e[0]) * s2 / (la * la);
+        let var_v = (e[3] - e[1] * e[1]) * s2 / (lb * lb);
+        let cov_uv = (e[4] - e[0] * e[1]) * s2 / (la * lb);
         roughness = material::slope_variance_roughness(roughness, var_u, var_v);
+        let t = a / la;
+        let bt = on_plane(b, t).normalize_or(n.cross(t));
+        spread = Some(SlopeSpread {
+            frame: [t, bt, n],
+            // The bump normal's own slopes, so that the lobe is centred where it points.
+            mean: Vec2::new(normal.dot(t), normal.dot(bt)) / normal.dot(n).max(1e-6),
+            cov: [var_u.max(0.0), var_v.max(0.0), cov_uv],
+            base_roughness: base,
+        });
     }
     Shading {
         normal,
         diffuse_normal: None,
         roughness,
+        spread,
     }
 }
 

@@ -353,6 +353,7 @@ pub(crate) fn shade(
             diffuse_normal: normal,
             position,
             occlusion: 1.0,
+            spread: None,
         };
         let rgb = light(&surface, true, &mut texels);
         return (rgb.extend(c.w).to_array(), texels);
@@ -457,6 +458,7 @@ pub(crate) fn shade(
         diffuse_normal: shading.diffuse_normal.unwrap_or(shading.normal),
         position,
         occlusion,
+        spread: shading.spread,
     };
     let rgb = light(&surface, false, &mut texels);
     (rgb.extend(c.w).to_array(), texels)

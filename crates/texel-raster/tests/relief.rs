@@ -128,6 +128,7 @@ fn bump_mapping_a_ramp_gives_the_tilted_planes_normal() {
                 diffuse_normal: normal,
                 position: eye + d * (-eye.z / d.z),
                 occlusion: 1.0,
+                spread: None,
             };
             let want = radiance(&surface, eye, &[light], false);
             let got = Vec3::from_slice(&frame.color[k][..3]);

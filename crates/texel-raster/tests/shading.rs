@@ -90,6 +90,7 @@ fn a_normal_map_tilts_the_shading_normal_in_gltf_tangent_space() {
                 diffuse_normal: world,
                 position: hit(m, eye, i, j),
                 occlusion: 1.0,
+                spread: None,
             };
             let want = radiance(&surface, eye, &[light], false);
             let got = Vec3::from_slice(&frame.color[k][..3]);

@@ -7,6 +7,7 @@ use std::sync::{Mutex, OnceLock};
 
 use texel_raster::environment::{self, Environment, EnvironmentMaps};
 use texel_raster::layers::{Layer, LayerBlend, Layers, MAX_LAYERS};
+use texel_raster::material::MomentMap;
 use texel_raster::{
     ChannelInput, ColorTarget, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
     TextureInput, UvEvaluation, UvMapping, Vertex,
@@ -127,10 +128,10 @@ pub struct PreparedScene {
     displacement: Option<texel_scene::Displacement>,
     /// LEAN moment maps ([`texel_raster::material::lean_map`]) of the normal maps of materials
     /// that use LEAN, by the normal map's texture name.
-    lean_maps: BTreeMap<String, Texture>,
+    lean_maps: BTreeMap<String, MomentMap>,
     /// Slope moment maps ([`texel_raster::material::height_moments`]) of the height maps of
     /// bump-mapped materials without a normal map that use LEAN or Toksvig, by texture name.
-    height_moments: BTreeMap<String, Texture>,
+    height_moments: BTreeMap<String, MomentMap>,
     /// [`SceneOptions::layer_order`].
     layer_order: Option<LayerOrder>,
     /// [`SceneOptions::surface_uv`]; [`PreparedScene::set_surface_uv`] changes it.
@@ -940,9 +941,9 @@ fn heights_of<'a>(
 struct Baked {
     composite: Composite,
     /// LEAN moments of the baked normals.
-    lean: Option<Texture>,
+    lean: Option<MomentMap>,
     /// Slope moments of the baked heights (bump-mapped, without normals).
-    slope_moments: Option<Texture>,
+    slope_moments: Option<MomentMap>,
 }
 
 /// The two kinds of moment map specular antialiasing reads.
@@ -979,7 +980,7 @@ fn moment_map(
     map: &Texture,
     budget: &mut MemoryBudget,
     what: &str,
-) -> Result<Texture, Error> {
+) -> Result<MomentMap, Error> {
     let limits = Limits {
         max_bytes: budget.remaining(),
         ..Limits::default()
@@ -1058,7 +1059,7 @@ fn red<'a>(texture: &'a Texture, sampler: &'a Sampler) -> ChannelInput<'a> {
 fn layers_of<'a>(
     spec: &MaterialSpec,
     maps: MapInputs<'a>,
-    lean_maps: &'a BTreeMap<String, Texture>,
+    lean_maps: &'a BTreeMap<String, MomentMap>,
 ) -> Layers<'a> {
     let input = |name: &String| maps.input(name);
     let mut layers = [Layer::default(); MAX_LAYERS];
