@@ -126,7 +126,9 @@ pub enum ViewArg {
 #[derive(Debug, Args)]
 pub struct SceneArgs {
     /// Scene file (TOML) or built-in scene (builtin:ground, builtin:ground-rotated, builtin:zoneplate,
-    /// builtin:cube, builtin:sphere, builtin:triangle, builtin:glossy, builtin:bricks).
+    /// builtin:cube, builtin:sphere, builtin:globe, builtin:globe-equirect, builtin:triangle,
+    /// builtin:glossy, builtin:bricks, builtin:terrain, builtin:knot, builtin:mirror-spheres,
+    /// builtin:mirror-plane).
     #[arg(default_value = "builtin:ground")]
     pub scene: String,
     /// Colour handling.

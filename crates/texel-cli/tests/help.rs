@@ -25,3 +25,18 @@ fn every_command_has_help_with_an_example() {
         assert!(help.contains("Usage: texel "), "{help}");
     }
 }
+
+/// The scene argument's help names every built-in scene.
+#[test]
+fn scene_help_lists_every_builtin() {
+    for c in ["render", "reference", "compare", "bench"] {
+        let help = stdout(&ok(&[c, "--help"]));
+        for name in BUILTINS {
+            assert!(
+                help.contains(&format!("builtin:{name},"))
+                    || help.contains(&format!("builtin:{name})")),
+                "texel {c} --help lacks builtin:{name}"
+            );
+        }
+    }
+}
