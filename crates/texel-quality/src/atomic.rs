@@ -31,7 +31,7 @@ use std::sync::{Mutex, MutexGuard};
 use image::ImageEncoder;
 
 use crate::error::QualityError;
-use crate::image8::checked_len;
+use crate::image8::check_data_len;
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
@@ -377,15 +377,7 @@ pub fn publish_dir<T, E: From<QualityError>>(
 
 /// Encode packed `RGBARGBA...` 8-bit bytes as PNG in memory.
 pub(crate) fn encode_png(width: u32, height: u32, rgba8: &[u8]) -> Result<Vec<u8>, QualityError> {
-    let n = checked_len(width, height)?;
-    if rgba8.len() != 4 * n {
-        return Err(QualityError::DataLength {
-            width,
-            height,
-            expected: 4 * n,
-            got: rgba8.len(),
-        });
-    }
+    check_data_len(width, height, 4, rgba8.len())?;
     let mut out = Vec::new();
     image::codecs::png::PngEncoder::new(&mut out)
         .write_image(rgba8, width, height, image::ExtendedColorType::Rgba8)
@@ -417,15 +409,7 @@ pub fn write_png_atomic(
 /// # Errors
 /// Size errors ([`QualityError::DataLength`], ...) and [`QualityError::Image`] from the encoder.
 pub fn encode_exr(width: u32, height: u32, rgba: &[[f32; 4]]) -> Result<Vec<u8>, QualityError> {
-    let n = checked_len(width, height)?;
-    if rgba.len() != n {
-        return Err(QualityError::DataLength {
-            width,
-            height,
-            expected: n,
-            got: rgba.len(),
-        });
-    }
+    check_data_len(width, height, 1, rgba.len())?;
     let bytes: Vec<u8> = rgba
         .iter()
         .flatten()

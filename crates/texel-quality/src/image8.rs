@@ -56,6 +56,26 @@ pub(crate) fn checked_len(width: u32, height: u32) -> Result<usize, QualityError
     Ok(width as usize * height as usize)
 }
 
+/// [`checked_len`], then that `got` elements are `per_pixel` for each of the `width * height`
+/// pixels ([`QualityError::DataLength`] otherwise). Returns the pixel count.
+pub(crate) fn check_data_len(
+    width: u32,
+    height: u32,
+    per_pixel: usize,
+    got: usize,
+) -> Result<usize, QualityError> {
+    let n = checked_len(width, height)?;
+    if got != per_pixel * n {
+        return Err(QualityError::DataLength {
+            width,
+            height,
+            expected: per_pixel * n,
+            got,
+        });
+    }
+    Ok(n)
+}
+
 pub(crate) fn check_same(a: (u32, u32), b: (u32, u32)) -> Result<(), QualityError> {
     if a != b {
         return Err(QualityError::SizeMismatch {
@@ -74,15 +94,7 @@ impl Image8 {
     /// # Errors
     /// [`QualityError::EmptyImage`], [`QualityError::TooLarge`], [`QualityError::DataLength`].
     pub fn new(width: u32, height: u32, pixels: Vec<[u8; 4]>) -> Result<Self, QualityError> {
-        let expected = checked_len(width, height)?;
-        if pixels.len() != expected {
-            return Err(QualityError::DataLength {
-                width,
-                height,
-                expected,
-                got: pixels.len(),
-            });
-        }
+        check_data_len(width, height, 1, pixels.len())?;
         Ok(Image8 {
             width,
             height,
@@ -95,15 +107,7 @@ impl Image8 {
     /// # Errors
     /// As [`Image8::new`]; the length is checked in bytes.
     pub fn from_rgba_bytes(width: u32, height: u32, bytes: &[u8]) -> Result<Self, QualityError> {
-        let n = checked_len(width, height)?;
-        if bytes.len() != 4 * n {
-            return Err(QualityError::DataLength {
-                width,
-                height,
-                expected: 4 * n,
-                got: bytes.len(),
-            });
-        }
+        check_data_len(width, height, 4, bytes.len())?;
         let pixels = bytes
             .chunks_exact(4)
             .map(|p| [p[0], p[1], p[2], p[3]])
@@ -122,15 +126,7 @@ impl Image8 {
         pixels: &[[f32; 4]],
         encoding: Encoding,
     ) -> Result<Self, QualityError> {
-        let n = checked_len(width, height)?;
-        if pixels.len() != n {
-            return Err(QualityError::DataLength {
-                width,
-                height,
-                expected: n,
-                got: pixels.len(),
-            });
-        }
+        check_data_len(width, height, 1, pixels.len())?;
         let px = pixels.iter().map(|&c| encoding.encode(c)).collect();
         Self::new(width, height, px)
     }

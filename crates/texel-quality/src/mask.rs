@@ -1,7 +1,7 @@
 //! [`Mask`]: which pixels a measurement averages over (usually the geometry's coverage).
 
 use crate::error::QualityError;
-use crate::image8::checked_len;
+use crate::image8::{check_data_len, checked_len};
 
 /// A row-major boolean image; `true` pixels are measured. Sides are `1..=MAX_SIDE`.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -17,15 +17,7 @@ impl Mask {
     /// # Errors
     /// [`QualityError::EmptyImage`], [`QualityError::TooLarge`], [`QualityError::DataLength`].
     pub fn new(width: u32, height: u32, bits: Vec<bool>) -> Result<Self, QualityError> {
-        let expected = checked_len(width, height)?;
-        if bits.len() != expected {
-            return Err(QualityError::DataLength {
-                width,
-                height,
-                expected,
-                got: bits.len(),
-            });
-        }
+        check_data_len(width, height, 1, bits.len())?;
         Ok(Mask {
             width,
             height,
