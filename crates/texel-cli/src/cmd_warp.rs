@@ -11,7 +11,7 @@ use texel_texture::{AddressMode, Sampler, Texture};
 
 use crate::cli::WarpArgs;
 use crate::input::Input;
-use crate::output::write_png;
+use crate::output::write_linear;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
 
 /// Run `texel warp`.
@@ -66,5 +66,5 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
         };
         anyhow::Error::new(e).context(what)
     })?;
-    write_png(&args.output, w, h, &pixels, args.color)
+    write_linear(&args.output, w, h, &pixels, args.color)
 }

@@ -33,16 +33,14 @@ pub fn is_exr(path: &Path) -> bool {
 /// written as it is, an 8-bit one decoded), else PNG encoded as `encoding` ([`write_image`]).
 pub fn write_frame(path: &Path, frame: &Frame, encoding: Encoding) -> Result<()> {
     if is_exr(path) {
-        return texel_quality::write_exr_atomic(path, frame.width, frame.height, &frame.linear())
-            .with_context(|| format!("cannot write {}", path.display()));
+        return write_exr(path, frame.width, frame.height, &frame.linear());
     }
     write_image(path, &texel::frame_image(frame, encoding)?)
 }
 
-/// Encode a linear RGBA frame as PNG (OpenEXR for a `.exr` path, [`is_exr`]) and publish it at `path` ([`texel_quality::write_atomic`]:
-/// atomically over a regular file or a new path, through to a device or FIFO), or stream it to
-/// standard output when `path` is `-`.
-pub fn write_png(
+/// Publish linear RGBA pixels at `path`: OpenEXR for a `.exr` path ([`is_exr`]), else PNG
+/// encoded as `color` says ([`write_image`]).
+pub fn write_linear(
     path: &Path,
     width: u32,
     height: u32,
@@ -50,14 +48,20 @@ pub fn write_png(
     color: ColorArg,
 ) -> Result<()> {
     if is_exr(path) {
-        return texel_quality::write_exr_atomic(path, width, height, pixels)
-            .with_context(|| format!("cannot write {}", path.display()));
+        return write_exr(path, width, height, pixels);
     }
     let image = Image8::from_linear(width, height, pixels, encoding(color))?;
     write_image(path, &image)
 }
 
-/// Publish an 8-bit image as PNG at `path`, or on standard output for `-`.
+/// Publish linear RGBA pixels as OpenEXR at `path` ([`texel_quality::write_exr_atomic`]).
+fn write_exr(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<()> {
+    texel_quality::write_exr_atomic(path, width, height, pixels)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Publish an 8-bit image as PNG at `path` ([`texel_quality::write_atomic`]: atomically over a
+/// regular file or a new path, through to a device or FIFO), or on standard output for `-`.
 pub fn write_image(path: &Path, image: &Image8) -> Result<()> {
     if path.as_os_str() == "-" {
         let png = image.to_png()?;
