@@ -333,14 +333,19 @@ pub struct SlopeSpread {
 }
 
 impl SlopeSpread {
-    /// An isotropic spread about the unit `normal` (no mean slope) of variance `var` per axis.
-    pub fn isotropic(normal: Vec3, var: f32, base_roughness: f32) -> SlopeSpread {
+    /// The isotropic spread about the unit `normal` (no mean slope) that turns perceptual
+    /// roughness `base` into `widened` (`alpha^2 = alpha_0^2 + 2 sigma^2`, so
+    /// `sigma^2 = (alpha^2 - alpha_0^2) / 2` per axis): how Toksvig's widening is shaped.
+    pub fn isotropic(normal: Vec3, base: f32, widened: f32) -> SlopeSpread {
+        let a0 = base.clamp(MIN_ROUGHNESS, 1.0).powi(4);
+        let a1 = widened.clamp(MIN_ROUGHNESS, 1.0).powi(4);
+        let var = (0.5 * (a1 - a0)).max(0.0);
         let (t, b) = normal.any_orthonormal_pair();
         SlopeSpread {
             frame: [t, b, normal],
             mean: glam::Vec2::ZERO,
-            cov: [var.max(0.0), var.max(0.0), 0.0],
-            base_roughness,
+            cov: [var, var, 0.0],
+            base_roughness: base,
         }
     }
 
@@ -363,8 +368,57 @@ impl SlopeSpread {
     }
 
     /// The microfacet distribution `D(h)` of the pixel for the half vector `h` (unit), with
-    /// `alpha` the widened GGX alpha (`alpha^2 = alpha_0^2 + tr(cov)`, as
-    /// [`slope_variance_roughness`] gives): with `w = alpha_0^2 / alpha^2`,
+    /// `alpha` the widened GGX alpha: [`SpreadLobe::d`] of [`SlopeSpread::lobe`].
+    pub fn d(&self, h: Vec3, alpha: f32) -> f32 {
+        self.lobe(alpha).d(h)
+    }
+
+    /// What [`SpreadLobe::d`] needs that does not depend on the light, for the widened GGX
+    /// `alpha` (`alpha^2 = alpha_0^2 + tr(cov)`, as [`slope_variance_roughness`] gives): worked
+    /// out once per pixel, before the lights.
+    pub fn lobe(&self, alpha: f32) -> SpreadLobe {
+        let [t, b, n] = self.frame;
+        let a0 = self.base_roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
+        let lobe = 0.5 * a0 * a0;
+        let (sxx, syy) = (self.cov[0].max(0.0) + lobe, self.cov[1].max(0.0) + lobe);
+        // Keep the matrix positive definite whatever rounding did to the cross term.
+        let sxy = self.cov[2].clamp(-0.999 * (sxx * syy).sqrt(), 0.999 * (sxx * syy).sqrt());
+        let det = sxx * syy - sxy * sxy;
+        SpreadLobe {
+            frame: self.frame,
+            mean: self.mean,
+            alpha,
+            w: (a0 * a0 / (alpha * alpha).max(1e-12)).min(1.0),
+            mean_normal: (t * self.mean.x + b * self.mean.y + n).normalize(),
+            sigma: [sxx, syy, sxy],
+            det,
+            gauss_norm: 2.0 * std::f32::consts::PI * det.sqrt(),
+        }
+    }
+}
+
+/// A pixel's [`SlopeSpread`] made ready for its lights ([`SlopeSpread::lobe`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpreadLobe {
+    frame: [Vec3; 3],
+    mean: glam::Vec2,
+    /// The widened GGX alpha.
+    alpha: f32,
+    /// GGX's weight `alpha_0^2 / alpha^2`.
+    w: f32,
+    /// The unit normal of the mean slope.
+    mean_normal: Vec3,
+    /// The Gaussian's covariance `cov + alpha_0^2 / 2 I`, `[xx, yy, xy]`.
+    sigma: [f32; 3],
+    /// Its determinant.
+    det: f32,
+    /// `2 pi sqrt(det)`.
+    gauss_norm: f32,
+}
+
+impl SpreadLobe {
+    /// The microfacet distribution `D(h)` for the unit half vector `h`, with
+    /// `w = alpha_0^2 / alpha^2`:
     ///
     /// `D = w D_GGX(n'.h; alpha) + (1 - w) N(m_h - mean; cov + alpha_0^2 / 2 I) / (h.n)^4`,
     ///
@@ -376,28 +430,21 @@ impl SlopeSpread {
     /// `alpha_0^2 / (pi |m|^4)`, the base lobe's own (GGX's tail scales as `alpha^2`, and
     /// `w alpha^2 = alpha_0^2`), where a widened GGX alone (what Toksvig's and LEAN's GGX
     /// adaptations use) carries `alpha^2`: a highlight too wide and too bright in its tails.
-    pub fn d(&self, h: Vec3, alpha: f32) -> f32 {
+    pub fn d(&self, h: Vec3) -> f32 {
         let [t, b, n] = self.frame;
         let c = h.dot(n);
         if c <= 0.0 {
             return 0.0;
         }
-        let a0 = self.base_roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
-        let w = (a0 * a0 / (alpha * alpha).max(1e-12)).min(1.0);
-        let mean_normal = (t * self.mean.x + b * self.mean.y + n).normalize();
-        let ggx = ggx_d(mean_normal.dot(h).max(0.0), alpha);
-        if w >= 1.0 {
+        let ggx = ggx_d(self.mean_normal.dot(h).max(0.0), self.alpha);
+        if self.w >= 1.0 {
             return ggx;
         }
         let m = glam::Vec2::new(h.dot(t), h.dot(b)) / c - self.mean;
-        let lobe = 0.5 * a0 * a0;
-        let (sxx, syy) = (self.cov[0].max(0.0) + lobe, self.cov[1].max(0.0) + lobe);
-        // Keep the matrix positive definite whatever rounding did to the cross term.
-        let sxy = self.cov[2].clamp(-0.999 * (sxx * syy).sqrt(), 0.999 * (sxx * syy).sqrt());
-        let det = sxx * syy - sxy * sxy;
-        let q = (syy * m.x * m.x - 2.0 * sxy * m.x * m.y + sxx * m.y * m.y) / det;
-        let gauss = (-0.5 * q).exp() / (2.0 * std::f32::consts::PI * det.sqrt());
-        w * ggx + (1.0 - w) * gauss / (c * c * c * c)
+        let [sxx, syy, sxy] = self.sigma;
+        let q = (syy * m.x * m.x - 2.0 * sxy * m.x * m.y + sxx * m.y * m.y) / self.det;
+        let gauss = (-0.5 * q).exp() / self.gauss_norm;
+        self.w * ggx + (1.0 - self.w) * gauss / (c * c * c * c)
     }
 }
 
@@ -458,6 +505,8 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
     } else {
         Vec3::splat(0.04).lerp(surface.base, surface.metallic)
     };
+    // The spread's lobe does not depend on the light: once per pixel.
+    let lobe = surface.spread.as_ref().map(|s| s.lobe(alpha));
     let mut out = Vec3::ZERO;
     for light in lights {
         let (l, e) = match *light {
@@ -497,8 +546,8 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
         }
         let h = (l + v).normalize_or_zero();
         let fr = fresnel(f0, v.dot(h));
-        let d = match &surface.spread {
-            Some(spread) => spread.d(h, alpha),
+        let d = match &lobe {
+            Some(lobe) => lobe.d(h),
             None => ggx_d(n.dot(h).max(0.0), alpha),
         };
         let spec = fr * (d * smith_visibility(n_dot_l, n_dot_v, alpha));
@@ -588,13 +637,11 @@ pub fn lean_map(
     })
 }
 
-/// LEAN's tangent-space normal (unit) and widened roughness from the filtered moments
-/// `[b_x, b_y, b_x^2, b_y^2, b_x b_y]` ([`MomentMap`]), for a normal map scaled by `scale` and
-/// base `roughness`. See [`SpecularAa::Lean`].
-pub fn lean_normal_roughness(moments: [f32; 5], scale: f32, roughness: f32) -> (Vec3, f32) {
-    let (b, cov) = lean_mean_covariance(moments, scale);
+/// LEAN's tangent-space normal (unit) and widened roughness for base `roughness`, from the mean
+/// slope and slope covariance [`lean_mean_covariance`] gives. See [`SpecularAa::Lean`].
+pub fn lean_normal_roughness(mean: glam::Vec2, cov: [f32; 3], roughness: f32) -> (Vec3, f32) {
     (
-        b.extend(1.0).normalize(),
+        mean.extend(1.0).normalize(),
         slope_variance_roughness(roughness, cov[0], cov[1]),
     )
 }
@@ -608,15 +655,6 @@ pub fn lean_mean_covariance(moments: [f32; 5], scale: f32) -> (glam::Vec2, [f32;
     let var_x = (moments[2] * s2 - b.x * b.x).max(0.0);
     let var_y = (moments[3] * s2 - b.y * b.y).max(0.0);
     (b, [var_x, var_y, moments[4] * s2 - b.x * b.y])
-}
-
-/// The isotropic [`SlopeSpread`] about the unit shading `normal` that turns perceptual roughness
-/// `base` into `widened` (`alpha^2 = alpha_0^2 + 2 sigma^2`, so `sigma^2 = (alpha^2 -
-/// alpha_0^2) / 2` per axis): how Toksvig's widening is shaped.
-pub fn isotropic_spread(normal: Vec3, base: f32, widened: f32) -> SlopeSpread {
-    let a0 = base.clamp(MIN_ROUGHNESS, 1.0).powi(4);
-    let a1 = widened.clamp(MIN_ROUGHNESS, 1.0).powi(4);
-    SlopeSpread::isotropic(normal, 0.5 * (a1 - a0), base)
 }
 
 /// The perceptual roughness whose lobe also covers normals with slope variances `var_x` and
@@ -830,17 +868,21 @@ mod tests {
     #[test]
     fn lean_moments_give_the_mean_normal_and_the_slope_variance() {
         // One flat texel: the normal is z and nothing widens.
-        let flat = lean_normal_roughness([0.0; 5], 1.0, 0.3);
+        let lean = |m: [f32; 5], scale: f32, r: f32| {
+            let (mean, cov) = lean_mean_covariance(m, scale);
+            lean_normal_roughness(mean, cov, r)
+        };
+        let flat = lean([0.0; 5], 1.0, 0.3);
         assert!((flat.0 - Vec3::Z).length() < 1e-6 && (flat.1 - 0.3).abs() < 1e-6);
         // Two slopes (+0.5, 0) and (-0.5, 0) averaged: mean 0, variance 0.25 along x, 0 along y:
         // sigma^2 = 0.125, alpha'^2 = alpha^2 + 0.25.
-        let (n, r) = lean_normal_roughness([0.0, 0.0, 0.25, 0.0, 0.0], 1.0, 0.3);
+        let (n, r) = lean([0.0, 0.0, 0.25, 0.0, 0.0], 1.0, 0.3);
         assert!((n - Vec3::Z).length() < 1e-6);
         let want = (0.3f32.powi(4) + 0.25).sqrt().sqrt();
         assert!((r - want).abs() < 1e-6, "{r} vs {want}");
         // A constant slope (0.5, 0.25): the normal tilts, no variance. Scale 2 doubles the slope.
         let m = [0.5, 0.25, 0.25, 0.0625, 0.125];
-        let (n, r) = lean_normal_roughness(m, 2.0, 0.3);
+        let (n, r) = lean(m, 2.0, 0.3);
         assert!(
             (n - Vec3::new(1.0, 0.5, 1.0).normalize()).length() < 1e-6,
             "{n}"

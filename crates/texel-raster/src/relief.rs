@@ -149,8 +149,8 @@ pub(crate) fn shading_normal(
         let mut spread = None;
         let antialiased = match (aa, mapped.moments) {
             (SpecularAa::Lean, Some(moments)) => {
-                let (nt, r) = material::lean_normal_roughness(moments, 1.0, roughness);
                 let (mean, cov) = material::lean_mean_covariance(moments, 1.0);
+                let (nt, r) = material::lean_normal_roughness(mean, cov, roughness);
                 roughness = r;
                 spread = Some(SlopeSpread {
                     frame: [t, b, n],
@@ -170,7 +170,7 @@ pub(crate) fn shading_normal(
         };
         let normal = to_world(antialiased.unwrap_or(mapped.mean)).normalize_or(n);
         if antialiased.is_some() && spread.is_none() {
-            spread = Some(material::isotropic_spread(normal, base, roughness));
+            spread = Some(SlopeSpread::isotropic(normal, base, roughness));
         }
         return Shading {
             normal,
