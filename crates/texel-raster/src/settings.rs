@@ -87,6 +87,18 @@ impl ColorTarget {
         self != ColorTarget::Float
     }
 
+    /// Whether this target stores colour exactly as an 8-bit texture of `format` stores its
+    /// texels (`Srgb8` for `Rgba8Srgb`, `Unorm8` for `Rgba8Unorm`), so that a texel written
+    /// unchanged may be copied byte for byte: [`ColorTarget::encode`] inverts that format's
+    /// decoding for every code.
+    pub fn stores_like(self, format: texel_texture::Format) -> bool {
+        use texel_texture::Format;
+        matches!(
+            (self, format),
+            (ColorTarget::Srgb8, Format::Rgba8Srgb) | (ColorTarget::Unorm8, Format::Rgba8Unorm)
+        )
+    }
+
     /// One linear RGBA colour as this 8-bit target stores it ([`rgba_to_srgb8`] or
     /// [`rgba_to_unorm8`]); [`ColorTarget::Float`] encodes as [`ColorTarget::Srgb8`] (the display
     /// encoding).

@@ -136,6 +136,13 @@ impl<'a> DrawContext<'a> {
         })
     }
 
+    /// Whether an unlit fragment's colour is the texture sample unchanged: no material (no
+    /// factor, no layers) and every vertex colour opaque white ([`shade`] without lighting then
+    /// returns its `tex`).
+    pub fn unshaded(&self) -> bool {
+        !self.colored && self.material.is_none()
+    }
+
     /// The triangle's vertices.
     #[inline(always)]
     pub fn vertices(&self, t: &TriangleSetup) -> [&'a Vertex; 3] {

@@ -140,6 +140,28 @@ struct Context<'a> {
     capture: bool,
     /// The environment's camera rays, when it is the background of a colour view.
     background: Option<(Environment<'a>, ViewRays)>,
+    /// Per draw: its fragments are its texels' stored bytes in this frame's target (see
+    /// [`copies_texels`]).
+    copies: Vec<bool>,
+}
+
+/// Whether draw `dc`'s colour-view fragments may be written as the stored bytes of the texel
+/// each reads ([`texel_texture::Sampler::sample_batch_stored`]): the sampler reads one texel
+/// (nearest, no or nearest mipmaps), nothing changes the sample (no lights, no material, white
+/// vertex colours) and the target stores colour as the texture stores texels. The bytes are then
+/// those the target's encoder gives for the decoded sample (every code round-trips), so the image
+/// is unchanged and the decode, the shading and the encode are skipped.
+fn copies_texels(
+    settings: &RenderSettings,
+    lit: bool,
+    target: ColorTarget,
+    dc: &DrawContext,
+) -> bool {
+    settings.view == View::Color
+        && !lit
+        && dc.unshaded()
+        && dc.sampler.reads_one_texel()
+        && target.stores_like(dc.texture.format())
 }
 
 /// What the fragment stage needs besides the pixel: barycentrics and the footprint's inputs.
@@ -165,12 +187,19 @@ pub(crate) fn draw_frame(
     let bins = bin(setups.iter().flatten(), width, height, |t| t.bbox, |_, t| t);
     let counting = settings.counts_texels();
     let capture = settings.capture_footprints;
+    let draws: Vec<DrawContext> = draws.iter().map(DrawContext::new).collect();
+    let lighting = Lighting::of(settings, false);
+    let copies = draws
+        .iter()
+        .map(|dc| copies_texels(settings, lighting.is_some(), frame.target, dc))
+        .collect();
     let ctx = Context {
         settings,
-        draws: draws.iter().map(DrawContext::new).collect(),
-        lighting: Lighting::of(settings, false),
+        draws,
+        lighting,
         counting,
         capture,
+        copies,
         background: settings
             .environment
             .filter(|_| settings.view == View::Color)
@@ -365,6 +394,8 @@ struct Span {
     /// The sampler's input and output.
     fps: [Footprint; SPAN],
     texs: [[f32; 4]; SPAN],
+    /// The stored-bytes path's output ([`copies_texels`]).
+    bytes: [[u8; 4]; SPAN],
 }
 
 impl Span {
@@ -382,6 +413,7 @@ impl Span {
             ldy: [[0.0; SPAN]; 3],
             fps: [Footprint::default(); SPAN],
             texs: [[0.0; 4]; SPAN],
+            bytes: [[0; 4]; SPAN],
         })
     }
 
@@ -552,6 +584,34 @@ fn flush_span(
     let deriv = ctx.capture || dc.sampler.uses_derivatives() || dc.material.is_some();
     span.barycentrics(t, ctx.settings.perspective, deriv);
     span.footprints(dc, t, deriv);
+    if ctx.copies[t.draw as usize]
+        && dc
+            .sampler
+            .sample_batch_stored(dc.texture, &span.fps[..n], &mut span.bytes[..n])
+    {
+        let (color8, depth) = (&mut tile.color8, &mut tile.depth);
+        write_rows(span, &span.bytes, color8, depth, |&b| b);
+    } else {
+        shade_span(ctx, tile, t, dc, span);
+    }
+    if ctx.capture {
+        for k in 0..n {
+            tile.footprints[span.lj[k] as usize][span.li[k] as usize] = span.fps[k];
+        }
+    }
+    span.n = 0;
+}
+
+/// Sample, shade and write the span's fragments whose footprints are ready.
+#[inline(always)]
+fn shade_span(
+    ctx: &Context,
+    tile: &mut TileTarget,
+    t: &TriangleSetup,
+    dc: &DrawContext,
+    span: &mut Span,
+) {
+    let n = span.n;
     dc.sampler
         .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
     let verts = dc.vertices(t);
@@ -568,26 +628,22 @@ fn flush_span(
     // Fragments arrive row by row: look each row's buffers up once per run of equal rows, with
     // the target's format decided once per span.
     let (color8, depth) = (&mut tile.color8, &mut tile.depth);
+    let texs = &span.texs;
     match tile.target {
-        ColorTarget::Float => write_rows(span, &mut tile.color, depth, |c| c),
-        ColorTarget::Srgb8 => write_rows(span, color8, depth, rgba_to_srgb8),
-        ColorTarget::Unorm8 => write_rows(span, color8, depth, rgba_to_unorm8),
+        ColorTarget::Float => write_rows(span, texs, &mut tile.color, depth, |&c| c),
+        ColorTarget::Srgb8 => write_rows(span, texs, color8, depth, |&c| rgba_to_srgb8(c)),
+        ColorTarget::Unorm8 => write_rows(span, texs, color8, depth, |&c| rgba_to_unorm8(c)),
     }
-    if ctx.capture {
-        for k in 0..n {
-            tile.footprints[span.lj[k] as usize][span.li[k] as usize] = span.fps[k];
-        }
-    }
-    span.n = 0;
 }
 
-/// Write the span's shaded colours (`span.texs`, through `encode`) and depths into the tile's rows.
+/// Write the span's colours (`values`, through `encode`) and depths into the tile's rows.
 #[inline(always)]
-fn write_rows<C>(
+fn write_rows<V, C>(
     span: &Span,
+    values: &[V],
     color: &mut [&mut [C]],
     depth: &mut [&mut [f32]],
-    encode: impl Fn([f32; 4]) -> C,
+    encode: impl Fn(&V) -> C,
 ) {
     let n = span.n;
     let mut k = 0;
@@ -596,7 +652,7 @@ fn write_rows<C>(
         let (color, depth) = (&mut *color[lj], &mut *depth[lj]);
         while k < n && span.lj[k] as usize == lj {
             let li = span.li[k] as usize;
-            color[li] = encode(span.texs[k]);
+            color[li] = encode(&values[k]);
             depth[li] = span.z[k];
             k += 1;
         }

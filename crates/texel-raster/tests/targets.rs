@@ -111,3 +111,85 @@ fn drawing_on_top_of_an_eight_bit_frame_keeps_the_nearer_fragments() {
     let mut frame = Frame::new(&settings(w, h, ColorTarget::Srgb8));
     assert!(draw_into(&settings(w, h, ColorTarget::Float), &[grid], &mut frame).is_err());
 }
+
+/// Nearest samplers write unshaded texels into an 8-bit target of the texture's own format as
+/// stored bytes (`Sampler::sample_batch_stored`): the frame must still be the float frame's
+/// encoding, texel for texel and at the border, and the other pairings (the other format, vertex
+/// colours) must take the shading path to the same result.
+#[test]
+fn copied_texels_are_the_encoded_float_frame() {
+    use texel_texture::{
+        AddressMode, BorderColor, Format, Limits, MipmapFilterMode, SamplerDescriptor,
+    };
+    let (w, h) = (300, 170);
+    let noise = |format| {
+        Texture::from_fn(61, 47, format, &Limits::default(), |i, j| {
+            let k = (i * 7919 + j * 104_729) % 997;
+            [
+                (k % 97) as f32 / 96.0,
+                (k % 13) as f32 / 12.0,
+                (k % 251) as f32 / 250.0,
+                (k % 5) as f32 / 4.0,
+            ]
+        })
+        .unwrap()
+    };
+    let textures = [noise(Format::Rgba8Srgb), noise(Format::Rgba8Unorm)];
+    let samplers: Vec<Sampler> = [
+        (
+            MipmapFilterMode::None,
+            AddressMode::Repeat,
+            BorderColor::OpaqueWhite,
+        ),
+        (
+            MipmapFilterMode::Nearest,
+            AddressMode::MirrorRepeat,
+            BorderColor::OpaqueWhite,
+        ),
+        (
+            MipmapFilterMode::Nearest,
+            AddressMode::ClampToBorder,
+            BorderColor::Custom([0.3, 0.6, 0.9, 0.5]),
+        ),
+    ]
+    .into_iter()
+    .map(|(mipmap_filter, addr, border_color)| {
+        let d = SamplerDescriptor {
+            mipmap_filter,
+            border_color,
+            ..SamplerDescriptor::lab_mode(1)
+                .unwrap()
+                .with_address_mode(addr)
+        };
+        Sampler::new(d).unwrap()
+    })
+    .collect();
+    let (verts, tris, _) = screen_grid(w, h, 23, 11);
+    // The grid's uv reaches past [0, 1] so that the border and the wrapping are read.
+    let wide: Vec<Vertex> = verts
+        .iter()
+        .map(|v| Vertex::new(v.position, v.uv * 3.0 - 1.0))
+        .collect();
+    let mut tinted = wide.clone();
+    tinted[5].color = glam::Vec4::new(0.5, 1.0, 1.0, 1.0);
+    for tex in &textures {
+        let ground = Ground::with_texture(w, h, noise(tex.format()));
+        for s in &samplers {
+            assert!(s.reads_one_texel());
+            for target in [ColorTarget::Srgb8, ColorTarget::Unorm8] {
+                let draws = [
+                    ("ground", ground.draw(s)),
+                    ("grid", screen_draw(&wide, &tris, tex, s)),
+                    ("tinted grid", screen_draw(&tinted, &tris, tex, s)),
+                ];
+                for (name, draw) in draws {
+                    let label =
+                        format!("{:?} {:?} {target:?} {name}", tex.format(), s.descriptor());
+                    let float = render(&settings(w, h, ColorTarget::Float), &[draw]).unwrap();
+                    let eight = render(&settings(w, h, target), &[draw]).unwrap();
+                    assert_encoded(&float, &eight, target, &label);
+                }
+            }
+        }
+    }
+}

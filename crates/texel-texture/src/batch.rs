@@ -217,12 +217,20 @@ impl<const N: usize, T: Taps> Pass<N, T> {
 
 /// Filter `footprints` into `out` (same length) with `s`'s core kernel: `min_filter` Nearest or
 /// Linear (equal to `mag_filter`), any `mipmap_filter`, level 0 below [`MAX_SIDE`] per side
-/// (`Sampler::new` decides; see `Sampler::sample_batch`).
+/// (`Sampler::new` decides; see `Sampler::sample_batch`). Texels outside the level under
+/// `ClampToBorder` read `addr.border` (the sampler's own address, or for the stored-codes path
+/// its border colour as codes).
 #[inline(always)]
-pub(crate) fn run<P: Pyramid>(p: &P, s: &Sampler, footprints: &[Footprint], out: &mut [[f32; 4]]) {
+pub(crate) fn run<P: Pyramid>(
+    p: &P,
+    s: &Sampler,
+    addr: Address,
+    footprints: &[Footprint],
+    out: &mut [[f32; 4]],
+) {
     match s.descriptor().min_filter {
-        FilterMode::Nearest => run_with(p, Point, s, (footprints, out)),
-        _ => run_with(p, Bilinear, s, (footprints, out)),
+        FilterMode::Nearest => run_with(p, Point, s, addr, (footprints, out)),
+        _ => run_with(p, Bilinear, s, addr, (footprints, out)),
     }
 }
 
@@ -232,12 +240,13 @@ fn run_with<P: Pyramid, T: Taps>(
     p: &P,
     taps: T,
     s: &Sampler,
+    addr: Address,
     (footprints, out): (&[Footprint], &mut [[f32; 4]]),
 ) {
     if footprints.len() <= 16 {
-        run_in::<P, T, 16, 1>(p, taps, s, (footprints, out));
+        run_in::<P, T, 16, 1>(p, taps, s, addr, (footprints, out));
     } else {
-        run_in::<P, T, CHUNK, LEVELS>(p, taps, s, (footprints, out));
+        run_in::<P, T, CHUNK, LEVELS>(p, taps, s, addr, (footprints, out));
     }
 }
 
@@ -249,6 +258,7 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     p: &P,
     taps: T,
     s: &Sampler,
+    addr: Address,
     (footprints, out): (&[Footprint], &mut [[f32; 4]]),
 ) {
     // Level 0 is at most 2^22 per side (`MAX_SIDE`), so there are at most 23 levels.
@@ -272,8 +282,8 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
         }
     };
     let d = s.descriptor();
-    let mut first = Pass::<N, T>::new(taps, s.address());
-    let mut second = Pass::<N, T>::new(taps, s.address());
+    let mut first = Pass::<N, T>::new(taps, addr);
+    let mut second = Pass::<N, T>::new(taps, addr);
     let mut delta = [0.0f32; N];
     let mut chunk = Chunk::<N>::new();
     let last = levels - 1;

@@ -56,6 +56,30 @@ impl Decode for Table8 {
     }
 }
 
+/// 8-bit texels as their stored code values, `0.0..=255.0` per channel (exact in `f32`), with
+/// no transfer function: the stored-bytes path ([`crate::Sampler::sample_batch_stored`]) runs the
+/// same single-texel kernels on these and converts the results back to bytes, bit for bit the
+/// texels the decoding views read.
+#[derive(Clone, Copy)]
+pub(crate) struct Codes8;
+
+impl Decode for Codes8 {
+    type Texel = [u8; 4];
+    const BLACK: &'static [[u8; 4]] = &[[0; 4]];
+    #[inline(always)]
+    fn decode(&self, t: [u8; 4]) -> Vec4 {
+        Vec4::new(
+            f32::from(t[0]),
+            f32::from(t[1]),
+            f32::from(t[2]),
+            f32::from(t[3]),
+        )
+    }
+    fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
+        Table8::texels(storage)
+    }
+}
+
 /// Linear `f32` texels, read as they are.
 #[derive(Clone, Copy)]
 pub(crate) struct Float;
@@ -294,6 +318,16 @@ pub(crate) fn table8(format: Format) -> Table8 {
         },
         alpha: unorm8_table(),
     }
+}
+
+/// The pyramid of an 8-bit texture read as stored codes ([`Codes8`]); `None` for float storage.
+pub(crate) fn codes_of(tex: &Texture) -> Option<Stored<'_, Codes8>> {
+    Some(Stored {
+        tex,
+        levels: tex.levels(),
+        texels: Codes8::texels(tex.storage())?,
+        decode: Codes8,
+    })
 }
 
 pub(crate) fn pyramid_of(tex: &Texture) -> AnyPyramid<'_> {

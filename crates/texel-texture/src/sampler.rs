@@ -59,15 +59,16 @@ use crate::aniso::{anisotropic, filter_planned, plan_chunk, Plan};
 use crate::batch::{self, Chunk, Probes};
 use crate::bicubic::Cubic;
 use crate::bilinear::Bilinear;
+use crate::color::{rgba_to_srgb8, rgba_to_unorm8};
 use crate::error::TextureError;
 use crate::ewa::ewa;
-use crate::fetch::{with_pyramid, Counted, Fetch, Pyramid};
+use crate::fetch::{codes_of, with_pyramid, Counted, Fetch, Pyramid};
 pub use crate::footprint::UV_LIMIT;
 use crate::footprint::{finite_uv, lod_from_rho_squared, rho_squared, Footprint, Query};
 use crate::mip::{filter_level, mip_nearest, trilinear};
 use crate::ripmap::ripmap;
 use crate::sat::summed_area;
-use crate::texture::Texture;
+use crate::texture::{Format, Texture};
 
 /// Filter used within one mip level (WebGPU `GPUFilterMode`, plus cubic).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -367,6 +368,75 @@ impl Sampler {
         })
     }
 
+    /// Whether every sample reads exactly one texel (or the border colour) and returns it as it
+    /// is: nearest filtering (`min_filter == mag_filter == Nearest`) with no mipmaps or nearest
+    /// mipmaps. Such samples need no blending, so [`Sampler::sample_batch_stored`] can return the
+    /// stored bytes.
+    pub fn reads_one_texel(&self) -> bool {
+        self.batched
+            && self.desc.min_filter == FilterMode::Nearest
+            && self.desc.mipmap_filter != MipmapFilterMode::Linear
+    }
+
+    /// The stored bytes of the texel each footprint reads: for a sampler that
+    /// [reads one texel](Sampler::reads_one_texel) on an 8-bit texture, `out[k]` is the texel
+    /// whose decoding `sample(texture, footprints[k])` returns (the same query, level and texel,
+    /// bit for bit), or, where `ClampToBorder` reads outside the texture, the border colour
+    /// encoded in the texture's format (sRGB RGB and linear alpha for `Rgba8Srgb`, all linear
+    /// for `Rgba8Unorm`; [`crate::color::rgba_to_srgb8`], [`crate::color::rgba_to_unorm8`]).
+    ///
+    /// Encoding a sample in the texture's own format gives these bytes (the decode tables
+    /// round-trip every code), so a renderer writing an 8-bit target of that format may copy
+    /// them and skip the decode and the encode. Returns `false`, writing nothing, when the path
+    /// does not apply: another filter, float storage, or a level 0 wider or taller than the
+    /// staged kernels take.
+    ///
+    /// # Panics
+    /// If `footprints.len() != out.len()` (a programming error, not bad input).
+    pub fn sample_batch_stored(
+        &self,
+        texture: &Texture,
+        footprints: &[Footprint],
+        out: &mut [[u8; 4]],
+    ) -> bool {
+        assert_eq!(
+            footprints.len(),
+            out.len(),
+            "sample_batch_stored: footprints and out differ in length"
+        );
+        if !self.reads_one_texel() {
+            return false;
+        }
+        let Some(p) = codes_of(texture) else {
+            return false;
+        };
+        let (w, h) = p.level(0).size();
+        if w > batch::MAX_SIDE || h > batch::MAX_SIDE {
+            return false;
+        }
+        let border = match texture.format() {
+            Format::Rgba8Srgb => rgba_to_srgb8(self.addr.border.to_array()),
+            _ => rgba_to_unorm8(self.addr.border.to_array()),
+        };
+        let addr = Address {
+            border: Vec4::from_array(border.map(f32::from)),
+            ..self.addr
+        };
+        let mut codes = [[0.0f32; 4]; batch::CHUNK];
+        for (fps, out) in footprints
+            .chunks(batch::CHUNK)
+            .zip(out.chunks_mut(batch::CHUNK))
+        {
+            let codes = &mut codes[..fps.len()];
+            batch::run(&p, self, addr, fps, codes);
+            for (o, c) in out.iter_mut().zip(codes.iter()) {
+                // Codes are integers in 0..=255: the conversion is exact.
+                *o = c.map(|x| x as u8);
+            }
+        }
+        true
+    }
+
     /// Sample many footprints at once: `out[k] = sample(texture, footprints[k])`, bit for bit. The
     /// texture's format is dispatched once for the whole batch, and the lods of up to 64
     /// footprints are computed in one loop before any is filtered (independent iterations that
@@ -385,7 +455,7 @@ impl Sampler {
         with_pyramid!(texture, |p| {
             let size = p.level(0).size();
             if self.batched && size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE {
-                return batch::run(&p, self, footprints, out);
+                return batch::run(&p, self, self.addr, footprints, out);
             }
             // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
             // arithmetic vectorised), then all filters.

@@ -914,3 +914,66 @@ fn jpeg_completeness_walks_the_segments() {
     // Cut inside the headers, the decoder's own header parser refuses it first.
     assert!(Texture::decode(&jpeg[..30], ColorSpace::Srgb, &limits).is_err());
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// `sample_batch_stored` returns, for every single-texel sampler (nearest, with no or nearest
+    /// mipmaps) under every address mode and border colour, the bytes the texture's own format
+    /// encodes `sample` to, and for texels inside the texture a code whose decoding is `sample`
+    /// bit for bit. Other samplers and float textures are refused with nothing written.
+    #[test]
+    fn stored_bytes_are_the_encoded_samples(
+        fps in proptest::collection::vec(footprint_strategy(), 1..150),
+        (w, h) in prop_oneof![Just((64u32, 32u32)), Just((37, 5)), Just((1, 9))],
+    ) {
+        let borders = [
+            BorderColor::TransparentBlack,
+            BorderColor::OpaqueWhite,
+            BorderColor::Custom([0.3, 0.7, 0.05, 0.5]),
+            BorderColor::Custom([2.0, -1.0, f32::NAN, 0.25]),
+        ];
+        let mut out = vec![[7u8; 4]; fps.len()];
+        for format in [Format::Rgba8Srgb, Format::Rgba8Unorm, Format::Rgba32Float] {
+            let tex = noise_texture(w, h, format);
+            let table = match format {
+                Format::Rgba8Srgb => texel_texture::color::srgb_table(),
+                _ => texel_texture::color::unorm8_table(),
+            };
+            for border in borders {
+                for s in every_sampler(border) {
+                    let d = s.descriptor();
+                    let one = d.min_filter == FilterMode::Nearest
+                        && d.mag_filter == FilterMode::Nearest
+                        && d.mipmap_filter != MipmapFilterMode::Linear;
+                    prop_assert_eq!(s.reads_one_texel(), one);
+                    out.fill([7; 4]);
+                    let took = s.sample_batch_stored(&tex, &fps, &mut out);
+                    prop_assert_eq!(took, one && format != Format::Rgba32Float);
+                    if !took {
+                        prop_assert!(out.iter().all(|&o| o == [7; 4]));
+                        continue;
+                    }
+                    for (f, &o) in fps.iter().zip(&out) {
+                        let c = s.sample(&tex, f);
+                        let encoded = match format {
+                            Format::Rgba8Srgb => texel_texture::color::rgba_to_srgb8(c),
+                            _ => texel_texture::color::rgba_to_unorm8(c),
+                        };
+                        prop_assert_eq!(o, encoded, "{:?} {:?} {:?}", d, f, format);
+                        let decoded = [
+                            table[o[0] as usize],
+                            table[o[1] as usize],
+                            table[o[2] as usize],
+                            f32::from(o[3]) / 255.0,
+                        ];
+                        // Texels and the two borders that 8 bits represent exactly decode
+                        // back to the sample bit for bit (a custom border only encodes).
+                        if !matches!(border, BorderColor::Custom(_)) {
+                            prop_assert_eq!(decoded.map(f32::to_bits), c.map(f32::to_bits));
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
