@@ -14,6 +14,8 @@ Run from the repository root after `cargo build --release` and the peer set-up o
 texel runs with `--color raw` (texture bytes are linear, as a GPU samples a plain RGBA8 texture),
 which is what llvmpipe does with the scene's textures. llvmpipe's 16x anisotropic filter (an EWA
 port in Mesa 22.3) takes seconds per frame; `--llvmpipe-aniso` times one frame of it once.
+`--gpu-precision` also times texel's four core filters with `--precision gpu` (8-bit fixed-point
+weights, as llvmpipe blends) in every round and adds its columns.
 """
 
 import argparse
@@ -41,15 +43,21 @@ def main():
     ap.add_argument("--peer", default="../shared/peers/llvmpipe_bench.py")
     ap.add_argument("--llvmpipe-aniso", action="store_true",
                     help="also time one llvmpipe aniso16 frame (tens of seconds)")
+    ap.add_argument("--gpu-precision", action="store_true",
+                    help="also time texel's core filters with --precision gpu")
     a = ap.parse_args()
 
-    texel, peer = [], []
+    texel, peer, fixed = [], [], []
     renderer = "llvmpipe"
     for r in range(a.rounds):
         print(f"round {r + 1}/{a.rounds}", file=sys.stderr)
         texel.append(run_json([a.texel, "bench", a.scene, "--color", "raw", "--frames",
                                str(a.frames), "--threads", str(a.threads), "--filters",
                                ",".join(CORE + TEXEL_ONLY), "--json"])["median_ms"])
+        if a.gpu_precision:
+            fixed.append(run_json([a.texel, "bench", a.scene, "--color", "raw", "--frames",
+                                   str(a.frames), "--threads", str(a.threads), "--filters",
+                                   ",".join(CORE), "--precision", "gpu", "--json"])["median_ms"])
         p = run_json([sys.executable, a.peer, a.scene, "--frames", str(a.frames), "--threads",
                       str(a.threads), "--filters", ",".join(CORE)])
         renderer = f"{p.get('renderer', 'llvmpipe')}, {p.get('version', '')}"
@@ -61,20 +69,28 @@ def main():
 
     print(f"{renderer}; {a.rounds} alternating rounds, {a.frames} frames each, "
           f"{a.threads} threads; ms per frame (median of the rounds' medians)\n")
-    print("| filter | texel | llvmpipe | texel / llvmpipe (per round) |")
-    print("|---|--:|--:|--:|")
-    for f in CORE:
-        t = [x[f] for x in texel]
-        p = [x[f] for x in peer]
+    extra_head = " texel gpu precision | gpu precision / llvmpipe (per round) |" if fixed else ""
+    print(f"| filter | texel | llvmpipe | texel / llvmpipe (per round) |{extra_head}")
+    print("|---|--:|--:|--:|" + ("--:|--:|" if fixed else ""))
+
+    def ratio_cells(t, p):
         ratios = [x / y for x, y in zip(t, p)]
         per_round = ", ".join(f"{x:.2f}" for x in ratios)
-        print(f"| {f} | {statistics.median(t):.2f} | {statistics.median(p):.2f} | "
-              f"{statistics.median(ratios):.2f} ({per_round}) |")
+        return f"{statistics.median(t):.2f} | ", f"{statistics.median(ratios):.2f} ({per_round}) |"
+
+    for f in CORE:
+        p = [x[f] for x in peer]
+        t, r = ratio_cells([x[f] for x in texel], p)
+        extra = ""
+        if fixed:
+            g, gr = ratio_cells([x[f] for x in fixed], p)
+            extra = f" {g}{gr}"
+        print(f"| {f} | {t}{statistics.median(p):.2f} | {r}{extra}")
     for f in TEXEL_ONLY:
         t = statistics.median(x[f] for x in texel)
         other = f"{aniso_peer:.0f} (one frame)" if f == "aniso16" and aniso_peer else "-"
         ratio = f"{t / aniso_peer:.4f}" if f == "aniso16" and aniso_peer else "-"
-        print(f"| {f} | {t:.2f} | {other} | {ratio} |")
+        print(f"| {f} | {t:.2f} | {other} | {ratio} |" + (" | |" if fixed else ""))
     for f in TEXEL_ONLY:
         per_round = ", ".join(f"{x[f] / x['trilinear']:.1f}" for x in texel)
         print(f"\ntexel {f} / texel trilinear per round: {per_round}")

@@ -162,6 +162,31 @@ pub struct SceneArgs {
     /// get their uv: exactly at every pixel (the default), or at the vertices, interpolated.
     #[arg(long, value_enum, value_name = "AT")]
     pub surface_uv: Option<SurfaceUvArg>,
+    /// Filtering arithmetic for 8-bit unorm textures (`--color raw`) with nearest, bilinear,
+    /// mip-nearest or trilinear: exact f32, or as GPUs blend unorm8 texels (8-bit sub-texel and
+    /// mip weights, each blend rounded to 8 bits; faster, within about a code of exact). sRGB
+    /// textures, the other filters and the reference stay exact.
+    #[arg(long, value_enum, default_value_t)]
+    pub precision: PrecisionArg,
+}
+
+/// The filtering arithmetic (see texel-raster's `Precision`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum PrecisionArg {
+    /// f32 throughout.
+    #[default]
+    Exact,
+    /// 8-bit weights and 8-bit results per blend, as GPUs filter unorm8 textures.
+    Gpu,
+}
+
+impl From<PrecisionArg> for texel::raster::Precision {
+    fn from(a: PrecisionArg) -> Self {
+        match a {
+            PrecisionArg::Exact => texel::raster::Precision::Exact,
+            PrecisionArg::Gpu => texel::raster::Precision::Gpu,
+        }
+    }
 }
 
 /// Where a sphere mapping is evaluated (see texel-raster's `UvMapping`).

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
-use crate::cli::{BenchArgs, SimdArg, TargetArg};
+use crate::cli::{BenchArgs, PrecisionArg, SimdArg, TargetArg};
 use crate::filters::parse_list;
 use crate::input::{load_scene, Input};
 use crate::threads::{thread_count, with_threads};
@@ -202,10 +202,11 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         };
         writeln!(
             stdout,
-            "{{\n \"renderer\": \"{renderer}\",\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
+            "{{\n \"renderer\": \"{renderer}\",\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
             serde_json::Value::from(cpu_model()),
             simd_level(),
             target_name(args.target),
+            precision_name(args.scene.precision),
             scene.width,
             scene.height,
             args.frames,
@@ -224,7 +225,13 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
             args.frames,
             args.warmup
         )?;
-        writeln!(stdout, "cpu: {}; simd: {}", cpu_model(), simd_level())?;
+        writeln!(
+            stdout,
+            "cpu: {}; simd: {}; precision: {}",
+            cpu_model(),
+            simd_level(),
+            precision_name(args.scene.precision)
+        )?;
         writeln!(
             stdout,
             "{:<12} {:>10} {:>10} {:>10} {:>10}",
@@ -270,6 +277,14 @@ fn cpu_model() -> String {
 /// `texel_raster::simd_level`).
 fn simd_level() -> String {
     format!("{}, run-time dispatch", texel_raster::simd_level().name())
+}
+
+/// `--precision`'s value as the bench prints it.
+fn precision_name(p: PrecisionArg) -> &'static str {
+    match p {
+        PrecisionArg::Exact => "exact",
+        PrecisionArg::Gpu => "gpu",
+    }
 }
 
 #[cfg(test)]

@@ -115,6 +115,8 @@ pub struct MaterialOverrides {
     pub environment_mapping: Option<texel_scene::Mapping>,
     /// `--surface-uv`.
     pub surface_uv: Option<texel::raster::UvEvaluation>,
+    /// `--precision`.
+    pub precision: texel::raster::Precision,
 }
 
 impl MaterialOverrides {
@@ -127,6 +129,7 @@ impl MaterialOverrides {
             layer_order: args.layer_order.map(Into::into),
             environment_mapping: args.environment_mapping.map(Into::into),
             surface_uv: args.surface_uv.map(Into::into),
+            precision: args.precision.into(),
         }
     }
 }
@@ -164,6 +167,7 @@ pub fn load_scene_with(
         layer_order: overrides.layer_order,
         environment_mapping: overrides.environment_mapping,
         surface_uv: overrides.surface_uv.unwrap_or_default(),
+        precision: overrides.precision,
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;

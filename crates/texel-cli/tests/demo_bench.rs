@@ -98,6 +98,7 @@ fn bench_json_has_the_llvmpipe_shape() {
             "frames",
             "height",
             "median_ms",
+            "precision",
             "renderer",
             "simd",
             "target",
@@ -107,6 +108,7 @@ fn bench_json_has_the_llvmpipe_shape() {
     );
     assert_eq!(v["renderer"], "texel");
     assert_eq!(v["target"], "rgba8");
+    assert_eq!(v["precision"], "exact");
     assert!(v["cpu"].as_str().is_some_and(|c| !c.is_empty()));
     assert!(v["simd"]
         .as_str()

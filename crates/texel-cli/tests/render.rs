@@ -173,3 +173,38 @@ fn shipped_ground_scene_renders_like_the_builtin() {
         "{bottom:?}"
     );
 }
+
+/// `--precision gpu` filters unorm8 textures (`--color raw`) in fixed point: within 3 codes of
+/// exact and not identical to it on the textured ground; sRGB textures (the default colour
+/// handling) keep the exact path, byte for byte; a bad value is refused.
+#[test]
+fn precision_gpu_changes_raw_frames_by_at_most_three_codes() {
+    let d = Dir::new("render-precision");
+    for filter in ["bilinear", "trilinear"] {
+        let render = |color: &str, precision: &str| {
+            let out = d.arg(&format!("{filter}-{color}-{precision}.png"));
+            let args = ["render", "--size", "160x90", "--filter", filter];
+            let more = ["--color", color, "--precision", precision, "-o", &out];
+            ok(&[&args[..], &more[..]].concat());
+            load(&out)
+        };
+        let (exact, gpu) = (render("raw", "exact"), render("raw", "gpu"));
+        let diffs: Vec<u8> = exact
+            .pixels()
+            .iter()
+            .zip(gpu.pixels())
+            .flat_map(|(a, b)| (0..4).map(move |c| a[c].abs_diff(b[c])))
+            .collect();
+        let max = diffs.iter().copied().max().unwrap();
+        assert!(max <= 3, "{filter}: {max} codes from exact");
+        assert!(
+            diffs.iter().any(|&x| x > 0),
+            "{filter}: gpu precision changed nothing"
+        );
+        assert!(
+            render("srgb", "exact") == render("srgb", "gpu"),
+            "{filter}: sRGB changed"
+        );
+    }
+    fails(&["render", "--precision", "half"], 2, &["half"]);
+}

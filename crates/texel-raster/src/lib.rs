@@ -70,7 +70,8 @@ pub use material::{
 };
 pub use reference::{render_reference, render_reference_strata};
 pub use settings::{
-    ColorTarget, Derivatives, Perspective, RenderSettings, View, MAX_DIMENSION, MAX_PIXELS,
+    ColorTarget, Derivatives, Perspective, Precision, RenderSettings, View, MAX_DIMENSION,
+    MAX_PIXELS,
 };
 
 /// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].

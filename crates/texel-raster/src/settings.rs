@@ -61,6 +61,19 @@ pub enum View {
     Barycentric,
 }
 
+/// How the colour view filters textures stored as 8-bit unorm (`Rgba8Unorm`) with the core
+/// filters (nearest or bilinear within a level, any mipmap filter).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Precision {
+    /// `f32` throughout: texels decoded to floats, exact weights, one encode at the end.
+    #[default]
+    Exact,
+    /// As GPUs filter unorm8 texels: 8-bit sub-texel and mip weights and a rounding to 8 bits
+    /// per blend ([`texel_texture::fixed8`]; the CLI's `--precision gpu`). Other textures, other
+    /// filters and the reference keep [`Precision::Exact`].
+    Gpu,
+}
+
 /// The colour render target's format: what [`crate::Frame`] stores per pixel, as a GPU's colour
 /// attachment format. Fragments are encoded as they are written, so an 8-bit target's bytes are
 /// exactly what [`crate::Frame::to_srgb8`] or [`crate::Frame::to_raw8`] make of a
@@ -166,6 +179,8 @@ pub struct RenderSettings<'a> {
     /// into the 8-bit target its output encodes to). The reference renderer always renders into
     /// a float target.
     pub target: ColorTarget,
+    /// The filtering arithmetic for unorm8 textures ([`Precision::Exact`] by default).
+    pub precision: Precision,
     /// The environment map ([`crate::environment`]): light from every direction for lit
     /// frames (it makes a frame lit on its own), reflected by materials, and the background
     /// where [`Environment::background`] says so. `None` by default.
@@ -191,6 +206,7 @@ impl RenderSettings<'_> {
             capture_footprints: false,
             scissor: None,
             target: ColorTarget::Float,
+            precision: Precision::Exact,
             environment: None,
         }
     }

@@ -38,7 +38,7 @@
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8};
+use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8, unorm8_table};
 use texel_texture::Footprint;
 
 use crate::dispatch::Kernel;
@@ -46,7 +46,7 @@ use crate::draw::DrawCall;
 use crate::environment::{Environment, ViewRays};
 use crate::frame::Frame;
 use crate::interp::{self, quad_differences};
-use crate::settings::{ColorTarget, Derivatives, Perspective, RenderSettings, View};
+use crate::settings::{ColorTarget, Derivatives, Perspective, Precision, RenderSettings, View};
 use crate::setup::{pixel_center_fixed, setup_chunks, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
 use crate::views;
@@ -140,9 +140,36 @@ struct Context<'a> {
     capture: bool,
     /// The environment's camera rays, when it is the background of a colour view.
     background: Option<(Environment<'a>, ViewRays)>,
-    /// Per draw: its fragments are its texels' stored bytes in this frame's target (see
-    /// [`copies_texels`]).
-    copies: Vec<bool>,
+    /// Per draw: how its colour-view fragments are sampled ([`Route::of`]).
+    routes: Vec<Route>,
+}
+
+/// How a draw's colour-view fragments get their texture colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Route {
+    /// [`texel_texture::Sampler::sample_batch`], `f32`, then shaded and encoded.
+    Float,
+    /// The stored bytes of the texel each reads, written as they are ([`copies_texels`]).
+    Stored,
+    /// [`texel_texture::Sampler::sample_batch_fixed8`] under [`Precision::Gpu`]: written as
+    /// they are (`copy`: unshaded, into a unorm8 target), else decoded (`b / 255`) and shaded.
+    Fixed8 { copy: bool },
+}
+
+impl Route {
+    /// Draw `dc`'s route in a frame of `settings` (lit or not) with colour target `target`.
+    fn of(settings: &RenderSettings, lit: bool, target: ColorTarget, dc: &DrawContext) -> Route {
+        let unshaded = settings.view == View::Color && !lit && dc.unshaded();
+        if copies_texels(settings, lit, target, dc) {
+            Route::Stored
+        } else if settings.precision == Precision::Gpu && dc.sampler.filters_fixed8(dc.texture) {
+            Route::Fixed8 {
+                copy: unshaded && target == ColorTarget::Unorm8,
+            }
+        } else {
+            Route::Float
+        }
+    }
 }
 
 /// Whether draw `dc`'s colour-view fragments may be written as the stored bytes of the texel
@@ -189,9 +216,9 @@ pub(crate) fn draw_frame(
     let capture = settings.capture_footprints;
     let draws: Vec<DrawContext> = draws.iter().map(DrawContext::new).collect();
     let lighting = Lighting::of(settings, false);
-    let copies = draws
+    let routes = draws
         .iter()
-        .map(|dc| copies_texels(settings, lighting.is_some(), frame.target, dc))
+        .map(|dc| Route::of(settings, lighting.is_some(), frame.target, dc))
         .collect();
     let ctx = Context {
         settings,
@@ -199,7 +226,7 @@ pub(crate) fn draw_frame(
         lighting,
         counting,
         capture,
-        copies,
+        routes,
         background: settings
             .environment
             .filter(|_| settings.view == View::Color)
@@ -584,15 +611,24 @@ fn flush_span(
     let deriv = ctx.capture || dc.sampler.uses_derivatives() || dc.material.is_some();
     span.barycentrics(t, ctx.settings.perspective, deriv);
     span.footprints(dc, t, deriv);
-    if ctx.copies[t.draw as usize]
-        && dc
-            .sampler
-            .sample_batch_stored(dc.texture, &span.fps[..n], &mut span.bytes[..n])
-    {
-        let (color8, depth) = (&mut tile.color8, &mut tile.depth);
-        write_rows(span, &span.bytes, color8, depth, |&b| b);
-    } else {
-        shade_span(ctx, tile, t, dc, span);
+    let (fps, bytes) = (&span.fps[..n], &mut span.bytes[..n]);
+    match ctx.routes[t.draw as usize] {
+        Route::Stored if dc.sampler.sample_batch_stored(dc.texture, fps, bytes) => {
+            let (color8, depth) = (&mut tile.color8, &mut tile.depth);
+            write_rows(span, &span.bytes, color8, depth, |&b| b);
+        }
+        Route::Fixed8 { copy } if dc.sampler.sample_batch_fixed8(dc.texture, fps, bytes) => {
+            if copy {
+                let (color8, depth) = (&mut tile.color8, &mut tile.depth);
+                write_rows(span, &span.bytes, color8, depth, |&b| b);
+            } else {
+                for (t, b) in span.texs[..n].iter_mut().zip(&span.bytes[..n]) {
+                    *t = decode_unorm8(*b);
+                }
+                shade_span(ctx, tile, t, dc, span, false);
+            }
+        }
+        _ => shade_span(ctx, tile, t, dc, span, true),
     }
     if ctx.capture {
         for k in 0..n {
@@ -602,7 +638,8 @@ fn flush_span(
     span.n = 0;
 }
 
-/// Sample, shade and write the span's fragments whose footprints are ready.
+/// Sample (when `sample`; else `span.texs` holds the samples), shade and write the span's
+/// fragments whose footprints are ready.
 #[inline(always)]
 fn shade_span(
     ctx: &Context,
@@ -610,10 +647,13 @@ fn shade_span(
     t: &TriangleSetup,
     dc: &DrawContext,
     span: &mut Span,
+    sample: bool,
 ) {
     let n = span.n;
-    dc.sampler
-        .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
+    if sample {
+        dc.sampler
+            .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
+    }
     let verts = dc.vertices(t);
     for k in 0..n {
         let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
@@ -634,6 +674,13 @@ fn shade_span(
         ColorTarget::Srgb8 => write_rows(span, texs, color8, depth, |&c| rgba_to_srgb8(c)),
         ColorTarget::Unorm8 => write_rows(span, texs, color8, depth, |&c| rgba_to_unorm8(c)),
     }
+}
+
+/// A unorm8 colour as linear RGBA, `b / 255` (the texture decoding of `Rgba8Unorm`).
+#[inline(always)]
+fn decode_unorm8(b: [u8; 4]) -> [f32; 4] {
+    let table = unorm8_table();
+    b.map(|c| table[c as usize])
 }
 
 /// Write the span's colours (`values`, through `encode`) and depths into the tile's rows.
@@ -742,13 +789,20 @@ fn write_fragment(
     f: &Fragment,
 ) {
     let fp = dc.footprint(f.uv, f.duv_dx, f.duv_dy);
-    let (tex, count) = if ctx.counting {
+    let (mut tex, count) = if ctx.counting {
         dc.sampler.sample_counted(dc.texture, &fp)
     } else if ctx.settings.view == View::Color {
         (dc.sampler.sample(dc.texture, &fp), 0)
     } else {
         ([0.0; 4], 0)
     };
+    if let Route::Fixed8 { .. } = ctx.routes[t.draw as usize] {
+        // The same texels (so the same count), blended in fixed point.
+        let mut b = [[0u8; 4]];
+        if dc.sampler.sample_batch_fixed8(dc.texture, &[fp], &mut b) {
+            tex = decode_unorm8(b[0]);
+        }
+    }
     let lit = ctx.lighting.as_ref();
     // The texels a material's maps read count too (in every view, so the fetches view agrees
     // with the counts of the colour view).

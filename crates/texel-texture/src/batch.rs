@@ -33,6 +33,7 @@ use glam::{Vec2, Vec4};
 use crate::address::Address;
 use crate::bilinear::{lerp, Bilinear};
 use crate::fetch::{Fetch, Pyramid};
+use crate::fixed8::{Bilinear8, Point8};
 use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
 use crate::footprint::{
     finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, Query,
@@ -153,6 +154,12 @@ pub(crate) trait Taps: LevelFilter {
     const REACH: f32;
     /// The value of a sample whose taps lie inside `level`: first tap `(i, j)`, fractions `ab`.
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, ab: (f32, f32)) -> Vec4;
+    /// The blend of two levels' values with weight `t` on `b` ([`lerp`]; the fixed-point
+    /// filters of [`crate::fixed8`] round it).
+    #[inline(always)]
+    fn mix(a: Vec4, b: Vec4, t: f32) -> Vec4 {
+        lerp(a, b, t)
+    }
 }
 
 /// One level pass over a chunk with the within-level filter `T`, under the address modes `addr`:
@@ -231,6 +238,21 @@ pub(crate) fn run<P: Pyramid>(
     match s.descriptor().min_filter {
         FilterMode::Nearest => run_with(p, Point, s, addr, (footprints, out)),
         _ => run_with(p, Bilinear, s, addr, (footprints, out)),
+    }
+}
+
+/// [`run`] with [`crate::fixed8`]'s fixed-point filters, on a pyramid of stored codes.
+#[inline(always)]
+pub(crate) fn run_fixed8<P: Pyramid>(
+    p: &P,
+    s: &Sampler,
+    addr: Address,
+    footprints: &[Footprint],
+    out: &mut [[f32; 4]],
+) {
+    match s.descriptor().min_filter {
+        FilterMode::Nearest => run_with(p, Point8, s, addr, (footprints, out)),
+        _ => run_with(p, Bilinear8, s, addr, (footprints, out)),
     }
 }
 
@@ -323,7 +345,7 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             let a = first.filtered(&view(first.level[k]), k, uv);
             // As `mip::trilinear`: the coarser level only when it is weighed.
             out[k] = if trilinear && delta[k] > 0.0 && (first.level[k] as usize) < last {
-                lerp(a, second.filtered(&view(second.level[k]), k, uv), delta[k])
+                T::mix(a, second.filtered(&view(second.level[k]), k, uv), delta[k])
             } else {
                 a
             }

@@ -65,6 +65,15 @@ pub(crate) fn texel_or_border<F: Fetch>(
 /// Bilinear sample of `level` at normalised `uv` (finite).
 #[inline(always)]
 pub(crate) fn bilinear<F: Fetch>(level: &F, addr: &Address, uv: Vec2) -> Vec4 {
+    let (quad, a, b) = taps(level, addr, uv);
+    blend(quad, a, b)
+}
+
+/// The four texels (or border colours) a bilinear sample of `level` at normalised `uv` (finite)
+/// reads, in [`Fetch::quad`]'s order, and its fractions `(a, b)`: [`bilinear`] before the blend
+/// (also [`crate::fixed8`]'s).
+#[inline(always)]
+pub(crate) fn taps<F: Fetch>(level: &F, addr: &Address, uv: Vec2) -> ([Vec4; 4], f32, f32) {
     let (w, h) = level.size();
     let x = origin(uv.x, w as f32);
     let y = origin(uv.y, h as f32);
@@ -84,7 +93,7 @@ pub(crate) fn bilinear<F: Fetch>(level: &F, addr: &Address, uv: Vec2) -> Vec4 {
             texel_or_border(level, addr, i[1], j[1]),
         ]
     };
-    blend(quad, a, b)
+    (quad, a, b)
 }
 
 /// Bilinear as a type: the one-sample filter ([`LevelFilter`]) and its staged form for the batched

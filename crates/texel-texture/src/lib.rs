@@ -39,6 +39,7 @@ pub mod color;
 mod error;
 pub mod ewa;
 mod fetch;
+pub mod fixed8;
 pub mod floor;
 pub mod footprint;
 pub mod input;

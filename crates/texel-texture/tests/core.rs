@@ -977,3 +977,49 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// `sample_batch_fixed8` (GPU-style 8-bit weights, one rounding per blend) stays within a
+    /// stated distance of the exact sample's unorm8 encoding: nearest without mip blending is
+    /// exact, one bilinear level at most 2 codes (each weight's quantisation moves the value by
+    /// at most half a code, the rounding by another half, the exact path's encoding by half),
+    /// a mip blend of two levels at most 3. It applies to the core filters on `Rgba8Unorm` only.
+    #[test]
+    fn fixed8_is_within_its_bound_of_exact(
+        fps in proptest::collection::vec(footprint_strategy(), 1..150),
+        (w, h) in prop_oneof![Just((64u32, 32u32)), Just((37, 5)), Just((1, 9))],
+    ) {
+        let mut out = vec![[7u8; 4]; fps.len()];
+        for format in [Format::Rgba8Srgb, Format::Rgba8Unorm, Format::Rgba32Float] {
+            let tex = noise_texture(w, h, format);
+            for border in [BorderColor::OpaqueWhite, BorderColor::Custom([0.3, 0.7, 0.05, 0.5])] {
+                for s in every_sampler(border) {
+                    let d = *s.descriptor();
+                    let core = matches!(d.min_filter, FilterMode::Nearest | FilterMode::Linear);
+                    let applies = core && format == Format::Rgba8Unorm;
+                    prop_assert_eq!(s.filters_fixed8(&tex), applies);
+                    out.fill([7; 4]);
+                    prop_assert_eq!(s.sample_batch_fixed8(&tex, &fps, &mut out), applies);
+                    if !applies {
+                        prop_assert!(out.iter().all(|&o| o == [7; 4]));
+                        continue;
+                    }
+                    let bound = match (d.min_filter, d.mipmap_filter) {
+                        (FilterMode::Nearest, MipmapFilterMode::Linear) => 1,
+                        (FilterMode::Nearest, _) => 0,
+                        (_, MipmapFilterMode::Linear) => 3,
+                        _ => 2,
+                    };
+                    for (f, o) in fps.iter().zip(&out) {
+                        let exact = texel_texture::color::rgba_to_unorm8(s.sample(&tex, f));
+                        for c in 0..4 {
+                            let diff = (i32::from(o[c]) - i32::from(exact[c])).abs();
+                            prop_assert!(diff <= bound, "{:?} {:?}: {:?} vs {:?}", d, f, o, exact);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

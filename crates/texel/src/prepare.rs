@@ -9,8 +9,8 @@ use texel_raster::environment::{self, Environment, EnvironmentMaps};
 use texel_raster::layers::{Layer, LayerBlend, Layers, MAX_LAYERS};
 use texel_raster::material::MomentMap;
 use texel_raster::{
-    ChannelInput, ColorTarget, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
-    TextureInput, UvEvaluation, UvMapping, Vertex,
+    ChannelInput, ColorTarget, Displacement, DrawCall, Light, Material, Precision, RenderSettings,
+    SpecularAa, TextureInput, UvEvaluation, UvMapping, Vertex,
 };
 use texel_scene::{
     ColorInput, LayerBlendSpec, LayerOrder, LightSpec, MaterialSpec, ScalarInput, Scene,
@@ -62,6 +62,9 @@ pub struct SceneOptions {
     /// Where meshes with a sphere mapping (`sphere_uv`) get their uv: exactly per pixel (the
     /// default) or interpolated from the vertices (the CLI's `--surface-uv`).
     pub surface_uv: UvEvaluation,
+    /// The filtering arithmetic for unorm8 textures in [`PreparedScene::settings`] (the CLI's
+    /// `--precision`; the reference ignores it).
+    pub precision: Precision,
 }
 
 /// `spec` with its procedural sky laid out in `mapping` at about the same texel angle: an
@@ -122,6 +125,8 @@ pub struct PreparedScene {
     pub replaced: Vec<(String, u64)>,
     /// The (texture, structure) pairs [`PreparedScene::build_structures_within`] has charged.
     charged: Mutex<BTreeSet<(String, &'static str)>>,
+    /// [`SceneOptions::precision`].
+    pub precision: Precision,
     /// [`SceneOptions::specular_aa`].
     specular_aa: Option<SpecularAa>,
     /// [`SceneOptions::displacement`].
@@ -391,6 +396,7 @@ impl PreparedScene {
             color: options.color,
             replaced,
             charged: Mutex::new(BTreeSet::new()),
+            precision: options.precision,
             specular_aa: options.specular_aa,
             displacement: options.displacement,
             lean_maps,
@@ -789,7 +795,8 @@ impl PreparedScene {
     }
 
     /// Render settings for this scene's size, background (decoded as the colour handling says),
-    /// lights and colour target: the 8-bit target the colour handling encodes to
+    /// lights, precision ([`SceneOptions::precision`]) and colour target: the 8-bit target the
+    /// colour handling encodes to
     /// ([`ColorTarget::Srgb8`] for [`ColorHandling::Srgb`], [`ColorTarget::Unorm8`] for
     /// [`ColorHandling::Raw`]), so a frame holds the bytes a PNG of it holds. Set
     /// `target = ColorTarget::Float` for linear floats (accumulating, comparing before
@@ -800,6 +807,7 @@ impl PreparedScene {
             ColorHandling::Srgb => ColorTarget::Srgb8,
             ColorHandling::Raw => ColorTarget::Unorm8,
         };
+        s.precision = self.precision;
         for (slot, light) in s.lights.iter_mut().zip(&self.scene.lights) {
             *slot = Some(match *light {
                 LightSpec::Directional {

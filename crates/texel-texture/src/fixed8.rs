@@ -1,0 +1,242 @@
+//! GPU-style fixed-point filtering of 8-bit unorm textures (the CLI's `--precision gpu`).
+//!
+//! texel filters in `f32` by default: every texel decoded to a float, weights and blends in
+//! single precision, the result encoded once at the end. Hardware samplers (and llvmpipe, which
+//! blends unorm8 texels in 16-bit lanes) work on the stored 8-bit codes with weights of a few
+//! bits: Vulkan exposes them as `subTexelPrecisionBits` (at least 4; 8 on current desktop GPUs)
+//! and `mipmapPrecisionBits` (at least 4). This module defines texel's version, with 8 bits for
+//! both and round-to-nearest wherever a result is narrowed:
+//!
+//! - **sub-texel weight**: a fraction `a` in `[0, 1)` becomes `A = round(256 a)` in `0..=256`
+//!   ([`weight8`]);
+//! - **bilinear**: `S = sum A_i B_j T_ij` over the four codes with weights `256 - A, A` and
+//!   `256 - B, B` (an integer at most `255 * 2^16`), narrowed to `round(S / 2^16)`
+//!   ([`bilinear8`]): the quad's exact weighted mean under the 8-bit weights, rounded once;
+//! - **mip blend**: `D = round(256 delta)`, `round((a (256 - D) + b D) / 256)` ([`mix8`]).
+//!
+//! Every rounding is to the nearest integer with halves to even (IEEE's default, so it costs an
+//! addition and a subtraction; hardware documents only its precision, not its tie rule).
+//!
+//! Level selection (the lod) is the `f32` path's, so both read the same texels. Every value is an
+//! integer below `2^24`, so `f32` holds it exactly: the kernels run in the `f32` lanes the other
+//! filters use, on codes as floats (`0.0..=255.0`), and equal the integer definitions bit for bit
+//! (tested against them).
+//!
+//! Only unorm textures: an sRGB texture must be decoded to linear before it is filtered
+//! (Vulkan spec, "Texel Filtering"), so hardware decodes sRGB texels to more than 8 bits first,
+//! and texel keeps its `f32` path for them. Against the `f32` path a fixed-point sample differs
+//! by the weights' quantisation (at most `255 / 512` of a code per weight), plus the one
+//! rounding per stage; the images' differences are measured in README.md.
+
+use glam::{Vec2, Vec4};
+
+use crate::address::Address;
+use crate::batch::Taps;
+use crate::bilinear;
+use crate::fetch::Fetch;
+use crate::mip::LevelFilter;
+use crate::nearest;
+
+/// `round(x)` with halves to even, for `0 <= x < 2^22`: adding and subtracting `2^23` leaves
+/// no fraction bits, so the addition rounds (IEEE round-to-nearest-even). Branch-free and
+/// without conversions, so it runs in vector lanes.
+#[inline(always)]
+fn round_even(x: f32) -> f32 {
+    const MAGIC: f32 = 8_388_608.0; // 2^23
+    (x + MAGIC) - MAGIC
+}
+
+/// [`round_even`] per lane.
+#[inline(always)]
+fn round_even4(x: Vec4) -> Vec4 {
+    const MAGIC: Vec4 = Vec4::splat(8_388_608.0);
+    (x + MAGIC) - MAGIC
+}
+
+/// The 8-bit weight of a fraction `a` in `[0, 1]`: `round(256 a)` (halves to even), in
+/// `0..=256`. A fraction outside `[0, 1]` is clamped first; NaN gives 0.
+#[inline(always)]
+pub fn weight8(a: f32) -> f32 {
+    // `max` returns the non-NaN operand, so NaN becomes 0 (`clamp` would keep NaN).
+    #[allow(clippy::manual_clamp)]
+    let a = a.max(0.0).min(1.0);
+    round_even(a * 256.0)
+}
+
+/// The fixed-point bilinear blend of four codes `[T00, T10, T01, T11]` (each `0.0..=255.0`, one
+/// vector per texel, per channel) with fractions `a` (along x) and `b` (along y): the quad's
+/// mean under the 8-bit weights [`weight8`], rounded to the nearest code (halves to even).
+#[inline(always)]
+pub fn bilinear8([t00, t10, t01, t11]: [Vec4; 4], a: f32, b: f32) -> Vec4 {
+    let (wa, wb) = (weight8(a), weight8(b));
+    let (ia, ib) = (256.0 - wa, 256.0 - wb);
+    // Rows: at most 255 * 256; the sum: at most 255 * 2^16 < 2^24; all exact, and the scaling
+    // by 2^-16 is exact.
+    let r0 = t00 * ia + t10 * wa;
+    let r1 = t01 * ia + t11 * wa;
+    round_even4((r0 * ib + r1 * wb) * (1.0 / 65536.0))
+}
+
+/// The fixed-point blend of two codes `a` and `b` (per channel, `0.0..=255.0`) with weight
+/// `delta` on `b`: `D = weight8(delta)`, `round((a (256 - D) + b D) / 256)` (halves to even).
+#[inline(always)]
+pub fn mix8(a: Vec4, b: Vec4, delta: f32) -> Vec4 {
+    let d = weight8(delta);
+    round_even4((a * (256.0 - d) + b * d) * (1.0 / 256.0))
+}
+
+/// Nearest on codes with [`mix8`] between levels (a nearest sample itself has no arithmetic).
+#[derive(Clone, Copy)]
+pub(crate) struct Point8;
+
+impl LevelFilter for Point8 {
+    #[inline(always)]
+    fn filter<F: Fetch>(self, level: &F, addr: &Address, uv: Vec2) -> Vec4 {
+        nearest::nearest(level, addr, uv)
+    }
+}
+
+impl Taps for Point8 {
+    const HALF: f32 = nearest::HALF;
+    const REACH: f32 = 0.0;
+    #[inline(always)]
+    fn inside<F: Fetch>(level: &F, i: u32, j: u32, _: (f32, f32)) -> Vec4 {
+        level.texel(i, j)
+    }
+    #[inline(always)]
+    fn mix(a: Vec4, b: Vec4, t: f32) -> Vec4 {
+        mix8(a, b, t)
+    }
+}
+
+/// Bilinear on codes: [`bilinear8`] of the taps [`crate::bilinear`] reads, [`mix8`] between
+/// levels.
+#[derive(Clone, Copy)]
+pub(crate) struct Bilinear8;
+
+impl LevelFilter for Bilinear8 {
+    #[inline(always)]
+    fn filter<F: Fetch>(self, level: &F, addr: &Address, uv: Vec2) -> Vec4 {
+        let (quad, a, b) = bilinear::taps(level, addr, uv);
+        bilinear8(quad, a, b)
+    }
+}
+
+impl Taps for Bilinear8 {
+    const HALF: f32 = bilinear::HALF;
+    const REACH: f32 = 1.0;
+    #[inline(always)]
+    fn inside<F: Fetch>(level: &F, i: u32, j: u32, (a, b): (f32, f32)) -> Vec4 {
+        bilinear8(level.quad(i, j), a, b)
+    }
+    #[inline(always)]
+    fn mix(a: Vec4, b: Vec4, t: f32) -> Vec4 {
+        mix8(a, b, t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The integer definitions the module documents.
+    /// `round(n / 2^shift)`, halves to even, in integers.
+    fn narrow(n: u64, shift: u32) -> u64 {
+        let (q, r, half) = (n >> shift, n & ((1 << shift) - 1), 1u64 << (shift - 1));
+        if r > half || (r == half && q % 2 == 1) {
+            q + 1
+        } else {
+            q
+        }
+    }
+
+    fn weight_int(a: f32) -> u64 {
+        (f64::from(a) * 256.0).round_ties_even() as u64
+    }
+
+    fn bilinear_int(t: [u64; 4], a: f32, b: f32) -> u64 {
+        let (wa, wb) = (weight_int(a), weight_int(b));
+        let s = (t[0] * (256 - wa) + t[1] * wa) * (256 - wb) + (t[2] * (256 - wa) + t[3] * wa) * wb;
+        narrow(s, 16)
+    }
+
+    fn mix_int(a: u64, b: u64, delta: f32) -> u64 {
+        let d = weight_int(delta);
+        narrow(a * (256 - d) + b * d, 8)
+    }
+
+    #[test]
+    fn weights_round_to_nearest_256th() {
+        assert_eq!(weight8(0.0), 0.0);
+        assert_eq!(weight8(1.0), 256.0);
+        assert_eq!(weight8(0.5), 128.0);
+        assert_eq!(weight8(1.0 / 512.0), 0.0); // halves to even
+        assert_eq!(weight8(3.0 / 512.0), 2.0);
+        assert_eq!(weight8(0.999), 256.0);
+        assert_eq!(weight8(-3.0), 0.0);
+        assert_eq!(weight8(f32::NAN), 0.0);
+        for k in 0..=256 {
+            assert_eq!(weight8(k as f32 / 256.0), k as f32);
+        }
+    }
+
+    /// Every fraction step of 1/4096 and a spread of code quads: the `f32` kernels equal the
+    /// integer definitions, and the result lies within the quad's codes.
+    #[test]
+    fn bilinear8_equals_the_integer_definition() {
+        let quads = [
+            [0, 0, 0, 0],
+            [255, 255, 255, 255],
+            [0, 255, 255, 0],
+            [255, 0, 0, 255],
+            [12, 200, 97, 31],
+            [1, 2, 3, 4],
+            [254, 255, 0, 1],
+        ];
+        for q in quads {
+            let t = q.map(|c| Vec4::splat(c as f32));
+            let (lo, hi) = (*q.iter().min().unwrap(), *q.iter().max().unwrap());
+            for i in 0..=64 {
+                for j in 0..=64 {
+                    let (a, b) = (i as f32 / 64.0 * 0.999, j as f32 / 64.0 * 0.999);
+                    let got = bilinear8(t, a, b).x;
+                    let want = bilinear_int(q, a, b);
+                    assert_eq!(got, want as f32, "{q:?} {a} {b}");
+                    assert!((lo..=hi).contains(&want));
+                }
+            }
+        }
+        // Every code pair along one axis, every weight.
+        for c0 in (0..256).step_by(5) {
+            for c1 in (0..256).step_by(3) {
+                for w in 0..=256 {
+                    let a = w as f32 / 256.0;
+                    let t = [c0, c1, c0, c1].map(|c| Vec4::splat(c as f32));
+                    assert_eq!(
+                        bilinear8(t, a, 0.0).x,
+                        bilinear_int([c0, c1, c0, c1], a, 0.0) as f32
+                    );
+                    let (x, y) = (Vec4::splat(c0 as f32), Vec4::splat(c1 as f32));
+                    assert_eq!(mix8(x, y, a).x, mix_int(c0, c1, a) as f32);
+                }
+            }
+        }
+    }
+
+    /// Against the exact blend of the codes: within half a code plus the weights' quantisation.
+    #[test]
+    fn bilinear8_is_near_the_exact_blend() {
+        let q = [12.0f32, 200.0, 97.0, 31.0];
+        let t = q.map(Vec4::splat);
+        for i in 0..100 {
+            for j in 0..100 {
+                let (a, b) = (i as f32 / 100.0, j as f32 / 100.0);
+                let exact =
+                    (q[0] * (1.0 - a) + q[1] * a) * (1.0 - b) + (q[2] * (1.0 - a) + q[3] * a) * b;
+                // Each weight moves by at most 1/512; the result by at most 255/512 per weight.
+                let bound = 0.5 + 2.0 * 255.0 / 512.0;
+                assert!((bilinear8(t, a, b).x - exact).abs() <= bound, "{a} {b}");
+            }
+        }
+    }
+}
