@@ -224,35 +224,24 @@ impl<const N: usize, T: Taps> Pass<N, T> {
 
 /// Filter `footprints` into `out` (same length) with `s`'s core kernel: `min_filter` Nearest or
 /// Linear (equal to `mag_filter`), any `mipmap_filter`, level 0 below [`MAX_SIDE`] per side
-/// (`Sampler::new` decides; see `Sampler::sample_batch`). Texels outside the level under
-/// `ClampToBorder` read `addr.border` (the sampler's own address, or for the stored-codes path
+/// (`Sampler::new` decides; see `Sampler::sample_batch`); with `fixed`, [`crate::fixed8`]'s
+/// fixed-point filters (on a pyramid of stored codes). Texels outside the level under
+/// `ClampToBorder` read `addr.border` (the sampler's own address, or for the stored-codes paths
 /// its border colour as codes).
 #[inline(always)]
 pub(crate) fn run<P: Pyramid>(
     p: &P,
     s: &Sampler,
-    addr: Address,
+    (addr, fixed): (Address, bool),
     footprints: &[Footprint],
     out: &mut [[f32; 4]],
 ) {
-    match s.descriptor().min_filter {
-        FilterMode::Nearest => run_with(p, Point, s, addr, (footprints, out)),
-        _ => run_with(p, Bilinear, s, addr, (footprints, out)),
-    }
-}
-
-/// [`run`] with [`crate::fixed8`]'s fixed-point filters, on a pyramid of stored codes.
-#[inline(always)]
-pub(crate) fn run_fixed8<P: Pyramid>(
-    p: &P,
-    s: &Sampler,
-    addr: Address,
-    footprints: &[Footprint],
-    out: &mut [[f32; 4]],
-) {
-    match s.descriptor().min_filter {
-        FilterMode::Nearest => run_with(p, Point8, s, addr, (footprints, out)),
-        _ => run_with(p, Bilinear8, s, addr, (footprints, out)),
+    let io = (footprints, out);
+    match (s.descriptor().min_filter, fixed) {
+        (FilterMode::Nearest, false) => run_with(p, Point, s, addr, io),
+        (_, false) => run_with(p, Bilinear, s, addr, io),
+        (FilterMode::Nearest, true) => run_with(p, Point8, s, addr, io),
+        (_, true) => run_with(p, Bilinear8, s, addr, io),
     }
 }
 

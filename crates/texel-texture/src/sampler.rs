@@ -402,12 +402,8 @@ impl Sampler {
         footprints: &[Footprint],
         out: &mut [[u8; 4]],
     ) -> bool {
-        assert_eq!(
-            footprints.len(),
-            out.len(),
-            "sample_batch_stored: footprints and out differ in length"
-        );
-        self.reads_one_texel() && self.run_codes(texture, footprints, out, false)
+        let applies = self.reads_one_texel();
+        self.run_codes(applies, texture, footprints, out, false)
     }
 
     /// Whether [`Sampler::sample_batch_fixed8`] filters `texture`: the core kernels (nearest or
@@ -437,26 +433,31 @@ impl Sampler {
         footprints: &[Footprint],
         out: &mut [[u8; 4]],
     ) -> bool {
-        assert_eq!(
-            footprints.len(),
-            out.len(),
-            "sample_batch_fixed8: footprints and out differ in length"
-        );
-        self.filters_fixed8(texture) && self.run_codes(texture, footprints, out, true)
+        let applies = self.filters_fixed8(texture);
+        self.run_codes(applies, texture, footprints, out, true)
     }
 
-    /// Run the staged kernels (`fixed`: [`crate::fixed8`]'s) over `texture`'s stored codes
-    /// ([`crate::fetch::Codes8`]) and narrow the results to bytes; the border colour enters as
-    /// codes of the texture's format. `false` for float storage or a level 0 beyond the staged
-    /// kernels.
+    /// Where the path `applies`, run the staged kernels (`fixed`: [`crate::fixed8`]'s) over
+    /// `texture`'s stored codes ([`crate::fetch::Codes8`]) and narrow the results to bytes; the
+    /// border colour enters as codes of the texture's format. `false` where it does not apply,
+    /// for float storage or a level 0 beyond the staged kernels. Panics if the lengths differ.
     #[inline(always)]
     fn run_codes(
         &self,
+        applies: bool,
         texture: &Texture,
         footprints: &[Footprint],
         out: &mut [[u8; 4]],
         fixed: bool,
     ) -> bool {
+        assert_eq!(
+            footprints.len(),
+            out.len(),
+            "sample_batch_stored/fixed8: footprints and out differ in length"
+        );
+        if !applies {
+            return false;
+        }
         let Some(p) = codes_of(texture) else {
             return false;
         };
@@ -478,11 +479,7 @@ impl Sampler {
             .zip(out.chunks_mut(batch::CHUNK))
         {
             let codes = &mut codes[..fps.len()];
-            if fixed {
-                batch::run_fixed8(&p, self, addr, fps, codes);
-            } else {
-                batch::run(&p, self, addr, fps, codes);
-            }
+            batch::run(&p, self, (addr, fixed), fps, codes);
             for (o, c) in out.iter_mut().zip(codes.iter()) {
                 // Codes are integers in 0..=255: the conversion is exact.
                 *o = c.map(|x| x as u8);
@@ -509,7 +506,7 @@ impl Sampler {
         with_pyramid!(texture, |p| {
             let size = p.level(0).size();
             if self.batched && size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE {
-                return batch::run(&p, self, self.addr, footprints, out);
+                return batch::run(&p, self, (self.addr, false), footprints, out);
             }
             // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
             // arithmetic vectorised), then all filters.
