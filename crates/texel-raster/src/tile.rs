@@ -655,7 +655,9 @@ fn shade_span(
             .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
     }
     let verts = dc.vertices(t);
-    for k in 0..n {
+    // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).
+    let shaded = !dc.unshaded() || ctx.lighting.is_some();
+    for k in (0..n).filter(|_| shaded) {
         let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
         let dlambda = [
             DVec3::new(span.ldx[0][k], span.ldx[1][k], span.ldx[2][k]),

@@ -10,6 +10,11 @@
 //! The `bound/*` group measures what the 8-bit path's design allows: the same samplers on a float
 //! copy of the texture (no decode), and the texel loads, table decodes and blends of the 1:1
 //! bilinear walk alone, with every coordinate computed beforehand (nothing a sampler could skip).
+//!
+//! The `fixed8/*` group compares, on a unorm copy of the texture, the exact `f32` path
+//! (`sample_batch`) with the GPU-style fixed-point one (`sample_batch_fixed8`, unorm8 codes out).
+//! Like every row here it runs the crate's baseline (SSE2) code: the rasterizer's run-time
+//! dispatch to x86-64-v3 does not apply to a direct call.
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items
 
@@ -185,5 +190,37 @@ fn bound(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, bound);
+/// Exact `f32` against fixed-point filtering of a unorm8 texture (see the module docs).
+fn fixed8(c: &mut Criterion) {
+    let unorm =
+        Texture::from_fn(1024, 1024, Format::Rgba8Unorm, &Limits::default(), pattern).unwrap();
+    let mut group = c.benchmark_group("fixed8");
+    for (label, scale, name) in [
+        ("1to1", 1.0f32, "bilinear"),
+        ("minified3x", 3.0, "mip-nearest"),
+        ("minified3x", 3.0, "trilinear"),
+    ] {
+        let fps = footprints(scale);
+        let (_, desc) = filters().into_iter().find(|f| f.0 == name).unwrap();
+        let s = Sampler::new(desc).unwrap();
+        group.throughput(Throughput::Elements(fps.len() as u64));
+        let mut out = vec![[0.0f32; 4]; fps.len()];
+        group.bench_function(format!("{label}/{name}/exact"), |b| {
+            b.iter(|| {
+                s.sample_batch(&unorm, black_box(&fps), &mut out);
+                black_box(&out);
+            })
+        });
+        let mut codes = vec![[0u8; 4]; fps.len()];
+        group.bench_function(format!("{label}/{name}/gpu"), |b| {
+            b.iter(|| {
+                assert!(s.sample_batch_fixed8(&unorm, black_box(&fps), &mut codes));
+                black_box(&codes);
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, bound, fixed8);
 criterion_main!(benches);
