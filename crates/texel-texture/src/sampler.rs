@@ -481,8 +481,9 @@ impl Sampler {
             let codes = &mut codes[..fps.len()];
             batch::run(&p, self, (addr, fixed), fps, codes);
             for (o, c) in out.iter_mut().zip(codes.iter()) {
-                // Codes are integers in 0..=255: the conversion is exact.
-                *o = c.map(|x| x as u8);
+                // Codes are integers in 0..=255: adding 2^23 puts each in the low bits of the
+                // mantissa, exactly (no saturating float conversion per channel).
+                *o = c.map(|x| (x + 8_388_608.0).to_bits() as u8);
             }
         }
         true
