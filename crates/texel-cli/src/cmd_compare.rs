@@ -306,11 +306,18 @@ pub fn compare(
         width: w,
         height: h,
         spp,
-        color: match scene.color {
-            texel::ColorHandling::Srgb => "srgb",
-            texel::ColorHandling::Raw => "raw",
-        }
-        .to_string(),
+        // The colour handling, and the filtering arithmetic where it is not the exact default.
+        color: format!(
+            "{}{}",
+            match scene.color {
+                texel::ColorHandling::Srgb => "srgb",
+                texel::ColorHandling::Raw => "raw",
+            },
+            match scene.precision {
+                texel::raster::Precision::Exact => "",
+                texel::raster::Precision::Gpu => ", gpu precision",
+            }
+        ),
         reference_image: "reference.png".to_string(),
         reference_crop,
         band_rows: scoring.band_rows,

@@ -295,3 +295,25 @@ fn psnr_of(path: &std::path::Path) -> impl Fn(&str) -> f64 {
             .psnr_all
     }
 }
+
+/// A report says when its frames were filtered with `--precision gpu`, and not otherwise.
+#[test]
+fn compare_reports_gpu_precision() {
+    let d = Dir::new("compare-precision");
+    for (precision, said) in [("gpu", true), ("exact", false)] {
+        let out = d.arg(precision);
+        let args = ["compare", "--color", "raw", "--size", "64x36", "--spp", "4"];
+        let more = [
+            "--filters",
+            "bilinear",
+            "--precision",
+            precision,
+            "--out",
+            &out,
+        ];
+        ok(&[&args[..], &more[..]].concat());
+        let md = std::fs::read_to_string(d.join(precision).join("report.md")).unwrap();
+        assert_eq!(md.contains("colour raw, gpu precision."), said, "{md}");
+        assert!(md.contains("colour raw"), "{md}");
+    }
+}
