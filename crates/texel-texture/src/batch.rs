@@ -7,7 +7,7 @@
 //! chunk whose iterations are independent, so they pipeline and (stages 0 to 2) vectorise:
 //!
 //! 0. [`queries`]: every sample's finite `uv` and lod;
-//! 1. levels: `mip::nearest_level` or `mip::linear_levels_staged` per sample;
+//! 1. levels: `mip::nearest_level_staged` or `mip::linear_levels_staged` per sample;
 //! 2. `Pass::coordinates`: per level pass, the filter's origin (`u * W`, or `u * W - 1/2` for
 //!    bilinear), its floor ([`floor_clamped`], the staged floor), the fractions, and whether every
 //!    texel the sample reads lies inside the level;
@@ -307,8 +307,9 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
         match d.mipmap_filter {
             MipmapFilterMode::None => first.level[..n].fill(0),
             MipmapFilterMode::Nearest => {
+                let top = last as f32;
                 for (l, &lod) in first.level[..n].iter_mut().zip(&chunk.lod) {
-                    *l = mip::nearest_level(lod, last) as u8;
+                    *l = mip::nearest_level_staged(lod, top);
                 }
             }
             MipmapFilterMode::Linear => {

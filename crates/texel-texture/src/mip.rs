@@ -51,6 +51,21 @@ pub fn nearest_level(lod: f32, last: usize) -> usize {
     (ceil_i32(e) - 1).max(0) as usize
 }
 
+/// [`nearest_level`] for the batched path's level stage, as a `u8` (at most 32 levels): the same
+/// rule without integer conversions, so a loop over a chunk of lods vectorises. `ceil(e)` comes
+/// from rounding `e` to an integer (`+ 2^23 - 2^23`, to nearest) plus one where that rounded
+/// down, and the level from the low mantissa byte of `level + 2^23`. NaN gives level 0 (`max`
+/// returns the non-NaN operand). Equal to [`nearest_level`] (tested).
+#[inline(always)]
+pub(crate) fn nearest_level_staged(lod: f32, last: f32) -> u8 {
+    const MAGIC: f32 = 8_388_608.0; // 2^23
+    #[allow(clippy::manual_clamp)] // `clamp` keeps NaN
+    let e = lod.max(0.0).min(last) + 0.5;
+    let t = (e + MAGIC) - MAGIC;
+    let ceil = if t < e { t + 1.0 } else { t };
+    ((ceil - 1.0).max(0.0) + MAGIC).to_bits() as u8
+}
+
 /// The Vulkan linear-level rule: the finer level `floor(d)` and the blend weight `d - floor(d)`
 /// toward level `floor(d) + 1`, with `d = clamp(lod, 0, last)`. NaN gives level 0 and a NaN weight,
 /// which reads level 0 only (the weight fails every `delta > 0` test).
@@ -137,6 +152,36 @@ mod tests {
         assert_eq!(nearest_level(99.0, 10), 10);
         assert_eq!(nearest_level(-3.0, 10), 0);
         assert_eq!(nearest_level(f32::NAN, 10), 0);
+    }
+
+    /// The staged rule equals the scalar one on a sweep of lods (both signs, the level
+    /// boundaries and their neighbours, NaN and infinities) for several level counts.
+    #[test]
+    fn nearest_level_staged_equals_nearest_level() {
+        for last in [0usize, 1, 5, 12, 22] {
+            let mut lods: Vec<f32> = (-3000..3000).map(|k| k as f32 * 0.01).collect();
+            for k in 0..=last + 1 {
+                let b = (k as f32 + 0.5).to_bits();
+                lods.extend((b - 8..=b + 8).map(f32::from_bits));
+                lods.push(k as f32);
+            }
+            lods.extend([
+                f32::NAN,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                -0.0,
+                1e30,
+                -1e30,
+            ]);
+            for lod in lods {
+                let want = nearest_level(lod, last);
+                assert_eq!(
+                    usize::from(nearest_level_staged(lod, last as f32)),
+                    want,
+                    "{lod} {last}"
+                );
+            }
+        }
     }
 
     /// The integer rounding equals the float formula `ceil(clamp(lod) + 1/2) - 1` everywhere.
