@@ -11,6 +11,8 @@ use std::sync::OnceLock;
 
 use glam::Vec4;
 
+use crate::floor::{floor_clamped4, integer_bytes4};
+
 /// sRGB-encoded value in `[0, 1]` to linear light in `[0, 1]` (IEC 61966-2-1).
 ///
 /// Values outside `[0, 1]` are extended symmetrically (`f(-x) = -f(x)`); NaN stays NaN.
@@ -71,18 +73,12 @@ pub fn rgba_to_srgb8(c: [f32; 4]) -> [u8; 4] {
 /// transfer function: what an `R8G8B8A8_UNORM` target stores.
 #[inline(always)]
 pub fn rgba_to_unorm8(c: [f32; 4]) -> [u8; 4] {
-    // [`unorm8`] per channel, in four lanes: `v = x * 255 + 1/2` clamped to `[0, 255]` (NaN to
-    // 0), its floor by rounding (`+ 2^23 - 2^23`, to nearest) less one where that rounded up,
-    // and the integer read from the low mantissa byte of `floor + 2^23`: no saturating float
-    // conversion per channel. Equal to `unorm8` for every input (tested on a sweep of all bit
-    // patterns and around every threshold).
-    const MAGIC: Vec4 = Vec4::splat(8_388_608.0); // 2^23
-    let v = (Vec4::from_array(c) * 255.0 + Vec4::splat(0.5))
-        .max(Vec4::ZERO)
-        .min(Vec4::splat(255.0));
-    let t = (v + MAGIC) - MAGIC;
-    let floor = Vec4::select(t.cmpgt(v), t - Vec4::ONE, t);
-    (floor + MAGIC).to_array().map(|x| x.to_bits() as u8)
+    // [`unorm8`] per channel without its saturating conversion: `x * 255 + 1/2` (NaN to 0 by
+    // `max`), floored and clamped to `[0, 255]` by the staged floor, whose integer comes from
+    // bits. Equal to `unorm8` for every input (tested on a sweep of all bit patterns and around
+    // every threshold).
+    let v = (Vec4::from_array(c) * 255.0 + Vec4::splat(0.5)).max(Vec4::ZERO);
+    integer_bytes4(floor_clamped4(v, 255.0).to_array())
 }
 
 /// The definition [`linear_to_srgb8`] is built from and tested against: `unorm8` of the sRGB OETF

@@ -15,7 +15,8 @@
 //! - **mip blend**: `D = round(256 delta)`, `round((a (256 - D) + b D) / 256)` ([`mix8`]).
 //!
 //! Every rounding is to the nearest integer with halves to even (IEEE's default, so it costs an
-//! addition and a subtraction; hardware documents only its precision, not its tie rule).
+//! addition and a subtraction: [`crate::floor::round_staged`]; hardware documents only its
+//! precision, not its tie rule).
 //!
 //! Level selection (the lod) is the `f32` path's, so both read the same texels. Every value is an
 //! integer below `2^24`, so `f32` holds it exactly: the kernels run in the `f32` lanes the other
@@ -34,24 +35,9 @@ use crate::address::Address;
 use crate::batch::Taps;
 use crate::bilinear;
 use crate::fetch::Fetch;
+use crate::floor::{round_staged, round_staged4};
 use crate::mip::LevelFilter;
 use crate::nearest;
-
-/// `round(x)` with halves to even, for `0 <= x < 2^22`: adding and subtracting `2^23` leaves
-/// no fraction bits, so the addition rounds (IEEE round-to-nearest-even). Branch-free and
-/// without conversions, so it runs in vector lanes.
-#[inline(always)]
-fn round_even(x: f32) -> f32 {
-    const MAGIC: f32 = 8_388_608.0; // 2^23
-    (x + MAGIC) - MAGIC
-}
-
-/// [`round_even`] per lane.
-#[inline(always)]
-fn round_even4(x: Vec4) -> Vec4 {
-    const MAGIC: Vec4 = Vec4::splat(8_388_608.0);
-    (x + MAGIC) - MAGIC
-}
 
 /// The 8-bit weight of a fraction `a` in `[0, 1]`: `round(256 a)` (halves to even), in
 /// `0..=256`. A fraction outside `[0, 1]` is clamped first; NaN gives 0.
@@ -60,7 +46,7 @@ pub fn weight8(a: f32) -> f32 {
     // `max` returns the non-NaN operand, so NaN becomes 0 (`clamp` would keep NaN).
     #[allow(clippy::manual_clamp)]
     let a = a.max(0.0).min(1.0);
-    round_even(a * 256.0)
+    round_staged(a * 256.0)
 }
 
 /// The fixed-point bilinear blend of four codes `[T00, T10, T01, T11]` (each `0.0..=255.0`, one
@@ -74,7 +60,7 @@ pub fn bilinear8([t00, t10, t01, t11]: [Vec4; 4], a: f32, b: f32) -> Vec4 {
     // by 2^-16 is exact.
     let r0 = t00 * ia + t10 * wa;
     let r1 = t01 * ia + t11 * wa;
-    round_even4((r0 * ib + r1 * wb) * (1.0 / 65536.0))
+    round_staged4((r0 * ib + r1 * wb) * (1.0 / 65536.0))
 }
 
 /// The fixed-point blend of two codes `a` and `b` (per channel, `0.0..=255.0`) with weight
@@ -82,7 +68,7 @@ pub fn bilinear8([t00, t10, t01, t11]: [Vec4; 4], a: f32, b: f32) -> Vec4 {
 #[inline(always)]
 pub fn mix8(a: Vec4, b: Vec4, delta: f32) -> Vec4 {
     let d = weight8(delta);
-    round_even4((a * (256.0 - d) + b * d) * (1.0 / 256.0))
+    round_staged4((a * (256.0 - d) + b * d) * (1.0 / 256.0))
 }
 
 /// Nearest on codes with [`mix8`] between levels (a nearest sample itself has no arithmetic).

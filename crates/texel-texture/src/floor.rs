@@ -17,8 +17,10 @@
 //!   whose saturating semantics cost about 20 instructions per value on SSE2; instead the value is
 //!   rounded by adding and subtracting `1.5 * 2^(mantissa bits)`, and one is taken off where that
 //!   rounded up. Exact below `2^22` (`f32`) or `2^51` (`f64`), which callers guarantee by clamping.
-//!   [`floor_clamped`] (the batched sampler's texel indices and levels), [`floor_staged_f64`]
-//!   (the rasterizer's period reduction of `uv`).
+//!   [`floor_clamped`] (the batched sampler's texel indices and levels; the stored codes as
+//!   bytes; the unorm8 encode), [`ceil_clamped`] (the nearest-mip level), [`round_staged`]
+//!   (the fixed-point filters' weights and results), [`floor_staged_f64`] (the rasterizer's
+//!   period reduction of `uv`).
 
 /// `floor(x)` as an `i64` texel index, saturating at the `i64` range; NaN gives 0.
 ///
@@ -79,6 +81,8 @@ pub fn ceil_f64(x: f64) -> f64 {
     -floor_f64(-x)
 }
 
+use glam::Vec4;
+
 /// Largest `hi` [`floor_clamped`] accepts (`2^22`): the sum with its rounding constant must stay
 /// in `[2^23, 2^24)`, where `f32` spacing is 1.
 pub const STAGED_F32_LIMIT: f32 = 4_194_304.0;
@@ -86,6 +90,50 @@ pub const STAGED_F32_LIMIT: f32 = 4_194_304.0;
 /// `1.5 * 2^23`: added to an `f32` of magnitude below `2^22`, the sum lies in `[2^23, 2^24)`, where
 /// the spacing is 1, so it is rounded to an integer, which its low mantissa bits hold.
 const ROUND_F32: f32 = 12_582_912.0;
+
+/// Staged `round(x)` to the nearest integer, halves to even (IEEE's rounding of the sum), for
+/// `|x| <` [`STAGED_F32_LIMIT`]: the rounding step [`floor_clamped`] and [`ceil_clamped`] start
+/// from. Branch-free and conversion-free.
+#[inline(always)]
+pub fn round_staged(x: f32) -> f32 {
+    (x + ROUND_F32) - ROUND_F32
+}
+
+/// [`round_staged`] in four lanes (one vector addition and subtraction).
+#[inline(always)]
+pub fn round_staged4(x: Vec4) -> Vec4 {
+    let r = Vec4::splat(ROUND_F32);
+    (x + r) - r
+}
+
+/// [`floor_clamped`]'s `f32` result in four lanes: `floor(clamp(x, -1, hi))` per lane, same
+/// domain; callers clear NaN first (glam's lane-wise `max` does not promise which operand a NaN
+/// gives).
+#[inline(always)]
+pub fn floor_clamped4(x: Vec4, hi: f32) -> Vec4 {
+    let c = x.max(Vec4::splat(-1.0)).min(Vec4::splat(hi));
+    let r = round_staged4(c);
+    Vec4::select(r.cmpgt(c), r - Vec4::ONE, r)
+}
+
+/// Lanes holding integers in `0..=255` as bytes, read from the bits of their sum with the
+/// rounding constant (the integer sits in the low mantissa bits): no saturating conversion.
+#[inline(always)]
+pub fn integer_bytes4(x: [f32; 4]) -> [u8; 4] {
+    x.map(|s| (s + ROUND_F32).to_bits() as u8)
+}
+
+/// `x` rounded by [`round_staged`] (the clamped value `c`), as an integer read from the sum's
+/// bits and as an `f32`.
+#[inline(always)]
+fn round_parts(c: f32) -> (i32, f32) {
+    let sum = c + ROUND_F32;
+    // Integer value of the rounded sum: its bits minus those of ROUND_F32.
+    (
+        sum.to_bits() as i32 - ROUND_F32.to_bits() as i32,
+        sum - ROUND_F32,
+    )
+}
 
 /// Staged `floor(clamp(x, -1, hi))` as an integer and as an `f32`, for `1 <= hi <=`
 /// [`STAGED_F32_LIMIT`] and any `x` except NaN (NaN clamps to -1).
@@ -97,15 +145,22 @@ const ROUND_F32: f32 = 12_582_912.0;
 #[inline(always)]
 pub fn floor_clamped(x: f32, hi: f32) -> (i32, f32) {
     let c = x.max(-1.0).min(hi);
-    let sum = c + ROUND_F32;
-    let rounded = sum - ROUND_F32;
-    // Integer value of the rounded sum: its bits minus those of ROUND_F32.
-    let r = sum.to_bits() as i32 - ROUND_F32.to_bits() as i32;
+    let (r, rounded) = round_parts(c);
     let down = rounded > c;
     (
         r - i32::from(down),
         if down { rounded - 1.0 } else { rounded },
     )
+}
+
+/// Staged `ceil(clamp(x, -1, hi))`, as [`floor_clamped`] (same domain; NaN clamps to -1): the
+/// rounded value plus one where rounding went down.
+#[inline(always)]
+pub fn ceil_clamped(x: f32, hi: f32) -> (i32, f32) {
+    let c = x.max(-1.0).min(hi);
+    let (r, rounded) = round_parts(c);
+    let up = rounded < c;
+    (r + i32::from(up), if up { rounded + 1.0 } else { rounded })
 }
 
 /// `1.5 * 2^52`, [`ROUND_F32`]'s `f64` counterpart.
@@ -223,7 +278,38 @@ mod tests {
                 let (i, f) = floor_clamped(x, hi);
                 assert_eq!(f, c.floor(), "x {x} hi {hi}");
                 assert_eq!(i as f32, c.floor(), "x {x} hi {hi}");
+                let (i, f) = ceil_clamped(x, hi);
+                assert_eq!(f, c.ceil(), "ceil: x {x} hi {hi}");
+                assert_eq!(i as f32, c.ceil(), "ceil: x {x} hi {hi}");
             }
         }
+    }
+
+    /// The staged rounding is IEEE's round-half-even (`f32::round_ties_even`) inside its range;
+    /// the four-lane forms equal the scalar ones lane by lane; the byte read-out is exact.
+    #[test]
+    fn round_staged_rounds_half_to_even() {
+        for x in samples().into_iter().filter(|x| x.abs() < STAGED_F32_LIMIT) {
+            assert_eq!(round_staged(x), x.round_ties_even(), "{x}");
+        }
+        for x in samples().into_iter().filter(|x| x.abs() < STAGED_F32_LIMIT) {
+            let v = Vec4::new(x, -x, x * 0.5, x + 0.5);
+            assert_eq!(
+                round_staged4(v),
+                v.to_array().map(round_staged).into(),
+                "{x}"
+            );
+            for hi in [1.0f32, 255.0, 1024.0] {
+                let want = v.to_array().map(|x| floor_clamped(x, hi).1);
+                assert_eq!(floor_clamped4(v, hi), want.into(), "{x} {hi}");
+            }
+        }
+        for k in 0..=255u8 {
+            let v = Vec4::new(f32::from(k), 0.0, 255.0, f32::from(255 - k));
+            assert_eq!(integer_bytes4(v.to_array()), [k, 0, 255, 255 - k]);
+        }
+        assert_eq!(round_staged(0.5), 0.0);
+        assert_eq!(round_staged(1.5), 2.0);
+        assert_eq!(round_staged(-2.5), -2.0);
     }
 }

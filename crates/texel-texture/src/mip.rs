@@ -17,7 +17,7 @@ use crate::address::Address;
 use crate::bicubic::bicubic;
 use crate::bilinear::{bilinear, lerp};
 use crate::fetch::{Fetch, Pyramid};
-use crate::floor::{ceil_i32, floor_nonneg, floor_nonneg_staged};
+use crate::floor::{ceil_clamped, ceil_i32, floor_nonneg, floor_nonneg_staged};
 use crate::footprint::Query;
 use crate::nearest::nearest;
 use crate::sampler::FilterMode;
@@ -52,18 +52,14 @@ pub fn nearest_level(lod: f32, last: usize) -> usize {
 }
 
 /// [`nearest_level`] for the batched path's level stage, as a `u8` (at most 32 levels): the same
-/// rule without integer conversions, so a loop over a chunk of lods vectorises. `ceil(e)` comes
-/// from rounding `e` to an integer (`+ 2^23 - 2^23`, to nearest) plus one where that rounded
-/// down, and the level from the low mantissa byte of `level + 2^23`. NaN gives level 0 (`max`
-/// returns the non-NaN operand). Equal to [`nearest_level`] (tested).
+/// rule through [`ceil_clamped`] instead of an integer conversion, so a loop over a chunk of lods
+/// vectorises. NaN gives level 0 (`max` returns the non-NaN operand). Equal to
+/// [`nearest_level`] (tested).
 #[inline(always)]
 pub(crate) fn nearest_level_staged(lod: f32, last: f32) -> u8 {
-    const MAGIC: f32 = 8_388_608.0; // 2^23
     #[allow(clippy::manual_clamp)] // `clamp` keeps NaN
-    let e = lod.max(0.0).min(last) + 0.5;
-    let t = (e + MAGIC) - MAGIC;
-    let ceil = if t < e { t + 1.0 } else { t };
-    ((ceil - 1.0).max(0.0) + MAGIC).to_bits() as u8
+    let d = lod.max(0.0).min(last);
+    (ceil_clamped(d + 0.5, last + 1.0).0 - 1).max(0) as u8
 }
 
 /// The Vulkan linear-level rule: the finer level `floor(d)` and the blend weight `d - floor(d)`

@@ -63,6 +63,7 @@ use crate::color::{rgba_to_srgb8, rgba_to_unorm8};
 use crate::error::TextureError;
 use crate::ewa::ewa;
 use crate::fetch::{codes_of, with_pyramid, Counted, Fetch, Pyramid};
+use crate::floor::integer_bytes4;
 pub use crate::footprint::UV_LIMIT;
 use crate::footprint::{finite_uv, lod_from_rho_squared, rho_squared, Footprint, Query};
 use crate::mip::{filter_level, mip_nearest, trilinear};
@@ -481,9 +482,9 @@ impl Sampler {
             let codes = &mut codes[..fps.len()];
             batch::run(&p, self, (addr, fixed), fps, codes);
             for (o, c) in out.iter_mut().zip(codes.iter()) {
-                // Codes are integers in 0..=255: adding 2^23 puts each in the low bits of the
-                // mantissa, exactly (no saturating float conversion per channel).
-                *o = c.map(|x| (x + 8_388_608.0).to_bits() as u8);
+                // Codes are integers in 0..=255: read from bits, without a saturating float
+                // conversion per channel.
+                *o = integer_bytes4(*c);
             }
         }
         true
