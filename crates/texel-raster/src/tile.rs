@@ -149,7 +149,7 @@ struct Context<'a> {
 enum Route {
     /// [`texel_texture::Sampler::sample_batch`], `f32`, then shaded and encoded.
     Float,
-    /// The stored bytes of the texel each reads, written as they are ([`copies_texels`]).
+    /// The stored bytes of the texel each reads, written as they are ([`Route::of`]).
     Stored,
     /// [`texel_texture::Sampler::sample_batch_fixed8`] under [`Precision::Gpu`]: written as
     /// they are (`copy`: unshaded, into a unorm8 target), else decoded (`b / 255`) and shaded.
@@ -158,37 +158,26 @@ enum Route {
 
 impl Route {
     /// Draw `dc`'s route in a frame of `settings` (lit or not) with colour target `target`.
+    ///
+    /// Its samples may be written as they are (`copy`) when nothing changes them — the colour
+    /// view, no lights, no material, white vertex colours ([`DrawContext::unshaded`]) — and the
+    /// target stores colour as the texture stores texels: the target's encoder then gives back
+    /// the texture's bytes for every code, so copying them leaves the image unchanged. A
+    /// sampler that reads one texel copies the texel's stored bytes
+    /// ([`texel_texture::Sampler::sample_batch_stored`]).
     fn of(settings: &RenderSettings, lit: bool, target: ColorTarget, dc: &DrawContext) -> Route {
-        let unshaded = settings.view == View::Color && !lit && dc.unshaded();
-        if copies_texels(settings, lit, target, dc) {
+        if settings.view != View::Color {
+            return Route::Float;
+        }
+        let copy = !lit && dc.unshaded() && target.stores_like(dc.texture.format());
+        if copy && dc.sampler.reads_one_texel() {
             Route::Stored
         } else if settings.precision == Precision::Gpu && dc.sampler.filters_fixed8(dc.texture) {
-            Route::Fixed8 {
-                copy: unshaded && target == ColorTarget::Unorm8,
-            }
+            Route::Fixed8 { copy }
         } else {
             Route::Float
         }
     }
-}
-
-/// Whether draw `dc`'s colour-view fragments may be written as the stored bytes of the texel
-/// each reads ([`texel_texture::Sampler::sample_batch_stored`]): the sampler reads one texel
-/// (nearest, no or nearest mipmaps), nothing changes the sample (no lights, no material, white
-/// vertex colours) and the target stores colour as the texture stores texels. The bytes are then
-/// those the target's encoder gives for the decoded sample (every code round-trips), so the image
-/// is unchanged and the decode, the shading and the encode are skipped.
-fn copies_texels(
-    settings: &RenderSettings,
-    lit: bool,
-    target: ColorTarget,
-    dc: &DrawContext,
-) -> bool {
-    settings.view == View::Color
-        && !lit
-        && dc.unshaded()
-        && dc.sampler.reads_one_texel()
-        && target.stores_like(dc.texture.format())
 }
 
 /// What the fragment stage needs besides the pixel: barycentrics and the footprint's inputs.
@@ -421,7 +410,7 @@ struct Span {
     /// The sampler's input and output.
     fps: [Footprint; SPAN],
     texs: [[f32; 4]; SPAN],
-    /// The stored-bytes path's output ([`copies_texels`]).
+    /// The stored-bytes and fixed-point paths' output ([`Route`]).
     bytes: [[u8; 4]; SPAN],
 }
 
@@ -656,16 +645,17 @@ fn shade_span(
     }
     let verts = dc.vertices(t);
     // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).
-    let shaded = !dc.unshaded() || ctx.lighting.is_some();
-    for k in (0..n).filter(|_| shaded) {
-        let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
-        let dlambda = [
-            DVec3::new(span.ldx[0][k], span.ldx[1][k], span.ldx[2][k]),
-            DVec3::new(span.ldy[0][k], span.ldy[1][k], span.ldy[2][k]),
-        ];
-        let lit = ctx.lighting.as_ref();
-        let (tex, fp) = (span.texs[k], &span.fps[k]);
-        span.texs[k] = shade(dc, verts, lambda, dlambda, tex, fp, lit, false).0;
+    let lit = ctx.lighting.as_ref();
+    if !dc.unshaded() || lit.is_some() {
+        for k in 0..n {
+            let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
+            let dlambda = [
+                DVec3::new(span.ldx[0][k], span.ldx[1][k], span.ldx[2][k]),
+                DVec3::new(span.ldy[0][k], span.ldy[1][k], span.ldy[2][k]),
+            ];
+            let (tex, fp) = (span.texs[k], &span.fps[k]);
+            span.texs[k] = shade(dc, verts, lambda, dlambda, tex, fp, lit, false).0;
+        }
     }
     // Fragments arrive row by row: look each row's buffers up once per run of equal rows, with
     // the target's format decided once per span.
@@ -791,19 +781,20 @@ fn write_fragment(
     f: &Fragment,
 ) {
     let fp = dc.footprint(f.uv, f.duv_dx, f.duv_dy);
+    // Under `Precision::Gpu` the colour is the fixed-point sample (of the same texels, so the
+    // counts are the exact sampler's).
+    let mut code = [[0u8; 4]];
+    let fixed = matches!(ctx.routes[t.draw as usize], Route::Fixed8 { .. })
+        && dc.sampler.sample_batch_fixed8(dc.texture, &[fp], &mut code);
     let (mut tex, count) = if ctx.counting {
         dc.sampler.sample_counted(dc.texture, &fp)
-    } else if ctx.settings.view == View::Color {
+    } else if ctx.settings.view == View::Color && !fixed {
         (dc.sampler.sample(dc.texture, &fp), 0)
     } else {
         ([0.0; 4], 0)
     };
-    if let Route::Fixed8 { .. } = ctx.routes[t.draw as usize] {
-        // The same texels (so the same count), blended in fixed point.
-        let mut b = [[0u8; 4]];
-        if dc.sampler.sample_batch_fixed8(dc.texture, &[fp], &mut b) {
-            tex = decode_unorm8(b[0]);
-        }
+    if fixed {
+        tex = decode_unorm8(code[0]);
     }
     let lit = ctx.lighting.as_ref();
     // The texels a material's maps read count too (in every view, so the fetches view agrees
