@@ -3,7 +3,7 @@
 //! texel filters in `f32` by default: every texel decoded to a float, weights and blends in
 //! single precision, the result encoded once at the end. Hardware samplers (and llvmpipe, which
 //! blends unorm8 texels in 16-bit lanes) work on the stored 8-bit codes with weights of a few
-//! bits: Vulkan exposes them as `subTexelPrecisionBits` (at least 4; 8 on current desktop GPUs)
+//! bits: Vulkan exposes them as `subTexelPrecisionBits` (at least 4; 8 is common on desktop GPUs)
 //! and `mipmapPrecisionBits` (at least 4). This module defines texel's version, with 8 bits for
 //! both and round-to-nearest wherever a result is narrowed:
 //!
