@@ -142,6 +142,12 @@ pub struct SceneArgs {
     /// are exact.
     #[arg(long, value_enum)]
     pub specular_aa: Option<SpecularAaArg>,
+    /// Adaptive shading supersampling for every material, overriding the scene's
+    /// `shading_samples`: where the shading normal turns from one pixel to the next by more
+    /// than the specular lobe is wide, shade up to N x N sub-samples per pixel (1 to 8; 1 is
+    /// off) and average them. Lit scenes only; the reference ignores it.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=i64::from(texel_scene::MAX_SHADING_SAMPLES)))]
+    pub shading_samples: Option<u32>,
     /// What every material's height map does, overriding the scene's `displacement` (materials
     /// without a height map are unaffected).
     #[arg(long, value_enum)]

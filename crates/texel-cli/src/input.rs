@@ -105,6 +105,8 @@ pub fn load_scene(args: &SceneArgs, input: &mut Input) -> Result<PreparedScene> 
 pub struct MaterialOverrides {
     /// `--specular-aa`.
     pub specular_aa: Option<SpecularAa>,
+    /// `--shading-samples`.
+    pub shading_samples: Option<u32>,
     /// `--displacement`.
     pub displacement: Option<texel_scene::Displacement>,
     /// `--edge-px`.
@@ -124,6 +126,7 @@ impl MaterialOverrides {
     pub fn of(args: &SceneArgs) -> Self {
         MaterialOverrides {
             specular_aa: args.specular_aa.map(SpecularAaArg::into),
+            shading_samples: args.shading_samples,
             displacement: args.displacement.map(Into::into),
             edge_px: args.edge_px,
             layer_order: args.layer_order.map(Into::into),
@@ -162,6 +165,7 @@ pub fn load_scene_with(
         color: color.into(),
         replace_non_finite: input.sanitize,
         specular_aa: overrides.specular_aa,
+        shading_samples: overrides.shading_samples,
         displacement: overrides.displacement,
         edge_px: overrides.edge_px,
         layer_order: overrides.layer_order,

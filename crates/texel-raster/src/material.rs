@@ -42,6 +42,10 @@ pub const MAX_LIGHTS: usize = 8;
 /// highlight under a point light would be a Dirac pulse no pixel samples.
 pub const MIN_ROUGHNESS: f32 = 0.045;
 
+/// The most shading sub-samples per pixel axis that [`Material::shading_samples`] may ask for
+/// (8 x 8 = 64 shadings of one pixel).
+pub const MAX_SHADING_SAMPLES: u32 = 8;
+
 /// One light, in world space, linear RGB.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {
@@ -178,6 +182,14 @@ pub struct Material<'a> {
     pub normal_scale: f32,
     /// Specular antialiasing.
     pub specular_aa: SpecularAa,
+    /// Adaptive shading supersampling: at most this many shading sub-samples per pixel axis
+    /// (`1` turns it off, [`MAX_SHADING_SAMPLES`] at most). Where the shading normal turns from
+    /// one pixel to the next by more than half the specular lobe's width, one shading sample
+    /// cannot stand for the pixel; such pixels are shaded on a grid of `ceil(2 |dn| / alpha)`
+    /// sub-samples per axis (`dn` the normal's change to the next pixel along that axis, `alpha`
+    /// the lobe's GGX width after `specular_aa`) and averaged in linear light. Lit frames only; the
+    /// reference ignores it (its sub-samples resolve the pixel already).
+    pub shading_samples: u32,
     /// The LEAN moment map of `normal_map` ([`lean_map`]), read through the normal map's
     /// sampler; required by [`SpecularAa::Lean`] on a normal map.
     pub lean: Option<&'a MomentMap>,
@@ -217,6 +229,7 @@ impl Default for Material<'_> {
             normal_map: None,
             normal_scale: 1.0,
             specular_aa: SpecularAa::None,
+            shading_samples: 1,
             lean: None,
             height_map: None,
             height_scale: 0.05,
@@ -231,8 +244,9 @@ impl Default for Material<'_> {
 
 impl Material<'_> {
     /// Whether every factor is finite and in range (`roughness` and `metallic` in `[0, 1]`,
-    /// channels `0..=3`, `height_scale >= 0`), LEAN has its moment map for the map that gives
-    /// the normal, and a displacement has a height map.
+    /// channels `0..=3`, `height_scale >= 0`, `shading_samples` in `1..=`[`MAX_SHADING_SAMPLES`]),
+    /// LEAN has its moment map for the map that gives the normal, and a displacement has a
+    /// height map.
     pub fn is_valid(&self) -> bool {
         let channel_ok = |c: &Option<ChannelInput>| c.is_none_or(|c| c.channel < 4);
         let lean_ok = self.specular_aa != SpecularAa::Lean
@@ -244,6 +258,7 @@ impl Material<'_> {
         let height_ok = self.displacement == Displacement::None || self.has_height();
         lean_ok
             && height_ok
+            && (1..=MAX_SHADING_SAMPLES).contains(&self.shading_samples)
             && self.layers.as_ref().is_none_or(Layers::is_valid)
             && self.height_scale.is_finite()
             && self.height_scale >= 0.0

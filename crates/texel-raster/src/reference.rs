@@ -141,6 +141,7 @@ pub fn render_reference_strata(
                     .zip(n.as_ref())
                     .map(|(t, s)| TextureInput { sampler: s, ..t }),
                 specular_aa: SpecularAa::None,
+                shading_samples: 1,
                 ..mat
             })
         })

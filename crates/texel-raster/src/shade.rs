@@ -21,7 +21,8 @@ use crate::draw::{DrawCall, UvEvaluation, Vertex};
 use crate::environment::{self, Environment};
 use crate::layers::Needs;
 use crate::material::{
-    self, Displacement, Light, Material, SpecularAa, Surface, TextureInput, MIN_ROUGHNESS,
+    self, Displacement, Light, Material, SpecularAa, Surface, TextureInput, MAX_SHADING_SAMPLES,
+    MIN_ROUGHNESS,
 };
 use crate::relief;
 use crate::settings::RenderSettings;
@@ -315,7 +316,9 @@ fn lerp3(verts: [&Vertex; 3], lambda: DVec3, f: impl Fn(&Vertex) -> Vec3) -> DVe
 /// `lambda` and their screen derivatives `dlambda` (per pixel right and down; zero where not
 /// known, as for the reference's sub-samples), and footprint `fp` (for the material's maps); also
 /// the texels the maps read when `count`. Unlit frames show `tex * base_color * vertex colour`;
-/// lit frames [`crate::material::radiance`] with the normal and roughness of [`crate::relief`].
+/// lit frames [`crate::material::radiance`] with the normal and roughness of [`crate::relief`],
+/// averaged over a grid of shading sub-samples where [`Material::shading_samples`] asks for one
+/// (see [`shade_grid`]).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade(
@@ -328,6 +331,85 @@ pub(crate) fn shade(
     lighting: Option<&Lighting>,
     count: bool,
 ) -> ([f32; 4], u32) {
+    let adaptive = lighting.is_some() && ctx.material.is_some_and(|m| m.shading_samples > 1);
+    let (c, texels, grid) = shade_once(
+        ctx, verts, lambda, dlambda, tex, fp, lighting, count, adaptive,
+    );
+    if grid == [1, 1] {
+        return (c, texels);
+    }
+    let (c, more) = shade_grid(ctx, verts, (lambda, dlambda), fp, lighting, count, grid);
+    (c, texels + more)
+}
+
+/// The mean of [`shade_once`] over a `grid[0] x grid[1]` grid of sub-samples centred in the
+/// pixel: sub-sample `(a, b)` sits at offset `o = ((a + 1/2) / kx - 1/2, (b + 1/2) / ky - 1/2)`
+/// pixels from the centre, where barycentrics and footprint are moved to first order
+/// (`lambda + dlambda . o`, `uv + J o`) and the footprint's derivatives shrink to the sub-sample's
+/// spacing (`J / k` per axis), so every map, the base colour included, is filtered over the
+/// sub-sample's own footprint. The sub-samples are averaged in linear light (as the reference
+/// averages its own), and return the texels they read when `count`.
+#[allow(clippy::too_many_arguments)]
+fn shade_grid(
+    ctx: &DrawContext,
+    verts: [&Vertex; 3],
+    (lambda, dlambda): (DVec3, [DVec3; 2]),
+    fp: &Footprint,
+    lighting: Option<&Lighting>,
+    count: bool,
+    [kx, ky]: [u32; 2],
+) -> ([f32; 4], u32) {
+    let base = TextureInput {
+        texture: ctx.texture,
+        sampler: ctx.sampler,
+    };
+    let (sx, sy) = (1.0 / kx as f32, 1.0 / ky as f32);
+    let dl = [dlambda[0] * f64::from(sx), dlambda[1] * f64::from(sy)];
+    let mut texels = 0;
+    let mut sum = Vec4::ZERO;
+    for b in 0..ky {
+        let oy = (b as f32 + 0.5) * sy - 0.5;
+        for a in 0..kx {
+            let ox = (a as f32 + 0.5) * sx - 0.5;
+            let fp = Footprint {
+                u: fp.u + fp.dudx * ox + fp.dudy * oy,
+                v: fp.v + fp.dvdx * ox + fp.dvdy * oy,
+                dudx: fp.dudx * sx,
+                dvdx: fp.dvdx * sx,
+                dudy: fp.dudy * sy,
+                dvdy: fp.dvdy * sy,
+            };
+            let l = lambda + dlambda[0] * f64::from(ox) + dlambda[1] * f64::from(oy);
+            let tex = material::read(&base, &fp, count, &mut texels);
+            let (c, t, _) = shade_once(ctx, verts, l, dl, tex, &fp, lighting, count, false);
+            sum += Vec4::from_array(c);
+            texels += t;
+        }
+    }
+    ((sum / (kx * ky) as f32).to_array(), texels)
+}
+
+/// One shading sample: [`shade`] without the sub-sample grid. When `measure`, also the grid the
+/// pixel needs (`[1, 1]` otherwise): per screen axis `ceil(2 |n' - n| / alpha)`, at most
+/// [`Material::shading_samples`], where `n'` is the shading normal one pixel along that axis
+/// (read as the projected method reads it) and `alpha` the GGX width of the lobe after
+/// texture-space antialiasing. Neighbouring sub-samples' normals then differ by at most
+/// `alpha / 2` (in slope, to first order), about 2.6 sub-samples across the GGX lobe's full
+/// width at half maximum (`2 alpha sqrt(sqrt(2) - 1) = 1.29 alpha`), so the pixel's mean
+/// highlight is integrated rather than point-sampled.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn shade_once(
+    ctx: &DrawContext,
+    verts: [&Vertex; 3],
+    lambda: DVec3,
+    dlambda: [DVec3; 2],
+    tex: [f32; 4],
+    fp: &Footprint,
+    lighting: Option<&Lighting>,
+    count: bool,
+    measure: bool,
+) -> ([f32; 4], u32, [u32; 2]) {
     let l = lambda.as_vec3();
     let mut texels = 0;
     let Some(lighting) = lighting else {
@@ -339,7 +421,7 @@ pub(crate) fn shade(
             };
             c *= layers.sample(fp, needs, count, &mut texels).base;
         }
-        return (c.to_array(), texels);
+        return (c.to_array(), texels, [1, 1]);
     };
     // The lights' and the environment's radiance; `lambert` drops the specular lobe.
     let light = |surface: &Surface, lambert: bool, texels: &mut u32| {
@@ -363,7 +445,7 @@ pub(crate) fn shade(
             spread: None,
         };
         let rgb = light(&surface, true, &mut texels);
-        return (rgb.extend(c.w).to_array(), texels);
+        return (rgb.extend(c.w).to_array(), texels, [1, 1]);
     };
     // Parallax occlusion mapping moves every read to where the view ray meets the relief.
     let mut fp = *fp;
@@ -419,7 +501,9 @@ pub(crate) fn shade(
         count,
         &mut texels,
     );
-    if m.specular_aa == SpecularAa::Projected {
+    let mut grid = [1, 1];
+    let projected = m.specular_aa == SpecularAa::Projected;
+    if projected || measure {
         // The normals one pixel right and one down, as a fragment quad's ddx and ddy see them.
         let neighbour = |dl: DVec3, duv: [f32; 2], texels: &mut u32| {
             let l = (lambda + dl).as_vec3();
@@ -454,8 +538,17 @@ pub(crate) fn shade(
         };
         let nx = neighbour(dlambda[0], [fp.dudx, fp.dvdx], &mut texels);
         let ny = neighbour(dlambda[1], [fp.dudy, fp.dvdy], &mut texels);
-        shading.roughness =
-            material::projected_roughness(roughness, nx - shading.normal, ny - shading.normal);
+        let (dn_dx, dn_dy) = (nx - shading.normal, ny - shading.normal);
+        if measure {
+            let alpha = shading.roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
+            let most = m.shading_samples.clamp(1, MAX_SHADING_SAMPLES);
+            // NaN (a degenerate normal) casts to 0 and is clamped to one sample.
+            let k = |dn: Vec3| ((2.0 * dn.length() / alpha).ceil() as u32).clamp(1, most);
+            grid = [k(dn_dx), k(dn_dy)];
+        }
+        if projected {
+            shading.roughness = material::projected_roughness(roughness, dn_dx, dn_dy);
+        }
     }
     let surface = Surface {
         base: c.truncate(),
@@ -468,7 +561,7 @@ pub(crate) fn shade(
         spread: shading.spread,
     };
     let rgb = light(&surface, false, &mut texels);
-    (rgb.extend(c.w).to_array(), texels)
+    (rgb.extend(c.w).to_array(), texels, grid)
 }
 
 /// The unlit colour: texture times vertex colour times the material's factor.

@@ -49,7 +49,9 @@
 //! specular_aa = "toksvig"       # height = "TEXTURE" (red, color = "linear"), height_scale
 //!                               # (world units, default 0.05), displacement = "none" | "bump" |
 //!                               # "pom" | "tessellate"; occlusion = "TEXTURE" (red, linear; dims
-//!                               # ambient light), occlusion_strength (default 1)
+//!                               # ambient light), occlusion_strength (default 1);
+//!                               # shading_samples = 1..8 (default 1: adaptive shading
+//!                               # sub-samples per pixel axis where the normal turns fast)
 //! [materials.terrain]           # layered: mask = "TEXTURE" (linear; channel k weighs layer k),
 //! mask = "splat"                #   blend = "linear" | "height", blend_depth (default 0.2),
 //! blend = "height"              #   layer_order = "filter-then-blend" | "blend-then-filter";
@@ -244,6 +246,7 @@ struct RawMaterial {
     layer_order: Option<RawLayerOrder>,
     occlusion: Option<String>,
     occlusion_strength: Option<f32>,
+    shading_samples: Option<u32>,
 }
 
 #[derive(Deserialize)]
@@ -356,6 +359,7 @@ fn material_spec(m: RawMaterial) -> MaterialSpec {
         },
         occlusion: m.occlusion,
         occlusion_strength: m.occlusion_strength.unwrap_or(d.occlusion_strength),
+        shading_samples: m.shading_samples.unwrap_or(d.shading_samples),
     }
 }
 

@@ -59,6 +59,7 @@ pub use model::{
     ColorInput, Displacement, EncodedImage, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec,
     MaterialSpec, Mesh, MeshFilters, Output, ScalarInput, Scene, SpecularAaSpec, SphereUv,
     TextureSampler, TextureSource, TextureSpec, MAX_LAYERS, MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
+    MAX_SHADING_SAMPLES,
 };
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::{NoiseKind, Procedural};

@@ -194,7 +194,14 @@ pub struct MaterialSpec {
     pub occlusion: Option<String>,
     /// `occlusion_strength`: how much of the occlusion map applies, `[0, 1]`. Default 1.
     pub occlusion_strength: f32,
+    /// `shading_samples`: adaptive shading supersampling, at most this many shading
+    /// sub-samples per pixel axis where the shading normal turns faster than the specular lobe
+    /// is wide, `1..=`[`MAX_SHADING_SAMPLES`]. Default 1 (off).
+    pub shading_samples: u32,
 }
+
+/// The most shading sub-samples per pixel axis a material may ask for (`shading_samples`).
+pub const MAX_SHADING_SAMPLES: u32 = 8;
 
 /// The most layers a material has (one per channel of its mask).
 pub const MAX_LAYERS: usize = 4;
@@ -278,6 +285,7 @@ impl Default for MaterialSpec {
             layer_order: LayerOrder::FilterThenBlend,
             occlusion: None,
             occlusion_strength: 1.0,
+            shading_samples: 1,
         }
     }
 }

@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::error::SceneError;
 use crate::model::{
     ColorInput, Displacement, LightSpec, MaterialSpec, ScalarInput, Scene, MAX_LAYERS,
-    MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS,
+    MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS, MAX_SHADING_SAMPLES,
 };
 
 fn finite3(what: impl Fn() -> String, v: Vec3) -> Result<(), SceneError> {
@@ -268,6 +268,12 @@ impl Scene {
         if let Some(o) = &m.occlusion {
             self.linear("occlusion map", o, "visibilities")
                 .map_err(bad)?;
+        }
+        if !(1..=MAX_SHADING_SAMPLES).contains(&m.shading_samples) {
+            return Err(bad(format!(
+                "shading_samples = {} must be in 1..={MAX_SHADING_SAMPLES}",
+                m.shading_samples
+            )));
         }
         if !(0.0..=1.0).contains(&m.occlusion_strength) {
             return Err(bad(format!(

@@ -5,7 +5,7 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 use texel_scene::{
     ColorInput, Displacement, LayerBlendSpec, LayerOrder, LayerSpec, LightSpec, MaterialSpec, Mesh,
-    Procedural, ScalarInput, Scene, SceneError, SpecularAaSpec,
+    Procedural, ScalarInput, Scene, SceneError, SpecularAaSpec, MAX_SHADING_SAMPLES,
 };
 
 const BASE: &str = r#"
@@ -102,8 +102,8 @@ specular_aa = "toksvig"
     assert_eq!(d.roughness, ScalarInput::Value(0.5));
     assert_eq!(d.metallic, ScalarInput::Value(0.0));
     assert_eq!(
-        (d.normal.as_deref(), d.specular_aa),
-        (None, SpecularAaSpec::None)
+        (d.normal.as_deref(), d.specular_aa, d.shading_samples),
+        (None, SpecularAaSpec::None, 1)
     );
     // A constant base colour multiplies the mesh's texture, which must then be given.
     let s = with_texture("[materials.m]\nbase_color = [0.5, 0.25, 1.0]\n").unwrap();
@@ -133,6 +133,13 @@ fn every_specular_aa_method_and_height_maps_parse() {
         ))
         .unwrap();
         assert_eq!(s.materials["m"].specular_aa, want);
+    }
+    for n in [1, 4, MAX_SHADING_SAMPLES] {
+        let s = parse(&format!(
+            "[materials.m]\nbase_color = \"grey\"\nnormal = \"bumps\"\nshading_samples = {n}\n"
+        ))
+        .unwrap();
+        assert_eq!(s.materials["m"].shading_samples, n);
     }
     for (name, want) in [
         ("none", Displacement::None),
@@ -268,7 +275,19 @@ height = 0.25
 
 #[test]
 fn bad_lights_and_materials_are_refused_with_the_reason() {
-    let cases: [(&str, &str); 11] = [
+    let cases: [(&str, &str); 14] = [
+        (
+            "[materials.m]\nbase_color = \"grey\"\nshading_samples = 0\n",
+            "shading_samples = 0 must be in 1..=8",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\nshading_samples = 9\n",
+            "shading_samples = 9 must be in 1..=8",
+        ),
+        (
+            "[materials.m]\nbase_color = \"grey\"\nshading_samples = -1\n",
+            "invalid value: integer `-1`, expected u32",
+        ),
         (
             "[materials.m]\nbase_color = \"grey\"\nshininess = 3.0\n",
             "unknown field `shininess`",

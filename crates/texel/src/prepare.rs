@@ -24,6 +24,10 @@ use crate::memory::{raster_bytes, FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_
 use crate::tessellate::Tessellated;
 use crate::{Error, Filter, MemoryBudget};
 
+// The scene schema's bound is the renderer's.
+const _: () =
+    assert!(texel_scene::MAX_SHADING_SAMPLES == texel_raster::material::MAX_SHADING_SAMPLES);
+
 /// How 8-bit texture bytes and output bytes are interpreted (the CLI's `--color`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum ColorHandling {
@@ -47,6 +51,10 @@ pub struct SceneOptions {
     /// Specular antialiasing for every material, overriding each one's `specular_aa` (the
     /// CLI's `--specular-aa`).
     pub specular_aa: Option<SpecularAa>,
+    /// Adaptive shading sub-samples per pixel axis for every material, overriding each one's
+    /// `shading_samples` (the CLI's `--shading-samples`; `1..=`[`texel_scene::MAX_SHADING_SAMPLES`],
+    /// larger values are clamped).
+    pub shading_samples: Option<u32>,
     /// What every material's height map does, overriding each one's `displacement` (the CLI's
     /// `--displacement`; materials without a height map are unaffected).
     pub displacement: Option<texel_scene::Displacement>,
@@ -129,6 +137,8 @@ pub struct PreparedScene {
     pub precision: Precision,
     /// [`SceneOptions::specular_aa`].
     specular_aa: Option<SpecularAa>,
+    /// [`SceneOptions::shading_samples`].
+    shading_samples: Option<u32>,
     /// [`SceneOptions::displacement`].
     displacement: Option<texel_scene::Displacement>,
     /// LEAN moment maps ([`texel_raster::material::lean_map`]) of the normal maps of materials
@@ -398,6 +408,7 @@ impl PreparedScene {
             charged: Mutex::new(BTreeSet::new()),
             precision: options.precision,
             specular_aa: options.specular_aa,
+            shading_samples: options.shading_samples,
             displacement: options.displacement,
             lean_maps,
             height_moments,
@@ -749,6 +760,10 @@ impl PreparedScene {
             normal_map: spec.normal.as_deref().map(|n| maps.input(n)),
             normal_scale: spec.normal_scale,
             specular_aa,
+            shading_samples: self
+                .shading_samples
+                .unwrap_or(spec.shading_samples)
+                .clamp(1, texel_scene::MAX_SHADING_SAMPLES),
             lean: spec.normal.as_ref().and_then(|n| self.lean_maps.get(n)),
             height_map: spec.height.as_deref().map(|h| maps.red(h)),
             height_scale: spec.height_scale,
