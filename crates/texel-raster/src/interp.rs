@@ -13,6 +13,7 @@
 //! fragments at a time) both call them, so both give the same bits.
 
 use glam::{DVec2, DVec3};
+use texel_texture::Footprint;
 
 use crate::settings::Perspective;
 use crate::setup::TriangleSetup;
@@ -104,6 +105,204 @@ impl TriangleSetup {
     #[inline(always)]
     pub fn depth_at(&self, x: f64, y: f64) -> f64 {
         self.z.at(x, y)
+    }
+}
+
+/// `uv` over one triangle's pixels in one tile, as `f32` planes re-anchored there: what every
+/// rasterizer path (span, per pixel, quads) interpolates `uv` with, so their footprints agree bit
+/// for bit.
+///
+/// With `r = 1 / w` and `P_u = u / w = sum_k u_k q_k` linear in screen space (affine: `r = 1`,
+/// `P_u = sum_k u_k lambda_k`), `u = P_u / r` and `du/dx = (P_u,x - u r_x) / r`. The planes are
+/// evaluated in `f64` once, at an anchor pixel of the tile, and whole periods of the address mode
+/// (`n`, the periods below `u` at the anchor) are taken out there: `P_u' = P_u - n r`, so
+/// `u' = u - n`. Per pixel they are stepped in `f32` from the anchor by whole pixels (at most a
+/// tile, exact in `f32`), so the values stay near the anchor's `u' in [0, period)` instead of the
+/// ground's 250 periods. Then `u'` is reduced into `[0, period)` in `f32` (exactly: an integer
+/// subtracted from a value in range).
+///
+/// Accuracy: a few `f32` ulps of `u'` (tested against the exact ray-plane intersection,
+/// `tests/perspective.rs`); where the image is magnified `u'` stays within about one period of the
+/// anchor, where an ulp is `2^-23` of a period, 1.2e-4 texel of a 1024-texel texture. The `f64`
+/// barycentrics ([`TriangleSetup::barycentrics`]) remain for shading and the reference.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct UvPlanes {
+    /// The anchor pixel (frame coordinates; its centre is where the planes' constants hold).
+    pub anchor: [u32; 2],
+    /// `r` as `[value at the anchor, d/dx, d/dy]`.
+    pub r: [f32; 3],
+    /// `P_u'` likewise.
+    pub u: [f32; 3],
+    /// `P_v'` likewise.
+    pub v: [f32; 3],
+    /// The address modes' periods in u and v (0: not periodic) and their reciprocals.
+    pub period: [f32; 2],
+    pub inv_period: [f32; 2],
+}
+
+impl UvPlanes {
+    /// The planes of triangle `t` with vertex `uvs` for the pixels `range` (`[i_lo, j_lo, i_hi,
+    /// j_hi]`, inclusive) under `perspective`, with the address modes' `period`s (0: none). The
+    /// anchor is the pixel of the range's centre and corners where `r` is largest (the nearest,
+    /// most magnified part, where accuracy matters most; all of them are equal when affine).
+    pub fn new(
+        t: &TriangleSetup,
+        uvs: [DVec2; 3],
+        perspective: Perspective,
+        range: [u32; 4],
+        period: DVec2,
+    ) -> UvPlanes {
+        let [i_lo, j_lo, i_hi, j_hi] = range;
+        let (weights, r) = match perspective {
+            Perspective::Correct => (t.q, t.r),
+            Perspective::Affine => (
+                t.affine,
+                crate::setup::Plane {
+                    c: 1.0,
+                    dx: 0.0,
+                    dy: 0.0,
+                },
+            ),
+        };
+        let centre = [i_lo + (i_hi - i_lo) / 2, j_lo + (j_hi - j_lo) / 2];
+        let at = |p: [u32; 2]| r.at(f64::from(p[0]) + 0.5, f64::from(p[1]) + 0.5);
+        let mut anchor = centre;
+        for p in [[i_lo, j_lo], [i_hi, j_lo], [i_lo, j_hi], [i_hi, j_hi]] {
+            if at(p) > at(anchor) {
+                anchor = p;
+            }
+        }
+        let (xa, ya) = (f64::from(anchor[0]) + 0.5, f64::from(anchor[1]) + 0.5);
+        let r0 = r.at(xa, ya);
+        let plane = |c: usize, p: f64| -> [f32; 3] {
+            let a = |f: &dyn Fn(&crate::setup::Plane) -> f64| {
+                weights
+                    .iter()
+                    .zip(&uvs)
+                    .map(|(w, uv)| uv[c] * f(w))
+                    .sum::<f64>()
+            };
+            let (pc, px, py) = (a(&|w| w.at(xa, ya)), a(&|w| w.dx), a(&|w| w.dy));
+            // Whole periods below u at the anchor (none where u is not finite there or beyond
+            // what f64 can floor).
+            let t = pc / r0 / p.max(f64::MIN_POSITIVE);
+            let n = if p > 0.0 && t.is_finite() && t.abs() < 1e15 {
+                p * t.floor()
+            } else {
+                0.0
+            };
+            [
+                (pc - n * r0) as f32,
+                (px - n * r.dx) as f32,
+                (py - n * r.dy) as f32,
+            ]
+        };
+        let inv = |p: f64| if p > 0.0 { (1.0 / p) as f32 } else { 0.0 };
+        UvPlanes {
+            anchor,
+            r: [r0 as f32, r.dx as f32, r.dy as f32],
+            u: plane(0, period.x),
+            v: plane(1, period.y),
+            period: [period.x as f32, period.y as f32],
+            inv_period: [inv(period.x), inv(period.y)],
+        }
+    }
+
+    /// `1 / r` at `(dx, dy)` pixels from the anchor.
+    #[inline(always)]
+    pub fn inv_r(&self, dx: f32, dy: f32) -> f32 {
+        1.0 / (self.r[0] + self.r[1] * dx + self.r[2] * dy)
+    }
+
+    /// `u'` (`c = 0`) or `v'` (`c = 1`) at `(dx, dy)` pixels from the anchor, given `1 / r` there.
+    #[inline(always)]
+    pub fn value(&self, c: usize, dx: f32, dy: f32, inv_r: f32) -> f32 {
+        let p = if c == 0 { &self.u } else { &self.v };
+        (p[0] + p[1] * dx + p[2] * dy) * inv_r
+    }
+
+    /// `(d/dx, d/dy)` of `u'` (`c = 0`) or `v'` (`c = 1`), given its value and `1 / r`.
+    #[inline(always)]
+    pub fn derivatives(&self, c: usize, value: f32, inv_r: f32) -> (f32, f32) {
+        let p = if c == 0 { &self.u } else { &self.v };
+        (
+            (p[1] - value * self.r[1]) * inv_r,
+            (p[2] - value * self.r[2]) * inv_r,
+        )
+    }
+
+    /// The offset of pixel `(i, j)` from the anchor, in pixels (exact: both are below `2^24`).
+    #[inline(always)]
+    pub fn offset(&self, i: u32, j: u32) -> (f32, f32) {
+        (
+            (i as i32 - self.anchor[0] as i32) as f32,
+            (j as i32 - self.anchor[1] as i32) as f32,
+        )
+    }
+
+    /// The footprint at pixel `(i, j)`: `uv` reduced and its analytic derivatives. The span
+    /// stages in `tile.rs` perform the same operations in the same order over many pixels.
+    #[inline(always)]
+    pub fn footprint(&self, i: u32, j: u32) -> Footprint {
+        let (dx, dy) = self.offset(i, j);
+        let inv = self.inv_r(dx, dy);
+        let (u, v) = (self.value(0, dx, dy, inv), self.value(1, dx, dy, inv));
+        let (dudx, dudy) = self.derivatives(0, u, inv);
+        let (dvdx, dvdy) = self.derivatives(1, v, inv);
+        Footprint {
+            u: self.reduce(0, u),
+            v: self.reduce(1, v),
+            dudx,
+            dudy,
+            dvdx,
+            dvdy,
+        }
+    }
+
+    /// The footprints of the 2x2 quad whose top-left pixel is `(qi, qj)`, in
+    /// [`quad_differences`]' order: `uv'` at the four pixels, derivatives as its differences
+    /// within the quad (before the reduction, which would break them at a period's edge).
+    #[inline(always)]
+    pub fn quad_footprints(&self, qi: u32, qj: u32) -> [Footprint; 4] {
+        let uv: [[f32; 2]; 4] = std::array::from_fn(|k| {
+            let (dx, dy) = self.offset(qi + (k as u32 & 1), qj + (k as u32 >> 1));
+            let inv = self.inv_r(dx, dy);
+            [self.value(0, dx, dy, inv), self.value(1, dx, dy, inv)]
+        });
+        let d = |a: [f32; 2], b: [f32; 2]| [b[0] - a[0], b[1] - a[1]];
+        let (dx_top, dx_bottom) = (d(uv[0], uv[1]), d(uv[2], uv[3]));
+        let (dy_left, dy_right) = (d(uv[0], uv[2]), d(uv[1], uv[3]));
+        let ds = [
+            (dx_top, dy_left),
+            (dx_top, dy_right),
+            (dx_bottom, dy_left),
+            (dx_bottom, dy_right),
+        ];
+        std::array::from_fn(|k| {
+            let (dx, dy) = ds[k];
+            Footprint {
+                u: self.reduce(0, uv[k][0]),
+                v: self.reduce(1, uv[k][1]),
+                dudx: dx[0],
+                dudy: dy[0],
+                dvdx: dx[1],
+                dvdy: dy[1],
+            }
+        })
+    }
+
+    /// `x` (a `u'` for `c = 0`, a `v'` for `c = 1`) reduced into `[0, period)` by whole periods
+    /// (unchanged without a period, or for `|x / period| >= 2^22`, beyond the staged floor).
+    #[inline(always)]
+    pub fn reduce(&self, c: usize, x: f32) -> f32 {
+        let (p, inv_p) = (self.period[c], self.inv_period[c]);
+        let t = x * inv_p;
+        let q = texel_texture::floor::floor_staged(t);
+        if p > 0.0 && t.abs() < texel_texture::floor::STAGED_F32_LIMIT {
+            x - p * q
+        } else {
+            x
+        }
     }
 }
 

@@ -19,13 +19,14 @@ use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
 use crate::draw::{DrawCall, UvEvaluation, Vertex};
 use crate::environment::{self, Environment};
+use crate::interp::UvPlanes;
 use crate::layers::Needs;
 use crate::material::{
     self, Displacement, Light, Material, SpecularAa, Surface, TextureInput, MAX_SHADING_SAMPLES,
     MIN_ROUGHNESS,
 };
 use crate::relief;
-use crate::settings::RenderSettings;
+use crate::settings::{Perspective, RenderSettings};
 use crate::setup::TriangleSetup;
 
 /// Per-draw state resolved once per frame.
@@ -156,6 +157,27 @@ impl<'a> DrawContext<'a> {
         self.vertices(t).map(|v| v.uv.as_dvec2())
     }
 
+    /// How triangle `t`'s fragments in the pixels `range` of one tile get their `uv`: its
+    /// sphere mapping, or [`UvPlanes`] anchored there.
+    #[inline(always)]
+    pub fn uv_source(
+        &self,
+        t: &TriangleSetup,
+        perspective: Perspective,
+        range: [u32; 4],
+    ) -> UvSource {
+        match self.mapped(t) {
+            Some(m) => UvSource::Mapped(m),
+            None => UvSource::Planes(UvPlanes::new(
+                t,
+                self.uvs(t),
+                perspective,
+                range,
+                self.period,
+            )),
+        }
+    }
+
     /// The footprint for the sampler: `uv` reduced by whole periods, derivatives as given.
     #[inline(always)]
     pub fn footprint(&self, uv: DVec2, duv_dx: DVec2, duv_dy: DVec2) -> Footprint {
@@ -168,6 +190,15 @@ impl<'a> DrawContext<'a> {
             dvdy: duv_dy.y as f32,
         }
     }
+}
+
+/// Where a triangle's fragments get their `uv` ([`DrawContext::uv_source`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum UvSource {
+    /// A per-pixel sphere mapping of the interpolated position.
+    Mapped(MappedTriangle),
+    /// The vertices' `uv`, interpolated by `f32` planes re-anchored in the tile.
+    Planes(UvPlanes),
 }
 
 /// One triangle of a draw with a per-pixel sphere mapping ([`crate::UvMapping`]): its vertices

@@ -45,10 +45,10 @@ use crate::dispatch::Kernel;
 use crate::draw::DrawCall;
 use crate::environment::{Environment, ViewRays};
 use crate::frame::Frame;
-use crate::interp::{self, quad_differences};
+use crate::interp::{self, quad_differences, UvPlanes};
 use crate::settings::{ColorTarget, Derivatives, Perspective, Precision, RenderSettings, View};
 use crate::setup::{pixel_center_fixed, setup_chunks, TriangleSetup, SUBPIXEL};
-use crate::shade::{shade, DrawContext, Lighting};
+use crate::shade::{shade, DrawContext, Lighting, MappedTriangle, UvSource};
 use crate::views;
 use crate::RasterError;
 
@@ -180,14 +180,12 @@ impl Route {
     }
 }
 
-/// What the fragment stage needs besides the pixel: barycentrics and the footprint's inputs.
+/// What the fragment stage needs besides the pixel: barycentrics and the footprint.
 struct Fragment {
     lambda: DVec3,
     /// `lambda`'s derivatives per pixel right and down.
     dlambda: [DVec3; 2],
-    uv: DVec2,
-    duv_dx: DVec2,
-    duv_dy: DVec2,
+    fp: Footprint,
     z: f32,
 }
 
@@ -327,24 +325,38 @@ fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]
             continue;
         }
         let range = [i_lo, j_lo, i_hi, j_hi];
+        // Where `uv`'s planes are anchored: the triangle's box in the whole tile, so that a
+        // scissor does not change a pixel.
+        let home = [
+            bi0.max(tile.x0),
+            bj0.max(tile.y0),
+            bi1.min(tile.x0 + tile.w - 1),
+            bj1.min(tile.y0 + tile.h - 1),
+        ];
+        let source = ctx.draws[t.draw as usize].uv_source(t, ctx.settings.perspective, home);
         match (ctx.settings.derivatives, span.as_deref_mut()) {
-            (Derivatives::Analytic, Some(span)) => raster_pixels_batched(ctx, tile, t, range, span),
-            (Derivatives::Analytic, None) => raster_pixels(ctx, tile, t, range),
-            (Derivatives::Quad, _) => raster_quads(ctx, tile, t, range),
+            (Derivatives::Analytic, Some(span)) => {
+                raster_pixels_batched(ctx, tile, (t, &source), range, span)
+            }
+            (Derivatives::Analytic, None) => raster_pixels(ctx, tile, (t, &source), range),
+            (Derivatives::Quad, _) => raster_quads(ctx, tile, (t, &source), range),
         }
     }
 }
 
 /// Analytic derivatives: walk the pixels of `range`, stepping the edge functions along rows.
 #[inline(always)]
-fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: [u32; 4]) {
+fn raster_pixels(
+    ctx: &Context,
+    tile: &mut TileTarget,
+    (t, source): (&TriangleSetup, &UvSource),
+    range: [u32; 4],
+) {
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];
-    let uvs = dc.uvs(t);
-    let mapped = dc.mapped(t);
+    let perspective = ctx.settings.perspective;
     let step = t.edges.map(|e| e.a * SUBPIXEL);
     let x_start = pixel_center_fixed(i_lo);
-    let perspective = ctx.settings.perspective;
     for j in j_lo..=j_hi {
         let y_fixed = pixel_center_fixed(j);
         let mut e = t.edges.map(|e| e.at(x_start, y_fixed));
@@ -357,19 +369,17 @@ fn raster_pixels(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range:
                 let z = t.depth_at(x, y) as f32;
                 if z < tile.depth[lj][li] {
                     let b = t.barycentrics(x, y, perspective);
-                    let (uv, duv_dx, duv_dy) = match &mapped {
-                        Some(m) => m.uv(b.lambda, Some([b.dx, b.dy])),
-                        None => {
-                            let (dx, dy) = b.derivatives2(uvs);
-                            (b.interpolate2(uvs), dx, dy)
+                    let fp = match source {
+                        UvSource::Mapped(m) => {
+                            let (uv, dx, dy) = m.uv(b.lambda, Some([b.dx, b.dy]));
+                            dc.footprint(uv, dx, dy)
                         }
+                        UvSource::Planes(p) => p.footprint(i, j),
                     };
                     let f = Fragment {
                         lambda: b.lambda,
                         dlambda: [b.dx, b.dy],
-                        uv,
-                        duv_dx,
-                        duv_dy,
+                        fp,
                         z,
                     };
                     write_fragment(ctx, dc, t, tile, li, lj, &f);
@@ -407,6 +417,12 @@ struct Span {
     /// Their x and y derivatives (only when the footprint needs them).
     ldx: [[f64; SPAN]; 3],
     ldy: [[f64; SPAN]; 3],
+    /// Their offsets from the [`UvPlanes`] anchor, `1 / r` and `u'`, `v'` ([`UvPlanes`]).
+    ox: [f32; SPAN],
+    oy: [f32; SPAN],
+    inv: [f32; SPAN],
+    u: [f32; SPAN],
+    v: [f32; SPAN],
     /// The sampler's input and output.
     fps: [Footprint; SPAN],
     texs: [[f32; 4]; SPAN],
@@ -427,6 +443,11 @@ impl Span {
             l: [[0.0; SPAN]; 3],
             ldx: [[0.0; SPAN]; 3],
             ldy: [[0.0; SPAN]; 3],
+            ox: [0.0; SPAN],
+            oy: [0.0; SPAN],
+            inv: [0.0; SPAN],
+            u: [0.0; SPAN],
+            v: [0.0; SPAN],
             fps: [Footprint::default(); SPAN],
             texs: [[0.0; 4]; SPAN],
             bytes: [[0; 4]; SPAN],
@@ -480,44 +501,65 @@ impl Span {
         }
     }
 
-    /// The footprints of the span's fragments from their barycentrics: `uv` and (when `deriv`)
-    /// its derivatives as [`crate::interp::Barycentrics::interpolate2`] and `derivatives2` compute
-    /// them (or a per-pixel sphere mapping, [`DrawContext::mapped`]), reduced by
-    /// [`DrawContext::footprint`].
+    /// The footprints of the span's fragments under a per-pixel sphere mapping, from their
+    /// barycentrics (and, when `deriv`, their derivatives), reduced by [`DrawContext::footprint`]:
+    /// not a linear combination, one fragment at a time.
     #[inline(always)]
-    fn footprints(&mut self, dc: &DrawContext, t: &TriangleSetup, deriv: bool) {
-        let n = self.n;
+    fn mapped_footprints(&mut self, dc: &DrawContext, m: &MappedTriangle, deriv: bool) {
         let [l0, l1, l2] = &self.l;
         let [x0, x1, x2] = &self.ldx;
         let [y0, y1, y2] = &self.ldy;
-        if let Some(m) = dc.mapped(t) {
-            // A per-pixel sphere mapping: not a linear combination, one fragment at a time.
-            for k in 0..n {
-                let lambda = DVec3::new(l0[k], l1[k], l2[k]);
-                let dlambda = deriv.then(|| {
-                    [
-                        DVec3::new(x0[k], x1[k], x2[k]),
-                        DVec3::new(y0[k], y1[k], y2[k]),
-                    ]
-                });
-                let (uv, dx, dy) = m.uv(lambda, dlambda);
-                self.fps[k] = dc.footprint(uv, dx, dy);
-            }
-            return;
-        }
-        let uvs = dc.uvs(t);
-        let dot = |a: [DVec2; 3], l: [f64; 3]| a[0] * l[0] + a[1] * l[1] + a[2] * l[2];
-        for k in 0..n {
-            let uv = dot(uvs, [l0[k], l1[k], l2[k]]);
-            let (dx, dy) = if deriv {
-                (
-                    dot(uvs, [x0[k], x1[k], x2[k]]),
-                    dot(uvs, [y0[k], y1[k], y2[k]]),
-                )
-            } else {
-                (DVec2::ZERO, DVec2::ZERO)
-            };
+        for k in 0..self.n {
+            let lambda = DVec3::new(l0[k], l1[k], l2[k]);
+            let dlambda = deriv.then(|| {
+                [
+                    DVec3::new(x0[k], x1[k], x2[k]),
+                    DVec3::new(y0[k], y1[k], y2[k]),
+                ]
+            });
+            let (uv, dx, dy) = m.uv(lambda, dlambda);
             self.fps[k] = dc.footprint(uv, dx, dy);
+        }
+    }
+
+    /// The footprints of the span's fragments from `uv`'s planes `p`: [`UvPlanes::footprint`]'s
+    /// operations, stage by stage over the span in `f32` (eight lanes with AVX2), for a tile
+    /// whose top-left pixel is `origin`. Without `deriv` the derivatives are zero.
+    #[inline(always)]
+    fn plane_footprints(&mut self, p: &UvPlanes, origin: [u32; 2], deriv: bool) {
+        let n = self.n;
+        // Tile-local anchor: `li - a` is the frame's `i - anchor`, exactly as `UvPlanes::offset`.
+        let (ai, aj) = (
+            p.anchor[0] as i32 - origin[0] as i32,
+            p.anchor[1] as i32 - origin[1] as i32,
+        );
+        for k in 0..n {
+            self.ox[k] = (self.li[k] as i32 - ai) as f32;
+            self.oy[k] = (self.lj[k] as i32 - aj) as f32;
+        }
+        for k in 0..n {
+            self.inv[k] = p.inv_r(self.ox[k], self.oy[k]);
+        }
+        for k in 0..n {
+            let (x, y, inv) = (self.ox[k], self.oy[k], self.inv[k]);
+            self.u[k] = p.value(0, x, y, inv);
+            self.v[k] = p.value(1, x, y, inv);
+        }
+        for k in 0..n {
+            let (u, v, inv) = (self.u[k], self.v[k], self.inv[k]);
+            let fp = &mut self.fps[k];
+            (fp.dudx, fp.dudy) = if deriv {
+                p.derivatives(0, u, inv)
+            } else {
+                (0.0, 0.0)
+            };
+            (fp.dvdx, fp.dvdy) = if deriv {
+                p.derivatives(1, v, inv)
+            } else {
+                (0.0, 0.0)
+            };
+            fp.u = p.reduce(0, u);
+            fp.v = p.reduce(1, v);
         }
     }
 }
@@ -537,7 +579,7 @@ impl Span {
 fn raster_pixels_batched(
     ctx: &Context,
     tile: &mut TileTarget,
-    t: &TriangleSetup,
+    (t, source): (&TriangleSetup, &UvSource),
     range: [u32; 4],
     span: &mut Span,
 ) {
@@ -550,7 +592,7 @@ fn raster_pixels_batched(
     span.n = 0;
     for j in j_lo..=j_hi {
         if span.n + width > SPAN {
-            flush_span(ctx, tile, t, dc, span);
+            flush_span(ctx, tile, t, (dc, source), span);
         }
         let y_fixed = pixel_center_fixed(j);
         let mut e = t.edges.map(|e| e.at(x_start, y_fixed));
@@ -578,7 +620,7 @@ fn raster_pixels_batched(
         }
         span.n = n;
     }
-    flush_span(ctx, tile, t, dc, span);
+    flush_span(ctx, tile, t, (dc, source), span);
 }
 
 /// Interpolate, sample, shade and write the `span.n` gathered fragments of triangle `t`, then empty
@@ -588,7 +630,7 @@ fn flush_span(
     ctx: &Context,
     tile: &mut TileTarget,
     t: &TriangleSetup,
-    dc: &DrawContext,
+    (dc, source): (&DrawContext, &UvSource),
     span: &mut Span,
 ) {
     let n = span.n;
@@ -598,8 +640,20 @@ fn flush_span(
     // Nearest or bilinear without mipmaps ignore the derivatives: skip them unless captured or a
     // material's maps may need them.
     let deriv = ctx.capture || dc.sampler.uses_derivatives() || dc.material.is_some();
-    span.barycentrics(t, ctx.settings.perspective, deriv);
-    span.footprints(dc, t, deriv);
+    // Barycentrics only where something reads them: shading, or a sphere mapping.
+    let shaded = !dc.unshaded() || ctx.lighting.is_some();
+    match source {
+        UvSource::Mapped(m) => {
+            span.barycentrics(t, ctx.settings.perspective, deriv);
+            span.mapped_footprints(dc, m, deriv);
+        }
+        UvSource::Planes(p) => {
+            if shaded {
+                span.barycentrics(t, ctx.settings.perspective, deriv);
+            }
+            span.plane_footprints(p, [tile.x0, tile.y0], deriv);
+        }
+    }
     let (fps, bytes) = (&span.fps[..n], &mut span.bytes[..n]);
     match ctx.routes[t.draw as usize] {
         Route::Stored if dc.sampler.sample_batch_stored(dc.texture, fps, bytes) => {
@@ -700,11 +754,14 @@ fn write_rows<V, C>(
 
 /// Quad derivatives: walk aligned 2x2 quads; a quad with any covered pixel interpolates all four.
 #[inline(always)]
-fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: [u32; 4]) {
+fn raster_quads(
+    ctx: &Context,
+    tile: &mut TileTarget,
+    (t, source): (&TriangleSetup, &UvSource),
+    range: [u32; 4],
+) {
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];
-    let uvs = dc.uvs(t);
-    let mapped = dc.mapped(t);
     let perspective = ctx.settings.perspective;
     for qj in (j_lo & !1..=j_hi).step_by(2) {
         for qi in (i_lo & !1..=i_hi).step_by(2) {
@@ -738,17 +795,14 @@ fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: 
                 let third = |d: DVec2| DVec3::new(d.x, d.y, -d.x - d.y);
                 [third(dx), third(dy)]
             });
-            let (uv, d) = match &mapped {
+            let fps: [Footprint; 4] = match source {
                 // A per-pixel sphere mapping differences the positions (continuous) and maps the
                 // differences through the projection's Jacobian, never differencing u.
-                Some(m) => {
-                    let eval = std::array::from_fn(|k| m.uv(lambda[k], Some(dl[k])));
-                    (eval.map(|e| e.0), eval.map(|e| (e.1, e.2)))
-                }
-                None => {
-                    let uv = lambda.map(|l| uvs[0] * l.x + uvs[1] * l.y + uvs[2] * l.z);
-                    (uv, quad_differences(uv))
-                }
+                UvSource::Mapped(m) => std::array::from_fn(|k| {
+                    let (uv, dx, dy) = m.uv(lambda[k], Some(dl[k]));
+                    dc.footprint(uv, dx, dy)
+                }),
+                UvSource::Planes(p) => p.quad_footprints(qi, qj),
             };
             for k in 0..4usize {
                 if mask & (1 << k) != 0 {
@@ -756,9 +810,7 @@ fn raster_quads(ctx: &Context, tile: &mut TileTarget, t: &TriangleSetup, range: 
                     let f = Fragment {
                         lambda: lambda[k],
                         dlambda: dl[k],
-                        uv: uv[k],
-                        duv_dx: d[k].0,
-                        duv_dy: d[k].1,
+                        fp: fps[k],
                         z: z[k],
                     };
                     let (li, lj) = ((i - tile.x0) as usize, (j - tile.y0) as usize);
@@ -780,7 +832,7 @@ fn write_fragment(
     lj: usize,
     f: &Fragment,
 ) {
-    let fp = dc.footprint(f.uv, f.duv_dx, f.duv_dy);
+    let fp = f.fp;
     // Under `Precision::Gpu` the colour is the fixed-point sample (of the same texels, so the
     // counts are the exact sampler's).
     let mut code = [[0u8; 4]];
@@ -817,7 +869,7 @@ fn write_fragment(
     let count = count + map_texels;
     let color = match ctx.settings.view {
         View::Color => shaded,
-        View::Uv => views::uv_color(f.uv.x, f.uv.y),
+        View::Uv => views::uv_color(f64::from(fp.u), f64::from(fp.v)),
         View::Mip => views::mip_color(dc.sampler, dc.texture, &fp),
         View::Lod => views::lod_color(dc.sampler, dc.texture, &fp),
         View::Aniso => views::aniso_color(dc.texture, &fp),

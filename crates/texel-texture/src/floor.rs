@@ -19,8 +19,8 @@
 //!   rounded up. Exact below `2^22` (`f32`) or `2^51` (`f64`), which callers guarantee by clamping.
 //!   [`floor_clamped`] (the batched sampler's texel indices and levels; the stored codes as
 //!   bytes; the unorm8 encode), [`ceil_clamped`] (the nearest-mip level), [`round_staged`]
-//!   (the fixed-point filters' weights and results), [`floor_staged_f64`] (the rasterizer's
-//!   period reduction of `uv`).
+//!   (the fixed-point filters' weights and results), [`floor_staged`] and [`floor_staged_f64`]
+//!   (the rasterizer's period reduction of `uv`).
 
 /// `floor(x)` as an `i64` texel index, saturating at the `i64` range; NaN gives 0.
 ///
@@ -163,6 +163,19 @@ pub fn ceil_clamped(x: f32, hi: f32) -> (i32, f32) {
     (r + i32::from(up), if up { rounded + 1.0 } else { rounded })
 }
 
+/// Staged `floor(t)` for `f32`, exact for `|t| <` [`STAGED_F32_LIMIT`] (callers check the range
+/// and keep their input beyond it; NaN stays NaN). Branch-free, as [`floor_staged_f64`]: the
+/// rasterizer's `f32` period reduction of `uv`.
+#[inline(always)]
+pub fn floor_staged(t: f32) -> f32 {
+    let r = (t + ROUND_F32) - ROUND_F32;
+    if r > t {
+        r - 1.0
+    } else {
+        r
+    }
+}
+
 /// `1.5 * 2^52`, [`ROUND_F32`]'s `f64` counterpart.
 const ROUND_F64: f64 = 6_755_399_441_055_744.0;
 
@@ -262,6 +275,21 @@ mod tests {
             }
         }
         assert!(floor_f64(f64::NAN).is_nan() && ceil_f64(f64::NAN).is_nan());
+    }
+
+    #[test]
+    fn floor_staged_is_the_floor_below_the_limit() {
+        let mut xs: Vec<f32> = samples().into_iter().filter(|x| !x.is_nan()).collect();
+        for e in [1.0f32, 2.0, 16_384.0, STAGED_F32_LIMIT] {
+            xs.extend([e - 0.5, e - 1e-3 * e.sqrt(), e, -e, -e + 0.25, e - 0.75]);
+        }
+        let mut checked = 0;
+        for x in xs.into_iter().filter(|x| x.abs() < STAGED_F32_LIMIT) {
+            assert_eq!(floor_staged(x), x.floor(), "staged {x}");
+            checked += 1;
+        }
+        assert!(checked > 20, "{checked}");
+        assert!(floor_staged(f32::NAN).is_nan());
     }
 
     /// The staged floor equals `f32::floor` of the clamped value for every `hi` up to the limit.
