@@ -6,11 +6,13 @@
 //! the original triangle's vertices. Alpha is `texture.a * base_color.a * vertex.a`; there is no
 //! blending (the nearest fragment replaces the pixel).
 //!
-//! Footprints: `uv` is interpolated in `f64`. For periodic address modes the sampler's result does
-//! not change when a whole period is subtracted, so `u` (`v`) is reduced modulo 1 (Repeat) or 2
-//! (MirrorRepeat) in `f64` before the conversion to `f32`: far from the origin (the ground scene
-//! reaches `|u| = 250`, 256 000 texels) this keeps the texel position exact to `f32` precision
-//! instead of losing 1/64 texel.
+//! Footprints: for periodic address modes the sampler's result does not change when a whole
+//! period is subtracted, so `u` (`v`) is reduced modulo 1 (Repeat) or 2 (MirrorRepeat) before the
+//! sampler sees it: far from the origin (the ground scene reaches `|u| = 250`, 256 000 texels) this
+//! keeps the texel position to `f32` precision instead of losing 1/64 texel. Interpolated `uv`
+//! comes from [`UvPlanes`] (`f32` planes from which whole periods were taken out at an anchor
+//! pixel of the tile, in `f64`); sphere mappings and the reference compute `uv` in `f64` and
+//! reduce it here ([`DrawContext::footprint`]) before the conversion to `f32`.
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3, Vec4};
 use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};

@@ -19,8 +19,10 @@
 //! Row-span batching: in the colour view without texel counting, a triangle's covered,
 //! depth-passing fragments in a tile are gathered into structure-of-arrays scratch (`Span`, one
 //! per tile, reused, never cleared per triangle): up to 64 fragments over as many rows as fit,
-//! each fragment carrying its row. The span is then interpolated stage by stage (barycentrics,
-//! their derivatives, the footprints; each stage a branch-free loop the compiler vectorises),
+//! each fragment carrying its row. The span is then interpolated stage by stage (`1/w`, `u'` and
+//! `v'` and their derivatives from the triangle's `f32` `UvPlanes` re-anchored in the tile, eight
+//! lanes with AVX2; the `f64` barycentrics only where shading or a sphere mapping reads them;
+//! each stage a branch-free loop the compiler vectorises),
 //! sampled by one `Sampler::sample_batch` call, then shaded and written. Each stage performs the
 //! per-pixel path's operations in the same order, so images are bit for bit the per-pixel path's
 //! (`tests/threads.rs`, also on grids of small triangles, head-on and tilted). Why: the per-pixel
@@ -29,7 +31,8 @@
 //! the independent lod computations of a span overlap, and gathering several rows samples a small
 //! triangle in one `sample_batch` call instead of one per row (the sampler runs calls of at most
 //! 16 footprints with 16-sample scratch). The periodic `uv` reduction multiplies by the exact
-//! reciprocal of the period instead of dividing. When the sampler ignores derivatives
+//! reciprocal of the period instead of dividing. The planes' anchor is chosen from the triangle's
+//! box in the whole tile, not the scissored range, so a scissor never changes a pixel. When the sampler ignores derivatives
 //! (`Sampler::uses_derivatives`: nearest or bilinear without mipmaps) and footprints are not
 //! captured, the span skips them. Frames are reusable (`render_into`, `draw_into`).
 //!
