@@ -331,11 +331,15 @@ fn ewa(uv: vec2<f32>, px: vec2<f32>, py: vec2<f32>, iso_lod: f32) -> vec4<f32> {
 
 // ---- The fragment shader -------------------------------------------------------------------------
 
+// Both targets hold f32 bit patterns in unsigned-integer formats (`Rgba32Uint`, `R32Uint`): every
+// device renders to those, where `Rgba32Float` and `R32Float` are not renderable on some (GL, and
+// GLES without EXT_color_buffer_float), and the bits read back are the shader's f32 values exactly.
 struct FragmentOut {
-    @location(0) color: vec4<f32>,
-    // The fragment's NDC depth in the CPU's convention (OpenGL's z / w in [-1, 1]); the target is
-    // cleared to +inf, so coverage is implied by depth, as in the CPU's frame.
-    @location(1) depth: vec4<f32>,
+    // The colour's f32 bits.
+    @location(0) color: vec4<u32>,
+    // The f32 bits of the fragment's NDC depth in the CPU's convention (OpenGL's z / w in [-1, 1]);
+    // the target is cleared to +inf's bits, so coverage is implied by depth, as in the CPU's frame.
+    @location(1) depth: u32,
 }
 
 @fragment
@@ -369,7 +373,7 @@ fn fs_main(in: VertexOut) -> FragmentOut {
         c = anisotropic(in.uv, duv_dx, duv_dy, px, py, lod);
     }
     var out: FragmentOut;
-    out.color = c * in.color;
-    out.depth = vec4<f32>(2.0 * in.clip.z - 1.0, 0.0, 0.0, 0.0);
+    out.color = bitcast<vec4<u32>>(c * in.color);
+    out.depth = bitcast<u32>(2.0 * in.clip.z - 1.0);
     return out;
 }

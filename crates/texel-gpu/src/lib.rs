@@ -319,8 +319,12 @@ impl Gpu {
     }
 }
 
-const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-const FRAG_DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// Linear colour as f32 bit patterns: unsigned-integer targets are renderable on every device
+/// (`Rgba32Float` is not on GL: Mesa's llvmpipe through wgpu's GL backend, for one), and the bits
+/// read back are the shader's f32 values exactly.
+const COLOR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+/// The fragment's NDC depth as f32 bits (`R32Float` is not renderable on GL either).
+const FRAG_DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// position (3), uv (2), colour (4) as `f32`.
 const VERTEX_FLOATS: usize = 9;
@@ -717,7 +721,9 @@ impl GpuDraws<'_> {
             let color_view = color.create_view(&Default::default());
             let frag_depth_view = frag_depth.create_view(&Default::default());
             let depth_view = depth.create_view(&Default::default());
-            let [r, g, b, a] = settings.background.map(f64::from);
+            // The integer targets are cleared to the f32 bits of the background and of +inf (a
+            // u32 is exact in f64; the backends convert the clear colour to u32 for uint targets).
+            let [r, g, b, a] = settings.background.map(|c| f64::from(c.to_bits()));
             let attachment = |view, clear| {
                 Some(wgpu::RenderPassColorAttachment {
                     view,
@@ -736,7 +742,7 @@ impl GpuDraws<'_> {
                     attachment(
                         &frag_depth_view,
                         wgpu::Color {
-                            r: f64::INFINITY,
+                            r: f64::from(f32::INFINITY.to_bits()),
                             ..wgpu::Color::TRANSPARENT
                         },
                     ),
@@ -833,11 +839,13 @@ impl GpuDraws<'_> {
     }
 }
 
-/// A frame's render targets: linear colour, fragment depth and the depth buffer, `size` pixels.
+/// A frame's render targets: linear colour (f32 bits in `Rgba32Uint`), fragment depth and the
+/// depth buffer, `size` pixels.
 struct Targets {
     size: (u32, u32),
     color: wgpu::Texture,
-    /// The fragment shader's NDC depth (`R32Float`, cleared to +inf): read back as the frame's depth.
+    /// The fragment shader's NDC depth (f32 bits in `R32Uint`, cleared to +inf): read back as the
+    /// frame's depth.
     frag_depth: wgpu::Texture,
     depth: wgpu::Texture,
 }
