@@ -5,7 +5,8 @@
 //! (planes from [`crate::setup`]), `lambda_k = q_k / r` and, by the quotient rule,
 //! `d lambda_k / dx = (q_k,x r - q_k r_x) / r^2 = (q_k,x - lambda_k r_x) / r`. Any attribute
 //! `a = sum_k lambda_k a_k` then has `da/dx = sum_k a_k d lambda_k / dx`: this is exactly
-//! `du/dx = (q_x r - q r_x) / r^2` for `q = u / w`, evaluated in `f64`.
+//! `du/dx = (q_x r - q r_x) / r^2` for `q = u / w`, evaluated in `f64` here ([`UvPlanes`] evaluates
+//! the same formulas in `f32` from planes re-anchored per tile and triangle).
 //! Affine: `lambda_k` is itself a plane and its derivatives are constants.
 //!
 //! The two formulas are the kernels `lambda` and `lambda_derivative`: the one-pixel API
@@ -118,8 +119,10 @@ impl TriangleSetup {
 /// (`n`, the periods below `u` at the anchor) are taken out there: `P_u' = P_u - n r`, so
 /// `u' = u - n`. Per pixel they are stepped in `f32` from the anchor by whole pixels (at most a
 /// tile, exact in `f32`), so the values stay near the anchor's `u' in [0, period)` instead of the
-/// ground's 250 periods. Then `u'` is reduced into `[0, period)` in `f32` (exactly: an integer
-/// subtracted from a value in range).
+/// ground's 250 periods. Then `u'` is reduced into `[0, period]` in `f32` (an integer number of
+/// periods subtracted; the product and the difference round, so `period` itself can come out). All
+/// nine coefficients are divided by `r` at the anchor in `f64` before they are rounded to `f32`,
+/// so they have the size of `u` and its steps whatever the scale of `w` (`r` is 1 at the anchor).
 ///
 /// Accuracy: a few `f32` ulps of `u'` (tested against the exact ray-plane intersection,
 /// `tests/perspective.rs`); where the image is magnified `u'` stays within about one period of the
@@ -191,16 +194,18 @@ impl UvPlanes {
             } else {
                 0.0
             };
+            // Divided by r0 (the ratios u = P_u / r and the derivatives do not change), so the
+            // f32 coefficients are of the size of u and its steps whatever the scale of w.
             [
-                (pc - n * r0) as f32,
-                (px - n * r.dx) as f32,
-                (py - n * r.dy) as f32,
+                ((pc - n * r0) / r0) as f32,
+                ((px - n * r.dx) / r0) as f32,
+                ((py - n * r.dy) / r0) as f32,
             ]
         };
         let inv = |p: f64| if p > 0.0 { (1.0 / p) as f32 } else { 0.0 };
         UvPlanes {
             anchor,
-            r: [r0 as f32, r.dx as f32, r.dy as f32],
+            r: [1.0, (r.dx / r0) as f32, (r.dy / r0) as f32],
             u: plane(0, period.x),
             v: plane(1, period.y),
             period: [period.x as f32, period.y as f32],
@@ -291,7 +296,7 @@ impl UvPlanes {
         })
     }
 
-    /// `x` (a `u'` for `c = 0`, a `v'` for `c = 1`) reduced into `[0, period)` by whole periods
+    /// `x` (a `u'` for `c = 0`, a `v'` for `c = 1`) reduced into `[0, period]` by whole periods
     /// (unchanged without a period, or for `|x / period| >= 2^22`, beyond the staged floor).
     #[inline(always)]
     pub fn reduce(&self, c: usize, x: f32) -> f32 {

@@ -381,7 +381,10 @@ pub(crate) fn shade(
 /// (`lambda + dlambda . o`, `uv + J o`) and the footprint's derivatives shrink to the sub-sample's
 /// spacing (`J / k` per axis), so every map, the base colour included, is filtered over the
 /// sub-sample's own footprint. The sub-samples are averaged in linear light (as the reference
-/// averages its own), and return the texels they read when `count`.
+/// averages its own), and return the texels they read when `count`. The sub-samples read the
+/// base colour with the `f32` sampler even where the pixel's own sample took the `--precision gpu`
+/// fixed-point route (`tile.rs`'s `Route::Fixed8`): sub-sampling is a quality feature, and the
+/// fixed-point route exists for the plain filters' speed.
 #[allow(clippy::too_many_arguments)]
 fn shade_grid(
     ctx: &DrawContext,

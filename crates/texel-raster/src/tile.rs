@@ -4,12 +4,15 @@
 //! - Every frame buffer is split, without copying, into per-tile row slices (`chunks_mut`), so tiles
 //!   are written in place by whichever thread renders them; no locks, no `unsafe`, no final copy.
 //! - Each tile processes its triangles in submission order (draw, then triangle, then sub-triangle)
-//!   and every per-pixel computation depends only on the pixel and the triangle, so the image is bit
-//!   for bit the same for any thread count and any scheduling.
+//!   and every per-pixel computation depends only on the pixel, the triangle and the tile (the
+//!   `UvPlanes` anchor), never on the thread or the order tiles run in, so the image is bit for bit
+//!   the same for any thread count and any scheduling.
 //! - Fragments are depth-tested (`z < depth`, `f32`, `+inf` cleared) before any interpolation or
 //!   sampling, so hidden fragments cost only their edge and depth test.
 //! - Coverage in the analytic mode steps the three integer edge functions incrementally along each
-//!   row (three adds per pixel); the quad mode evaluates 2x2 aligned quads (tiles have even origins,
+//!   row (three adds per pixel); the colour view's spans instead solve each row's covered run in
+//!   integers (per edge, `e + m step >= 0` for `m` from a floor division: exactly the pixels the
+//!   stepping accepts) and depth-test the run in one loop that vectorises; the quad mode evaluates 2x2 aligned quads (tiles have even origins,
 //!   so quads never straddle tiles) and interpolates all four pixels of a touched quad.
 //! - Triangle setups run in parallel chunks ([`crate::setup`]'s `setup_chunks`) and are binned in
 //!   the chunks they are computed in (the bins hold references; binning itself is serial), never
@@ -23,9 +26,11 @@
 //! `v'` and their derivatives from the triangle's `f32` `UvPlanes` re-anchored in the tile, eight
 //! lanes with AVX2; the `f64` barycentrics only where shading or a sphere mapping reads them;
 //! each stage a branch-free loop the compiler vectorises),
-//! sampled by one `Sampler::sample_batch` call, then shaded and written. Each stage performs the
-//! per-pixel path's operations in the same order, so images are bit for bit the per-pixel path's
-//! (`tests/threads.rs`, also on grids of small triangles, head-on and tilted). Why: the per-pixel
+//! sampled by one `Sampler::sample_batch` call, then shaded and written: a row whose whole run
+//! passed the depth test is written as slices (the encode in lanes, the depths a copy), other rows
+//! fragment by fragment. Each stage performs the per-pixel path's operations in the same order, so
+//! images are bit for bit the per-pixel path's (`tests/threads.rs`, also on grids of small
+//! triangles, head-on and tilted, and on draws that cross in depth). Why: the per-pixel
 //! path is latency-bound (one long chain per pixel: `1/w` division, footprint, `log2`, level,
 //! texel loads, blend), so cutting instructions alone does not move the wall time; batching lets
 //! the independent lod computations of a span overlap, and gathering several rows samples a small
@@ -39,9 +44,11 @@
 //! Frame times, the mesh's triangle rate and the profiles are in README.md's Benchmarks section;
 //! how each of these decisions moved them is in docs/perf-log.md.
 
+use std::cell::Cell;
+
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8, unorm8_table};
+use texel_texture::color::{rgba_to_unorm8, srgb8_encoder, unorm8_table, Srgb8Encoder};
 use texel_texture::Footprint;
 
 use crate::dispatch::Kernel;
@@ -317,7 +324,7 @@ fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]
         return;
     }
     let batched = ctx.settings.view == View::Color && !ctx.counting;
-    let mut span = if batched { Some(Span::new()) } else { None };
+    let mut span = if batched { Some(Span::take()) } else { None };
     for &t in bin {
         let Some([bi0, bj0, bi1, bj1]) = t.bbox else {
             continue;
@@ -344,6 +351,9 @@ fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]
             (Derivatives::Analytic, None) => raster_pixels(ctx, tile, (t, &source), range),
             (Derivatives::Quad, _) => raster_quads(ctx, tile, (t, &source), range),
         }
+    }
+    if let Some(span) = span {
+        span.give_back();
     }
 }
 
@@ -396,7 +406,7 @@ fn raster_pixels(
 }
 
 /// Pixels in a row span of a tile.
-const SPAN: usize = TILE as usize;
+const SPAN: usize = 4 * TILE as usize;
 
 /// Structure-of-arrays scratch for one row span of one triangle, reused across the spans and
 /// triangles of a tile (no allocation or clearing per triangle). Each stage below is a short loop
@@ -410,14 +420,14 @@ struct Span {
     lj: [u32; SPAN],
     /// Their depth.
     z: [f32; SPAN],
-    /// Their pixel-centre `x` and `y`.
+    /// Their pixel-centre `x` and `y` (filled by `barycentrics` from the rows and columns).
     x: [f64; SPAN],
     y: [f64; SPAN],
     /// `1 / r` (perspective) or 1 (affine).
     inv_r: [f64; SPAN],
     /// Barycentrics.
     l: [[f64; SPAN]; 3],
-    /// Their x and y derivatives (only when the footprint needs them).
+    /// Their x and y derivatives (zero unless the footprint or a material needs them).
     ldx: [[f64; SPAN]; 3],
     ldy: [[f64; SPAN]; 3],
     /// Their offsets from the [`UvPlanes`] anchor, `1 / r` and `u'`, `v'` ([`UvPlanes`]).
@@ -426,6 +436,9 @@ struct Span {
     inv: [f32; SPAN],
     u: [f32; SPAN],
     v: [f32; SPAN],
+    /// Rows gathered so far: `(first, end, contiguous)` fragment ranges, one per row, in order.
+    run: [(u32, u32, bool); SPAN],
+    runs: usize,
     /// The sampler's input and output.
     fps: [Footprint; SPAN],
     texs: [[f32; 4]; SPAN],
@@ -433,7 +446,23 @@ struct Span {
     bytes: [[u8; 4]; SPAN],
 }
 
+thread_local! {
+    /// Each thread's span scratch: made (and zeroed, 48 KB) once per thread and reused by every
+    /// tile the thread renders, where a fresh one per tile cost its allocation and clearing.
+    static SPARE_SPAN: Cell<Option<Box<Span>>> = const { Cell::new(None) };
+}
+
 impl Span {
+    /// This thread's spare span, or a new one.
+    fn take() -> Box<Span> {
+        SPARE_SPAN.with(Cell::take).unwrap_or_else(Span::new)
+    }
+
+    /// Keep this span for the thread's next tile.
+    fn give_back(self: Box<Span>) {
+        SPARE_SPAN.with(|s| s.set(Some(self)));
+    }
+
     fn new() -> Box<Span> {
         Box::new(Span {
             n: 0,
@@ -449,6 +478,8 @@ impl Span {
             ox: [0.0; SPAN],
             oy: [0.0; SPAN],
             inv: [0.0; SPAN],
+            run: [(0, 0, false); SPAN],
+            runs: 0,
             u: [0.0; SPAN],
             v: [0.0; SPAN],
             fps: [Footprint::default(); SPAN],
@@ -457,12 +488,32 @@ impl Span {
         })
     }
 
+    /// Record the fragments from `k` to `self.n` as one row's run (none if empty); `contiguous`:
+    /// their columns follow one another, so their writes are slices.
+    #[inline(always)]
+    fn push_run(&mut self, k: usize, contiguous: bool) {
+        if self.n > k {
+            self.run[self.runs] = (k as u32, self.n as u32, contiguous);
+            self.runs += 1;
+        }
+    }
+
     /// Barycentrics of the span's fragments at their pixel centres, with the derivatives when
     /// asked: [`interp::lambda`] and [`interp::lambda_derivative`], the kernels of
     /// [`TriangleSetup::barycentrics`], staged over the span (so the same bits).
     #[inline(always)]
-    fn barycentrics(&mut self, t: &TriangleSetup, perspective: Perspective, deriv: bool) {
+    fn barycentrics(
+        &mut self,
+        t: &TriangleSetup,
+        perspective: Perspective,
+        deriv: bool,
+        origin: [u32; 2],
+    ) {
         let n = self.n;
+        for k in 0..n {
+            self.x[k] = f64::from(self.li[k] + origin[0]) + 0.5;
+            self.y[k] = f64::from(self.lj[k] + origin[1]) + 0.5;
+        }
         let xys = self.x[..n].iter().zip(&self.y[..n]);
         match perspective {
             Perspective::Correct => {
@@ -476,7 +527,12 @@ impl Span {
                         *l = interp::lambda(q.at(x, y), inv);
                     }
                 }
-                if deriv {
+                if !deriv {
+                    // Nothing reads them (no material, a sampler without derivatives): zero,
+                    // not left over from an earlier span.
+                    self.ldx.iter_mut().for_each(|d| d[..n].fill(0.0));
+                    self.ldy.iter_mut().for_each(|d| d[..n].fill(0.0));
+                } else {
                     for k in 0..3 {
                         let q = t.q[k];
                         let it = self.l[k][..n].iter().zip(&self.inv_r[..n]);
@@ -494,11 +550,14 @@ impl Span {
                         *l = a.at(x, y);
                     }
                 }
-                if deriv {
-                    for k in 0..3 {
-                        self.ldx[k][..n].fill(t.affine[k].dx);
-                        self.ldy[k][..n].fill(t.affine[k].dy);
-                    }
+                for k in 0..3 {
+                    let d = if deriv {
+                        t.affine[k]
+                    } else {
+                        Default::default()
+                    };
+                    self.ldx[k][..n].fill(d.dx);
+                    self.ldy[k][..n].fill(d.dy);
                 }
             }
         }
@@ -593,35 +652,66 @@ fn raster_pixels_batched(
     // A row adds at most this many fragments.
     let width = (i_hi - i_lo + 1) as usize;
     span.n = 0;
+    span.runs = 0;
     for j in j_lo..=j_hi {
         if span.n + width > SPAN {
             flush_span(ctx, tile, t, (dc, source), span);
         }
         let y_fixed = pixel_center_fixed(j);
-        let mut e = t.edges.map(|e| e.at(x_start, y_fixed));
+        let e = t.edges.map(|e| e.at(x_start, y_fixed));
+        // The row's covered pixels, `i_lo + m` for `m` in `lo..=hi`: exactly those where every
+        // edge function `e + m step` is `>= 0` (integers, solved per edge), so the pixels need no
+        // edge test of their own.
+        let (mut lo, mut hi) = (0i64, width as i64 - 1);
+        for (e, s) in e.into_iter().zip(step) {
+            if s > 0 {
+                lo = lo.max(-e.div_euclid(s));
+            } else if s < 0 {
+                hi = hi.min(e.div_euclid(-s));
+            } else if e < 0 {
+                hi = -1;
+            }
+        }
+        if lo > hi {
+            continue;
+        }
         let y = f64::from(j) + 0.5;
         let lj = j - tile.y0;
         let depth_row = &tile.depth[lj as usize];
-        let mut n = span.n;
-        for i in i_lo..=i_hi {
-            if (e[0] | e[1] | e[2]) >= 0 {
-                let x = f64::from(i) + 0.5;
-                let li = i - tile.x0;
-                let z = t.depth_at(x, y) as f32;
-                if z < depth_row[li as usize] {
-                    span.li[n] = li;
-                    span.lj[n] = lj;
-                    span.z[n] = z;
-                    span.x[n] = x;
-                    span.y[n] = y;
-                    n += 1;
-                }
-            }
-            e[0] += step[0];
-            e[1] += step[1];
-            e[2] += step[2];
+        let n = span.n;
+        let len = (hi - lo + 1) as usize;
+        let i0 = i_lo + lo as u32;
+        let l0 = (i0 - tile.x0) as usize;
+        // Depth of the whole run and how many pass, in one loop that vectorises (the pixel
+        // index as `i32` converts to `f64` in lanes; the same value as from `u32`).
+        let (zs, ds) = (&mut span.z[n..n + len], &depth_row[l0..l0 + len]);
+        let mut pass = 0usize;
+        for (m, (z, d)) in zs.iter_mut().zip(ds).enumerate() {
+            *z = t.depth_at(f64::from((i0 + m as u32) as i32) + 0.5, y) as f32;
+            pass += usize::from(*z < *d);
         }
-        span.n = n;
+        let (lis, ljs) = (&mut span.li[n..n + len], &mut span.lj[n..n + len]);
+        if pass == len {
+            for (m, (li, lj_)) in lis.iter_mut().zip(ljs).enumerate() {
+                *li = (l0 + m) as u32;
+                *lj_ = lj;
+            }
+            span.n = n + len;
+            span.push_run(n, true);
+        } else {
+            // Compact in place (the write slot never passes the read slot): every fragment is
+            // written at slot `w`, which advances only when it passes the depth test.
+            let mut w = n;
+            for (m, &d) in ds.iter().enumerate() {
+                let z = span.z[n + m];
+                span.z[w] = z;
+                span.li[w] = (l0 + m) as u32;
+                span.lj[w] = lj;
+                w += usize::from(z < d);
+            }
+            span.n = w;
+            span.push_run(n, false);
+        }
     }
     flush_span(ctx, tile, t, (dc, source), span);
 }
@@ -647,12 +737,12 @@ fn flush_span(
     let shaded = !dc.unshaded() || ctx.lighting.is_some();
     match source {
         UvSource::Mapped(m) => {
-            span.barycentrics(t, ctx.settings.perspective, deriv);
+            span.barycentrics(t, ctx.settings.perspective, deriv, [tile.x0, tile.y0]);
             span.mapped_footprints(dc, m, deriv);
         }
         UvSource::Planes(p) => {
             if shaded {
-                span.barycentrics(t, ctx.settings.perspective, deriv);
+                span.barycentrics(t, ctx.settings.perspective, deriv, [tile.x0, tile.y0]);
             }
             span.plane_footprints(p, [tile.x0, tile.y0], deriv);
         }
@@ -661,12 +751,12 @@ fn flush_span(
     match ctx.routes[t.draw as usize] {
         Route::Stored if dc.sampler.sample_batch_stored(dc.texture, fps, bytes) => {
             let (color8, depth) = (&mut tile.color8, &mut tile.depth);
-            write_rows(span, &span.bytes, color8, depth, |&b| b);
+            write_rows(span, &span.bytes, color8, depth, Copied);
         }
         Route::Fixed8 { copy } if dc.sampler.sample_batch_fixed8(dc.texture, fps, bytes) => {
             if copy {
                 let (color8, depth) = (&mut tile.color8, &mut tile.depth);
-                write_rows(span, &span.bytes, color8, depth, |&b| b);
+                write_rows(span, &span.bytes, color8, depth, Copied);
             } else {
                 for (t, b) in span.texs[..n].iter_mut().zip(&span.bytes[..n]) {
                     *t = decode_unorm8(*b);
@@ -682,6 +772,7 @@ fn flush_span(
         }
     }
     span.n = 0;
+    span.runs = 0;
 }
 
 /// Sample (when `sample`; else `span.texs` holds the samples), shade and write the span's
@@ -719,9 +810,9 @@ fn shade_span(
     let (color8, depth) = (&mut tile.color8, &mut tile.depth);
     let texs = &span.texs;
     match tile.target {
-        ColorTarget::Float => write_rows(span, texs, &mut tile.color, depth, |&c| c),
-        ColorTarget::Srgb8 => write_rows(span, texs, color8, depth, |&c| rgba_to_srgb8(c)),
-        ColorTarget::Unorm8 => write_rows(span, texs, color8, depth, |&c| rgba_to_unorm8(c)),
+        ColorTarget::Float => write_rows(span, texs, &mut tile.color, depth, Copied),
+        ColorTarget::Srgb8 => write_rows(span, texs, color8, depth, srgb8_encoder()),
+        ColorTarget::Unorm8 => write_rows(span, texs, color8, depth, Unorm8),
     }
 }
 
@@ -732,6 +823,43 @@ fn decode_unorm8(b: [u8; 4]) -> [f32; 4] {
     b.map(|c| table[c as usize])
 }
 
+/// How [`write_rows`] turns a value into what the target stores: a trait with always-inlined
+/// methods rather than a closure, which the compiler kept out of line (in the baseline copy, not
+/// the tile's x86-64-v3 one: 15 % of an sRGB trilinear frame's samples).
+trait Encode<V, C>: Copy {
+    fn encode(self, v: &V) -> C;
+}
+
+/// Values stored as they are.
+#[derive(Clone, Copy)]
+struct Copied;
+
+impl<V: Copy> Encode<V, V> for Copied {
+    #[inline(always)]
+    fn encode(self, v: &V) -> V {
+        *v
+    }
+}
+
+/// Linear RGBA to unorm8 bytes ([`rgba_to_unorm8`]).
+#[derive(Clone, Copy)]
+struct Unorm8;
+
+impl Encode<[f32; 4], [u8; 4]> for Unorm8 {
+    #[inline(always)]
+    fn encode(self, v: &[f32; 4]) -> [u8; 4] {
+        rgba_to_unorm8(*v)
+    }
+}
+
+/// Linear RGBA to sRGB bytes (`rgba_to_srgb8`), the encoder looked up once per span.
+impl Encode<[f32; 4], [u8; 4]> for &Srgb8Encoder {
+    #[inline(always)]
+    fn encode(self, v: &[f32; 4]) -> [u8; 4] {
+        self.encode_rgba(*v)
+    }
+}
+
 /// Write the span's colours (`values`, through `encode`) and depths into the tile's rows.
 #[inline(always)]
 fn write_rows<V, C>(
@@ -739,18 +867,27 @@ fn write_rows<V, C>(
     values: &[V],
     color: &mut [&mut [C]],
     depth: &mut [&mut [f32]],
-    encode: impl Fn(&V) -> C,
+    encode: impl Encode<V, C>,
 ) {
-    let n = span.n;
-    let mut k = 0;
-    while k < n {
-        let lj = span.lj[k] as usize;
+    for &(k0, k1, contiguous) in &span.run[..span.runs] {
+        let (k0, k1) = (k0 as usize, k1 as usize);
+        let lj = span.lj[k0] as usize;
         let (color, depth) = (&mut *color[lj], &mut *depth[lj]);
-        while k < n && span.lj[k] as usize == lj {
-            let li = span.li[k] as usize;
-            color[li] = encode(&values[k]);
-            depth[li] = span.z[k];
-            k += 1;
+        let (values, zs) = (&values[k0..k1], &span.z[k0..k1]);
+        if contiguous {
+            // Slices: the encode runs in lanes and the depths are a copy.
+            let li = span.li[k0] as usize;
+            let color = &mut color[li..li + values.len()];
+            for (c, v) in color.iter_mut().zip(values) {
+                *c = encode.encode(v);
+            }
+            depth[li..li + zs.len()].copy_from_slice(zs);
+        } else {
+            for (k, (v, &z)) in values.iter().zip(zs).enumerate() {
+                let li = span.li[k0 + k] as usize;
+                color[li] = encode.encode(v);
+                depth[li] = z;
+            }
         }
     }
 }

@@ -5,7 +5,9 @@
 //! displayed value) so that the ordinary sRGB encoding of [`crate::Frame::to_srgb8`] shows exactly the
 //! displayed value. Scales are fixed, not normalised per image, so images are comparable.
 //!
-//! - uv: `(fract(u), fract(v), 0)`, with `u`, `v` unreduced `f64`.
+//! - uv: `(fract(u), fract(v), 0)`, with `u`, `v` the footprint's `f32` uv handed to the sampler
+//!   (reduced by whole periods of the address mode, which leaves `fract` unchanged: periods are
+//!   whole numbers).
 //! - mip: [`MIP_PALETTE`]`[level]`, `level` = the nearest-level rule `ceil(lod + 1/2) - 1` clamped to
 //!   the pyramid (the level `*_MIPMAP_NEAREST` reads), `lod` from `Sampler::lod`.
 //! - lod: the palette interpolated linearly between `floor(lod)` and `floor(lod) + 1`.

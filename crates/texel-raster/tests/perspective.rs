@@ -47,13 +47,16 @@ fn ground_uv_matches_ray_plane_intersection() {
 /// sampler, in the span, per-pixel and quad paths) against the exact ray-plane intersection,
 /// modulo the period, on the ground with a 256-texel texture (u reaches 250 periods): within
 /// 1e-4 texel where the image is magnified (a pixel spans less than a texel; 3.9e-7 of a period,
-/// about 3 `f32` ulps of a `u` in `[0, 1)`) and elsewhere within 1e-4 of the footprint's extent.
-/// Measured: 4.9e-5 texel (1.9e-7 period) and 4.8e-5 of the extent. The `f64` barycentrics
+/// about 6.5 `f32` ulps of a `u` in `[0.5, 1)`) and elsewhere within 1e-4 of the footprint's
+/// extent; in the analytic paths (span, per pixel) the four derivatives are within 1e-5 of the
+/// largest of the `f64` barycentrics' derivatives.
+/// Measured: 3.95e-5 texel (1.5e-7 period), 4.5e-5 of the extent, derivatives 7.9e-7. The `f64` barycentrics
 /// above keep 1e-4 texel of a 1024-texel texture at any distance.
 #[test]
 fn rendered_footprints_match_the_ray_plane_intersection() {
     const BOUND: f64 = 1e-4;
     const REL: f64 = 1e-4;
+    const DERIV: f64 = 1e-5;
     let (w, h) = (1280, 720);
     let scene = Ground::with_texture(w, h, common::checker(256, 8));
     let sampler = lab_sampler(4);
@@ -62,6 +65,8 @@ fn rendered_footprints_match_the_ray_plane_intersection() {
         capture_footprints: true,
         ..RenderSettings::new(w, h)
     };
+    let setups = setup_draws(&base, &[scene.draw(&sampler)]).unwrap();
+    let vertices = scene.draw(&sampler).vertices;
     let paths = [
         ("span", base),
         (
@@ -82,6 +87,7 @@ fn rendered_footprints_match_the_ray_plane_intersection() {
     for (name, settings) in paths {
         let frame = texel_raster::render(&settings, &[scene.draw(&sampler)]).unwrap();
         let (mut magnified, mut worst_mag, mut worst_rel) = (0, 0.0f64, 0.0f64);
+        let mut worst_deriv = 0.0f64;
         for j in 0..h {
             for i in 0..w {
                 let k = frame.index(i, j);
@@ -99,6 +105,21 @@ fn rendered_footprints_match_the_ray_plane_intersection() {
                     .iter()
                     .fold(0.0f64, |m, d| m.max(f64::from(d.abs())))
                     * texels;
+                // The analytic paths' four derivatives against the f64 barycentrics' (quads
+                // difference neighbouring pixels instead: a different quantity).
+                if name != "quads" {
+                    let t = setups.iter().find(|t| t.covers(i, j)).unwrap();
+                    let uvs = t.indices.map(|k| vertices[k as usize].uv.as_dvec2());
+                    let (dx, dy) = t.barycentrics(x, y, Perspective::Correct).derivatives2(uvs);
+                    let got = [fp.dudx, fp.dvdx, fp.dudy, fp.dvdy].map(f64::from);
+                    let want = [dx.x, dx.y, dy.x, dy.y];
+                    let scale = want.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+                    for (g, e) in got.iter().zip(want) {
+                        let rel = (g - e).abs() / scale;
+                        worst_deriv = worst_deriv.max(rel);
+                        assert!(rel < DERIV, "{name} ({i}, {j}): derivative {g} vs {e}");
+                    }
+                }
                 if extent < 1.0 {
                     magnified += 1;
                     worst_mag = worst_mag.max(err);
@@ -114,7 +135,7 @@ fn rendered_footprints_match_the_ray_plane_intersection() {
         }
         eprintln!(
             "{name}: {magnified} magnified pixels, worst {worst_mag:.2e} texel; elsewhere \
-             {worst_rel:.2e} of the extent"
+             {worst_rel:.2e} of the extent; derivatives within {worst_deriv:.2e} of the largest"
         );
         assert!(magnified > 50_000, "{name}: {magnified}");
     }

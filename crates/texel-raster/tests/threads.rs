@@ -3,8 +3,12 @@
 mod common;
 
 use common::{lab_sampler, screen_grid, Ground};
-use glam::{Mat4, Vec3};
-use texel_raster::{render, render_reference, Derivatives, DrawCall, RenderSettings, View};
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use texel_raster::{
+    render, render_reference, Derivatives, DrawCall, Light, Material, RenderSettings, TextureInput,
+    UvEvaluation, UvMapping, View, MAX_LIGHTS,
+};
+use texel_texture::sphere::SurfaceProjection;
 
 #[test]
 fn one_and_two_threads_give_identical_frames() {
@@ -49,15 +53,25 @@ fn one_and_two_threads_give_identical_frames() {
 /// Render `draw` with batched sampling (the colour view) and with the per-pixel path (texel
 /// counting) and require the same frame, bit for bit, with and without captured footprints.
 fn assert_batched_equals_per_pixel(w: u32, h: u32, draw: DrawCall, label: &str) {
+    assert_batched_equals_per_pixel_in(&RenderSettings::new(w, h), draw, label);
+}
+
+/// As [`assert_batched_equals_per_pixel`] under `base` settings (lights, say).
+fn assert_batched_equals_per_pixel_in(base: &RenderSettings, draw: DrawCall, label: &str) {
+    assert_draws_batched_equal_per_pixel(base, &[draw], label);
+}
+
+/// As [`assert_batched_equals_per_pixel`] for several draws in order.
+fn assert_draws_batched_equal_per_pixel(base: &RenderSettings, draws: &[DrawCall], label: &str) {
     for capture_footprints in [true, false] {
         let settings = |count_texels| RenderSettings {
             count_texels,
             threads: Some(2),
             capture_footprints,
-            ..RenderSettings::new(w, h)
+            ..*base
         };
-        let batched = render(&settings(false), &[draw]).unwrap();
-        let single = render(&settings(true), &[draw]).unwrap();
+        let batched = render(&settings(false), draws).unwrap();
+        let single = render(&settings(true), draws).unwrap();
         assert!(batched.covered_pixels() > 0, "{label}");
         let bits = |f: &texel_raster::Frame| {
             f.color
@@ -113,6 +127,110 @@ fn batched_small_triangles_equal_per_pixel() {
             };
             let label = format!("{name} grid, lab mode {mode}");
             assert_batched_equals_per_pixel(w, h, draw, &label);
+        }
+    }
+}
+
+/// The span path's other branches against the per-pixel path: lit draws without a material,
+/// lit draws with a normal-mapped material, vertex colours, and a per-pixel sphere mapping (the
+/// span computes barycentrics only for these), for a filter that ignores derivatives (lab mode 2)
+/// and one that reads them (mode 4).
+#[test]
+fn batched_shaded_and_mapped_draws_equal_per_pixel() {
+    let (w, h) = (300, 170);
+    let scene = Ground::new(w, h);
+    let mut lights = [None; MAX_LIGHTS];
+    lights[0] = Some(Light::Directional {
+        direction: Vec3::new(-0.4, 1.0, 0.3),
+        intensity: Vec3::splat(2.0),
+    });
+    let lit = RenderSettings {
+        lights,
+        ..RenderSettings::new(w, h)
+    };
+    let plain = RenderSettings::new(w, h);
+    let mut coloured = scene.vertices.clone();
+    for (k, v) in coloured.iter_mut().enumerate() {
+        v.color = Vec4::new(0.2 + 0.2 * k as f32, 1.0 - 0.2 * k as f32, 0.5, 1.0);
+    }
+    for mode in [2, 4] {
+        let sampler = lab_sampler(mode);
+        let draw = scene.draw(&sampler);
+        assert_batched_equals_per_pixel_in(&lit, draw, &format!("lit, mode {mode}"));
+        let material = Material {
+            roughness: 0.4,
+            normal_map: Some(TextureInput {
+                texture: &scene.texture,
+                sampler: &sampler,
+            }),
+            ..Material::default()
+        };
+        let with_material = DrawCall {
+            material: Some(material),
+            ..draw
+        };
+        let label = format!("lit, normal map, mode {mode}");
+        assert_batched_equals_per_pixel_in(&lit, with_material, &label);
+        let label = format!("unlit, material, mode {mode}");
+        assert_batched_equals_per_pixel_in(&plain, with_material, &label);
+        let vertex_coloured = DrawCall {
+            vertices: &coloured,
+            ..draw
+        };
+        let label = format!("vertex colours, mode {mode}");
+        assert_batched_equals_per_pixel_in(&plain, vertex_coloured, &label);
+        let mapped = DrawCall {
+            uv_mapping: Some(UvMapping {
+                projection: SurfaceProjection::Equirect,
+                centre: Vec3::new(0.0, -3.0, -20.0),
+                evaluation: UvEvaluation::PerPixel,
+            }),
+            ..draw
+        };
+        let label = format!("sphere-mapped, mode {mode}");
+        assert_batched_equals_per_pixel_in(&plain, mapped, &label);
+    }
+}
+
+/// Two draws that cross in depth, so that the second one's rows pass the depth test only in
+/// part (the span's compaction) and elsewhere in whole (its contiguous runs): a grid whose depth
+/// rises from left to right, then a flat one in front of its right part, in big triangles (3 x 2
+/// cells) and small ones (60 x 40).
+#[test]
+fn batched_equals_per_pixel_where_draws_cross_in_depth() {
+    let (w, h) = (300, 170);
+    for (nx, ny) in [(3, 2), (60, 40)] {
+        let (mut sloped, triangles, texture) = screen_grid(w, h, nx, ny);
+        let mut flat = sloped.clone();
+        for v in &mut sloped {
+            v.position.z = 0.5 * v.position.x + 0.05 * v.position.y;
+        }
+        for v in &mut flat {
+            v.position.z = 0.1;
+            v.uv = Vec2::new(v.uv.y, v.uv.x);
+        }
+        for mode in [1, 2, 4] {
+            let sampler = lab_sampler(mode);
+            let draw = |vertices| DrawCall {
+                vertices,
+                triangles: &triangles,
+                texture: &texture,
+                sampler: &sampler,
+                clip_from_world: Mat4::IDENTITY,
+                material: None,
+                uv_mapping: None,
+            };
+            let base = RenderSettings::new(w, h);
+            let label = format!("{nx} x {ny} cells, lab mode {mode}");
+            let draws = [draw(&sloped), draw(&flat)];
+            assert_draws_batched_equal_per_pixel(&base, &draws, &label);
+            // Both draws really show: the flat one's constant depth on the right, the sloped
+            // one's on the left.
+            let frame = render(&base, &draws).unwrap();
+            let depth = |i, j| frame.depth[frame.index(i, j)];
+            assert_eq!(depth(280, 85), depth(250, 40), "{label}");
+            assert_ne!(depth(20, 85), depth(280, 85), "{label}");
+            assert_ne!(depth(20, 85), depth(40, 85), "{label}");
         }
     }
 }

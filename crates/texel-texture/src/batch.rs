@@ -162,6 +162,189 @@ pub(crate) trait Taps: LevelFilter {
     }
 }
 
+/// Probes gathered from several samples before they are filtered ([`anisotropic`]).
+const PROBES: usize = 256;
+
+/// Anisotropic filtering of `footprints` into `out` for a sampler whose technique is
+/// anisotropic, on a pyramid whose level 0 is at most [`MAX_SIDE`] per side: per chunk the
+/// queries ([`queries`]) and probe plans ([`crate::aniso::plan_chunk`]); every sample with more
+/// than one probe (and a positive lod) lays its probes out in shared scratch, up to [`PROBES`]
+/// from several samples, which are then filtered together, stage by stage, as [`run`] filters
+/// trilinear samples (so the lods, floors and texel loads of many probes pipeline, where one
+/// sample's few probes did not); the other samples go to `single` (plain trilinear or the
+/// magnification filter). Bit for bit [`crate::aniso::filter_planned`]: the same probe positions,
+/// levels and blends, each sample's probes summed in order from zero, times `1 / N`.
+#[inline(always)]
+pub(crate) fn anisotropic<P: Pyramid>(
+    p: &P,
+    s: &Sampler,
+    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
+    mut single: impl FnMut(&Query, &crate::aniso::Plan) -> Vec4,
+) {
+    let size0 = p.level(0).size();
+    let last = p.level_count() - 1;
+    let levels = p.level_count().min(LEVELS);
+    let (mut dims_w, mut dims_h) = ([0.0f32; LEVELS], [0.0f32; LEVELS]);
+    let mut views = [p.level(0); LEVELS];
+    for (l, view) in views.iter_mut().enumerate().take(levels) {
+        *view = p.level(l);
+        let (w, h) = view.size();
+        (dims_w[l], dims_h[l]) = (w as f32, h as f32);
+    }
+    let size = |l: u8| {
+        let l = l as usize & (LEVELS - 1);
+        (dims_w[l], dims_h[l])
+    };
+    let mut chunk = Chunk::<CHUNK>::new();
+    let mut plans = [crate::aniso::Plan::default(); CHUNK];
+    let mut probes = ProbeBatch::new(s.address());
+    // Per sample of the chunk: its probes' sum, and `1 / N` (0: not a probed sample).
+    let mut sums = [Vec4::ZERO; CHUNK];
+    let mut inv = [0.0f32; CHUNK];
+    let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
+    for (fps, out) in footprints.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+        queries(s, size0, fps, &mut chunk);
+        crate::aniso::plan_chunk(s, size0, fps, &mut plans);
+        for (k, fp) in fps.iter().enumerate() {
+            let (q, plan) = (chunk.query(k, fp), &plans[k]);
+            if !(q.lod > 0.0 && plan.n > 1) {
+                inv[k] = 0.0;
+                out[k] = single(&q, plan).to_array();
+                continue;
+            }
+            // `filter_planned`'s probes (`n <= 64`: `plan`).
+            let n = (plan.n as usize).min(CHUNK);
+            if probes.m + n > PROBES {
+                probes.flush(&views, size, &mut sums);
+            }
+            inv[k] = 1.0 / plan.n as f32;
+            sums[k] = Vec4::ZERO;
+            let (l, delta) = mip::linear_levels(plan.lod, last);
+            let coarse = delta > 0.0 && l < last;
+            for i in 0..n {
+                let t = (i as f32 + 0.5) * inv[k] - 0.5;
+                let m = probes.m;
+                probes.at.u[m] = finite(q.fp.u + t * plan.axis.x);
+                probes.at.v[m] = finite(q.fp.v + t * plan.axis.y);
+                probes.fine.level[m] = l as u8;
+                probes.next.level[m] = if coarse { l + 1 } else { l } as u8;
+                probes.delta[m] = delta;
+                probes.coarse[m] = coarse;
+                probes.owner[m] = k as u8;
+                probes.m += 1;
+            }
+        }
+        probes.flush(&views, size, &mut sums);
+        for (k, o) in out.iter_mut().enumerate().take(fps.len()) {
+            if inv[k] > 0.0 {
+                *o = (sums[k] * inv[k]).to_array();
+            }
+        }
+    }
+}
+
+/// [`anisotropic`]'s probe scratch: up to [`PROBES`] probes with their levels (`fine.level`,
+/// `next.level`), blend weight, whether the coarser level is weighed, and the sample they belong
+/// to.
+struct ProbeBatch {
+    m: usize,
+    at: Chunk<PROBES>,
+    fine: Pass<PROBES, Bilinear>,
+    next: Pass<PROBES, Bilinear>,
+    delta: [f32; PROBES],
+    coarse: [bool; PROBES],
+    owner: [u8; PROBES],
+}
+
+impl ProbeBatch {
+    fn new(addr: Address) -> Box<ProbeBatch> {
+        Box::new(ProbeBatch {
+            m: 0,
+            at: Chunk::new(),
+            fine: Pass::new(Bilinear, addr),
+            next: Pass::new(Bilinear, addr),
+            delta: [0.0; PROBES],
+            coarse: [false; PROBES],
+            owner: [0; PROBES],
+        })
+    }
+
+    /// Filter the gathered probes and add each, in order, to its sample's sum: `Probes::trilinear_sum`'s
+    /// stages (the finer level's bilinear sample, blended with the coarser one's by `delta` where
+    /// weighed) over probes of several samples. Empties the batch.
+    #[inline(always)]
+    fn flush<F: Fetch>(
+        &mut self,
+        views: &[F; LEVELS],
+        size: impl Fn(u8) -> (f32, f32),
+        sums: &mut [Vec4; CHUNK],
+    ) {
+        let m = self.m;
+        if m == 0 {
+            return;
+        }
+        let (us, vs) = (&self.at.u[..m], &self.at.v[..m]);
+        self.fine.coordinates(&size, us, vs);
+        self.next.coordinates(&size, us, vs);
+        for k in 0..m {
+            let uv = self.at.uv(k);
+            let level = |l: u8| &views[l as usize & (LEVELS - 1)];
+            let a = self.fine.filtered(level(self.fine.level[k]), k, uv);
+            let value = if self.coarse[k] {
+                lerp(
+                    a,
+                    self.next.filtered(level(self.next.level[k]), k, uv),
+                    self.delta[k],
+                )
+            } else {
+                a
+            };
+            sums[self.owner[k] as usize] += value;
+        }
+        self.m = 0;
+    }
+}
+
+/// Nearest sampling of `level` (level 0 of a lod-free sampler: `mipmap_filter` None, both
+/// filters nearest) as stored bytes: [`run`] with [`Point`] in one level, bit for bit, without
+/// the decode to codes and back. Per sample the same query ([`finite_uv`]), origin,
+/// [`floor_clamped`] and inside test as [`Pass::coordinates`]; inside the level the texel's
+/// bytes are copied, elsewhere [`Point`]'s one-sample filter (address wrapping, border codes
+/// in `addr`) gives the codes. The indices of a chunk are computed in one loop that vectorises,
+/// then the texels are copied.
+#[inline(always)]
+pub(crate) fn point_bytes(
+    level: &crate::fetch::Level<'_, crate::fetch::Codes8>,
+    addr: &Address,
+    footprints: &[Footprint],
+    out: &mut [[u8; 4]],
+) {
+    let (w, h) = level.size();
+    let (wf, hf) = (w as f32, h as f32);
+    let (mut ii, mut jj) = ([0i32; CHUNK], [0i32; CHUNK]);
+    let mut inside = [false; CHUNK];
+    for (fps, out) in footprints.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+        for (k, fp) in fps.iter().enumerate() {
+            let (u, v) = (finite_uv(fp.u), finite_uv(fp.v));
+            let (x, y) = (u * wf - Point::HALF, v * hf - Point::HALF);
+            let (i, fi) = floor_clamped(x, wf);
+            let (j, fj) = floor_clamped(y, hf);
+            ii[k] = i;
+            jj[k] = j;
+            inside[k] = fi >= 0.0 && fi < wf - Point::REACH && fj >= 0.0 && fj < hf - Point::REACH;
+        }
+        for (k, (o, fp)) in out.iter_mut().zip(fps).enumerate() {
+            *o = if inside[k] {
+                level.texels[jj[k] as u32 as usize * w as usize + ii[k] as u32 as usize]
+            } else {
+                let uv = Vec2::new(finite_uv(fp.u), finite_uv(fp.v));
+                let c = Point.filter(level, addr, uv).to_array();
+                crate::floor::integer_bytes4(c)
+            };
+        }
+    }
+}
+
 /// One level pass over a chunk with the within-level filter `T`, under the address modes `addr`:
 /// per sample its level, first tap, fractions and whether all its taps lie inside the level.
 struct Pass<const N: usize, T> {
@@ -303,6 +486,16 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     for (fps, out) in footprints.chunks(N).zip(out.chunks_mut(N)) {
         let n = fps.len();
         queries(s, size0, fps, &mut chunk);
+        if d.mipmap_filter == MipmapFilterMode::None {
+            // Every sample in level 0: stages 2 and 3 with its view and size, no per-sample
+            // level lookups.
+            let size = (dims_w[0], dims_h[0]);
+            first.coordinates(|_| size, &chunk.u[..n], &chunk.v[..n]);
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = first.filtered(&base, k, chunk.uv(k)).to_array();
+            }
+            continue;
+        }
         // Stage 1: levels (u8: at most 32 levels for a 2^31 side; textures are far smaller).
         match d.mipmap_filter {
             MipmapFilterMode::None => first.level[..n].fill(0),

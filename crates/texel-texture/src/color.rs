@@ -61,12 +61,7 @@ pub fn linear_to_srgb8(l: f32) -> u8 {
 /// stores and what texel's PNGs hold.
 #[inline(always)]
 pub fn rgba_to_srgb8(c: [f32; 4]) -> [u8; 4] {
-    [
-        linear_to_srgb8(c[0]),
-        linear_to_srgb8(c[1]),
-        linear_to_srgb8(c[2]),
-        unorm8(c[3]),
-    ]
+    srgb8_encoder().encode_rgba(c)
 }
 
 /// One RGBA colour as 8-bit unorm bytes, every channel [`unorm8`] (clamped, NaN gives 0), no
@@ -137,6 +132,17 @@ impl Srgb8Encoder {
             top <= encoder.base[b].saturating_add(1)
         }));
         encoder
+    }
+
+    /// [`rgba_to_srgb8`] with this encoder (callers encoding many colours look it up once).
+    #[inline(always)]
+    pub fn encode_rgba(&self, c: [f32; 4]) -> [u8; 4] {
+        [
+            self.encode(c[0]),
+            self.encode(c[1]),
+            self.encode(c[2]),
+            unorm8(c[3]),
+        ]
     }
 
     /// [`linear_to_srgb8`].

@@ -52,8 +52,9 @@ pub struct SceneOptions {
     /// CLI's `--specular-aa`).
     pub specular_aa: Option<SpecularAa>,
     /// Adaptive shading sub-samples per pixel axis for every material, overriding each one's
-    /// `shading_samples` (the CLI's `--shading-samples`; `1..=`[`texel_scene::MAX_SHADING_SAMPLES`],
-    /// larger values are clamped).
+    /// `shading_samples` (the CLI's `--shading-samples`; `1..=`[`texel_scene::MAX_SHADING_SAMPLES`]:
+    /// larger values are clamped to the maximum and 0 to 1, one sample, as the CLI's own bounds
+    /// check cannot reach this library call).
     pub shading_samples: Option<u32>,
     /// What every material's height map does, overriding each one's `displacement` (the CLI's
     /// `--displacement`; materials without a height map are unaffected).
