@@ -12,8 +12,9 @@ use texel::{Filter, MemoryBudget, PreparedScene, Scene, SceneOptions};
 use texel_gpu::{Gpu, GpuError, GpuFilter};
 
 /// The device, or `None` (with the reason printed) where there is no Vulkan adapter and CI does not
-/// demand one. A GL adapter alone does not count: on Mesa 22.3's GL llvmpipe mip-nearest and
-/// trilinear differ from the CPU in a few pixels by up to 255 codes (24-30 dB), where lavapipe
+/// demand one. A GL adapter alone does not count: GLSL ES has no fine derivatives (naga writes
+/// `dFdx` for `dpdxFine`, coarse on llvmpipe), so mip-nearest and trilinear there differ from the
+/// CPU's fine quad derivatives in whole quads by up to 255 codes (24-30 dB), where lavapipe
 /// agrees to within 1 code.
 fn gpu() -> Option<Gpu> {
     let ci = std::env::var("CI").as_deref() == Ok("true");
