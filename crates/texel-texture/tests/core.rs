@@ -278,6 +278,84 @@ fn batch_equals_single_on_extreme_derivatives() {
     }
 }
 
+/// The batched anisotropic path (probes of several samples filtered together, flushed when 256
+/// would overflow) equals `sample` bit for bit: chunks of strongly anisotropic footprints (16
+/// probes each, so a 64-sample chunk flushes four times, and a sample's probes land at any offset
+/// of the scratch), interleaved with isotropic, magnified and non-finite ones, every clamp, on
+/// the three texel formats, with lengths that leave a partial last chunk.
+#[test]
+fn batched_anisotropic_probes_equal_single_samples() {
+    let mut fps = Vec::new();
+    for k in 0..300 {
+        let t = k as f32 * 0.173;
+        let (u, v) = (t.sin() * 3.0, t.cos() * 2.0 + t * 0.1);
+        // Major axis 2^(k % 9) texels of a 64-texel side over minor 1/8..1 texel, turning.
+        let major = (1u32 << (k % 9)) as f32 / 64.0;
+        let minor = (1.0 + (k % 8) as f32) / 8.0 / 64.0;
+        let (c, s) = (t.cos(), t.sin());
+        let fp = match k % 7 {
+            // Isotropic, and magnified: one probe or the magnification filter.
+            5 => Footprint {
+                u,
+                v,
+                dudx: minor,
+                dvdx: 0.0,
+                dudy: 0.0,
+                dvdy: minor,
+            },
+            6 if k % 2 == 0 => Footprint {
+                u,
+                v,
+                dudx: 1e-4,
+                dvdx: 0.0,
+                dudy: 0.0,
+                dvdy: 1e-4,
+            },
+            6 => Footprint {
+                u: f32::NAN,
+                v,
+                dudx: f32::INFINITY,
+                dvdx: 0.0,
+                dudy: 0.0,
+                dvdy: minor,
+            },
+            _ => Footprint {
+                u,
+                v,
+                dudx: major * c,
+                dvdx: major * s,
+                dudy: -minor * s,
+                dvdy: minor * c,
+            },
+        };
+        fps.push(fp);
+    }
+    let textures = [
+        noise_texture(64, 64, Format::Rgba8Srgb),
+        noise_texture(64, 64, Format::Rgba8Unorm),
+        noise_texture(61, 37, Format::Rgba32Float),
+    ];
+    for tex in &textures {
+        for clamp in [2u16, 4, 8, 16] {
+            for addr in ADDRESS_MODES {
+                let s = Sampler::new(SamplerDescriptor::anisotropic(clamp).with_address_mode(addr))
+                    .unwrap();
+                for len in [fps.len(), 64, 37] {
+                    let mut out = vec![[0.0; 4]; len];
+                    s.sample_batch(tex, &fps[..len], &mut out);
+                    for (fp, o) in fps.iter().zip(&out) {
+                        assert_eq!(
+                            s.sample(tex, fp).map(f32::to_bits),
+                            o.map(f32::to_bits),
+                            "clamp {clamp} {addr:?} {fp:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Catmull-Rom interpolates: at every texel centre it returns the texel.
 #[test]
 fn catmull_rom_interpolates_at_centres() {
