@@ -138,6 +138,19 @@ impl Decode for Codes8 {
             f32::from(t[3]),
         )
     }
+    /// The sixteen conversions in lanes, as [`unorm8_lanes`] converts them.
+    #[inline(always)]
+    fn decode4(&self, t: [[u8; 4]; 4]) -> [Vec4; 4] {
+        let mut b = [0u8; 16];
+        b.copy_from_slice(t.as_flattened());
+        let f = b.map(f32::from);
+        [
+            Vec4::from_slice(&f[0..4]),
+            Vec4::from_slice(&f[4..8]),
+            Vec4::from_slice(&f[8..12]),
+            Vec4::from_slice(&f[12..16]),
+        ]
+    }
     fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
         Table8::texels(storage)
     }
