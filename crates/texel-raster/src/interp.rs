@@ -5,7 +5,7 @@
 //! (planes from [`crate::setup`]), `lambda_k = q_k / r` and, by the quotient rule,
 //! `d lambda_k / dx = (q_k,x r - q_k r_x) / r^2 = (q_k,x - lambda_k r_x) / r`. Any attribute
 //! `a = sum_k lambda_k a_k` then has `da/dx = sum_k a_k d lambda_k / dx`: this is exactly
-//! `du/dx = (q_x r - q r_x) / r^2` for `q = u / w`, evaluated in `f64` here ([`UvPlanes`] evaluates
+//! `du/dx = (q_x r - q r_x) / r^2` for `q = u / w`, evaluated in `f64` here (`UvPlanes` evaluates
 //! the same formulas in `f32` from planes re-anchored per tile and triangle).
 //! Affine: `lambda_k` is itself a plane and its derivatives are constants.
 //!

@@ -121,7 +121,7 @@ pub struct MapNormal {
     /// LEAN's moments `[b_x, b_y, b_x^2, b_y^2, b_x b_y]` after scaling, where every
     /// normal-mapped layer has its moment map and they were asked for.
     pub moments: Option<[f32; 5]>,
-    /// How far `raw` may fall short of unit length by quantisation ([`UNORM8_NORMAL_SLACK`] if
+    /// How far `raw` may fall short of unit length by quantisation (`UNORM8_NORMAL_SLACK`, 0.0068, if
     /// any map is 8-bit, else 0).
     pub slack: f32,
 }

@@ -69,7 +69,7 @@ pub fn builtin_names() -> &'static [&'static str] {
 /// - `mirror-spheres`: a mirror sphere and a glossy one (rough metal) in the procedural sky,
 ///   which is also the background: reflections of an environment map;
 /// - `mirror-plane`: a rippled mirror floor receding to the horizon under the procedural sky
-///   ([`mirror_plane_mesh`]): grazing reflections, whose footprints in the map grow long towards
+///   (`mirror_plane_mesh`): grazing reflections, whose footprints in the map grow long towards
 ///   the horizon.
 pub fn shaded_builtin_names() -> &'static [&'static str] {
     &[

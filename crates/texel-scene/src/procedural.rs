@@ -122,7 +122,7 @@ pub enum Procedural {
         heights: bool,
     },
     /// Tiling fractal value noise: `v = sum_o 2^-o n(2^o cells x / size, ...) / sum_o 2^-o` over
-    /// [`NOISE_OCTAVES`] octaves, `n` value noise on an integer lattice of `cells` (doubled per
+    /// `NOISE_OCTAVES` octaves, `n` value noise on an integer lattice of `cells` (doubled per
     /// octave) cells per side, wrapping so the texture tiles, with quintic interpolation
     /// (`6t^5 - 15t^4 + 10t^3`, Perlin 2002) between lattice values hashed from `seed`; `v` lies in
     /// `[0, 1]`. `kind = Color` (`"noise"`): the colour `rgba` scaled by `0.4 + 0.6 v` (alpha
@@ -145,9 +145,9 @@ pub enum Procedural {
     /// A globe's map for the spherical mappings ([`texel_texture::sphere::SurfaceProjection`]):
     /// texel `(i, j)` is coloured by the point of the sphere it shows, `d = direction(u, v)` at its
     /// centre, latitude `phi`, longitude `lambda` (east from `+z`). Ocean `[28, 64, 128]`;
-    /// Tissot's indicatrix, discs of [`GLOBE_DISC_DEG`] radius on the sphere centred every 30
+    /// Tissot's indicatrix, discs of `GLOBE_DISC_DEG` radius on the sphere centred every 30
     /// degrees of longitude at latitudes -60 to 60, in `[240, 150, 40]`; parallels and meridians
-    /// every 15 degrees ([`GLOBE_LINE_DEG`] wide on the sphere; meridians end at 75 degrees of
+    /// every 15 degrees (`GLOBE_LINE_DEG` wide on the sphere; meridians end at 75 degrees of
     /// latitude except every 90th) in white; the prime meridian (the seam `u = 0 = 1`) in
     /// `[220, 40, 40]`. Every line and disc has the same size on the sphere, so on a correctly
     /// mapped globe they all look alike. Edges are antialiased with the texel's own angular size

@@ -66,7 +66,7 @@ pub struct SceneOptions {
     /// `--layer-order`).
     pub layer_order: Option<LayerOrder>,
     /// The mapping the scene's procedural sky is laid out in, overriding its `mapping` (the
-    /// CLI's `--environment-mapping`; [`relay_sky`]).
+    /// CLI's `--environment-mapping`; a procedural sky is laid out again at the same texel angle).
     pub environment_mapping: Option<texel_scene::Mapping>,
     /// Where meshes with a sphere mapping (`sphere_uv`) get their uv: exactly per pixel (the
     /// default) or interpolated from the vertices (the CLI's `--surface-uv`).
