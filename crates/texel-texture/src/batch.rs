@@ -519,6 +519,30 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             let l = l as usize & (LEVELS - 1);
             (dims_w[l], dims_h[l])
         };
+        let l0 = first.level[0];
+        if first.level[..n].iter().all(|&l| l == l0) {
+            // The whole chunk in one level (neighbouring pixels' lods are close, so chunks along
+            // a row often are): its view and size looked up once, the same arithmetic.
+            let (fine, s0) = (view(l0), size(l0));
+            first.coordinates(|_| s0, &chunk.u[..n], &chunk.v[..n]);
+            let l1 = second.level[0];
+            let (coarse, s1) = (view(l1), size(l1));
+            if trilinear {
+                second.coordinates(|_| s1, &chunk.u[..n], &chunk.v[..n]);
+            }
+            let weighed = trilinear && (l0 as usize) < last;
+            for (k, o) in out.iter_mut().enumerate() {
+                let uv = chunk.uv(k);
+                let a = first.filtered(&fine, k, uv);
+                *o = if weighed && delta[k] > 0.0 {
+                    T::mix(a, second.filtered(&coarse, k, uv), delta[k])
+                } else {
+                    a
+                }
+                .to_array();
+            }
+            continue;
+        }
         first.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
         if trilinear {
             second.coordinates(size, &chunk.u[..n], &chunk.v[..n]);

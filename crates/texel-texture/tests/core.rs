@@ -278,6 +278,57 @@ fn batch_equals_single_on_extreme_derivatives() {
     }
 }
 
+/// `sample_batch` equals `sample` bit for bit where whole chunks share one level (the batch's
+/// one-level path: the view and size looked up once per chunk) and where one sample of a chunk
+/// leaves it: footprints of one fractional lod (1.3, and 0.6 for the nearest-mip rounding) at
+/// spread positions, 64-sample chunks with and without an outlier, every mipmap mode and filter,
+/// the three formats.
+#[test]
+fn batch_equals_single_when_a_chunk_shares_a_level() {
+    let textures = [
+        noise_texture(64, 64, Format::Rgba8Srgb),
+        noise_texture(64, 64, Format::Rgba8Unorm),
+        noise_texture(61, 37, Format::Rgba32Float),
+    ];
+    for lod in [1.3f32, 0.6, 2.9] {
+        // rho = 2^lod texels of the 64-texel side, along u.
+        let d = lod.exp2() / 64.0;
+        let mut fps: Vec<Footprint> = (0..200)
+            .map(|k| {
+                let t = k as f32 * 0.618;
+                Footprint {
+                    u: t.fract() * 1.5 - 0.2,
+                    v: (t * 0.37).fract(),
+                    dudx: d,
+                    dvdx: 0.0,
+                    dudy: 0.0,
+                    dvdy: d * 0.5,
+                }
+            })
+            .collect();
+        // The third chunk has one sample two levels coarser.
+        fps[150].dudx = d * 4.0;
+        for tex in &textures {
+            for mip in [MipmapFilterMode::Nearest, MipmapFilterMode::Linear] {
+                for f in [FilterMode::Nearest, FilterMode::Linear] {
+                    for addr in ADDRESS_MODES {
+                        let s = sampler(f, f, mip, addr);
+                        let mut out = vec![[0.0; 4]; fps.len()];
+                        s.sample_batch(tex, &fps, &mut out);
+                        for (fp, o) in fps.iter().zip(&out) {
+                            assert_eq!(
+                                s.sample(tex, fp).map(f32::to_bits),
+                                o.map(f32::to_bits),
+                                "lod {lod} {mip:?} {f:?} {addr:?} {fp:?}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The batched anisotropic path (probes of several samples filtered together, flushed when 256
 /// would overflow) equals `sample` bit for bit: chunks of strongly anisotropic footprints (16
 /// probes each, so a 64-sample chunk flushes four times, and a sample's probes land at any offset
