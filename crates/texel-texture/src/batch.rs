@@ -284,6 +284,29 @@ impl ProbeBatch {
             return;
         }
         let (us, vs) = (&self.at.u[..m], &self.at.v[..m]);
+        let (l0, l1) = (self.fine.level[0], self.next.level[0]);
+        if self.fine.level[..m].iter().all(|&l| l == l0)
+            && self.next.level[..m].iter().all(|&l| l == l1)
+        {
+            // Every probe in the same two levels: views and sizes looked up once (as `run_in`).
+            let (s0, s1) = (size(l0), size(l1));
+            self.fine.coordinates(|_| s0, us, vs);
+            self.next.coordinates(|_| s1, us, vs);
+            let fine = &views[l0 as usize & (LEVELS - 1)];
+            let next = &views[l1 as usize & (LEVELS - 1)];
+            for k in 0..m {
+                let uv = self.at.uv(k);
+                let a = self.fine.filtered(fine, k, uv);
+                let value = if self.coarse[k] {
+                    lerp(a, self.next.filtered(next, k, uv), self.delta[k])
+                } else {
+                    a
+                };
+                sums[self.owner[k] as usize] += value;
+            }
+            self.m = 0;
+            return;
+        }
         self.fine.coordinates(&size, us, vs);
         self.next.coordinates(&size, us, vs);
         for k in 0..m {

@@ -332,8 +332,9 @@ fn batch_equals_single_when_a_chunk_shares_a_level() {
 /// The batched anisotropic path (probes of several samples filtered together, flushed when 256
 /// would overflow) equals `sample` bit for bit: chunks of strongly anisotropic footprints (16
 /// probes each, so a 64-sample chunk flushes four times, and a sample's probes land at any offset
-/// of the scratch), interleaved with isotropic, magnified and non-finite ones, every clamp, on
-/// the three texel formats, with lengths that leave a partial last chunk.
+/// of the scratch), interleaved with isotropic, magnified and non-finite ones, then runs of one
+/// shape whose batches share their levels; every clamp, the three texel formats, lengths that
+/// leave a partial last chunk.
 #[test]
 fn batched_anisotropic_probes_equal_single_samples() {
     let mut fps = Vec::new();
@@ -380,6 +381,20 @@ fn batched_anisotropic_probes_equal_single_samples() {
             },
         };
         fps.push(fp);
+    }
+    // Then 200 of one shape (8 texels by 1.5, a fractional probe lod) at spread positions, so
+    // that whole probe batches share their two levels (the batch's one-level path).
+    for k in 0..200 {
+        let t = k as f32 * 0.618;
+        let (u, v) = (t.fract() * 1.5 - 0.2, (t * 0.37).fract());
+        fps.push(Footprint {
+            u,
+            v,
+            dudx: 8.0 / 64.0,
+            dvdx: 0.0,
+            dudy: 0.0,
+            dvdy: 1.5 / 64.0,
+        });
     }
     let textures = [
         noise_texture(64, 64, Format::Rgba8Srgb),
