@@ -82,10 +82,27 @@ const UNORM8_LO: f32 = (1.0f64 / 255.0 - UNORM8_HI as f64) as f32;
 /// loads do not.
 #[inline(always)]
 pub(crate) fn unorm8_lanes(b: [u8; 16]) -> [f32; 16] {
-    b.map(|b| {
-        let x = f32::from(b);
-        x * UNORM8_HI + x * UNORM8_LO
-    })
+    b.map(|b| unorm8_of(f32::from(b)))
+}
+
+/// `x / 255` for `x` a byte's value, as [`unorm8_lanes`] computes it (the lanes' one formula).
+#[inline(always)]
+fn unorm8_of<T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>>(x: T) -> T {
+    x * UNORM8_HI + x * UNORM8_LO
+}
+
+/// A bilinear quad's four texels as sixteen lanes, each byte through `f`, back as four texels.
+#[inline(always)]
+fn quad_lanes(t: [[u8; 4]; 4], f: impl Fn([u8; 16]) -> [f32; 16]) -> [Vec4; 4] {
+    let mut b = [0u8; 16];
+    b.copy_from_slice(t.as_flattened());
+    let f = f(b);
+    [
+        Vec4::from_slice(&f[0..4]),
+        Vec4::from_slice(&f[4..8]),
+        Vec4::from_slice(&f[8..12]),
+        Vec4::from_slice(&f[12..16]),
+    ]
 }
 
 impl Decode for Unorm8 {
@@ -94,25 +111,11 @@ impl Decode for Unorm8 {
     #[inline(always)]
     fn decode(&self, t: [u8; 4]) -> Vec4 {
         // `unorm8_lanes`' arithmetic, four lanes.
-        let x = Vec4::new(
-            f32::from(t[0]),
-            f32::from(t[1]),
-            f32::from(t[2]),
-            f32::from(t[3]),
-        );
-        x * UNORM8_HI + x * UNORM8_LO
+        unorm8_of(Codes8.decode(t))
     }
     #[inline(always)]
     fn decode4(&self, t: [[u8; 4]; 4]) -> [Vec4; 4] {
-        let mut b = [0u8; 16];
-        b.copy_from_slice(t.as_flattened());
-        let f = unorm8_lanes(b);
-        [
-            Vec4::from_slice(&f[0..4]),
-            Vec4::from_slice(&f[4..8]),
-            Vec4::from_slice(&f[8..12]),
-            Vec4::from_slice(&f[12..16]),
-        ]
+        quad_lanes(t, unorm8_lanes)
     }
     fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
         Table8::texels(storage)
@@ -141,15 +144,7 @@ impl Decode for Codes8 {
     /// The sixteen conversions in lanes, as [`unorm8_lanes`] converts them.
     #[inline(always)]
     fn decode4(&self, t: [[u8; 4]; 4]) -> [Vec4; 4] {
-        let mut b = [0u8; 16];
-        b.copy_from_slice(t.as_flattened());
-        let f = b.map(f32::from);
-        [
-            Vec4::from_slice(&f[0..4]),
-            Vec4::from_slice(&f[4..8]),
-            Vec4::from_slice(&f[8..12]),
-            Vec4::from_slice(&f[12..16]),
-        ]
+        quad_lanes(t, |b| b.map(f32::from))
     }
     fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
         Table8::texels(storage)
@@ -447,12 +442,6 @@ mod tests {
                 assert_eq!(f[k].to_bits(), (f32::from(b) / 255.0).to_bits());
             }
         }
-        let t = [
-            [1, 2, 3, 4],
-            [250, 251, 252, 253],
-            [0, 128, 255, 7],
-            [9, 99, 199, 254],
-        ];
         let lin = Unorm8;
         for b in 0..=255u8 {
             for k in 0..4 {
@@ -462,6 +451,12 @@ mod tests {
                 assert_eq!(lin.decode(t).to_array()[k].to_bits(), want, "byte {b}");
             }
         }
+        let t = [
+            [1, 2, 3, 4],
+            [250, 251, 252, 253],
+            [0, 128, 255, 7],
+            [9, 99, 199, 254],
+        ];
         let quad = lin.decode4(t);
         for (q, t) in quad.iter().zip(t) {
             assert_eq!(*q, lin.decode(t));
