@@ -285,6 +285,7 @@ impl ProbeBatch {
         }
         let (us, vs) = (&self.at.u[..m], &self.at.v[..m]);
         let (l0, l1) = (self.fine.level[0], self.next.level[0]);
+        let level = |l: u8| &views[l as usize & (LEVELS - 1)];
         if self.fine.level[..m].iter().all(|&l| l == l0)
             && self.next.level[..m].iter().all(|&l| l == l1)
         {
@@ -292,39 +293,38 @@ impl ProbeBatch {
             let (s0, s1) = (size(l0), size(l1));
             self.fine.coordinates(|_| s0, us, vs);
             self.next.coordinates(|_| s1, us, vs);
-            let fine = &views[l0 as usize & (LEVELS - 1)];
-            let next = &views[l1 as usize & (LEVELS - 1)];
-            for k in 0..m {
-                let uv = self.at.uv(k);
-                let a = self.fine.filtered(fine, k, uv);
-                let value = if self.coarse[k] {
-                    lerp(a, self.next.filtered(next, k, uv), self.delta[k])
-                } else {
-                    a
-                };
-                sums[self.owner[k] as usize] += value;
-            }
-            self.m = 0;
-            return;
+            let (fine, next) = (level(l0), level(l1));
+            self.sum_into(m, |_| fine, |_| next, sums);
+        } else {
+            self.fine.coordinates(&size, us, vs);
+            self.next.coordinates(&size, us, vs);
+            let (fine, next) = (&self.fine.level, &self.next.level);
+            self.sum_into(m, |k| level(fine[k]), |k| level(next[k]), sums);
         }
-        self.fine.coordinates(&size, us, vs);
-        self.next.coordinates(&size, us, vs);
+        self.m = 0;
+    }
+
+    /// Stage 3 of the first `m` probes, each probe's level view given by `fine(k)` and
+    /// `next(k)`: the finer level's bilinear sample, blended with the coarser one's by `delta`
+    /// where weighed, added in order to its sample's sum.
+    #[inline(always)]
+    fn sum_into<'v, F: Fetch + 'v>(
+        &self,
+        m: usize,
+        fine: impl Fn(usize) -> &'v F,
+        next: impl Fn(usize) -> &'v F,
+        sums: &mut [Vec4; CHUNK],
+    ) {
         for k in 0..m {
             let uv = self.at.uv(k);
-            let level = |l: u8| &views[l as usize & (LEVELS - 1)];
-            let a = self.fine.filtered(level(self.fine.level[k]), k, uv);
+            let a = self.fine.filtered(fine(k), k, uv);
             let value = if self.coarse[k] {
-                lerp(
-                    a,
-                    self.next.filtered(level(self.next.level[k]), k, uv),
-                    self.delta[k],
-                )
+                lerp(a, self.next.filtered(next(k), k, uv), self.delta[k])
             } else {
                 a
             };
             sums[self.owner[k] as usize] += value;
         }
-        self.m = 0;
     }
 }
 
@@ -555,33 +555,42 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
                 second.coordinates(|_| s1, &chunk.u[..n], &chunk.v[..n]);
             }
             let weighed = trilinear && (l0 as usize) < last;
-            for (k, o) in out.iter_mut().enumerate() {
-                let uv = chunk.uv(k);
-                let a = first.filtered(&fine, k, uv);
-                *o = if weighed && delta[k] > 0.0 {
-                    T::mix(a, second.filtered(&coarse, k, uv), delta[k])
-                } else {
-                    a
-                }
-                .to_array();
-            }
+            let stages = (&first, &second, &chunk, &delta);
+            filter_chunk(stages, |_| weighed, |_| fine, |_| coarse, out);
             continue;
         }
         first.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
         if trilinear {
             second.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
         }
-        for k in 0..n {
-            let uv = chunk.uv(k);
-            let a = first.filtered(&view(first.level[k]), k, uv);
-            // As `mip::trilinear`: the coarser level only when it is weighed.
-            out[k] = if trilinear && delta[k] > 0.0 && (first.level[k] as usize) < last {
-                T::mix(a, second.filtered(&view(second.level[k]), k, uv), delta[k])
-            } else {
-                a
-            }
-            .to_array();
+        let (fl, sl) = (&first.level, &second.level);
+        // As `mip::trilinear`: the coarser level only when it is weighed.
+        let weighed = |k: usize| trilinear && (fl[k] as usize) < last;
+        let stages = (&first, &second, &chunk, &delta);
+        filter_chunk(stages, weighed, |k| view(fl[k]), |k| view(sl[k]), out);
+    }
+}
+
+/// Stage 3 of [`run_in`] for a chunk's samples (`out.len()` of them): the finer level's value
+/// from `fine(k)`'s view, blended with the coarser one's from `coarse(k)` by `delta` where
+/// `weighed(k)` and `delta > 0`.
+#[inline(always)]
+fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
+    (first, second, chunk, delta): (&Pass<N, T>, &Pass<N, T>, &Chunk<N>, &[f32; N]),
+    weighed: impl Fn(usize) -> bool,
+    fine: impl Fn(usize) -> F,
+    coarse: impl Fn(usize) -> F,
+    out: &mut [[f32; 4]],
+) {
+    for (k, o) in out.iter_mut().enumerate() {
+        let uv = chunk.uv(k);
+        let a = first.filtered(&fine(k), k, uv);
+        *o = if weighed(k) && delta[k] > 0.0 {
+            T::mix(a, second.filtered(&coarse(k), k, uv), delta[k])
+        } else {
+            a
         }
+        .to_array();
     }
 }
 
