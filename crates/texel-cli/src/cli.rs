@@ -494,8 +494,10 @@ pub struct BenchArgs {
     /// The colour render target the frames are drawn into.
     #[arg(long, value_enum, default_value_t = TargetArg::Rgba8)]
     pub target: TargetArg,
-    /// The instruction set of the tile rasterizer: the best the CPU has (x86-64-v3 where it has
-    /// AVX2 and FMA), or the baseline copy, to measure the difference (images are the same).
+    /// The instruction set of the tile rasterizer: the best the CPU has (x86-64-v4 where it has
+    /// AVX-512, x86-64-v3 where it has AVX2 and FMA), or a lower copy, to measure the difference
+    /// (images are the same). A level the CPU lacks runs the CPU's best; the report names the
+    /// level that ran.
     #[arg(long, value_enum, default_value_t = SimdArg::Best)]
     pub simd: SimdArg,
     /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has):
@@ -513,8 +515,24 @@ pub struct BenchArgs {
 pub enum SimdArg {
     /// The best the CPU has.
     Best,
+    /// At most the x86-64-v4 (AVX-512) copy.
+    V4,
+    /// At most the x86-64-v3 (AVX2 and FMA) copy.
+    V3,
     /// The x86-64 baseline (SSE2) copy.
     Baseline,
+}
+
+impl SimdArg {
+    /// The highest level this choice allows.
+    pub fn limit(self) -> texel_raster::SimdLevel {
+        use texel_raster::SimdLevel;
+        match self {
+            SimdArg::Best | SimdArg::V4 => SimdLevel::X86_64V4,
+            SimdArg::V3 => SimdLevel::X86_64V3,
+            SimdArg::Baseline => SimdLevel::Baseline,
+        }
+    }
 }
 
 /// A colour render target ([`texel::ColorTarget`]).

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
-use crate::cli::{BenchArgs, PrecisionArg, SimdArg, TargetArg};
+use crate::cli::{BenchArgs, PrecisionArg, TargetArg};
 use crate::filters::parse_list;
 use crate::input::{load_scene, Input};
 use crate::threads::{thread_count, with_threads};
@@ -157,7 +157,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let scene = load_scene(&args.scene, input)?;
     let filters = parse_list(&args.filters)?;
     let budget = &mut input.budget;
-    texel_raster::force_baseline(args.simd == SimdArg::Baseline);
+    texel_raster::limit_level(args.simd.limit());
     let timings = if args.gpu {
         time_gpu(args, &scene, &filters)?
     } else {

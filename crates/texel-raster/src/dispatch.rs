@@ -2,36 +2,54 @@
 //!
 //! texel is compiled for the x86-64 baseline (SSE2), so one binary runs on every x86-64 CPU. The
 //! tile rasterizer (coverage, interpolation, sampling, shading, encoding: everything
-//! `tile::raster_tile` inlines) gets a second copy compiled for x86-64-v3 (AVX2, FMA, BMI1/2,
-//! F16C, LZCNT, MOVBE), chosen per tile when the CPU has every one of those features.
+//! `tile::raster_tile` inlines) gets two more copies: one compiled for x86-64-v3 (AVX2, FMA,
+//! BMI1/2, F16C, LZCNT, MOVBE) and one for x86-64-v4 (v3 plus AVX-512 F, BW, CD, DQ and VL). Each
+//! tile runs on the best copy whose every feature the CPU has ([`level`]), unless capped
+//! ([`limit_level`]).
 //!
-//! Images are bit for bit the same on both copies: Rust never fuses a multiply and an add unless
-//! asked (`mul_add`), and no code here asks, so the wider instructions compute the same IEEE
-//! operations (`tests/targets.rs` renders every view both ways; `scripts/same_images.sh` compared
-//! 134 images of a whole-program x86-64-v3 build with the baseline build, all identical).
+//! Images are bit for bit the same on every copy: Rust never fuses a multiply and an add unless
+//! asked (`mul_add`), and no code here asks, and without fast-math flags LLVM emits no
+//! approximate instruction (AVX-512's `vrcp14`, `vrsqrt14`, `vgetexp` are not used for `/`,
+//! `sqrt` or `log2`), so the wider instructions compute the same IEEE operations
+//! (`tests/targets.rs` renders every view on every copy the CPU has; `scripts/same_images.sh`
+//! compared 134 images of the v4 copy with the v3 copy, and earlier of a whole-program x86-64-v3
+//! build with the baseline build, all identical).
 //!
 //! Safety argument: calling a `#[target_feature]` function is `unsafe` because running its
 //! instructions on a CPU without the features is undefined behaviour. [`run`] calls [`v3`] only
-//! when [`level`] is [`SimdLevel::X86_64V3`], which it is only when `is_x86_feature_detected!`
-//! reported every feature `v3` enables (the list below is the one `v3`'s attribute names).
+//! when [`level`] is [`SimdLevel::X86_64V3`] and [`v4`] only when it is [`SimdLevel::X86_64V4`].
+//! [`level`] is at most what [`detect`] found, and [`detect`] reports a level only when
+//! `is_x86_feature_detected!` reported every feature that level's function enables (the lists in
+//! [`detect`] are the ones the functions' attributes name; v4's includes v3's).
 #![allow(unsafe_code)]
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::OnceLock;
 
-/// The instruction set the rasterizer's tiles run on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The instruction set the rasterizer's tiles run on, ordered from the least to the most.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum SimdLevel {
     /// The build's own target (x86-64: SSE2; other architectures: their baseline).
     Baseline,
     /// x86-64-v3: AVX2, FMA, BMI1, BMI2, F16C, LZCNT, MOVBE (and the v2 features below them).
     X86_64V3,
+    /// x86-64-v4: x86-64-v3 plus AVX-512 F, BW, CD, DQ and VL.
+    X86_64V4,
 }
 
 impl SimdLevel {
-    /// A short name for reports: `"x86-64-v3 (avx2+fma)"` or `"baseline (sse2)"`.
+    /// Every level, from the least to the most.
+    pub const ALL: [SimdLevel; 3] = [
+        SimdLevel::Baseline,
+        SimdLevel::X86_64V3,
+        SimdLevel::X86_64V4,
+    ];
+
+    /// A short name for reports: `"x86-64-v4 (avx512)"`, `"x86-64-v3 (avx2+fma)"` or
+    /// `"baseline (sse2)"`.
     pub fn name(self) -> &'static str {
         match self {
+            SimdLevel::X86_64V4 => "x86-64-v4 (avx512)",
             SimdLevel::X86_64V3 => "x86-64-v3 (avx2+fma)",
             SimdLevel::Baseline if cfg!(target_arch = "x86_64") => "baseline (sse2)",
             SimdLevel::Baseline => "baseline",
@@ -39,10 +57,10 @@ impl SimdLevel {
     }
 }
 
-/// Set by [`force_baseline`].
-static FORCE_BASELINE: AtomicBool = AtomicBool::new(false);
+/// Set by [`limit_level`]: the highest level allowed, as its index in [`SimdLevel::ALL`].
+static LIMIT: AtomicU8 = AtomicU8::new(u8::MAX);
 
-/// What the CPU supports, detected once.
+/// What the CPU supports, detected once: the best level whose every feature it has.
 fn detected() -> SimdLevel {
     static DETECTED: OnceLock<SimdLevel> = OnceLock::new();
     *DETECTED.get_or_init(detect)
@@ -63,7 +81,15 @@ fn detect() -> SimdLevel {
         && is_x86_feature_detected!("ssse3")
         && is_x86_feature_detected!("sse4.1")
         && is_x86_feature_detected!("sse4.2");
-    if v3 {
+    let v4 = v3
+        && is_x86_feature_detected!("avx512f")
+        && is_x86_feature_detected!("avx512bw")
+        && is_x86_feature_detected!("avx512cd")
+        && is_x86_feature_detected!("avx512dq")
+        && is_x86_feature_detected!("avx512vl");
+    if v4 {
+        SimdLevel::X86_64V4
+    } else if v3 {
         SimdLevel::X86_64V3
     } else {
         SimdLevel::Baseline
@@ -75,19 +101,18 @@ fn detect() -> SimdLevel {
     SimdLevel::Baseline
 }
 
-/// The level tiles run on now: the CPU's, unless [`force_baseline`] is on.
+/// The level tiles run on now: the CPU's ([`detected`]), or the limit set by [`limit_level`]
+/// when that is lower.
 pub fn level() -> SimdLevel {
-    if FORCE_BASELINE.load(Ordering::Relaxed) {
-        SimdLevel::Baseline
-    } else {
-        detected()
-    }
+    let limit = LIMIT.load(Ordering::Relaxed) as usize;
+    detected().min(SimdLevel::ALL[limit.min(SimdLevel::ALL.len() - 1)])
 }
 
-/// Run every later tile on the baseline copy (`true`) or on the CPU's best again (`false`), for
-/// comparing the two. Process-wide; images do not depend on it.
-pub fn force_baseline(on: bool) {
-    FORCE_BASELINE.store(on, Ordering::Relaxed);
+/// Run every later tile on a copy no higher than `max` (`SimdLevel::Baseline`: the baseline copy;
+/// the highest level: the CPU's best again), for comparing the copies. A level above the CPU's
+/// runs the CPU's best. Process-wide; images do not depend on it.
+pub fn limit_level(max: SimdLevel) {
+    LIMIT.store(max as u8, Ordering::Relaxed);
 }
 
 /// Work compiled once per instruction set. `run` must be `#[inline(always)]` (a closure's body
@@ -100,13 +125,17 @@ pub(crate) trait Kernel {
 }
 
 /// Run `k` on the copy for [`level`]: its body (with everything it inlines) is compiled once for
-/// the baseline and once inside [`v3`].
+/// the baseline, once inside [`v3`] and once inside [`v4`].
 #[inline(always)]
 pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
     #[cfg(target_arch = "x86_64")]
-    if level() == SimdLevel::X86_64V3 {
-        // SAFETY: `level()` is `X86_64V3` only when `detect` saw every feature `v3` enables.
-        return unsafe { v3(k) };
+    match level() {
+        // SAFETY: `level()` is `X86_64V4` only when `detect` saw every feature `v4` enables.
+        SimdLevel::X86_64V4 => return unsafe { v4(k) },
+        // SAFETY: `level()` is at least `X86_64V3` only when `detect` saw every feature `v3`
+        // enables.
+        SimdLevel::X86_64V3 => return unsafe { v3(k) },
+        SimdLevel::Baseline => {}
     }
     k.run()
 }
@@ -117,5 +146,14 @@ pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2"
 )]
 unsafe fn v3<K: Kernel>(k: K) -> K::Output {
+    k.run()
+}
+
+/// `k.run()` compiled for x86-64-v4.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(
+    enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
+)]
+unsafe fn v4<K: Kernel>(k: K) -> K::Output {
     k.run()
 }

@@ -59,7 +59,7 @@ mod shade;
 pub mod tile;
 pub mod views;
 
-pub use dispatch::{force_baseline, level as simd_level, SimdLevel};
+pub use dispatch::{level as simd_level, limit_level, SimdLevel};
 pub use draw::{DrawCall, UvEvaluation, UvMapping, Vertex};
 pub use environment::{Environment, EnvironmentMaps};
 pub use error::RasterError;

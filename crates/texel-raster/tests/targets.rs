@@ -1,15 +1,16 @@
 //! Colour targets: an 8-bit target stores exactly the encoding of what the float target stores,
 //! for every view, derivative mode and draw path, and `draw_into` on top of an 8-bit frame
-//! depth-tests against the frame's depth as on a float frame. The tile code's baseline copy and
-//! its run-time dispatched x86-64-v3 copy draw the same bits.
+//! depth-tests against the frame's depth as on a float frame. Every copy of the tile code the CPU
+//! can run (the baseline, and the run-time dispatched x86-64-v3 and x86-64-v4 copies) draws the
+//! same bits.
 
 mod common;
 
 use common::{lab_sampler, screen_grid, Ground};
 use glam::Mat4;
 use texel_raster::{
-    draw_into, force_baseline, render, simd_level, ColorTarget, Derivatives, DrawCall, Frame,
-    RenderSettings, Vertex, View,
+    draw_into, limit_level, render, simd_level, ColorTarget, Derivatives, DrawCall, Frame,
+    RenderSettings, SimdLevel, Vertex, View,
 };
 use texel_texture::{Sampler, Texture};
 
@@ -63,6 +64,15 @@ fn eight_bit_targets_store_the_float_targets_encoding() {
     let (verts, tris, tex) = screen_grid(w, h, 23, 11);
     let grid_sampler = lab_sampler(2);
     let grid = screen_draw(&verts, &tris, &tex, &grid_sampler);
+    // The copies this CPU runs, the best last.
+    let best = simd_level();
+    let levels: Vec<SimdLevel> = SimdLevel::ALL.into_iter().filter(|&l| l <= best).collect();
+    for &l in SimdLevel::ALL.iter().filter(|&&l| l > best) {
+        println!(
+            "skipped: this CPU cannot run the {} copy of the tile code",
+            l.name()
+        );
+    }
     for target in [ColorTarget::Srgb8, ColorTarget::Unorm8] {
         for view in [View::Color, View::Uv, View::Mip, View::Fetches] {
             for derivatives in [Derivatives::Analytic, Derivatives::Quad] {
@@ -76,11 +86,14 @@ fn eight_bit_targets_store_the_float_targets_encoding() {
                     let float = render(&s(ColorTarget::Float), &[draw]).unwrap();
                     let eight = render(&s(target), &[draw]).unwrap();
                     assert_encoded(&float, &eight, target, &label);
-                    // The baseline copy of the tile code draws the same bits as the CPU's best.
-                    force_baseline(true);
-                    let baseline = render(&s(target), &[draw]).unwrap();
-                    force_baseline(false);
-                    assert!(baseline == eight, "{label}: {:?}", simd_level());
+                    // Every lower copy of the tile code draws the same bits as the CPU's best.
+                    for &level in &levels[..levels.len() - 1] {
+                        limit_level(level);
+                        assert_eq!(simd_level(), level);
+                        let lower = render(&s(target), &[draw]).unwrap();
+                        limit_level(best);
+                        assert!(lower == eight, "{label}: {level:?} against {best:?}");
+                    }
                 }
             }
         }
