@@ -101,8 +101,8 @@ fn detect() -> SimdLevel {
     SimdLevel::Baseline
 }
 
-/// The level tiles run on now: the CPU's ([`detected`]), or the limit set by [`limit_level`]
-/// when that is lower.
+/// The level tiles run on now: the best the CPU has (detected once), or the limit set by
+/// [`limit_level`] when that is lower.
 pub fn level() -> SimdLevel {
     let limit = LIMIT.load(Ordering::Relaxed) as usize;
     detected().min(SimdLevel::ALL[limit.min(SimdLevel::ALL.len() - 1)])
