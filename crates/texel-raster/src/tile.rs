@@ -237,8 +237,8 @@ pub(crate) fn draw_frame(
     };
     let (tx, ty) = tile_counts(width, height);
     // Bands of `TILE` rows, each split into its tiles' row lists by the thread that renders it:
-    // built serially, the lists of a 4K frame's 2 040 tiles cost more than a tenth of its
-    // two-thread frame.
+    // built serially, the lists of a 4K frame's 2 040 tiles cost a tenth of its two-thread
+    // nearest frame.
     let bands = band_slices(&mut frame.color, width, ty)
         .zip(band_slices(&mut frame.color8, width, ty))
         .zip(band_slices(&mut frame.depth, width, ty))

@@ -38,6 +38,14 @@ fn assert_encoded(float: &Frame, eight: &Frame, target: ColorTarget, label: &str
     assert!(eight.covered_pixels() > 0, "{label}");
 }
 
+/// Whether two frames hold the same bits: colour (float or 8-bit) and depth compared as bit
+/// patterns, so `-0.0` and `0.0` differ and NaNs compare.
+fn same_bits(a: &Frame, b: &Frame) -> bool {
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let color = |f: &Frame| bits(f.color.as_flattened());
+    a.color8 == b.color8 && color(a) == color(b) && bits(&a.depth) == bits(&b.depth)
+}
+
 /// A draw of screen-space vertices (`common::screen_grid`'s).
 fn screen_draw<'a>(
     vertices: &'a [Vertex],
@@ -86,13 +94,22 @@ fn eight_bit_targets_store_the_float_targets_encoding() {
                     let float = render(&s(ColorTarget::Float), &[draw]).unwrap();
                     let eight = render(&s(target), &[draw]).unwrap();
                     assert_encoded(&float, &eight, target, &label);
-                    // Every lower copy of the tile code draws the same bits as the CPU's best.
+                    // Every lower copy of the tile code draws the same bits as the CPU's best,
+                    // into the 8-bit and the float target (whose bits no encode can hide).
                     for &level in &levels[..levels.len() - 1] {
                         limit_level(level);
                         assert_eq!(simd_level(), level);
                         let lower = render(&s(target), &[draw]).unwrap();
+                        let lower_float = render(&s(ColorTarget::Float), &[draw]).unwrap();
                         limit_level(best);
-                        assert!(lower == eight, "{label}: {level:?} against {best:?}");
+                        assert!(
+                            same_bits(&lower, &eight),
+                            "{label}: {level:?} against {best:?}"
+                        );
+                        assert!(
+                            same_bits(&lower_float, &float),
+                            "{label}, float: {level:?} against {best:?}"
+                        );
                     }
                 }
             }

@@ -394,9 +394,10 @@ impl Sampler {
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
-    // Inlined into the tile rasterizer's x86-64-v3 copy since the level-0 point path
-    // (`batch::point_bytes`): one-thread nearest frames 2.05 -> 1.86 ms (before that path, the
-    // generic kernel measured about 5 % faster as its own baseline function).
+    // Inlined into each copy of the tile rasterizer since the level-0 point path
+    // (`batch::point_bytes`): one-thread nearest frames on the x86-64-v3 copy 2.05 -> 1.86 ms
+    // (before that path, the generic kernel measured about 5 % faster as its own baseline
+    // function).
     #[inline(always)]
     pub fn sample_batch_stored(
         &self,
