@@ -4,8 +4,8 @@
 //! - Every frame buffer is split, without copying, into per-tile row slices (`chunks_mut`), so tiles
 //!   are written in place by whichever thread renders them; no locks, no `unsafe`, no final copy.
 //!   The split is made per band of `TILE` rows by the thread that renders the band's tiles: made
-//!   serially up front, the row lists of a 4K frame (2 040 tiles) cost a tenth of a two-thread
-//!   nearest frame.
+//!   serially up front, the row lists of a 4K frame (2 040 tiles) held its two-thread nearest
+//!   frame at 11.2 ms against 8.5.
 //! - Each tile processes its triangles in submission order (draw, then triangle, then sub-triangle)
 //!   and every per-pixel computation depends only on the pixel, the triangle and the tile (the
 //!   `UvPlanes` anchor), never on the thread or the order tiles run in, so the image is bit for bit
@@ -105,8 +105,8 @@ pub(crate) fn split_rows<T>(buf: &mut [T], width: u32, height: u32) -> Vec<Vec<&
     if buf.is_empty() {
         return (0..tx * ty).map(|_| Vec::new()).collect();
     }
-    // Each tile's list allocated once at its row count (growing by pushes reallocated each list
-    // about seven times: 28 000 serial reallocations per 4K frame and buffer).
+    // Each tile's list allocated once at its row count (grown by pushes, a list of 64 rows is
+    // allocated once and reallocated four times: 8 160 reallocations per buffer of a 4K frame).
     let rows = |k: u32| TILE.min(height - (k / tx) * TILE) as usize;
     let mut tiles: Vec<Vec<&mut [T]>> = (0..tx * ty).map(|k| Vec::with_capacity(rows(k))).collect();
     for (j, row) in buf.chunks_mut(width as usize).enumerate() {
@@ -237,8 +237,8 @@ pub(crate) fn draw_frame(
     };
     let (tx, ty) = tile_counts(width, height);
     // Bands of `TILE` rows, each split into its tiles' row lists by the thread that renders it:
-    // built serially, the lists of a 4K frame's 2 040 tiles cost a tenth of its two-thread
-    // nearest frame.
+    // built serially up front, the lists of a 4K frame's 2 040 tiles held its two-thread nearest
+    // frame at 11.2 ms against 8.5.
     let bands = band_slices(&mut frame.color, width, ty)
         .zip(band_slices(&mut frame.color8, width, ty))
         .zip(band_slices(&mut frame.depth, width, ty))
