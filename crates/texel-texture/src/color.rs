@@ -11,7 +11,7 @@ use std::sync::OnceLock;
 
 use glam::Vec4;
 
-use crate::floor::{floor_clamped4, integer_bytes4};
+use crate::floor::{floor_clamped4, integer_byte, integer_bytes4, round_staged};
 
 /// sRGB-encoded value in `[0, 1]` to linear light in `[0, 1]` (IEC 61966-2-1).
 ///
@@ -74,6 +74,41 @@ pub fn rgba_to_unorm8(c: [f32; 4]) -> [u8; 4] {
     // every threshold).
     let v = (Vec4::from_array(c) * 255.0 + Vec4::splat(0.5)).max(Vec4::ZERO);
     integer_bytes4(floor_clamped4(v, 255.0).to_array())
+}
+
+/// [`rgba_to_unorm8`] of every colour of `colors` into `out`, bit for bit: one loop over the
+/// channels (`out` and `colors` flattened), which the compiler vectorises across colours —
+/// sixteen channels per step with AVX-512, eight with AVX2 — where the one-colour form works on
+/// one colour's four lanes at a time. What a renderer's resolve into an `R8G8B8A8_UNORM` target
+/// runs over a row: 64 colours measured 1.53 -> 0.47 ns per colour on an AVX-512 machine
+/// (docs/perf-log.md, entry 30).
+///
+/// # Panics
+/// If `colors` and `out` differ in length (a programming error, not bad input).
+#[inline(always)]
+pub fn rgba_to_unorm8_slice(colors: &[[f32; 4]], out: &mut [[u8; 4]]) {
+    assert_eq!(
+        colors.len(),
+        out.len(),
+        "rgba_to_unorm8_slice: colors and out differ in length"
+    );
+    for (o, &x) in out.as_flattened_mut().iter_mut().zip(colors.as_flattened()) {
+        *o = unorm8_lane(x);
+    }
+}
+
+/// One channel of [`rgba_to_unorm8`] in the operations of its four lanes, written as selects so
+/// that a loop over channels vectorises: `v = x * 255 + 1/2`; `v > 0` else 0 (NaN and negative
+/// zero give 0, as the lanes' `max` with zero does); at most 255; the staged floor
+/// ([`round_staged`] and a step down where it rounded up), read from the bits
+/// ([`integer_byte`]).
+#[inline(always)]
+fn unorm8_lane(x: f32) -> u8 {
+    let v = x * 255.0 + 0.5;
+    let v = if v > 0.0 { v } else { 0.0 };
+    let c = if v < 255.0 { v } else { 255.0 };
+    let r = round_staged(c);
+    integer_byte(if r > c { r - 1.0 } else { r })
 }
 
 /// The definition [`linear_to_srgb8`] is built from and tested against: `unorm8` of the sRGB OETF
@@ -191,15 +226,29 @@ mod tests {
         assert!((t[128] - 0.215_860_53).abs() < 1e-6);
     }
 
-    /// The four-lane encoder equals [`unorm8`] on a sweep through every `f32` bit pattern (a
-    /// stride of 31, both signs, NaNs and infinities included), on 64 patterns either side of
-    /// every rounding threshold `(k + 1/2) / 255`, and at the special values.
+    /// The four-lane encoder and the slice encoder equal [`unorm8`] on a sweep through every
+    /// `f32` bit pattern (a stride of 31, both signs, NaNs and infinities included), on 64
+    /// patterns either side of every rounding threshold `(k + 1/2) / 255`, and at the special
+    /// values. The slice encoder runs on runs of 1 to 37 colours, so its vector body and its
+    /// remainder both see every value.
     #[test]
     fn four_lane_unorm8_equals_unorm8() {
-        let check = |x: f32| {
-            let got = rgba_to_unorm8([x, -x, x * 0.5, 1.0 - x]);
+        let (mut run, mut bytes, mut runs) = (Vec::<[f32; 4]>::new(), Vec::<[u8; 4]>::new(), 0);
+        let mut check = |x: f32| {
+            let c = [x, -x, x * 0.5, 1.0 - x];
             let want = [unorm8(x), unorm8(-x), unorm8(x * 0.5), unorm8(1.0 - x)];
-            assert_eq!(got, want, "{x:e} ({:#x})", x.to_bits());
+            assert_eq!(rgba_to_unorm8(c), want, "{x:e} ({:#x})", x.to_bits());
+            run.push(c);
+            if run.len() == 1 + runs % 37 {
+                runs += 1;
+                bytes.resize(run.len(), [0; 4]);
+                rgba_to_unorm8_slice(&run, &mut bytes);
+                for (c, b) in run.iter().zip(&bytes) {
+                    let want = [unorm8(c[0]), unorm8(c[1]), unorm8(c[2]), unorm8(c[3])];
+                    assert_eq!(*b, want, "slice: {c:?}");
+                }
+                run.clear();
+            }
         };
         (0..=u32::MAX)
             .step_by(31)

@@ -120,7 +120,13 @@ pub fn floor_clamped4(x: Vec4, hi: f32) -> Vec4 {
 /// rounding constant (the integer sits in the low mantissa bits): no saturating conversion.
 #[inline(always)]
 pub fn integer_bytes4(x: [f32; 4]) -> [u8; 4] {
-    x.map(|s| (s + ROUND_F32).to_bits() as u8)
+    x.map(integer_byte)
+}
+
+/// [`integer_bytes4`] for one lane: an `f32` holding an integer in `0..=255` as that byte.
+#[inline(always)]
+pub fn integer_byte(x: f32) -> u8 {
+    (x + ROUND_F32).to_bits() as u8
 }
 
 /// `x` rounded by [`round_staged`] (the clamped value `c`), as an integer read from the sum's
