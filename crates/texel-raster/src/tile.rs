@@ -238,49 +238,78 @@ pub(crate) fn draw_frame(
             .and_then(|e| Some((e, e.background_rays(width, height)?))),
     };
     let (tx, ty) = tile_counts(width, height);
-    // Bands of `TILE` rows, each split into its tiles' row lists by the thread that renders it:
-    // built serially up front, the lists of a 4K frame's 2 040 tiles held its two-thread nearest
-    // frame at 11.2 ms against 8.5.
-    let bands = band_slices(&mut frame.color, width, ty)
-        .zip(band_slices(&mut frame.color8, width, ty))
-        .zip(band_slices(&mut frame.depth, width, ty))
-        .zip(band_slices(&mut frame.texels_read, width, ty))
-        .zip(band_slices(&mut frame.footprints, width, ty));
-    let bands: Vec<_> = bands.zip(bins.chunks(tx as usize)).enumerate().collect();
+    // Bands of `TILE` rows, each split into its tiles' row lists by the thread that renders it
+    // (`Band::tiles`).
+    let mut color = band_slices(&mut frame.color, width, ty);
+    let mut color8 = band_slices(&mut frame.color8, width, ty);
+    let mut depth = band_slices(&mut frame.depth, width, ty);
+    let mut texels = band_slices(&mut frame.texels_read, width, ty);
+    let mut footprints = band_slices(&mut frame.footprints, width, ty);
+    let bands: Vec<Band> = (0..ty)
+        .map(|y| Band {
+            y0: y * TILE,
+            color: color.next().unwrap_or_default(),
+            color8: color8.next().unwrap_or_default(),
+            depth: depth.next().unwrap_or_default(),
+            texels: texels.next().unwrap_or_default(),
+            footprints: footprints.next().unwrap_or_default(),
+        })
+        .collect();
     let target = frame.target;
-    bands.into_par_iter().with_max_len(1).for_each(
-        |(by, (((((color, color8), depth), texels), footprints), bins))| {
-            let y0 = by as u32 * TILE;
-            let rows = TILE.min(height - y0);
-            let mut color = split_rows(color, width, rows).into_iter();
-            let mut color8 = split_rows(color8, width, rows).into_iter();
-            let mut depth = split_rows(depth, width, rows).into_iter();
-            let mut texels = split_rows(texels, width, rows).into_iter();
-            let mut footprints = split_rows(footprints, width, rows).into_iter();
-            let mut tiles = Vec::with_capacity(tx as usize);
-            for bx in 0..tx {
-                let x0 = bx * TILE;
-                tiles.push(TileTarget {
-                    x0,
-                    y0,
-                    w: TILE.min(width - x0),
-                    h: rows,
-                    target,
-                    color: color.next().unwrap_or_default(),
-                    color8: color8.next().unwrap_or_default(),
-                    depth: depth.next().unwrap_or_default(),
-                    texels: texels.next().unwrap_or_default(),
-                    footprints: footprints.next().unwrap_or_default(),
-                });
-            }
-            tiles
+    let bins = bins.chunks(tx as usize);
+    bands
+        .into_par_iter()
+        .zip(bins.collect::<Vec<_>>())
+        .with_max_len(1)
+        .for_each(|(band, bins)| {
+            band.tiles((width, height), target)
                 .par_iter_mut()
                 .zip(bins.par_iter())
                 .with_max_len(1)
                 .for_each(|(tile, bin)| raster_tile(&ctx, tile, bin));
-        },
-    );
+        });
     Ok(())
+}
+
+/// One band of [`TILE`] rows (the last may be shorter) of every frame buffer, starting at row
+/// `y0`; a buffer the frame does not keep is empty.
+struct Band<'f> {
+    y0: u32,
+    color: &'f mut [[f32; 4]],
+    color8: &'f mut [[u8; 4]],
+    depth: &'f mut [f32],
+    texels: &'f mut [u32],
+    footprints: &'f mut [Footprint],
+}
+
+impl<'f> Band<'f> {
+    /// The band's tiles, left to right, for a `width x height` frame with colour target
+    /// `target`: each buffer split into per-tile row lists ([`split_rows`]) by the thread that
+    /// renders the band (built serially up front for the whole frame, the lists of a 4K frame's
+    /// 2 040 tiles held its two-thread nearest frame at 11.2 ms against 8.5).
+    fn tiles(self, (width, height): (u32, u32), target: ColorTarget) -> Vec<TileTarget<'f>> {
+        let rows = TILE.min(height - self.y0);
+        let mut color = split_rows(self.color, width, rows).into_iter();
+        let mut color8 = split_rows(self.color8, width, rows).into_iter();
+        let mut depth = split_rows(self.depth, width, rows).into_iter();
+        let mut texels = split_rows(self.texels, width, rows).into_iter();
+        let mut footprints = split_rows(self.footprints, width, rows).into_iter();
+        let tx = tile_counts(width, height).0;
+        (0..tx)
+            .map(|bx| TileTarget {
+                x0: bx * TILE,
+                y0: self.y0,
+                w: TILE.min(width - bx * TILE),
+                h: rows,
+                target,
+                color: color.next().unwrap_or_default(),
+                color8: color8.next().unwrap_or_default(),
+                depth: depth.next().unwrap_or_default(),
+                texels: texels.next().unwrap_or_default(),
+                footprints: footprints.next().unwrap_or_default(),
+            })
+            .collect()
+    }
 }
 
 /// A row-major `width`-wide buffer as `bands` slices of `TILE` rows each (the last may be
