@@ -54,8 +54,9 @@ const LEVELS: usize = 32;
 pub(crate) const MAX_SIDE: u32 = STAGED_F32_LIMIT as u32;
 
 /// A chunk of up to `N` queries, as arrays (so the stages vectorise); the first `n` are valid.
-/// Entries from `n` on hold stale values of earlier chunks (or zeros): stage 0 computes them
-/// too, so that its loops have no remainder, and nothing reads them.
+/// Entries from `n` on hold stale values of earlier chunks (or their initial values): stage 0
+/// ([`queries`]) computes them too, so that its loops have no remainder, and nothing reads them.
+/// The probe scratches use `u` and `v` only.
 pub(crate) struct Chunk<const N: usize> {
     /// Finite `u` ([`finite_uv`]).
     pub u: [f32; N],
