@@ -256,10 +256,9 @@ pub(crate) fn draw_frame(
         })
         .collect();
     let target = frame.target;
-    let bins = bins.chunks(tx as usize);
     bands
         .into_par_iter()
-        .zip(bins.collect::<Vec<_>>())
+        .zip(bins.par_chunks(tx as usize))
         .with_max_len(1)
         .for_each(|(band, bins)| {
             band.tiles((width, height), target)

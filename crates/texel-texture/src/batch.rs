@@ -56,7 +56,6 @@ pub(crate) const MAX_SIDE: u32 = STAGED_F32_LIMIT as u32;
 /// A chunk of up to `N` queries, as arrays (so the stages vectorise); the first `n` are valid.
 /// Entries from `n` on hold stale values of earlier chunks (or their initial values): stage 0
 /// ([`queries`]) computes them too, so that its loops have no remainder, and nothing reads them.
-/// The probe scratches use `u` and `v` only.
 pub(crate) struct Chunk<const N: usize> {
     /// Finite `u` ([`finite_uv`]).
     pub u: [f32; N],
@@ -64,9 +63,6 @@ pub(crate) struct Chunk<const N: usize> {
     pub v: [f32; N],
     /// The isotropic lod (0 for a lod-free sampler).
     pub lod: [f32; N],
-    /// The footprints' derivatives `(du/dx, dv/dx, du/dy, dv/dy)`, one array each: stage 0's
-    /// copy of them, so that its lod loop reads lanes instead of 24-byte structs.
-    d: [[f32; N]; 4],
     /// Valid entries.
     pub n: usize,
 }
@@ -77,9 +73,6 @@ impl<const N: usize> Chunk<N> {
             u: [0.0; N],
             v: [0.0; N],
             lod: [0.0; N],
-            // Ones, not zeros: a lane never written then has a normal rho^2 (zeros would send
-            // every chunk shorter than a multiple of 16 through the scalar recomputation).
-            d: [[1.0; N]; 4],
             n: 0,
         }
     }
@@ -112,8 +105,8 @@ impl<const N: usize> Chunk<N> {
 /// The footprints are first copied into lanes (one array per field), and the arithmetic then
 /// runs over the lanes rounded up to a multiple of 16 (at most `N`; the entries beyond `n` are
 /// stale and unread), so that it vectorises at the full width with no remainder loop: read from
-/// the 24-byte structs, the lod loop ran four lanes wide plus a scalar remainder (a one-thread
-/// raw trilinear frame: docs/perf-log.md, entry 30).
+/// the 24-byte structs, the lod loop ran four lanes wide plus a scalar remainder
+/// (docs/perf-log.md, entry 30).
 #[inline(always)]
 pub(crate) fn queries<const N: usize>(
     s: &Sampler,
@@ -123,8 +116,13 @@ pub(crate) fn queries<const N: usize>(
 ) {
     let n = fps.len().min(N);
     out.n = n;
-    let [dudx, dvdx, dudy, dvdy] = &mut out.d;
-    if s.uses_derivatives() {
+    let deriv = s.uses_derivatives();
+    // The derivatives' lanes `(du/dx, dv/dx, du/dy, dv/dy)`: ones, not zeros, beyond `n`, so that
+    // those lanes have a normal rho^2 (zeros would send every chunk shorter than a multiple of
+    // 16 through the scalar recomputation below).
+    let mut d = [[1.0f32; N]; 4];
+    let [dudx, dvdx, dudy, dvdy] = &mut d;
+    if deriv {
         for (k, f) in fps[..n].iter().enumerate() {
             (out.u[k], out.v[k]) = (f.u, f.v);
             (dudx[k], dvdx[k], dudy[k], dvdy[k]) = (f.dudx, f.dvdx, f.dudy, f.dvdy);
@@ -140,7 +138,7 @@ pub(crate) fn queries<const N: usize>(
         *u = finite_uv(*u);
         *v = finite_uv(*v);
     }
-    if !s.uses_derivatives() {
+    if !deriv {
         out.lod[..n].fill(0.0);
         return;
     }
@@ -166,7 +164,6 @@ pub(crate) fn queries<const N: usize>(
         // gives lod_max.
         let l = (0.5 * log2_normal(rho2) + bias).clamp(min, max);
         *lod = if finite { l } else { max };
-        // A stale lane beyond `n` may set it too: the loop below then recomputes nothing.
         special |= finite & (rho2 < f32::MIN_POSITIVE);
     }
     if special {

@@ -281,8 +281,8 @@ fn batch_equals_single_on_extreme_derivatives() {
 /// `sample_batch` equals `sample` bit for bit where whole chunks share one level (the batch's
 /// one-level path: the view and size looked up once per chunk) and where one sample of a chunk
 /// leaves it: footprints of one fractional lod (1.3; 0.6 for the nearest-mip rounding; 2.9, near
-/// the last level of a 64-texel side) at spread positions, 64-sample chunks with and without an outlier, every mipmap mode and filter,
-/// the three formats.
+/// the last level of a 64-texel side) at spread positions, 64-sample chunks with and without an
+/// outlier, every mipmap mode and filter, the three formats.
 #[test]
 fn batch_equals_single_when_a_chunk_shares_a_level() {
     let textures = [
