@@ -170,8 +170,9 @@ pub struct SceneArgs {
     pub surface_uv: Option<SurfaceUvArg>,
     /// Filtering arithmetic for 8-bit unorm textures (`--color raw`) with nearest, bilinear,
     /// mip-nearest or trilinear: exact f32, or as GPUs blend unorm8 texels (8-bit sub-texel and
-    /// mip weights, each blend rounded to 8 bits; faster, within about a code of exact). sRGB
-    /// textures, the other filters and the reference stay exact.
+    /// mip weights, each blend rounded to 8 bits; within about a code of exact, and on this CPU
+    /// path slower than exact from bilinear on: README.md). sRGB textures, the other filters and
+    /// the reference stay exact.
     #[arg(long, value_enum, default_value_t)]
     pub precision: PrecisionArg,
 }
