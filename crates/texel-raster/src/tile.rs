@@ -166,7 +166,7 @@ struct Context<'a> {
 /// How a draw's colour-view fragments get their texture colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Route {
-    /// [`texel_texture::Sampler::sample_batch`], `f32`, then shaded and encoded.
+    /// [`texel_texture::Sampler::sample_batch_lanes`], `f32`, then shaded and encoded.
     Float,
     /// The stored bytes of the texel each reads, written as they are ([`Route::of`]).
     Stored,
@@ -514,7 +514,7 @@ struct Span {
 }
 
 thread_local! {
-    /// Each thread's span scratch: made (and zeroed, 48 KB) once per thread and reused by every
+    /// Each thread's span scratch: made (and zeroed, about 54 KB) once per thread and reused by every
     /// tile the thread renders, where a fresh one per tile cost its allocation and clearing.
     static SPARE_SPAN: Cell<Option<Box<Span>>> = const { Cell::new(None) };
 }
@@ -725,7 +725,8 @@ fn footprint_lanes<'s>(
 /// [`raster_pixels`] for the colour view without texel counting: the triangle's covered,
 /// depth-passing fragments in the tile are gathered row by row into a [`Span`] (up to [`SPAN`] of
 /// them, several rows of a small triangle at once), then interpolated stage by stage over all of
-/// them, sampled with one [`texel_texture::Sampler::sample_batch`] call, then shaded and written.
+/// them, sampled with one [`texel_texture::Sampler::sample_batch_lanes`] call, then shaded and
+/// written.
 /// The fragments of one triangle are distinct pixels, so deferring their writes changes nothing,
 /// and each stage performs the per-pixel path's operations in the same order: the image is bit for
 /// bit the per-pixel path's (`tests/threads.rs`). What it buys: the interpolation stages

@@ -717,8 +717,9 @@ fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
 }
 
 /// The anisotropic probes' stage ([`crate::aniso`]): their coordinates, written by the caller, and
-/// two bilinear level passes. Made once per [`crate::Sampler::sample_batch`] call and reused by
-/// every sample (zeroing scratch per sample costs measurable frame time: docs/perf-log.md).
+/// two bilinear level passes. Made once per [`crate::Sampler::sample_batch`] call (per
+/// [`crate::sampler::LANES_PART`] footprints of a [`crate::Sampler::sample_batch_lanes`] call) and
+/// reused by every sample (zeroing scratch per sample costs measurable frame time: docs/perf-log.md).
 /// Entries beyond a sample's probe count are stale and never read.
 pub(crate) struct Probes {
     /// The probes' coordinates (`lod` unused), written by the caller for the first `at.n`.

@@ -107,6 +107,11 @@ impl FilterMode {
 /// EWA's eccentricity clamp when `anisotropy_clamp` is left at its WebGPU default of 1.
 pub const EWA_DEFAULT_ANISOTROPY: u16 = 16;
 
+/// Footprints per part when [`Sampler::sample_batch_lanes`] hands lanes to a filter that reads
+/// structs: the span of texel's tile rasterizer (256 fragments), so that a span's call makes the
+/// filter's scratch once (6 KB of structs on the stack).
+pub(crate) const LANES_PART: usize = 256;
+
 /// How mip levels are chosen and combined when minifying (WebGPU `GPUMipmapFilterMode`, plus `None`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum MipmapFilterMode {
@@ -579,8 +584,8 @@ impl Sampler {
     /// [`Sampler::sample_batch`] of footprints given as lanes: `out[k] = sample(texture,
     /// footprints.get(k))`, bit for bit. For the core filters (nearest, bilinear, their mipmap
     /// modes) the batched stages copy the lanes as they are, where a slice of [`Footprint`]s is
-    /// transposed field by field first; the other filters get the footprints as structs, a
-    /// chunk at a time.
+    /// transposed field by field first; the other filters get the footprints as structs,
+    /// [`LANES_PART`] at a time.
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
@@ -601,9 +606,12 @@ impl Sampler {
             if self.batched && size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE {
                 return batch::run(&p, self, (self.addr, false), footprints, out);
             }
-            let mut fps = [Footprint::default(); batch::CHUNK];
-            let parts = batch::parts(footprints, batch::CHUNK);
-            for (part, out) in parts.zip(out.chunks_mut(batch::CHUNK)) {
+            // Parts as long as a rasterizer's span, so that the scratch `sample_unbatched` makes
+            // (the anisotropic probe batch: 14 KB) is made once per span, as `sample_batch`
+            // makes it once per call.
+            let mut fps = [Footprint::default(); LANES_PART];
+            let parts = batch::parts(footprints, LANES_PART);
+            for (part, out) in parts.zip(out.chunks_mut(LANES_PART)) {
                 let fps = &mut fps[..part.len()];
                 for (k, f) in fps.iter_mut().enumerate() {
                     *f = part.get(k);
