@@ -585,7 +585,7 @@ impl Sampler {
     /// footprints.get(k))`, bit for bit. For the core filters (nearest, bilinear, their mipmap
     /// modes) the batched stages copy the lanes as they are, where a slice of [`Footprint`]s is
     /// transposed field by field first; the other filters get the footprints as structs,
-    /// [`LANES_PART`] at a time.
+    /// 256 at a time (a span of texel's tile rasterizer).
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
