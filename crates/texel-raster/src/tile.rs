@@ -29,8 +29,7 @@
 //! `v'` and their derivatives from the triangle's `f32` `UvPlanes` re-anchored in the tile, eight
 //! lanes with AVX2; the `f64` barycentrics only where shading or a sphere mapping reads them;
 //! each stage a branch-free loop the compiler vectorises),
-//! sampled by one `Sampler::sample_batch_lanes` call (the footprints as lanes, one array per
-//! field, as the stages compute them), then shaded and written: a row whose whole run
+//! sampled by one `Sampler::sample_batch` call, then shaded and written: a row whose whole run
 //! passed the depth test is written as slices (the encode in lanes, the depths a copy), other rows
 //! fragment by fragment. Each stage performs the per-pixel path's operations in the same order, so
 //! images are bit for bit the per-pixel path's (`tests/threads.rs`, also on grids of small
@@ -38,7 +37,7 @@
 //! path is latency-bound (one long chain per pixel: `1/w` division, footprint, `log2`, level,
 //! texel loads, blend), so cutting instructions alone does not move the wall time; batching lets
 //! the independent lod computations of a span overlap, and gathering several rows samples a small
-//! triangle in one sampler call instead of one per row (the sampler runs calls of at most
+//! triangle in one `sample_batch` call instead of one per row (the sampler runs calls of at most
 //! 16 footprints with 16-sample scratch). The periodic `uv` reduction multiplies by the exact
 //! reciprocal of the period instead of dividing. The planes' anchor is chosen from the triangle's
 //! box in the whole tile, not the scissored range, so a scissor never changes a pixel. When the sampler ignores derivatives
@@ -55,7 +54,7 @@ use rayon::prelude::*;
 use texel_texture::color::{
     rgba_to_unorm8, rgba_to_unorm8_slice, srgb8_encoder, unorm8_table, Srgb8Encoder,
 };
-use texel_texture::{Footprint, FootprintLanes};
+use texel_texture::Footprint;
 
 use crate::dispatch::Kernel;
 use crate::draw::DrawCall;
@@ -166,7 +165,7 @@ struct Context<'a> {
 /// How a draw's colour-view fragments get their texture colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Route {
-    /// [`texel_texture::Sampler::sample_batch_lanes`], `f32`, then shaded and encoded.
+    /// [`texel_texture::Sampler::sample_batch`], `f32`, then shaded and encoded.
     Float,
     /// The stored bytes of the texel each reads, written as they are ([`Route::of`]).
     Stored,
@@ -500,13 +499,7 @@ struct Span {
     /// Rows gathered so far: `(first, end, contiguous)` fragment ranges, one per row, in order.
     run: [(u32, u32, bool); SPAN],
     runs: usize,
-    /// The sampler's input: the footprints as lanes (`plane_footprints`, `mapped_footprints`),
-    /// `u`, `v` reduced, and `(du/dx, dv/dx, du/dy, dv/dy)`.
-    fu: [f32; SPAN],
-    fv: [f32; SPAN],
-    fd: [[f32; SPAN]; 4],
-    /// The footprints as structs (`lanes_to_structs`, for what reads those), and the sampler's
-    /// output.
+    /// The sampler's input and output.
     fps: [Footprint; SPAN],
     texs: [[f32; 4]; SPAN],
     /// The stored-bytes and fixed-point paths' output ([`Route`]).
@@ -514,7 +507,7 @@ struct Span {
 }
 
 thread_local! {
-    /// Each thread's span scratch: made (and zeroed, about 54 KB) once per thread and reused by every
+    /// Each thread's span scratch: made (and zeroed, 48 KB) once per thread and reused by every
     /// tile the thread renders, where a fresh one per tile cost its allocation and clearing.
     static SPARE_SPAN: Cell<Option<Box<Span>>> = const { Cell::new(None) };
 }
@@ -549,9 +542,6 @@ impl Span {
             runs: 0,
             u: [0.0; SPAN],
             v: [0.0; SPAN],
-            fu: [0.0; SPAN],
-            fv: [0.0; SPAN],
-            fd: [[0.0; SPAN]; 4],
             fps: [Footprint::default(); SPAN],
             texs: [[0.0; 4]; SPAN],
             bytes: [[0; 4]; SPAN],
@@ -635,7 +625,7 @@ impl Span {
 
     /// The footprints of the span's fragments under a per-pixel sphere mapping, from their
     /// barycentrics (and, when `deriv`, their derivatives), reduced by [`DrawContext::footprint`]:
-    /// not a linear combination, one fragment at a time; into the footprint lanes.
+    /// not a linear combination, one fragment at a time.
     #[inline(always)]
     fn mapped_footprints(&mut self, dc: &DrawContext, m: &MappedTriangle, deriv: bool) {
         let [l0, l1, l2] = &self.l;
@@ -650,17 +640,13 @@ impl Span {
                 ]
             });
             let (uv, dx, dy) = m.uv(lambda, dlambda);
-            let fp = dc.footprint(uv, dx, dy);
-            (self.fu[k], self.fv[k]) = (fp.u, fp.v);
-            let [dudx, dvdx, dudy, dvdy] = &mut self.fd;
-            (dudx[k], dvdx[k], dudy[k], dvdy[k]) = (fp.dudx, fp.dvdx, fp.dudy, fp.dvdy);
+            self.fps[k] = dc.footprint(uv, dx, dy);
         }
     }
 
-    /// The footprints of the span's fragments from `uv`'s planes `p`, as lanes (`fu`, `fv`,
-    /// `fd`): [`UvPlanes::footprint`]'s operations, stage by stage over the span in `f32` (eight
-    /// or sixteen lanes), for a tile whose top-left pixel is `origin`. Without `deriv` the
-    /// derivatives are zero.
+    /// The footprints of the span's fragments from `uv`'s planes `p`: [`UvPlanes::footprint`]'s
+    /// operations, stage by stage over the span in `f32` (eight lanes with AVX2), for a tile
+    /// whose top-left pixel is `origin`. Without `deriv` the derivatives are zero.
     #[inline(always)]
     fn plane_footprints(&mut self, p: &UvPlanes, origin: [u32; 2], deriv: bool) {
         let n = self.n;
@@ -681,52 +667,29 @@ impl Span {
             self.u[k] = p.value(0, x, y, inv);
             self.v[k] = p.value(1, x, y, inv);
         }
-        let [dudx, dvdx, dudy, dvdy] = &mut self.fd;
-        if deriv {
-            for k in 0..n {
-                let (u, v, inv) = (self.u[k], self.v[k], self.inv[k]);
-                (dudx[k], dudy[k]) = p.derivatives(0, u, inv);
-                (dvdx[k], dvdy[k]) = p.derivatives(1, v, inv);
-            }
-        } else {
-            for d in &mut self.fd {
-                d[..n].fill(0.0);
-            }
-        }
         for k in 0..n {
-            self.fu[k] = p.reduce(0, self.u[k]);
-            self.fv[k] = p.reduce(1, self.v[k]);
+            let (u, v, inv) = (self.u[k], self.v[k], self.inv[k]);
+            let fp = &mut self.fps[k];
+            (fp.dudx, fp.dudy) = if deriv {
+                p.derivatives(0, u, inv)
+            } else {
+                (0.0, 0.0)
+            };
+            (fp.dvdx, fp.dvdy) = if deriv {
+                p.derivatives(1, v, inv)
+            } else {
+                (0.0, 0.0)
+            };
+            fp.u = p.reduce(0, u);
+            fp.v = p.reduce(1, v);
         }
     }
-
-    /// The footprint lanes as structs (`fps`), for what reads those: shading, the capture, and
-    /// the bytes routes' samplers.
-    #[inline(always)]
-    fn lanes_to_structs(&mut self) {
-        let lanes = footprint_lanes(&self.fu, &self.fv, &self.fd, self.n);
-        for (k, fp) in self.fps[..self.n].iter_mut().enumerate() {
-            *fp = lanes.get(k);
-        }
-    }
-}
-
-/// The first `n` entries of a span's footprint lanes `u`, `v`, `d` ([`Span`]'s `fu`, `fv`,
-/// `fd`) as the sampler's [`FootprintLanes`].
-#[inline(always)]
-fn footprint_lanes<'s>(
-    u: &'s [f32; SPAN],
-    v: &'s [f32; SPAN],
-    d: &'s [[f32; SPAN]; 4],
-    n: usize,
-) -> FootprintLanes<'s> {
-    FootprintLanes::new(&u[..n], &v[..n], d.each_ref().map(|d| &d[..n]))
 }
 
 /// [`raster_pixels`] for the colour view without texel counting: the triangle's covered,
 /// depth-passing fragments in the tile are gathered row by row into a [`Span`] (up to [`SPAN`] of
 /// them, several rows of a small triangle at once), then interpolated stage by stage over all of
-/// them, sampled with one [`texel_texture::Sampler::sample_batch_lanes`] call, then shaded and
-/// written.
+/// them, sampled with one [`texel_texture::Sampler::sample_batch`] call, then shaded and written.
 /// The fragments of one triangle are distinct pixels, so deferring their writes changes nothing,
 /// and each stage performs the per-pixel path's operations in the same order: the image is bit for
 /// bit the per-pixel path's (`tests/threads.rs`). What it buys: the interpolation stages
@@ -844,14 +807,8 @@ fn flush_span(
             span.plane_footprints(p, [tile.x0, tile.y0], deriv);
         }
     }
-    // The `f32` route samples the lanes as they are; the footprints as structs only for what
-    // reads those: the shading, the capture, and the bytes routes' samplers.
-    let route = ctx.routes[t.draw as usize];
-    if shaded || ctx.capture || route != Route::Float {
-        span.lanes_to_structs();
-    }
     let (fps, bytes) = (&span.fps[..n], &mut span.bytes[..n]);
-    match route {
+    match ctx.routes[t.draw as usize] {
         Route::Stored if dc.sampler.sample_batch_stored(dc.texture, fps, bytes) => {
             let (color8, depth) = (&mut tile.color8, &mut tile.depth);
             write_rows(span, &span.bytes, color8, depth, Copied);
@@ -891,9 +848,8 @@ fn shade_span(
 ) {
     let n = span.n;
     if sample {
-        let lanes = footprint_lanes(&span.fu, &span.fv, &span.fd, n);
         dc.sampler
-            .sample_batch_lanes(dc.texture, lanes, &mut span.texs[..n]);
+            .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
     }
     let verts = dc.vertices(t);
     // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).

@@ -159,8 +159,7 @@ pub(crate) fn plan_chunk(
 /// Anisotropic filtering of `q` by its [`Plan`]:
 /// `c = 1/N sum_{i=0}^{N-1} trilinear(uv + ((i + 0.5) / N - 0.5) Pmax_uv, plan.lod)`, or trilinear
 /// at the isotropic lod when `N = 1`. `probes` is scratch (reused across a batch:
-/// `Sampler::sample_batch`, `Sampler::sample_batch_lanes`); the result does not depend on its
-/// contents.
+/// `Sampler::sample_batch`); the result does not depend on its contents.
 #[inline(always)]
 pub(crate) fn filter_planned<P: Pyramid>(
     p: &P,

@@ -36,7 +36,7 @@ use crate::fetch::{Fetch, Pyramid};
 use crate::fixed8::{Bilinear8, Point8};
 use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
 use crate::footprint::{
-    finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, FootprintLanes, Query,
+    finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, Query,
 };
 use crate::mip::{self, LevelFilter};
 use crate::nearest::Point;
@@ -96,98 +96,6 @@ impl<const N: usize> Chunk<N> {
     }
 }
 
-/// Where the stages read footprints from: a slice of [`Footprint`]s, or [`FootprintLanes`] (one
-/// slice per field, as a rasterizer's span interpolates them), which stage 0 copies lane by lane
-/// instead of transposing structs.
-pub(crate) trait Footprints: Copy {
-    /// Number of footprints.
-    fn count(&self) -> usize;
-    /// Footprints `start..start + len` (clipped to the end).
-    fn part(&self, start: usize, len: usize) -> Self;
-    /// Footprint `k < count()`.
-    fn get(&self, k: usize) -> Footprint;
-    /// The first `count()` (at most `N`) `u`, `v` into `u`, `v`, and with `d` the derivatives
-    /// `(du/dx, dv/dx, du/dy, dv/dy)` into its four lanes.
-    fn lanes_into<const N: usize>(
-        &self,
-        u: &mut [f32; N],
-        v: &mut [f32; N],
-        d: Option<&mut [[f32; N]; 4]>,
-    );
-}
-
-impl Footprints for &[Footprint] {
-    #[inline(always)]
-    fn count(&self) -> usize {
-        self.len()
-    }
-    #[inline(always)]
-    fn part(&self, start: usize, len: usize) -> Self {
-        &self[start..(start + len).min(self.len())]
-    }
-    #[inline(always)]
-    fn get(&self, k: usize) -> Footprint {
-        self[k]
-    }
-    #[inline(always)]
-    fn lanes_into<const N: usize>(
-        &self,
-        u: &mut [f32; N],
-        v: &mut [f32; N],
-        d: Option<&mut [[f32; N]; 4]>,
-    ) {
-        let n = self.len().min(N);
-        if let Some([dudx, dvdx, dudy, dvdy]) = d {
-            for (k, f) in self[..n].iter().enumerate() {
-                (u[k], v[k]) = (f.u, f.v);
-                (dudx[k], dvdx[k], dudy[k], dvdy[k]) = (f.dudx, f.dvdx, f.dudy, f.dvdy);
-            }
-        } else {
-            // Lod-free (bilinear frames measured 4-6 % slower copying the derivatives too).
-            for (k, f) in self[..n].iter().enumerate() {
-                (u[k], v[k]) = (f.u, f.v);
-            }
-        }
-    }
-}
-
-impl Footprints for FootprintLanes<'_> {
-    #[inline(always)]
-    fn count(&self) -> usize {
-        self.len()
-    }
-    #[inline(always)]
-    fn part(&self, start: usize, len: usize) -> Self {
-        self.slice(start..(start + len).min(self.len()))
-    }
-    #[inline(always)]
-    fn get(&self, k: usize) -> Footprint {
-        FootprintLanes::get(self, k)
-    }
-    #[inline(always)]
-    fn lanes_into<const N: usize>(
-        &self,
-        u: &mut [f32; N],
-        v: &mut [f32; N],
-        d: Option<&mut [[f32; N]; 4]>,
-    ) {
-        let n = self.len().min(N);
-        u[..n].copy_from_slice(&self.u()[..n]);
-        v[..n].copy_from_slice(&self.v()[..n]);
-        if let Some(d) = d {
-            for (to, from) in d.iter_mut().zip(self.derivatives()) {
-                to[..n].copy_from_slice(&from[..n]);
-            }
-        }
-    }
-}
-
-/// `fps` in consecutive parts of `n` (the last may be shorter), as `slice::chunks`.
-#[inline(always)]
-pub(crate) fn parts<S: Footprints>(fps: S, n: usize) -> impl Iterator<Item = S> {
-    (0..fps.count()).step_by(n).map(move |k| fps.part(k, n))
-}
-
 /// Stage 0: the queries of `fps` (at most `N`) on a `size` level 0, as `Sampler::query` makes one:
 /// [`finite_uv`], and `rho^2` ([`rho_squared`]) into [`lod_from_rho_squared`] with
 /// [`crate::footprint::fast_log2`]'s normal-input path written branch-free, so the loop
@@ -203,18 +111,28 @@ pub(crate) fn parts<S: Footprints>(fps: S, n: usize) -> impl Iterator<Item = S> 
 pub(crate) fn queries<const N: usize>(
     s: &Sampler,
     size: (u32, u32),
-    fps: impl Footprints,
+    fps: &[Footprint],
     out: &mut Chunk<N>,
 ) {
-    let n = fps.count().min(N);
+    let n = fps.len().min(N);
     out.n = n;
     let deriv = s.uses_derivatives();
     // The derivatives' lanes `(du/dx, dv/dx, du/dy, dv/dy)`: ones, not zeros, beyond `n`, so that
     // those lanes have a normal rho^2 (zeros would send every chunk shorter than a multiple of
     // 16 through the scalar recomputation below).
     let mut d = [[1.0f32; N]; 4];
-    fps.lanes_into(&mut out.u, &mut out.v, deriv.then_some(&mut d));
-    let [dudx, dvdx, dudy, dvdy] = &d;
+    let [dudx, dvdx, dudy, dvdy] = &mut d;
+    if deriv {
+        for (k, f) in fps[..n].iter().enumerate() {
+            (out.u[k], out.v[k]) = (f.u, f.v);
+            (dudx[k], dvdx[k], dudy[k], dvdy[k]) = (f.dudx, f.dvdx, f.dudy, f.dvdy);
+        }
+    } else {
+        // Lod-free (bilinear frames measured 4-6 % slower copying the derivatives too).
+        for (k, f) in fps[..n].iter().enumerate() {
+            (out.u[k], out.v[k]) = (f.u, f.v);
+        }
+    }
     let lanes = n.next_multiple_of(16).min(N);
     for (u, v) in out.u[..lanes].iter_mut().zip(&mut out.v[..lanes]) {
         *u = finite_uv(*u);
@@ -249,8 +167,8 @@ pub(crate) fn queries<const N: usize>(
         special |= finite & (rho2 < f32::MIN_POSITIVE);
     }
     if special {
-        for (k, lod) in out.lod[..n].iter_mut().enumerate() {
-            let rho2 = rho_squared(&fps.get(k), size.0, size.1);
+        for (f, lod) in fps.iter().zip(out.lod.iter_mut()) {
+            let rho2 = rho_squared(f, size.0, size.1);
             if rho2 < f32::MIN_POSITIVE {
                 *lod = lod_from_rho_squared(rho2, bias, min, max);
             }
@@ -554,7 +472,7 @@ pub(crate) fn run<P: Pyramid>(
     p: &P,
     s: &Sampler,
     (addr, fixed): (Address, bool),
-    footprints: impl Footprints,
+    footprints: &[Footprint],
     out: &mut [[f32; 4]],
 ) {
     let io = (footprints, out);
@@ -568,17 +486,17 @@ pub(crate) fn run<P: Pyramid>(
 
 /// [`run`] with the within-level filter `T`.
 #[inline(always)]
-fn run_with<P: Pyramid, T: Taps, S: Footprints>(
+fn run_with<P: Pyramid, T: Taps>(
     p: &P,
     taps: T,
     s: &Sampler,
     addr: Address,
-    (footprints, out): (S, &mut [[f32; 4]]),
+    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
 ) {
-    if footprints.count() <= 16 {
-        run_in::<P, T, S, 16, 1>(p, taps, s, addr, (footprints, out));
+    if footprints.len() <= 16 {
+        run_in::<P, T, 16, 1>(p, taps, s, addr, (footprints, out));
     } else {
-        run_in::<P, T, S, CHUNK, LEVELS>(p, taps, s, addr, (footprints, out));
+        run_in::<P, T, CHUNK, LEVELS>(p, taps, s, addr, (footprints, out));
     }
 }
 
@@ -586,12 +504,12 @@ fn run_with<P: Pyramid, T: Taps, S: Footprints>(
 /// each sample's view made when it is read, which is cheaper for a handful of samples than making
 /// 32 views.
 #[inline(always)]
-fn run_in<P: Pyramid, T: Taps, S: Footprints, const N: usize, const V: usize>(
+fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     p: &P,
     taps: T,
     s: &Sampler,
     addr: Address,
-    (footprints, out): (S, &mut [[f32; 4]]),
+    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
 ) {
     // Level 0 is at most 2^22 per side (`MAX_SIDE`), so there are at most 23 levels.
     let levels = p.level_count().min(LEVELS);
@@ -621,11 +539,8 @@ fn run_in<P: Pyramid, T: Taps, S: Footprints, const N: usize, const V: usize>(
     let last = levels - 1;
     let size0 = base.size();
     let trilinear = d.mipmap_filter == MipmapFilterMode::Linear;
-    for (fps, out) in parts(footprints, N).zip(out.chunks_mut(N)) {
-        // At most `N` (as `parts` gives), stated so that the stage loops over `[_; N]` arrays
-        // need no bounds checks.
-        let n = fps.count().min(N);
-        let out = &mut out[..n];
+    for (fps, out) in footprints.chunks(N).zip(out.chunks_mut(N)) {
+        let n = fps.len();
         queries(s, size0, fps, &mut chunk);
         if d.mipmap_filter == MipmapFilterMode::None {
             // Every sample in level 0: stages 2 and 3 with its view and size, no per-sample
@@ -648,15 +563,11 @@ fn run_in<P: Pyramid, T: Taps, S: Footprints, const N: usize, const V: usize>(
                 }
             }
             MipmapFilterMode::Linear => {
-                // Zipped slices: indexed, this loop's vectorisation came and went with unrelated
-                // changes to the code around it (docs/perf-log.md, entry 31).
-                let levels = first.level[..n].iter_mut().zip(&mut second.level[..n]);
-                let levels = levels.zip(&mut delta[..n]).zip(&chunk.lod[..n]);
-                for (((fine, next), delta), &lod) in levels {
+                for (k, &lod) in chunk.lod[..n].iter().enumerate() {
                     let (l, t) = mip::linear_levels_staged(lod, last);
-                    *fine = l as u8;
-                    *next = (l as u8 + 1).min(last as u8);
-                    *delta = t;
+                    first.level[k] = l as u8;
+                    second.level[k] = (l as u8 + 1).min(last as u8);
+                    delta[k] = t;
                 }
             }
         }
@@ -717,9 +628,8 @@ fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
 }
 
 /// The anisotropic probes' stage ([`crate::aniso`]): their coordinates, written by the caller, and
-/// two bilinear level passes. Made once per [`crate::Sampler::sample_batch`] call (per
-/// [`crate::sampler::LANES_PART`] footprints of a [`crate::Sampler::sample_batch_lanes`] call) and
-/// reused by every sample (zeroing scratch per sample costs measurable frame time: docs/perf-log.md).
+/// two bilinear level passes. Made once per [`crate::Sampler::sample_batch`] call and reused by
+/// every sample (zeroing scratch per sample costs measurable frame time: docs/perf-log.md).
 /// Entries beyond a sample's probe count are stale and never read.
 pub(crate) struct Probes {
     /// The probes' coordinates (`lod` unused), written by the caller for the first `at.n`.

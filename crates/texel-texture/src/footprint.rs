@@ -128,84 +128,6 @@ impl Footprint {
     }
 }
 
-/// Many footprints as lanes: one slice per [`Footprint`] field, footprint `k` made of entry `k`
-/// of each. The layout a rasterizer's vectorised interpolation produces and the batched
-/// sampler's stages read ([`crate::Sampler::sample_batch_lanes`]), so that neither side
-/// transposes through 24-byte structs.
-#[derive(Clone, Copy, Debug)]
-pub struct FootprintLanes<'a> {
-    u: &'a [f32],
-    v: &'a [f32],
-    /// `(du/dx, dv/dx, du/dy, dv/dy)`.
-    d: [&'a [f32]; 4],
-}
-
-impl<'a> FootprintLanes<'a> {
-    /// The lanes `u`, `v` and derivatives `d = [du/dx, dv/dx, du/dy, dv/dy]` (units as
-    /// [`Footprint`]'s fields).
-    ///
-    /// # Panics
-    /// If the six slices differ in length (a programming error, not bad input).
-    pub fn new(u: &'a [f32], v: &'a [f32], d: [&'a [f32]; 4]) -> FootprintLanes<'a> {
-        let n = u.len();
-        assert!(
-            v.len() == n && d.iter().all(|x| x.len() == n),
-            "FootprintLanes: the lanes differ in length"
-        );
-        FootprintLanes { u, v, d }
-    }
-
-    /// Number of footprints.
-    pub fn len(&self) -> usize {
-        self.u.len()
-    }
-
-    /// Whether there are no footprints.
-    pub fn is_empty(&self) -> bool {
-        self.u.is_empty()
-    }
-
-    /// Footprint `k`. Panics if `k >= len()`.
-    #[inline(always)]
-    pub fn get(&self, k: usize) -> Footprint {
-        let [dudx, dvdx, dudy, dvdy] = self.d;
-        Footprint {
-            u: self.u[k],
-            v: self.v[k],
-            dudx: dudx[k],
-            dudy: dudy[k],
-            dvdx: dvdx[k],
-            dvdy: dvdy[k],
-        }
-    }
-
-    /// The footprints `range` of these (as slicing each lane). Panics if out of range.
-    #[inline(always)]
-    pub fn slice(&self, range: std::ops::Range<usize>) -> FootprintLanes<'a> {
-        let d = self.d.map(|x| &x[range.clone()]);
-        FootprintLanes {
-            u: &self.u[range.clone()],
-            v: &self.v[range],
-            d,
-        }
-    }
-
-    /// The `u` lane.
-    pub fn u(&self) -> &'a [f32] {
-        self.u
-    }
-
-    /// The `v` lane.
-    pub fn v(&self) -> &'a [f32] {
-        self.v
-    }
-
-    /// The derivative lanes `[du/dx, dv/dx, du/dy, dv/dy]`.
-    pub fn derivatives(&self) -> [&'a [f32]; 4] {
-        self.d
-    }
-}
-
 /// Largest |u| or |v| honoured (2^24): coordinates beyond are clamped to it.
 pub const UV_LIMIT: f32 = 16_777_216.0;
 
@@ -318,43 +240,6 @@ pub(crate) fn log2_normal(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Lanes read back field by field, sliced as the lanes are, and refused when their lengths
-    /// differ.
-    #[test]
-    fn lanes_hold_footprints_field_by_field() {
-        let u = [0.1, 0.2, 0.3];
-        let v = [1.1, 1.2, 1.3];
-        let d = [
-            [2.0, 2.1, 2.2],
-            [3.0, 3.1, 3.2],
-            [4.0, 4.1, 4.2],
-            [5.0, 5.1, 5.2],
-        ];
-        let lanes = FootprintLanes::new(&u, &v, d.each_ref().map(|x| &x[..]));
-        assert_eq!(lanes.len(), 3);
-        let want = |k: usize| Footprint {
-            u: u[k],
-            v: v[k],
-            dudx: d[0][k],
-            dvdx: d[1][k],
-            dudy: d[2][k],
-            dvdy: d[3][k],
-        };
-        for k in 0..3 {
-            assert_eq!(lanes.get(k), want(k));
-        }
-        let tail = lanes.slice(1..3);
-        assert_eq!(
-            (tail.len(), tail.get(0), tail.get(1)),
-            (2, want(1), want(2))
-        );
-        assert!(lanes.slice(3..3).is_empty());
-        let short = std::panic::catch_unwind(|| {
-            FootprintLanes::new(&u, &v[..2], d.each_ref().map(|x| &x[..]))
-        });
-        assert!(short.is_err());
-    }
 
     /// Axes of 4 and 2 texels on a 256 x 256 texture, along x and y.
     const AXES_4_BY_2: Footprint = Footprint {

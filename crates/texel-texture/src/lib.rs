@@ -57,7 +57,7 @@ pub mod warp;
 pub use address::{Address, AddressMode, BorderColor};
 pub use bicubic::Cubic;
 pub use error::TextureError;
-pub use footprint::{Axes, Footprint, FootprintLanes};
+pub use footprint::{Axes, Footprint};
 pub use ripmap::Ripmap;
 pub use sampler::{
     FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,

@@ -65,9 +65,7 @@ use crate::ewa::ewa;
 use crate::fetch::{codes_of, with_pyramid, Counted, Fetch, Pyramid};
 use crate::floor::integer_bytes4;
 pub use crate::footprint::UV_LIMIT;
-use crate::footprint::{
-    finite_uv, lod_from_rho_squared, rho_squared, Footprint, FootprintLanes, Query,
-};
+use crate::footprint::{finite_uv, lod_from_rho_squared, rho_squared, Footprint, Query};
 use crate::mip::{filter_level, mip_nearest, trilinear};
 use crate::ripmap::ripmap;
 use crate::sat::summed_area;
@@ -106,11 +104,6 @@ impl FilterMode {
 
 /// EWA's eccentricity clamp when `anisotropy_clamp` is left at its WebGPU default of 1.
 pub const EWA_DEFAULT_ANISOTROPY: u16 = 16;
-
-/// Footprints per part when [`Sampler::sample_batch_lanes`] hands lanes to a filter that reads
-/// structs: the span of texel's tile rasterizer (256 fragments), so that a span's call makes the
-/// filter's scratch once (6 KB of structs on the stack).
-pub(crate) const LANES_PART: usize = 256;
 
 /// How mip levels are chosen and combined when minifying (WebGPU `GPUMipmapFilterMode`, plus `None`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -521,102 +514,54 @@ impl Sampler {
         );
         with_pyramid!(texture, |p| {
             let size = p.level(0).size();
-            if self.batched && size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE {
+            let staged = size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE;
+            if self.batched && staged {
                 return batch::run(&p, self, (self.addr, false), footprints, out);
             }
-            self.sample_unbatched(&p, footprints, out)
-        })
-    }
-
-    /// [`Sampler::sample_batch`] for the samplers and textures the staged core kernels do not
-    /// take (`batched` false, or a level 0 beyond [`batch::MAX_SIDE`]).
-    #[inline(always)]
-    fn sample_unbatched<P: Pyramid>(&self, p: &P, footprints: &[Footprint], out: &mut [[f32; 4]]) {
-        let size = p.level(0).size();
-        let staged = size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE;
-        if self.technique == Technique::Anisotropic && staged {
-            // Probes of several samples filtered together; the rest one by one, as
-            // `filter_planned` and `filter` do.
-            let mut probes = Probes::new(self.addr);
-            return batch::anisotropic(p, self, (footprints, out), |q, plan| {
-                if q.lod > 0.0 {
-                    filter_planned(p, q, plan, &mut probes)
-                } else {
-                    self.filter(p, q)
+            if self.technique == Technique::Anisotropic && staged {
+                // Probes of several samples filtered together; the rest one by one, as
+                // `filter_planned` and `filter` do.
+                let mut probes = Probes::new(self.addr);
+                return batch::anisotropic(&p, self, (footprints, out), |q, plan| {
+                    if q.lod > 0.0 {
+                        filter_planned(&p, q, plan, &mut probes)
+                    } else {
+                        self.filter(&p, q)
+                    }
+                });
+            }
+            // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
+            // arithmetic vectorised), then all filters.
+            let mut chunk = Chunk::<{ batch::CHUNK }>::new();
+            let chunks = footprints
+                .chunks(batch::CHUNK)
+                .zip(out.chunks_mut(batch::CHUNK));
+            if self.technique == Technique::Anisotropic {
+                // A third stage between the two: every sample's probe plan (axes, probe count,
+                // probe lod), vectorised as the lods are; the probes' scratch is made once.
+                let mut plans = [Plan::default(); batch::CHUNK];
+                let mut probes = Probes::new(self.addr);
+                for (fps, outs) in chunks {
+                    batch::queries(self, size, fps, &mut chunk);
+                    plan_chunk(self, size, fps, &mut plans);
+                    for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
+                        let q = chunk.query(k, fp);
+                        // As `filter`: magnification first.
+                        *o = if q.lod > 0.0 {
+                            filter_planned(&p, &q, &plans[k], &mut probes)
+                        } else {
+                            self.filter(&p, &q)
+                        }
+                        .to_array();
+                    }
                 }
-            });
-        }
-        // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
-        // arithmetic vectorised), then all filters.
-        let mut chunk = Chunk::<{ batch::CHUNK }>::new();
-        let chunks = footprints
-            .chunks(batch::CHUNK)
-            .zip(out.chunks_mut(batch::CHUNK));
-        if self.technique == Technique::Anisotropic {
-            // A third stage between the two: every sample's probe plan (axes, probe count,
-            // probe lod), vectorised as the lods are; the probes' scratch is made once.
-            let mut plans = [Plan::default(); batch::CHUNK];
-            let mut probes = Probes::new(self.addr);
+                return;
+            }
             for (fps, outs) in chunks {
                 batch::queries(self, size, fps, &mut chunk);
-                plan_chunk(self, size, fps, &mut plans);
                 for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
-                    let q = chunk.query(k, fp);
-                    // As `filter`: magnification first.
-                    *o = if q.lod > 0.0 {
-                        filter_planned(p, &q, &plans[k], &mut probes)
-                    } else {
-                        self.filter(p, &q)
-                    }
-                    .to_array();
+                    *o = self.filter(&p, &chunk.query(k, fp)).to_array();
                 }
-            }
-            return;
-        }
-        for (fps, outs) in chunks {
-            batch::queries(self, size, fps, &mut chunk);
-            for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
-                *o = self.filter(p, &chunk.query(k, fp)).to_array();
-            }
-        }
-    }
-
-    /// [`Sampler::sample_batch`] of footprints given as lanes: `out[k] = sample(texture,
-    /// footprints.get(k))`, bit for bit. For the core filters (nearest, bilinear, their mipmap
-    /// modes) the batched stages copy the lanes as they are, where a slice of [`Footprint`]s is
-    /// transposed field by field first; the other filters get the footprints as structs,
-    /// 256 at a time (a span of texel's tile rasterizer).
-    ///
-    /// # Panics
-    /// If `footprints.len() != out.len()` (a programming error, not bad input).
-    #[inline(always)]
-    pub fn sample_batch_lanes(
-        &self,
-        texture: &Texture,
-        footprints: FootprintLanes,
-        out: &mut [[f32; 4]],
-    ) {
-        assert_eq!(
-            footprints.len(),
-            out.len(),
-            "sample_batch_lanes: footprints and out differ in length"
-        );
-        with_pyramid!(texture, |p| {
-            let size = p.level(0).size();
-            if self.batched && size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE {
-                return batch::run(&p, self, (self.addr, false), footprints, out);
-            }
-            // Parts as long as a rasterizer's span, so that the scratch `sample_unbatched` makes
-            // (the anisotropic probe batch: 14 KB) is made once per span, as `sample_batch`
-            // makes it once per call.
-            let mut fps = [Footprint::default(); LANES_PART];
-            let parts = batch::parts(footprints, LANES_PART);
-            for (part, out) in parts.zip(out.chunks_mut(LANES_PART)) {
-                let fps = &mut fps[..part.len()];
-                for (k, f) in fps.iter_mut().enumerate() {
-                    *f = part.get(k);
-                }
-                self.sample_unbatched(&p, fps, out);
             }
         })
     }

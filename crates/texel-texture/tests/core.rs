@@ -3,36 +3,9 @@
 
 use proptest::prelude::*;
 use texel_texture::{
-    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, FootprintLanes,
-    Format, Limits, MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
+    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Limits,
+    MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
 };
-
-/// `fps` as lanes: `(u, v, [du/dx, dv/dx, du/dy, dv/dy])`, one vector per field.
-fn lanes_of(fps: &[Footprint]) -> (Vec<f32>, Vec<f32>, [Vec<f32>; 4]) {
-    let field = |f: fn(&Footprint) -> f32| fps.iter().map(f).collect::<Vec<f32>>();
-    (
-        field(|f| f.u),
-        field(|f| f.v),
-        [
-            field(|f| f.dudx),
-            field(|f| f.dvdx),
-            field(|f| f.dudy),
-            field(|f| f.dvdy),
-        ],
-    )
-}
-
-/// [`Sampler::sample_batch_lanes`] of `fps` given as lanes.
-fn sample_lanes(s: &Sampler, tex: &Texture, fps: &[Footprint], out: &mut [[f32; 4]]) {
-    let (u, v, d) = lanes_of(fps);
-    let lanes = FootprintLanes::new(&u, &v, d.each_ref().map(Vec::as_slice));
-    // Bit patterns: NaN fields are not equal to themselves.
-    let bits = |f: Footprint| [f.u, f.v, f.dudx, f.dudy, f.dvdx, f.dvdy].map(f32::to_bits);
-    for (k, fp) in fps.iter().enumerate() {
-        assert_eq!(bits(lanes.get(k)), bits(*fp));
-    }
-    s.sample_batch_lanes(tex, lanes, out);
-}
 
 const ADDRESS_MODES: [AddressMode; 5] = [
     AddressMode::ClampToEdge,
@@ -236,15 +209,11 @@ proptest! {
             samplers.push(Sampler::new(d.with_address_mode(AddressMode::MirrorRepeat)).unwrap());
         }
         let mut out = vec![[0.0; 4]; fps.len()];
-        let mut out_lanes = vec![[0.0; 4]; fps.len()];
         for tex in &textures {
             for s in &samplers {
                 s.sample_batch(tex, &fps, &mut out);
-                // Lanes: every filter, the core ones through the batched stages' lane copy.
-                sample_lanes(s, tex, &fps, &mut out_lanes);
-                for ((f, o), l) in fps.iter().zip(&out).zip(&out_lanes) {
+                for (f, o) in fps.iter().zip(&out) {
                     prop_assert_eq!(s.sample(tex, f).map(f32::to_bits), o.map(f32::to_bits), "{:?} {:?}", s.descriptor(), f);
-                    prop_assert_eq!(o.map(f32::to_bits), l.map(f32::to_bits), "lanes {:?} {:?}", s.descriptor(), f);
                 }
             }
         }
@@ -296,19 +265,12 @@ fn batch_equals_single_on_extreme_derivatives() {
                 })
                 .unwrap();
                 let mut out = vec![[0.0; 4]; fps.len()];
-                let mut out_lanes = vec![[0.0; 4]; fps.len()];
                 s.sample_batch(&tex, &fps, &mut out);
-                sample_lanes(&s, &tex, &fps, &mut out_lanes);
-                for ((fp, o), l) in fps.iter().zip(&out).zip(&out_lanes) {
+                for (fp, o) in fps.iter().zip(&out) {
                     assert_eq!(
                         s.sample(&tex, fp).map(f32::to_bits),
                         o.map(f32::to_bits),
                         "bias {bias} {mip:?} {f:?} {fp:?}"
-                    );
-                    assert_eq!(
-                        o.map(f32::to_bits),
-                        l.map(f32::to_bits),
-                        "lanes: bias {bias} {mip:?} {f:?} {fp:?}"
                     );
                 }
             }
