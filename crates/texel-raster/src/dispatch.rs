@@ -120,9 +120,8 @@ pub fn limit_level(max: SimdLevel) {
 pub(crate) trait Kernel {
     /// What the work returns.
     type Output;
-    /// Do the work, in the copy compiled for `level` (a constant in each copy, so that the work
-    /// can choose code by instruction set at compile time; the images must not depend on it).
-    fn run(self, level: SimdLevel) -> Self::Output;
+    /// Do the work.
+    fn run(self) -> Self::Output;
 }
 
 /// Run `k` on the copy for [`level`]: its body (with everything it inlines) is compiled once for
@@ -138,7 +137,7 @@ pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
         SimdLevel::X86_64V3 => return unsafe { v3(k) },
         SimdLevel::Baseline => {}
     }
-    k.run(SimdLevel::Baseline)
+    k.run()
 }
 
 /// `k.run()` compiled for x86-64-v3.
@@ -147,7 +146,7 @@ pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2"
 )]
 unsafe fn v3<K: Kernel>(k: K) -> K::Output {
-    k.run(SimdLevel::X86_64V3)
+    k.run()
 }
 
 /// `k.run()` compiled for x86-64-v4.
@@ -156,5 +155,5 @@ unsafe fn v3<K: Kernel>(k: K) -> K::Output {
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
 )]
 unsafe fn v4<K: Kernel>(k: K) -> K::Output {
-    k.run(SimdLevel::X86_64V4)
+    k.run()
 }

@@ -54,9 +54,9 @@ use rayon::prelude::*;
 use texel_texture::color::{
     rgba_to_unorm8, rgba_to_unorm8_slice, srgb8_encoder, unorm8_table, Srgb8Encoder,
 };
-use texel_texture::{Footprint, Kernels};
+use texel_texture::Footprint;
 
-use crate::dispatch::{Kernel, SimdLevel};
+use crate::dispatch::Kernel;
 use crate::draw::DrawCall;
 use crate::environment::{Environment, ViewRays};
 use crate::frame::Frame;
@@ -368,25 +368,14 @@ struct TileJob<'j, 'a, 'f, 's> {
 impl Kernel for TileJob<'_, '_, '_, '_> {
     type Output = ();
     #[inline(always)]
-    fn run(self, level: SimdLevel) {
-        // Gathers pay only where LLVM emits AVX-512 ones (docs/perf-log.md, entry 32).
-        let kernels = if level == SimdLevel::X86_64V4 {
-            Kernels::Gathered
-        } else {
-            Kernels::PerSample
-        };
-        raster_tile_body(self.ctx, self.tile, self.bin, kernels);
+    fn run(self) {
+        raster_tile_body(self.ctx, self.tile, self.bin);
     }
 }
 
 /// [`raster_tile`]'s work, inlined into each instruction set's copy.
 #[inline(always)]
-fn raster_tile_body(
-    ctx: &Context,
-    tile: &mut TileTarget,
-    bin: &[&TriangleSetup],
-    kernels: Kernels,
-) {
+fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
     // The tile's pixels inside the scissor, inclusive: [i0, j0, i1, j1].
     let [sx0, sy0, sx1, sy1] = ctx.settings.scissor_rect();
     let (ti0, tj0) = (tile.x0.max(sx0), tile.y0.max(sy0));
@@ -417,7 +406,7 @@ fn raster_tile_body(
         let source = ctx.draws[t.draw as usize].uv_source(t, ctx.settings.perspective, home);
         match (ctx.settings.derivatives, span.as_deref_mut()) {
             (Derivatives::Analytic, Some(span)) => {
-                raster_pixels_batched(ctx, tile, (t, &source), range, (span, kernels))
+                raster_pixels_batched(ctx, tile, (t, &source), range, span)
             }
             (Derivatives::Analytic, None) => raster_pixels(ctx, tile, (t, &source), range),
             (Derivatives::Quad, _) => raster_quads(ctx, tile, (t, &source), range),
@@ -714,7 +703,7 @@ fn raster_pixels_batched(
     tile: &mut TileTarget,
     (t, source): (&TriangleSetup, &UvSource),
     range: [u32; 4],
-    (span, kernels): (&mut Span, Kernels),
+    span: &mut Span,
 ) {
     let [i_lo, j_lo, i_hi, j_hi] = range;
     let dc = &ctx.draws[t.draw as usize];
@@ -726,7 +715,7 @@ fn raster_pixels_batched(
     span.runs = 0;
     for j in j_lo..=j_hi {
         if span.n + width > SPAN {
-            flush_span(ctx, tile, t, (dc, source), (span, kernels));
+            flush_span(ctx, tile, t, (dc, source), span);
         }
         let y_fixed = pixel_center_fixed(j);
         let e = t.edges.map(|e| e.at(x_start, y_fixed));
@@ -784,7 +773,7 @@ fn raster_pixels_batched(
             span.push_run(n, false);
         }
     }
-    flush_span(ctx, tile, t, (dc, source), (span, kernels));
+    flush_span(ctx, tile, t, (dc, source), span);
 }
 
 /// Interpolate, sample, shade and write the `span.n` gathered fragments of triangle `t`, then empty
@@ -795,7 +784,7 @@ fn flush_span(
     tile: &mut TileTarget,
     t: &TriangleSetup,
     (dc, source): (&DrawContext, &UvSource),
-    (span, kernels): (&mut Span, Kernels),
+    span: &mut Span,
 ) {
     let n = span.n;
     if n == 0 {
@@ -832,10 +821,10 @@ fn flush_span(
                 for (t, b) in span.texs[..n].iter_mut().zip(&span.bytes[..n]) {
                     *t = decode_unorm8(*b);
                 }
-                shade_span(ctx, tile, t, dc, span, None);
+                shade_span(ctx, tile, t, dc, span, false);
             }
         }
-        _ => shade_span(ctx, tile, t, dc, span, Some(kernels)),
+        _ => shade_span(ctx, tile, t, dc, span, true),
     }
     if ctx.capture {
         for k in 0..n {
@@ -846,8 +835,8 @@ fn flush_span(
     span.runs = 0;
 }
 
-/// Sample (when `sample` names the kernels; with `None` `span.texs` holds the samples), shade and
-/// write the span's fragments whose footprints are ready.
+/// Sample (when `sample`; else `span.texs` holds the samples), shade and write the span's
+/// fragments whose footprints are ready.
 #[inline(always)]
 fn shade_span(
     ctx: &Context,
@@ -855,12 +844,12 @@ fn shade_span(
     t: &TriangleSetup,
     dc: &DrawContext,
     span: &mut Span,
-    sample: Option<Kernels>,
+    sample: bool,
 ) {
     let n = span.n;
-    if let Some(kernels) = sample {
-        let (fps, texs) = (&span.fps[..n], &mut span.texs[..n]);
-        dc.sampler.sample_batch_with(kernels, dc.texture, fps, texs);
+    if sample {
+        dc.sampler
+            .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
     }
     let verts = dc.vertices(t);
     // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).

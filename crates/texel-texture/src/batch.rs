@@ -32,7 +32,7 @@ use glam::{Vec2, Vec4};
 
 use crate::address::Address;
 use crate::bilinear::{lerp, Bilinear};
-use crate::fetch::{Fetch, Pyramid, QuadTaps};
+use crate::fetch::{Fetch, Pyramid};
 use crate::fixed8::{Bilinear8, Point8};
 use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
 use crate::footprint::{
@@ -40,7 +40,7 @@ use crate::footprint::{
 };
 use crate::mip::{self, LevelFilter};
 use crate::nearest::Point;
-use crate::sampler::{FilterMode, Kernels, MipmapFilterMode, Sampler};
+use crate::sampler::{FilterMode, MipmapFilterMode, Sampler};
 
 /// Samples per stage (the sampler's chunk).
 pub(crate) const CHUNK: usize = 64;
@@ -187,9 +187,6 @@ pub(crate) trait Taps: LevelFilter {
     const REACH: f32;
     /// The value of a sample whose taps lie inside `level`: first tap `(i, j)`, fractions `ab`.
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, ab: (f32, f32)) -> Vec4;
-    /// Whether [`Taps::inside`] is [`Fetch::blend_lanes`]'s blend (bilinear), so that a level
-    /// pass may compute it in lanes ([`Kernels::Gathered`]).
-    const LANES: bool = false;
     /// The blend of two levels' values with weight `t` on `b` ([`lerp`]; the fixed-point
     /// filters of [`crate::fixed8`] round it).
     #[inline(always)]
@@ -214,7 +211,7 @@ const PROBES: usize = 256;
 pub(crate) fn anisotropic<P: Pyramid>(
     p: &P,
     s: &Sampler,
-    (footprints, out, kernels): (&[Footprint], &mut [[f32; 4]], Kernels),
+    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
     mut single: impl FnMut(&Query, &crate::aniso::Plan) -> Vec4,
 ) {
     let size0 = p.level(0).size();
@@ -233,7 +230,7 @@ pub(crate) fn anisotropic<P: Pyramid>(
     };
     let mut chunk = Chunk::<CHUNK>::new();
     let mut plans = [crate::aniso::Plan::default(); CHUNK];
-    let mut probes = ProbeBatch::new(s.address(), kernels);
+    let mut probes = ProbeBatch::new(s.address());
     // Per sample of the chunk: its probes' sum, and `1 / N` (0: not a probed sample).
     let mut sums = [Vec4::ZERO; CHUNK];
     let mut inv = [0.0f32; CHUNK];
@@ -290,13 +287,10 @@ struct ProbeBatch {
     delta: [f32; PROBES],
     coarse: [bool; PROBES],
     owner: [u8; PROBES],
-    /// The bilinear values of the probes inside their levels, per channel, where the batch
-    /// runs [`Kernels::Gathered`].
-    lanes: Option<Box<Lanes<PROBES>>>,
 }
 
 impl ProbeBatch {
-    fn new(addr: Address, kernels: Kernels) -> Box<ProbeBatch> {
+    fn new(addr: Address) -> Box<ProbeBatch> {
         Box::new(ProbeBatch {
             m: 0,
             at: Chunk::new(),
@@ -305,7 +299,6 @@ impl ProbeBatch {
             delta: [0.0; PROBES],
             coarse: [false; PROBES],
             owner: [0; PROBES],
-            lanes: (kernels == Kernels::Gathered).then(|| Box::new(Lanes::new())),
         })
     }
 
@@ -334,20 +327,6 @@ impl ProbeBatch {
             self.fine.coordinates(|_| s0, us, vs);
             self.next.coordinates(|_| s1, us, vs);
             let (fine, next) = (level(l0), level(l1));
-            if F::LANES {
-                if let Some(mut lanes) = self.lanes.take() {
-                    // Every probe's inside values in lanes, then the sums in probe order.
-                    let lanes_m = m.next_multiple_of(16).min(PROBES);
-                    fine.blend_lanes(self.fine.quad_taps(lanes_m), &mut lanes.fine);
-                    if self.coarse[..m].iter().any(|&c| c) {
-                        next.blend_lanes(self.next.quad_taps(lanes_m), &mut lanes.coarse);
-                    }
-                    self.sum_lanes(m, (fine, next), &lanes, sums);
-                    self.lanes = Some(lanes);
-                    self.m = 0;
-                    return;
-                }
-            }
             self.sum_into(m, |_| fine, |_| next, sums);
         } else {
             self.fine.coordinates(&size, us, vs);
@@ -379,63 +358,6 @@ impl ProbeBatch {
             };
             sums[self.owner[k] as usize] += value;
         }
-    }
-
-    /// [`ProbeBatch::sum_into`] for probes all in the levels `fine` and `next`, their inside
-    /// values taken from `lanes` (the same bits, [`Fetch::blend_lanes`]).
-    #[inline(always)]
-    fn sum_lanes<F: Fetch>(
-        &self,
-        m: usize,
-        (fine, next): (&F, &F),
-        lanes: &Lanes<PROBES>,
-        sums: &mut [Vec4; CHUNK],
-    ) {
-        for k in 0..m {
-            let uv = self.at.uv(k);
-            let a = if self.fine.inside[k] {
-                lanes.fine_at(k)
-            } else {
-                self.fine.edge(fine, uv)
-            };
-            let value = if self.coarse[k] {
-                let b = if self.next.inside[k] {
-                    lanes.coarse_at(k)
-                } else {
-                    self.next.edge(next, uv)
-                };
-                lerp(a, b, self.delta[k])
-            } else {
-                a
-            };
-            sums[self.owner[k] as usize] += value;
-        }
-    }
-}
-
-/// A chunk's bilinear values ([`Fetch::blend_lanes`]) in its finer and its coarser level, for
-/// [`Kernels::Gathered`].
-struct Lanes<const N: usize> {
-    fine: [[f32; 4]; N],
-    coarse: [[f32; 4]; N],
-}
-
-impl<const N: usize> Lanes<N> {
-    fn new() -> Self {
-        Lanes {
-            fine: [[0.0; 4]; N],
-            coarse: [[0.0; 4]; N],
-        }
-    }
-
-    #[inline(always)]
-    fn fine_at(&self, k: usize) -> Vec4 {
-        Vec4::from_array(self.fine[k])
-    }
-
-    #[inline(always)]
-    fn coarse_at(&self, k: usize) -> Vec4 {
-        Vec4::from_array(self.coarse[k])
     }
 }
 
@@ -533,22 +455,9 @@ impl<const N: usize, T: Taps> Pass<N, T> {
             let ab = (self.a[k], self.b[k]);
             T::inside(level, self.i[k] as u32, self.j[k] as u32, ab)
         } else {
-            self.edge(level, uv)
+            // Near an edge: the one-sample filter, wrapping addresses.
+            self.taps.filter(level, &self.addr, uv)
         }
-    }
-
-    /// Stage 3 for a sample at `uv` near an edge of `level`: the one-sample filter, wrapping
-    /// addresses.
-    #[inline(always)]
-    fn edge<F: Fetch>(&self, level: &F, uv: Vec2) -> Vec4 {
-        self.taps.filter(level, &self.addr, uv)
-    }
-
-    /// The first `m` lanes' first taps and fractions, for [`Fetch::blend_lanes`].
-    #[inline(always)]
-    fn quad_taps(&self, m: usize) -> QuadTaps<'_, N> {
-        let (i, j, a, b) = (&self.i, &self.j, &self.a, &self.b);
-        QuadTaps { i, j, a, b, m }
     }
 }
 
@@ -562,17 +471,16 @@ impl<const N: usize, T: Taps> Pass<N, T> {
 pub(crate) fn run<P: Pyramid>(
     p: &P,
     s: &Sampler,
-    (addr, fixed, kernels): (Address, bool, Kernels),
+    (addr, fixed): (Address, bool),
     footprints: &[Footprint],
     out: &mut [[f32; 4]],
 ) {
     let io = (footprints, out);
-    let a = (addr, kernels);
     match (s.descriptor().min_filter, fixed) {
-        (FilterMode::Nearest, false) => run_with(p, Point, s, a, io),
-        (_, false) => run_with(p, Bilinear, s, a, io),
-        (FilterMode::Nearest, true) => run_with(p, Point8, s, a, io),
-        (_, true) => run_with(p, Bilinear8, s, a, io),
+        (FilterMode::Nearest, false) => run_with(p, Point, s, addr, io),
+        (_, false) => run_with(p, Bilinear, s, addr, io),
+        (FilterMode::Nearest, true) => run_with(p, Point8, s, addr, io),
+        (_, true) => run_with(p, Bilinear8, s, addr, io),
     }
 }
 
@@ -582,7 +490,7 @@ fn run_with<P: Pyramid, T: Taps>(
     p: &P,
     taps: T,
     s: &Sampler,
-    addr: (Address, Kernels),
+    addr: Address,
     (footprints, out): (&[Footprint], &mut [[f32; 4]]),
 ) {
     if footprints.len() <= 16 {
@@ -600,7 +508,7 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     p: &P,
     taps: T,
     s: &Sampler,
-    (addr, kernels): (Address, Kernels),
+    addr: Address,
     (footprints, out): (&[Footprint], &mut [[f32; 4]]),
 ) {
     // Level 0 is at most 2^22 per side (`MAX_SIDE`), so there are at most 23 levels.
@@ -631,9 +539,6 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     let last = levels - 1;
     let size0 = base.size();
     let trilinear = d.mipmap_filter == MipmapFilterMode::Linear;
-    // Bilinear in lanes across the chunk ([`Fetch::blend_lanes`]) where asked and available.
-    let gathered = kernels == Kernels::Gathered && T::LANES && <P::Level<'_> as Fetch>::LANES;
-    let mut lanes = Lanes::<N>::new();
     for (fps, out) in footprints.chunks(N).zip(out.chunks_mut(N)) {
         let n = fps.len();
         queries(s, size0, fps, &mut chunk);
@@ -643,11 +548,6 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             // it (stage 1's fill, the level scan) bilinear frames measured 5-7 % slower.
             let size = (dims_w[0], dims_h[0]);
             first.coordinates(|_| size, &chunk.u[..n], &chunk.v[..n]);
-            if gathered {
-                let stages = (&first, &second, &chunk, &delta);
-                filter_chunk_lanes(stages, false, (&base, &base), &mut lanes, out);
-                continue;
-            }
             for (k, o) in out.iter_mut().enumerate() {
                 *o = first.filtered(&base, k, chunk.uv(k)).to_array();
             }
@@ -689,10 +589,6 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             }
             let weighed = trilinear && (l0 as usize) < last;
             let stages = (&first, &second, &chunk, &delta);
-            if gathered {
-                filter_chunk_lanes(stages, weighed, (&fine, &coarse), &mut lanes, out);
-                continue;
-            }
             filter_chunk(stages, |_| weighed, |_| fine, |_| coarse, out);
             continue;
         }
@@ -728,43 +624,6 @@ fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
             a
         }
         .to_array();
-    }
-}
-
-/// [`filter_chunk`] for a chunk in one pair of levels, `fine` and `coarse` (`weighed`: whether
-/// the coarser one is blended in where `delta > 0`): the finer level's values in lanes
-/// ([`Fetch::blend_lanes`], every lane up to a multiple of 16) straight into `out`, the samples
-/// near an edge then replaced by the one-sample filter's; likewise the coarser level's into
-/// scratch, blended in where weighed. The same bits as [`filter_chunk`].
-#[inline(always)]
-fn filter_chunk_lanes<T: Taps, F: Fetch, const N: usize>(
-    (first, second, chunk, delta): (&Pass<N, T>, &Pass<N, T>, &Chunk<N>, &[f32; N]),
-    weighed: bool,
-    (fine, coarse): (&F, &F),
-    lanes: &mut Lanes<N>,
-    out: &mut [[f32; 4]],
-) {
-    let n = out.len().min(N);
-    let m = n.next_multiple_of(16).min(N);
-    fine.blend_lanes(first.quad_taps(m), out);
-    for (k, o) in out.iter_mut().enumerate() {
-        if !first.inside[k] {
-            *o = first.edge(fine, chunk.uv(k)).to_array();
-        }
-    }
-    if !weighed {
-        return;
-    }
-    coarse.blend_lanes(second.quad_taps(m), &mut lanes.coarse);
-    for (k, o) in out.iter_mut().enumerate() {
-        if delta[k] > 0.0 {
-            let b = if second.inside[k] {
-                lanes.coarse_at(k)
-            } else {
-                second.edge(coarse, chunk.uv(k))
-            };
-            *o = T::mix(Vec4::from_array(*o), b, delta[k]).to_array();
-        }
     }
 }
 

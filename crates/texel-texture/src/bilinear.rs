@@ -111,7 +111,6 @@ impl LevelFilter for Bilinear {
 impl Taps for Bilinear {
     const HALF: f32 = HALF;
     const REACH: f32 = 1.0;
-    const LANES: bool = true;
     #[inline(always)]
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, (a, b): (f32, f32)) -> Vec4 {
         blend(level.quad(i, j), a, b)

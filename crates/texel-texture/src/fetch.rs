@@ -11,7 +11,6 @@ use std::cell::Cell;
 
 use glam::Vec4;
 
-use crate::bilinear::blend;
 use crate::color::{srgb_table, unorm8_table};
 use crate::texture::{Format, LevelInfo, Storage, Texture};
 
@@ -33,56 +32,6 @@ pub(crate) trait Decode: Copy {
     }
     /// The texels of `storage` if it holds this format.
     fn texels(storage: &Storage) -> Option<&[Self::Texel]>;
-    /// Whether [`Decode::blend_lanes`] is a lane kernel of its own (8-bit linear texels), which
-    /// the batched path runs in place of per-sample quads where the caller asks for gathers.
-    const LANES: bool = false;
-    /// [`Fetch::blend_lanes`] on a `(width, height)` level of `texels`. This default blends each
-    /// quad inside the level as [`Fetch::quad`] and [`blend`] do, sample by sample.
-    #[inline(always)]
-    fn blend_lanes<const N: usize>(
-        &self,
-        (texels, width, height): (&[Self::Texel], u32, u32),
-        taps: QuadTaps<'_, N>,
-        out: &mut [[f32; 4]],
-    ) {
-        blend_each((width, height), taps, out, |i, j| {
-            let (r0, r1) = rows2(texels, width, i, j);
-            self.decode4([r0[0], r0[1], r1[0], r1[1]])
-        });
-    }
-}
-
-/// The first taps `(i, j)` and fractions `(a, b)` of a chunk's bilinear quads, one array each,
-/// and how many lanes to compute (`m <= N`; entries from the caller's count up to `m` may be
-/// stale, and their results are never read).
-pub(crate) struct QuadTaps<'a, const N: usize> {
-    pub i: &'a [i32; N],
-    pub j: &'a [i32; N],
-    pub a: &'a [f32; N],
-    pub b: &'a [f32; N],
-    pub m: usize,
-}
-
-/// [`Fetch::blend_lanes`] sample by sample: for each of the first `taps.m` lanes (and `out`'s
-/// length) whose quad lies inside a `(w, h)` level, [`blend`] of `quad(i, j)`; zeros for the
-/// others.
-#[inline(always)]
-fn blend_each<const N: usize>(
-    (w, h): (u32, u32),
-    taps: QuadTaps<'_, N>,
-    out: &mut [[f32; 4]],
-    quad: impl Fn(u32, u32) -> [Vec4; 4],
-) {
-    for (k, o) in out.iter_mut().enumerate().take(taps.m.min(N)) {
-        let (i, j) = (taps.i[k], taps.j[k]);
-        let inside = i >= 0 && j >= 0 && (i as u32) < w.saturating_sub(1);
-        let inside = inside && (j as u32) < h.saturating_sub(1);
-        *o = if inside {
-            blend(quad(i as u32, j as u32), taps.a[k], taps.b[k]).to_array()
-        } else {
-            [0.0; 4]
-        };
-    }
 }
 
 /// 8-bit texels: one table load per channel (RGB through the colour table, sRGB or linear;
@@ -171,82 +120,6 @@ impl Decode for Unorm8 {
     fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
         Table8::texels(storage)
     }
-    const LANES: bool = true;
-    /// Across samples: per lane the four texels' words (`get`, so a quad outside the level reads
-    /// zeros instead of panicking: LLVM turns the loop into masked gathers where the instruction
-    /// set has them, AVX-512), each channel decoded by [`unorm8_lanes`]' formula and blended by
-    /// [`blend`]'s three lerps. The same operations per channel as the per-sample kernel, so
-    /// the same bits.
-    #[inline(always)]
-    fn blend_lanes<const N: usize>(
-        &self,
-        (texels, width, _): (&[[u8; 4]], u32, u32),
-        taps: QuadTaps<'_, N>,
-        out: &mut [[f32; 4]],
-    ) {
-        let w = width as usize;
-        let m = taps.m.min(N);
-        // Computed into a local array, then copied: stores into `out` (the caller's scratch) may
-        // alias the taps and texels as far as LLVM can tell, and that alone kept the loop scalar
-        // in the rasterizer (docs/perf-log.md, entry 32).
-        let mut values = [[0.0f32; 4]; N];
-        let ij = taps.i[..m].iter().zip(&taps.j[..m]);
-        let ab = taps.a[..m].iter().zip(&taps.b[..m]);
-        // Plain functions, not closures: a closure LLVM leaves outlined is compiled for the
-        // baseline, and the loop then neither inlines nor vectorises in the AVX-512 copy.
-        for ((o, (&i, &j)), (&a, &b)) in values[..m].iter_mut().zip(ij).zip(ab) {
-            // `j * w + i` for the quad's first texel; a tap outside the level (i or j of -1 or
-            // the side, or stale lanes) gives an index that `get` refuses or another texel.
-            let k = (j as u32 as usize)
-                .wrapping_mul(w)
-                .wrapping_add(i as u32 as usize);
-            let t00 = word(texels, k);
-            let t10 = word(texels, k.wrapping_add(1));
-            let t01 = word(texels, k.wrapping_add(w));
-            let t11 = word(texels, k.wrapping_add(w + 1));
-            let q = (t00, t10, t01, t11);
-            *o = [
-                blend1(q, 0, a, b),
-                blend1(q, 8, a, b),
-                blend1(q, 16, a, b),
-                blend1(q, 24, a, b),
-            ];
-        }
-        let n = m.min(out.len());
-        out[..n].copy_from_slice(&values[..n]);
-    }
-}
-
-/// Texel `k` of `texels` as a little-endian word, or 0 where `k` is out of range (which a
-/// vectorised loop turns into a masked gather).
-#[inline(always)]
-fn word(texels: &[[u8; 4]], k: usize) -> u32 {
-    match texels.get(k) {
-        Some(t) => u32::from_le_bytes(*t),
-        None => 0,
-    }
-}
-
-/// One channel (the byte at bit `shift`) of a quad of words, decoded as [`unorm8_lanes`] does
-/// and blended as [`blend`] does.
-#[inline(always)]
-fn blend1((t00, t10, t01, t11): (u32, u32, u32, u32), shift: u32, a: f32, b: f32) -> f32 {
-    let top = lerp1(channel(t00, shift), channel(t10, shift), a);
-    let bottom = lerp1(channel(t01, shift), channel(t11, shift), a);
-    lerp1(top, bottom, b)
-}
-
-/// The byte at bit `shift` of `t`, divided by 255 as [`unorm8_lanes`] does.
-#[inline(always)]
-fn channel(t: u32, shift: u32) -> f32 {
-    unorm8_of(((t >> shift) & 0xff) as f32)
-}
-
-/// [`crate::bilinear::lerp`] on one channel: `a + (b - a) * t`, the same operations as each of
-/// its four lanes.
-#[inline(always)]
-fn lerp1(a: f32, b: f32, t: f32) -> f32 {
-    a + (b - a) * t
 }
 
 /// 8-bit texels as their stored code values, `0.0..=255.0` per channel (exact in `f32`), with
@@ -324,18 +197,6 @@ pub(crate) trait Fetch: Copy {
             self.texel(i + 1, j + 1),
         ]
     }
-    /// Whether [`Fetch::blend_lanes`] runs a lane kernel (8-bit linear levels) rather than this
-    /// default's sample-by-sample loop.
-    const LANES: bool = false;
-    /// The bilinear blends of the first `taps.m` quads (at most `out.len()`), lane `k` the quad
-    /// at first tap `(taps.i[k], taps.j[k])` with fractions `(taps.a[k], taps.b[k])`: `out[k]`
-    /// is [`blend`]`(self.quad(i, j), a, b)`, bit for bit, for every lane whose quad lies inside
-    /// the level (`0 <= i < W - 1`, `0 <= j < H - 1`). Other lanes get unspecified values and
-    /// never a panic; the caller filters them another way.
-    #[inline(always)]
-    fn blend_lanes<const N: usize>(&self, taps: QuadTaps<'_, N>, out: &mut [[f32; 4]]) {
-        blend_each(self.size(), taps, out, |i, j| self.quad(i, j));
-    }
 }
 
 /// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level.
@@ -360,12 +221,6 @@ impl<D: Decode> Fetch for Level<'_, D> {
     fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
         let (r0, r1) = rows2(self.texels, self.width, i, j);
         self.decode.decode4([r0[0], r0[1], r1[0], r1[1]])
-    }
-    const LANES: bool = D::LANES;
-    #[inline(always)]
-    fn blend_lanes<const N: usize>(&self, taps: QuadTaps<'_, N>, out: &mut [[f32; 4]]) {
-        let level = (self.texels, self.width, self.height);
-        self.decode.blend_lanes(level, taps, out);
     }
 }
 
@@ -570,85 +425,6 @@ pub(crate) fn pyramid_of(tex: &Texture) -> AnyPyramid<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::texture::Limits;
-
-    /// `Unorm8`'s lane kernel equals `blend(quad)` bit for bit in every lane whose quad lies
-    /// inside the level, as does the sample-by-sample default (`Table8`'s, counting views'); lanes
-    /// outside the level (first taps of -1 or the side, huge stale values) neither panic nor
-    /// disturb the others.
-    #[test]
-    fn blend_lanes_equal_the_quad_blend() {
-        let (w, h) = (13u32, 7u32);
-        let tex = Texture::from_fn(w, h, Format::Rgba8Unorm, &Limits::default(), |i, j| {
-            let x = (i * 37 + j * 101) % 256;
-            [
-                x as f32 / 255.0,
-                (i * 19 % 256) as f32 / 255.0,
-                (j * 41 % 256) as f32 / 255.0,
-                0.5,
-            ]
-        })
-        .unwrap();
-        let AnyPyramid::Unorm8(p) = pyramid_of(&tex) else {
-            unreachable!()
-        };
-        let level = p.level(0);
-        let table = Level {
-            width: w,
-            height: h,
-            texels: level.texels,
-            decode: table8(Format::Rgba8Unorm),
-        };
-        const N: usize = 64;
-        let (mut i, mut j) = ([0i32; N], [0i32; N]);
-        let (mut a, mut b) = ([0.0f32; N], [0.0f32; N]);
-        for k in 0..N {
-            // Inside quads, then the edge cases in the last lanes.
-            i[k] = (k as i32 * 5) % (w as i32 - 1);
-            j[k] = (k as i32 * 3) % (h as i32 - 1);
-            a[k] = (k as f32 * 0.173).fract();
-            b[k] = (k as f32 * 0.618).fract();
-        }
-        let edges = [
-            (-1, 0),
-            (0, -1),
-            (w as i32 - 1, 0),
-            (0, h as i32 - 1),
-            (w as i32, h as i32),
-            (i32::MAX, i32::MIN),
-            (-1, -1),
-        ];
-        for (k, &(ei, ej)) in edges.iter().enumerate() {
-            i[N - 1 - k] = ei;
-            j[N - 1 - k] = ej;
-        }
-        let taps = || QuadTaps {
-            i: &i,
-            j: &j,
-            a: &a,
-            b: &b,
-            m: N,
-        };
-        let (mut lanes, mut each) = ([[0.0f32; 4]; N], [[0.0f32; 4]; N]);
-        level.blend_lanes(taps(), &mut lanes);
-        table.blend_lanes(taps(), &mut each);
-        assert!(Unorm8::LANES && !Table8::LANES);
-        for k in 0..N - edges.len() {
-            let want = blend(level.quad(i[k] as u32, j[k] as u32), a[k], b[k]).to_array();
-            for c in 0..4 {
-                assert_eq!(
-                    lanes[k][c].to_bits(),
-                    want[c].to_bits(),
-                    "lane {k} channel {c}"
-                );
-                assert_eq!(
-                    each[k][c].to_bits(),
-                    want[c].to_bits(),
-                    "lane {k} channel {c}"
-                );
-            }
-        }
-    }
 
     /// The lanes' `b * hi + b * lo` is the table's correctly rounded `b / 255`, for every byte
     /// in every position of a quad; `hi` has at most 12 significant bits (so `b * hi` is exact);

@@ -60,7 +60,7 @@ pub use error::TextureError;
 pub use footprint::{Axes, Footprint};
 pub use ripmap::Ripmap;
 pub use sampler::{
-    FilterMode, Kernels, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,
+    FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,
 };
 pub use sat::SummedAreaTable;
 pub use texture::{

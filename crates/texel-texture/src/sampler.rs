@@ -117,23 +117,6 @@ pub enum MipmapFilterMode {
     Linear,
 }
 
-/// Which bilinear kernels [`Sampler::sample_batch_with`] runs. Both give the same bits (the same
-/// IEEE operations per channel); they differ in how they load texels, so which is faster depends
-/// on the instruction set the caller is compiled for (figures in docs/perf-log.md, entry 32).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Kernels {
-    /// One sample's bilinear quad at a time: two 2-texel row loads, the quad's sixteen channels
-    /// in lanes. The fastest form without AVX-512.
-    #[default]
-    PerSample,
-    /// Each channel of a chunk's samples in lanes, the texels read by (masked) gathers: for
-    /// 8-bit linear (`Rgba8Unorm`) textures, samples whose quads lie inside their level, in
-    /// one-level chunks and anisotropic probe batches; everything else as `PerSample`. About 30 %
-    /// faster a quad where LLVM emits AVX-512 gathers; about 2.7x slower where it cannot
-    /// (the x86-64 baseline and AVX2 copies, whose loads stay scalar).
-    Gathered,
-}
-
 /// Everything that configures a [`Sampler`]. Field names follow WebGPU's `GPUSamplerDescriptor`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SamplerDescriptor {
@@ -504,7 +487,7 @@ impl Sampler {
             .zip(out.chunks_mut(batch::CHUNK))
         {
             let codes = &mut codes[..fps.len()];
-            batch::run(&p, self, (addr, fixed, Kernels::PerSample), fps, codes);
+            batch::run(&p, self, (addr, fixed), fps, codes);
             for (o, c) in out.iter_mut().zip(codes.iter()) {
                 // Codes are integers in 0..=255: read from bits, without a saturating float
                 // conversion per channel.
@@ -518,30 +501,12 @@ impl Sampler {
     /// texture's format is dispatched once for the whole batch, and the lods of up to 64
     /// footprints are computed in one loop before any is filtered (independent iterations that
     /// pipeline, instead of one long dependency chain per sample). A rasterizer should hand it a
-    /// row span at a time. The same as [`Sampler::sample_batch_with`] with
-    /// [`Kernels::PerSample`].
+    /// row span at a time.
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
     #[inline(always)]
     pub fn sample_batch(&self, texture: &Texture, footprints: &[Footprint], out: &mut [[f32; 4]]) {
-        self.sample_batch_with(Kernels::PerSample, texture, footprints, out);
-    }
-
-    /// [`Sampler::sample_batch`] with the bilinear kernels chosen by `kernels`: the same bits
-    /// whichever is chosen; only the speed depends on it (and on the instruction set the caller
-    /// is compiled for, since this inlines into it).
-    ///
-    /// # Panics
-    /// If `footprints.len() != out.len()` (a programming error, not bad input).
-    #[inline(always)]
-    pub fn sample_batch_with(
-        &self,
-        kernels: Kernels,
-        texture: &Texture,
-        footprints: &[Footprint],
-        out: &mut [[f32; 4]],
-    ) {
         assert_eq!(
             footprints.len(),
             out.len(),
@@ -551,14 +516,13 @@ impl Sampler {
             let size = p.level(0).size();
             let staged = size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE;
             if self.batched && staged {
-                let how = (self.addr, false, kernels);
-                return batch::run(&p, self, how, footprints, out);
+                return batch::run(&p, self, (self.addr, false), footprints, out);
             }
             if self.technique == Technique::Anisotropic && staged {
                 // Probes of several samples filtered together; the rest one by one, as
                 // `filter_planned` and `filter` do.
                 let mut probes = Probes::new(self.addr);
-                return batch::anisotropic(&p, self, (footprints, out, kernels), |q, plan| {
+                return batch::anisotropic(&p, self, (footprints, out), |q, plan| {
                     if q.lod > 0.0 {
                         filter_planned(&p, q, plan, &mut probes)
                     } else {

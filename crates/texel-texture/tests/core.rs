@@ -3,12 +3,9 @@
 
 use proptest::prelude::*;
 use texel_texture::{
-    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Kernels,
-    Limits, MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
+    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Limits,
+    MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
 };
-
-/// Both batched kernels: each must equal the one-sample path bit for bit.
-const KERNELS: [Kernels; 2] = [Kernels::PerSample, Kernels::Gathered];
 
 const ADDRESS_MODES: [AddressMode; 5] = [
     AddressMode::ClampToEdge,
@@ -214,11 +211,9 @@ proptest! {
         let mut out = vec![[0.0; 4]; fps.len()];
         for tex in &textures {
             for s in &samplers {
-                for kernels in KERNELS {
-                    s.sample_batch_with(kernels, tex, &fps, &mut out);
-                    for (f, o) in fps.iter().zip(&out) {
-                        prop_assert_eq!(s.sample(tex, f).map(f32::to_bits), o.map(f32::to_bits), "{:?} {:?} {:?}", s.descriptor(), f, kernels);
-                    }
+                s.sample_batch(tex, &fps, &mut out);
+                for (f, o) in fps.iter().zip(&out) {
+                    prop_assert_eq!(s.sample(tex, f).map(f32::to_bits), o.map(f32::to_bits), "{:?} {:?}", s.descriptor(), f);
                 }
             }
         }
@@ -270,15 +265,13 @@ fn batch_equals_single_on_extreme_derivatives() {
                 })
                 .unwrap();
                 let mut out = vec![[0.0; 4]; fps.len()];
-                for kernels in KERNELS {
-                    s.sample_batch_with(kernels, &tex, &fps, &mut out);
-                    for (fp, o) in fps.iter().zip(&out) {
-                        assert_eq!(
-                            s.sample(&tex, fp).map(f32::to_bits),
-                            o.map(f32::to_bits),
-                            "bias {bias} {mip:?} {f:?} {fp:?} {kernels:?}"
-                        );
-                    }
+                s.sample_batch(&tex, &fps, &mut out);
+                for (fp, o) in fps.iter().zip(&out) {
+                    assert_eq!(
+                        s.sample(&tex, fp).map(f32::to_bits),
+                        o.map(f32::to_bits),
+                        "bias {bias} {mip:?} {f:?} {fp:?}"
+                    );
                 }
             }
         }
@@ -321,15 +314,13 @@ fn batch_equals_single_when_a_chunk_shares_a_level() {
                     for addr in ADDRESS_MODES {
                         let s = sampler(f, f, mip, addr);
                         let mut out = vec![[0.0; 4]; fps.len()];
-                        for kernels in KERNELS {
-                            s.sample_batch_with(kernels, tex, &fps, &mut out);
-                            for (fp, o) in fps.iter().zip(&out) {
-                                assert_eq!(
-                                    s.sample(tex, fp).map(f32::to_bits),
-                                    o.map(f32::to_bits),
-                                    "lod {lod} {mip:?} {f:?} {addr:?} {fp:?} {kernels:?}"
-                                );
-                            }
+                        s.sample_batch(tex, &fps, &mut out);
+                        for (fp, o) in fps.iter().zip(&out) {
+                            assert_eq!(
+                                s.sample(tex, fp).map(f32::to_bits),
+                                o.map(f32::to_bits),
+                                "lod {lod} {mip:?} {f:?} {addr:?} {fp:?}"
+                            );
                         }
                     }
                 }
@@ -417,15 +408,13 @@ fn batched_anisotropic_probes_equal_single_samples() {
                     .unwrap();
                 for len in [fps.len(), 64, 37] {
                     let mut out = vec![[0.0; 4]; len];
-                    for kernels in KERNELS {
-                        s.sample_batch_with(kernels, tex, &fps[..len], &mut out);
-                        for (fp, o) in fps.iter().zip(&out) {
-                            assert_eq!(
-                                s.sample(tex, fp).map(f32::to_bits),
-                                o.map(f32::to_bits),
-                                "clamp {clamp} {addr:?} {fp:?} {kernels:?}"
-                            );
-                        }
+                    s.sample_batch(tex, &fps[..len], &mut out);
+                    for (fp, o) in fps.iter().zip(&out) {
+                        assert_eq!(
+                            s.sample(tex, fp).map(f32::to_bits),
+                            o.map(f32::to_bits),
+                            "clamp {clamp} {addr:?} {fp:?}"
+                        );
                     }
                 }
             }
