@@ -254,18 +254,22 @@ pub(crate) fn anisotropic<P: Pyramid>(
             sums[k] = Vec4::ZERO;
             let (l, delta) = mip::linear_levels(plan.lod, last);
             let coarse = delta > 0.0 && l < last;
-            for i in 0..n {
-                let t = (i as f32 + 0.5) * inv[k] - 0.5;
-                let m = probes.m;
-                probes.at.u[m] = finite(q.fp.u + t * plan.axis.x);
-                probes.at.v[m] = finite(q.fp.v + t * plan.axis.y);
-                probes.fine.level[m] = l as u8;
-                probes.next.level[m] = if coarse { l + 1 } else { l } as u8;
-                probes.delta[m] = delta;
-                probes.coarse[m] = coarse;
-                probes.owner[m] = k as u8;
-                probes.m += 1;
+            let pair = (l as u8, if coarse { l + 1 } else { l } as u8);
+            let p = &mut *probes;
+            p.sample(k, pair, (delta, coarse));
+            // The probes' positions and owners in one loop over lanes; the sample's levels,
+            // weight and coarse flag are recorded once, above, not per probe (perf-log 33).
+            let (m, invk) = (p.m, inv[k]);
+            let (us, vs) = (&mut p.at.u[m..m + n], &mut p.at.v[m..m + n]);
+            let lanes = us.iter_mut().zip(vs).zip(&mut p.owner[m..m + n]);
+            // `i` counts in `i32` (exact, as `usize` was) so that the conversion vectorises.
+            for (i, ((pu, pv), o)) in (0..n as i32).zip(lanes) {
+                let t = (i as f32 + 0.5) * invk - 0.5;
+                *pu = finite(q.fp.u + t * plan.axis.x);
+                *pv = finite(q.fp.v + t * plan.axis.y);
+                *o = k as u8;
             }
+            p.m = m + n;
         }
         probes.flush(&views, size, &mut sums);
         for (k, o) in out.iter_mut().enumerate().take(fps.len()) {
@@ -276,17 +280,23 @@ pub(crate) fn anisotropic<P: Pyramid>(
     }
 }
 
-/// [`anisotropic`]'s probe scratch: up to [`PROBES`] probes with their levels (`fine.level`,
-/// `next.level`), blend weight, whether the coarser level is weighed, and the sample they belong
-/// to.
+/// [`anisotropic`]'s probe scratch: up to [`PROBES`] probes with their positions and the sample
+/// they belong to (`owner`, an index into the chunk), and per sample of the chunk its two levels,
+/// blend weight and whether the coarser level is weighed. Each probe's levels (`fine.level`,
+/// `next.level`) are filled from its sample's only when a batch mixes levels.
 struct ProbeBatch {
     m: usize,
     at: Chunk<PROBES>,
     fine: Pass<PROBES, Bilinear>,
     next: Pass<PROBES, Bilinear>,
-    delta: [f32; PROBES],
-    coarse: [bool; PROBES],
     owner: [u8; PROBES],
+    /// Per sample: the finer and the coarser level read.
+    levels: [(u8, u8); CHUNK],
+    delta: [f32; CHUNK],
+    coarse: [bool; CHUNK],
+    /// The first sample's levels in this batch, and whether a later sample's differ.
+    pair: (u8, u8),
+    mixed: bool,
 }
 
 impl ProbeBatch {
@@ -296,10 +306,27 @@ impl ProbeBatch {
             at: Chunk::new(),
             fine: Pass::new(Bilinear, addr),
             next: Pass::new(Bilinear, addr),
-            delta: [0.0; PROBES],
-            coarse: [false; PROBES],
             owner: [0; PROBES],
+            levels: [(0, 0); CHUNK],
+            delta: [0.0; CHUNK],
+            coarse: [false; CHUNK],
+            pair: (0, 0),
+            mixed: false,
         })
+    }
+
+    /// Record sample `k`'s levels `pair` (finer, coarser), blend weight and whether the coarser
+    /// level is weighed, before its probes are added.
+    #[inline(always)]
+    fn sample(&mut self, k: usize, pair: (u8, u8), (delta, coarse): (f32, bool)) {
+        self.levels[k] = pair;
+        self.delta[k] = delta;
+        self.coarse[k] = coarse;
+        if self.m == 0 {
+            (self.pair, self.mixed) = (pair, false);
+        } else {
+            self.mixed |= pair != self.pair;
+        }
     }
 
     /// Filter the gathered probes and add each, in order, to its sample's sum: `Probes::trilinear_sum`'s
@@ -317,11 +344,9 @@ impl ProbeBatch {
             return;
         }
         let (us, vs) = (&self.at.u[..m], &self.at.v[..m]);
-        let (l0, l1) = (self.fine.level[0], self.next.level[0]);
+        let (l0, l1) = self.pair;
         let level = |l: u8| &views[l as usize & (LEVELS - 1)];
-        if self.fine.level[..m].iter().all(|&l| l == l0)
-            && self.next.level[..m].iter().all(|&l| l == l1)
-        {
+        if !self.mixed {
             // Every probe in the same two levels: views and sizes looked up once (as `run_in`).
             let (s0, s1) = (size(l0), size(l1));
             self.fine.coordinates(|_| s0, us, vs);
@@ -329,6 +354,9 @@ impl ProbeBatch {
             let (fine, next) = (level(l0), level(l1));
             self.sum_into(m, |_| fine, |_| next, sums);
         } else {
+            for (k, &o) in self.owner[..m].iter().enumerate() {
+                (self.fine.level[k], self.next.level[k]) = self.levels[o as usize];
+            }
             self.fine.coordinates(&size, us, vs);
             self.next.coordinates(&size, us, vs);
             let (fine, next) = (&self.fine.level, &self.next.level);
@@ -350,13 +378,14 @@ impl ProbeBatch {
     ) {
         for k in 0..m {
             let uv = self.at.uv(k);
+            let o = self.owner[k] as usize % CHUNK;
             let a = self.fine.filtered(fine(k), k, uv);
-            let value = if self.coarse[k] {
-                lerp(a, self.next.filtered(next(k), k, uv), self.delta[k])
+            let value = if self.coarse[o] {
+                lerp(a, self.next.filtered(next(k), k, uv), self.delta[o])
             } else {
                 a
             };
-            sums[self.owner[k] as usize] += value;
+            sums[o] += value;
         }
     }
 }
