@@ -30,7 +30,7 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::address::Address;
+use crate::address::{Address, AddressMode};
 use crate::bilinear::{lerp, Bilinear};
 use crate::fetch::{Fetch, Pyramid};
 use crate::fixed8::{Bilinear8, Point8};
@@ -187,6 +187,11 @@ pub(crate) trait Taps: LevelFilter {
     const REACH: f32;
     /// The value of a sample whose taps lie inside `level`: first tap `(i, j)`, fractions `ab`.
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, ab: (f32, f32)) -> Vec4;
+    /// The value of a sample near an edge whose taps the pass wrapped: first taps `i[0]`,
+    /// `j[0]`, the next ones `i[1]`, `j[1]` (all inside `level`), fractions `ab`. Bit for bit the
+    /// one-sample filter's, which reads the same texels (DESIGN.md: the address mode applies to
+    /// the integer taps).
+    fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], ab: (f32, f32)) -> Vec4;
     /// The blend of two levels' values with weight `t` on `b` ([`lerp`]; the fixed-point
     /// filters of [`crate::fixed8`] round it).
     #[inline(always)]
@@ -443,7 +448,39 @@ struct Pass<const N: usize, T> {
     /// Every tap lies inside the level.
     inside: [bool; N],
     addr: Address,
+    /// Neither address mode is `ClampToBorder`, so that taps within one texel of the level wrap
+    /// to texels ([`Pass::near`]); and which of the two modes is `Repeat`.
+    wraps: bool,
+    periodic: (bool, bool),
     taps: T,
+}
+
+/// The first tap `i` of a sample near an edge (`-1 <= i < n`, `n` the level's side) and the
+/// next one `i + 1`, wrapped into `[0, n)`: by `Repeat` (`-1 -> n - 1`, `n -> 0`) where
+/// `periodic`, else as `ClampToEdge`, `MirrorRepeat` and `MirrorClampToEdge` all map these two
+/// indices (`-1 -> 0`, `n -> n - 1`; [`crate::address::AddressMode::wrap`]): two selects, no
+/// division.
+#[inline(always)]
+fn wrap_pair(i: i32, n: i32, periodic: bool) -> (i32, i32) {
+    let first = if i < 0 {
+        if periodic {
+            n - 1
+        } else {
+            0
+        }
+    } else {
+        i
+    };
+    let second = if i + 1 >= n {
+        if periodic {
+            0
+        } else {
+            n - 1
+        }
+    } else {
+        i + 1
+    };
+    (first, second)
 }
 
 impl<const N: usize, T: Taps> Pass<N, T> {
@@ -456,6 +493,8 @@ impl<const N: usize, T: Taps> Pass<N, T> {
             b: [0.0; N],
             inside: [false; N],
             addr,
+            wraps: addr.u != AddressMode::ClampToBorder && addr.v != AddressMode::ClampToBorder,
+            periodic: (addr.u == AddressMode::Repeat, addr.v == AddressMode::Repeat),
             taps,
         }
     }
@@ -477,14 +516,40 @@ impl<const N: usize, T: Taps> Pass<N, T> {
         }
     }
 
-    /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value.
+    /// The wrapped taps `([i, i + 1], [j, j + 1])` of sample `k` (not inside) of a level
+    /// `w` x `h` texels, when its origin lies within one texel of the level, `-1 <= x < w` and
+    /// `-1 <= y < h`, and the address modes map such taps to texels (all but `ClampToBorder`);
+    /// else `None`. There [`floor_clamped`]'s clamp was the identity, so `i` is `floor(x)` and the
+    /// fractions are the one-sample filter's; an origin below -1 was clamped to -1 and leaves a
+    /// negative fraction, one at or beyond `w` the index `w`. Decided per sample, from what
+    /// [`Pass::coordinates`] stored: computed there for every sample, the wrapped taps cost more
+    /// than the edge route saved (docs/perf-log.md, entry 34).
+    #[inline(always)]
+    fn near(&self, (w, h): (u32, u32), k: usize) -> Option<([u32; 2], [u32; 2])> {
+        let (i, j, w, h) = (self.i[k], self.j[k], w as i32, h as i32);
+        let near = i >= -1 && i < w && j >= -1 && j < h;
+        if !(self.wraps && near && self.a[k] >= 0.0 && self.b[k] >= 0.0) {
+            return None;
+        }
+        let ((i0, i1), (j0, j1)) = (
+            wrap_pair(i, w, self.periodic.0),
+            wrap_pair(j, h, self.periodic.1),
+        );
+        Some(([i0 as u32, i1 as u32], [j0 as u32, j1 as u32]))
+    }
+
+    /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value. Three routes,
+    /// the same value from each: every tap inside the level; within one texel of it
+    /// ([`Pass::near`]: the taps wrapped by two selects each); elsewhere, or under
+    /// `ClampToBorder`, the one-sample filter, which wraps its taps in `i64` (`rem_euclid`).
     #[inline(always)]
     fn filtered<F: Fetch>(&self, level: &F, k: usize, uv: Vec2) -> Vec4 {
+        let ab = (self.a[k], self.b[k]);
         if self.inside[k] {
-            let ab = (self.a[k], self.b[k]);
             T::inside(level, self.i[k] as u32, self.j[k] as u32, ab)
+        } else if let Some((i, j)) = self.near(level.size(), k) {
+            T::wrapped(level, i, j, ab)
         } else {
-            // Near an edge: the one-sample filter, wrapping addresses.
             self.taps.filter(level, &self.addr, uv)
         }
     }
@@ -715,5 +780,125 @@ impl Probes {
             };
         }
         sum
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::address::BorderColor;
+    use crate::fetch::{Codes8, Level, Unorm8};
+
+    const MODES: [AddressMode; 5] = [
+        AddressMode::ClampToEdge,
+        AddressMode::Repeat,
+        AddressMode::MirrorRepeat,
+        AddressMode::ClampToBorder,
+        AddressMode::MirrorClampToEdge,
+    ];
+
+    /// Every sample of a pass over `(us, vs)` on `level` (any route: inside, near an edge with
+    /// the pass's wrapped taps, or the one-sample filter) equals `T`'s one-sample filter bit for
+    /// bit; returns how many took the wrapped route.
+    fn check_pass<T: Taps, F: Fetch>(taps: T, level: &F, addr: Address, uvs: &[Vec2]) -> usize {
+        let (w, h) = level.size();
+        let mut near = 0;
+        for part in uvs.chunks(16) {
+            let mut pass = Pass::<16, T>::new(taps, addr);
+            let us: Vec<f32> = part.iter().map(|p| p.x).collect();
+            let vs: Vec<f32> = part.iter().map(|p| p.y).collect();
+            pass.coordinates(|_| (w as f32, h as f32), &us, &vs);
+            for (k, &uv) in part.iter().enumerate() {
+                let got = pass.filtered(level, k, uv);
+                let want = taps.filter(level, &addr, uv);
+                assert_eq!(
+                    got.to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits),
+                    "{w}x{h} {addr:?} uv {uv} inside {} near {:?}",
+                    pass.inside[k],
+                    pass.near((w, h), k)
+                );
+                near += usize::from(!pass.inside[k] && pass.near((w, h), k).is_some());
+            }
+        }
+        near
+    }
+
+    /// The wrapped taps of samples near an edge (`Pass::near`, `wrap_pair`)
+    /// read exactly the texels the one-sample filters read through `AddressMode::wrap`: origins
+    /// in steps of 1/8 texel (and just inside each texel boundary) from two texels before to two
+    /// after the level along both axes, levels 1 to 5 texels a side, every pair of address modes,
+    /// nearest and bilinear, exact and fixed-point. Border modes never take the wrapped route;
+    /// the others take it for every origin in `[-1, W)` outside the level.
+    #[test]
+    fn wrapped_taps_equal_the_one_sample_filter() {
+        for (w, h) in [(1u32, 1u32), (2, 3), (5, 2), (3, 5), (4, 4)] {
+            let bytes: Vec<[u8; 4]> = (0..w * h)
+                .map(|k| {
+                    [
+                        (k * 37 % 251) as u8,
+                        (k * 91 % 253) as u8,
+                        (k * 13) as u8,
+                        255,
+                    ]
+                })
+                .collect();
+            let exact = Level {
+                width: w,
+                height: h,
+                texels: &bytes,
+                decode: Unorm8,
+            };
+            let codes = Level {
+                width: w,
+                height: h,
+                texels: &bytes,
+                decode: Codes8,
+            };
+            let offsets = |n: u32| -> Vec<f32> {
+                let mut xs = Vec::new();
+                for m in -16..=(8 * n as i32 + 16) {
+                    let x = m as f32 / 8.0;
+                    xs.extend([x, x - 1e-4]);
+                }
+                xs
+            };
+            for mu in MODES {
+                for mv in MODES {
+                    let addr = Address::new(mu, mv, BorderColor::Custom([0.25, 0.5, 0.75, 1.0]));
+                    let (xs, ys) = (offsets(w), offsets(h));
+                    // Bilinear's origin is `u W - 1/2`, nearest's `u W`.
+                    let uvs = |half: f32| -> Vec<Vec2> {
+                        let mut v = Vec::new();
+                        for &x in &xs {
+                            for &y in &ys {
+                                v.push(Vec2::new((x + half) / w as f32, (y + half) / h as f32));
+                            }
+                        }
+                        v
+                    };
+                    let (bl, pt) = (uvs(0.5), uvs(0.0));
+                    let counts = [
+                        check_pass(Bilinear, &exact, addr, &bl),
+                        check_pass(Bilinear8, &codes, addr, &bl),
+                        check_pass(Point, &exact, addr, &pt),
+                        check_pass(Point8, &codes, addr, &pt),
+                    ];
+                    let border =
+                        mu == AddressMode::ClampToBorder || mv == AddressMode::ClampToBorder;
+                    if border {
+                        assert_eq!(counts, [0; 4], "{addr:?}");
+                    } else {
+                        // Bilinear: every origin in [-1, W) x [-1, H) whose quad leaves the level.
+                        assert!(
+                            counts[0] > 8 * (w + h) as usize,
+                            "{w}x{h} {addr:?} {counts:?}"
+                        );
+                        assert_eq!(counts[0], counts[1]);
+                        assert!(counts[2] > 0 && counts[2] == counts[3], "{counts:?}");
+                    }
+                }
+            }
+        }
     }
 }

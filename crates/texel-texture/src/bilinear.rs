@@ -115,4 +115,20 @@ impl Taps for Bilinear {
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, (a, b): (f32, f32)) -> Vec4 {
         blend(level.quad(i, j), a, b)
     }
+    #[inline(always)]
+    fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], (a, b): (f32, f32)) -> Vec4 {
+        blend(wrapped_quad(level, i, j), a, b)
+    }
+}
+
+/// The 2x2 texels of taps `i`, `j` already wrapped into `level`, in [`Fetch::quad`]'s order: the
+/// texels [`taps`] reads near an edge where no tap takes the border colour.
+#[inline(always)]
+pub(crate) fn wrapped_quad<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2]) -> [Vec4; 4] {
+    [
+        level.texel(i[0], j[0]),
+        level.texel(i[1], j[0]),
+        level.texel(i[0], j[1]),
+        level.texel(i[1], j[1]),
+    ]
 }

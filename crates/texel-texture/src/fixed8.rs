@@ -90,6 +90,10 @@ impl Taps for Point8 {
         level.texel(i, j)
     }
     #[inline(always)]
+    fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], _: (f32, f32)) -> Vec4 {
+        level.texel(i[0], j[0])
+    }
+    #[inline(always)]
     fn mix(a: Vec4, b: Vec4, t: f32) -> Vec4 {
         mix8(a, b, t)
     }
@@ -114,6 +118,10 @@ impl Taps for Bilinear8 {
     #[inline(always)]
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, (a, b): (f32, f32)) -> Vec4 {
         bilinear8(level.quad(i, j), a, b)
+    }
+    #[inline(always)]
+    fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], (a, b): (f32, f32)) -> Vec4 {
+        bilinear8(bilinear::wrapped_quad(level, i, j), a, b)
     }
     #[inline(always)]
     fn mix(a: Vec4, b: Vec4, t: f32) -> Vec4 {

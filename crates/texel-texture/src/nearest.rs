@@ -57,4 +57,8 @@ impl Taps for Point {
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, _: (f32, f32)) -> Vec4 {
         level.texel(i, j)
     }
+    #[inline(always)]
+    fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], _: (f32, f32)) -> Vec4 {
+        level.texel(i[0], j[0])
+    }
 }
