@@ -11,8 +11,9 @@
 //! 2. `Pass::coordinates`: per level pass, the filter's origin (`u * W`, or `u * W - 1/2` for
 //!    bilinear), its floor ([`floor_clamped`], the staged floor), the fractions, and whether every
 //!    texel the sample reads lies inside the level;
-//! 3. `Pass::filtered`: loads and the blend for the samples inside the level; the few near an edge
-//!    call the one-sample filter with address wrapping.
+//! 3. `Pass::filtered`: loads and the blend for the samples inside the level; those within one
+//!    texel of it (`Pass::near`) read their taps wrapped by selects; the rest, and any under
+//!    `ClampToBorder`, call the one-sample filter with its address wrapping.
 //!
 //! The filters enter through [`Taps`], which `nearest.rs` and `bilinear.rs` implement with their
 //! own kernels (`bilinear::blend`, `bilinear::bilinear`, ...).
@@ -449,21 +450,22 @@ struct Pass<const N: usize, T> {
     inside: [bool; N],
     addr: Address,
     /// Neither address mode is `ClampToBorder`, so that taps within one texel of the level wrap
-    /// to texels ([`Pass::near`]); and which of the two modes is `Repeat`.
+    /// to texels ([`Pass::near`]); and which of the two modes is `Repeat` (not `MirrorRepeat`,
+    /// which maps the taps `-1` and `W` as `ClampToEdge` does).
     wraps: bool,
-    periodic: (bool, bool),
+    repeat: (bool, bool),
     taps: T,
 }
 
 /// The first tap `i` of a sample near an edge (`-1 <= i < n`, `n` the level's side) and the
 /// next one `i + 1`, wrapped into `[0, n)`: by `Repeat` (`-1 -> n - 1`, `n -> 0`) where
-/// `periodic`, else as `ClampToEdge`, `MirrorRepeat` and `MirrorClampToEdge` all map these two
+/// `repeat`, else as `ClampToEdge`, `MirrorRepeat` and `MirrorClampToEdge` all map these two
 /// indices (`-1 -> 0`, `n -> n - 1`; [`crate::address::AddressMode::wrap`]): two selects, no
 /// division.
 #[inline(always)]
-fn wrap_pair(i: i32, n: i32, periodic: bool) -> (i32, i32) {
+fn wrap_pair(i: i32, n: i32, repeat: bool) -> (i32, i32) {
     let first = if i < 0 {
-        if periodic {
+        if repeat {
             n - 1
         } else {
             0
@@ -472,7 +474,7 @@ fn wrap_pair(i: i32, n: i32, periodic: bool) -> (i32, i32) {
         i
     };
     let second = if i + 1 >= n {
-        if periodic {
+        if repeat {
             0
         } else {
             n - 1
@@ -494,7 +496,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
             inside: [false; N],
             addr,
             wraps: addr.u != AddressMode::ClampToBorder && addr.v != AddressMode::ClampToBorder,
-            periodic: (addr.u == AddressMode::Repeat, addr.v == AddressMode::Repeat),
+            repeat: (addr.u == AddressMode::Repeat, addr.v == AddressMode::Repeat),
             taps,
         }
     }
@@ -532,8 +534,8 @@ impl<const N: usize, T: Taps> Pass<N, T> {
             return None;
         }
         let ((i0, i1), (j0, j1)) = (
-            wrap_pair(i, w, self.periodic.0),
-            wrap_pair(j, h, self.periodic.1),
+            wrap_pair(i, w, self.repeat.0),
+            wrap_pair(j, h, self.repeat.1),
         );
         Some(([i0 as u32, i1 as u32], [j0 as u32, j1 as u32]))
     }
@@ -829,7 +831,7 @@ mod tests {
     /// in steps of 1/8 texel (and just inside each texel boundary) from two texels before to two
     /// after the level along both axes, levels 1 to 5 texels a side, every pair of address modes,
     /// nearest and bilinear, exact and fixed-point. Border modes never take the wrapped route;
-    /// the others take it for every origin in `[-1, W)` outside the level.
+    /// the others take it for exactly the origins in `[-1, W) x [-1, H)` not inside the level.
     #[test]
     fn wrapped_taps_equal_the_one_sample_filter() {
         for (w, h) in [(1u32, 1u32), (2, 3), (5, 2), (3, 5), (4, 4)] {
@@ -878,6 +880,18 @@ mod tests {
                         v
                     };
                     let (bl, pt) = (uvs(0.5), uvs(0.0));
+                    // The samples that should take the wrapped route: origin (as the pass
+                    // computes it) in [-1, W) x [-1, H) but not inside.
+                    let expect = |uvs: &[Vec2], half: f32, reach: f32| {
+                        let (wf, hf) = (w as f32, h as f32);
+                        let within = |x: f32, n: f32| (-1.0..n).contains(&x);
+                        let inside = |x: f32, n: f32| x >= 0.0 && x.floor() < n - reach;
+                        let near = |p: &&Vec2| {
+                            let (x, y) = (p.x * wf - half, p.y * hf - half);
+                            within(x, wf) && within(y, hf) && !(inside(x, wf) && inside(y, hf))
+                        };
+                        uvs.iter().filter(near).count()
+                    };
                     let counts = [
                         check_pass(Bilinear, &exact, addr, &bl),
                         check_pass(Bilinear8, &codes, addr, &bl),
@@ -889,13 +903,9 @@ mod tests {
                     if border {
                         assert_eq!(counts, [0; 4], "{addr:?}");
                     } else {
-                        // Bilinear: every origin in [-1, W) x [-1, H) whose quad leaves the level.
-                        assert!(
-                            counts[0] > 8 * (w + h) as usize,
-                            "{w}x{h} {addr:?} {counts:?}"
-                        );
-                        assert_eq!(counts[0], counts[1]);
-                        assert!(counts[2] > 0 && counts[2] == counts[3], "{counts:?}");
+                        let (b, p) = (expect(&bl, 0.5, 1.0), expect(&pt, 0.0, 0.0));
+                        assert!(b > 8 * (w + h) as usize && p > 0, "{w}x{h} {b} {p}");
+                        assert_eq!(counts, [b, b, p, p], "{w}x{h} {addr:?}");
                     }
                 }
             }
