@@ -15,6 +15,12 @@
 //! compared 134 images of the v4 copy with the v3 copy, and earlier of a whole-program x86-64-v3
 //! build with the baseline build, all identical).
 //!
+//! The copies differ in one more way: [`v3`] and [`v4`] hand the tile work
+//! [`texel_texture::Lanes::detect`], the sampler's eight-lane AVX2 quad kernel (safe intrinsics
+//! through `pulp`'s run-time token, bit for bit the four-lane kernel), and the baseline copy
+//! [`texel_texture::Lanes::scalar`]: only inside a function compiled with AVX2 do that kernel's
+//! intrinsics inline (in baseline code each would stay a call).
+//!
 //! Safety argument: calling a `#[target_feature]` function is `unsafe` because running its
 //! instructions on a CPU without the features is undefined behaviour. [`run`] calls [`v3`] only
 //! when [`level`] is [`SimdLevel::X86_64V3`] and [`v4`] only when it is [`SimdLevel::X86_64V4`].
@@ -24,7 +30,9 @@
 #![allow(unsafe_code)]
 
 use std::sync::atomic::{AtomicU8, Ordering};
+
 use std::sync::OnceLock;
+use texel_texture::Lanes;
 
 /// The instruction set the rasterizer's tiles run on, ordered from the least to the most.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -120,8 +128,9 @@ pub fn limit_level(max: SimdLevel) {
 pub(crate) trait Kernel {
     /// What the work returns.
     type Output;
-    /// Do the work.
-    fn run(self) -> Self::Output;
+    /// Do the work, sampling with `lanes`: [`Lanes::detect`] on the copies compiled with AVX2
+    /// (where its kernels' intrinsics inline), [`Lanes::scalar`] on the baseline copy.
+    fn run(self, lanes: Lanes) -> Self::Output;
 }
 
 /// Run `k` on the copy for [`level`]: its body (with everything it inlines) is compiled once for
@@ -137,7 +146,7 @@ pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
         SimdLevel::X86_64V3 => return unsafe { v3(k) },
         SimdLevel::Baseline => {}
     }
-    k.run()
+    k.run(Lanes::scalar())
 }
 
 /// `k.run()` compiled for x86-64-v3.
@@ -146,7 +155,7 @@ pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2"
 )]
 unsafe fn v3<K: Kernel>(k: K) -> K::Output {
-    k.run()
+    k.run(Lanes::detect())
 }
 
 /// `k.run()` compiled for x86-64-v4.
@@ -155,5 +164,5 @@ unsafe fn v3<K: Kernel>(k: K) -> K::Output {
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
 )]
 unsafe fn v4<K: Kernel>(k: K) -> K::Output {
-    k.run()
+    k.run(Lanes::detect())
 }

@@ -54,7 +54,7 @@ use rayon::prelude::*;
 use texel_texture::color::{
     rgba_to_unorm8, rgba_to_unorm8_slice, srgb8_encoder, unorm8_table, Srgb8Encoder,
 };
-use texel_texture::Footprint;
+use texel_texture::{Footprint, Lanes};
 
 use crate::dispatch::Kernel;
 use crate::draw::DrawCall;
@@ -368,14 +368,14 @@ struct TileJob<'j, 'a, 'f, 's> {
 impl Kernel for TileJob<'_, '_, '_, '_> {
     type Output = ();
     #[inline(always)]
-    fn run(self) {
-        raster_tile_body(self.ctx, self.tile, self.bin);
+    fn run(self, lanes: Lanes) {
+        raster_tile_body(self.ctx, self.tile, self.bin, lanes);
     }
 }
 
 /// [`raster_tile`]'s work, inlined into each instruction set's copy.
 #[inline(always)]
-fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
+fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup], lanes: Lanes) {
     // The tile's pixels inside the scissor, inclusive: [i0, j0, i1, j1].
     let [sx0, sy0, sx1, sy1] = ctx.settings.scissor_rect();
     let (ti0, tj0) = (tile.x0.max(sx0), tile.y0.max(sy0));
@@ -384,7 +384,13 @@ fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]
         return;
     }
     let batched = ctx.settings.view == View::Color && !ctx.counting;
-    let mut span = if batched { Some(Span::take()) } else { None };
+    let mut span = if batched {
+        let mut span = Span::take();
+        span.lanes = lanes;
+        Some(span)
+    } else {
+        None
+    };
     for &t in bin {
         let Some([bi0, bj0, bi1, bj1]) = t.bbox else {
             continue;
@@ -504,6 +510,8 @@ struct Span {
     texs: [[f32; 4]; SPAN],
     /// The stored-bytes and fixed-point paths' output ([`Route`]).
     bytes: [[u8; 4]; SPAN],
+    /// The sampler's quad kernel on the copy this tile runs on ([`Kernel::run`]).
+    lanes: Lanes,
 }
 
 thread_local! {
@@ -545,6 +553,7 @@ impl Span {
             fps: [Footprint::default(); SPAN],
             texs: [[0.0; 4]; SPAN],
             bytes: [[0; 4]; SPAN],
+            lanes: Lanes::scalar(),
         })
     }
 
@@ -849,7 +858,7 @@ fn shade_span(
     let n = span.n;
     if sample {
         dc.sampler
-            .sample_batch(dc.texture, &span.fps[..n], &mut span.texs[..n]);
+            .sample_batch_lanes(span.lanes, dc.texture, &span.fps[..n], &mut span.texs[..n]);
     }
     let verts = dc.vertices(t);
     // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).

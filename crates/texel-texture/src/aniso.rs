@@ -191,7 +191,8 @@ pub(crate) fn filter_planned<P: Pyramid>(
 mod tests {
     use super::*;
     use crate::bilinear::bilinear;
-    use crate::fetch::pyramid_of;
+    use crate::fetch::pyramid_with;
+    use crate::lanes::Lanes;
     use crate::sampler::SamplerDescriptor;
     use crate::texture::{Format, Limits, Texture};
 
@@ -209,7 +210,7 @@ mod tests {
             ]
         })
         .unwrap();
-        let crate::fetch::AnyPyramid::U8(p) = pyramid_of(&tex) else {
+        let crate::fetch::AnyPyramid::U8(p) = pyramid_with(&tex, Lanes::scalar()) else {
             unreachable!()
         };
         let d = SamplerDescriptor {

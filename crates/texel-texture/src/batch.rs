@@ -849,7 +849,7 @@ mod tests {
                 width: w,
                 height: h,
                 texels: &bytes,
-                decode: Unorm8,
+                decode: Unorm8::default(),
             };
             let codes = Level {
                 width: w,

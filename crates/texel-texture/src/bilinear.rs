@@ -113,11 +113,11 @@ impl Taps for Bilinear {
     const REACH: f32 = 1.0;
     #[inline(always)]
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, (a, b): (f32, f32)) -> Vec4 {
-        blend(level.quad(i, j), a, b)
+        level.bilinear_quad(i, j, a, b)
     }
     #[inline(always)]
     fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], (a, b): (f32, f32)) -> Vec4 {
-        blend(wrapped_quad(level, i, j), a, b)
+        level.bilinear_wrapped(i, j, a, b)
     }
 }
 

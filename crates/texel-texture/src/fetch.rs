@@ -11,7 +11,9 @@ use std::cell::Cell;
 
 use glam::Vec4;
 
+use crate::bilinear::{blend, wrapped_quad};
 use crate::color::{srgb_table, unorm8_table};
+use crate::lanes::Lanes;
 use crate::texture::{Format, LevelInfo, Storage, Texture};
 
 /// How a stored texel becomes linear RGBA, per storage format: [`Table8`] for 8-bit texels,
@@ -29,6 +31,13 @@ pub(crate) trait Decode: Copy {
     #[inline(always)]
     fn decode4(&self, t: [Self::Texel; 4]) -> [Vec4; 4] {
         t.map(|t| self.decode(t))
+    }
+    /// The bilinear blend ([`blend`]) of the quad whose rows are `r0 = [T00, T10]` and
+    /// `r1 = [T01, T11]`, with fractions `a` (x) and `b` (y): [`Decode::decode4`] then [`blend`],
+    /// which a decoder may compute in wider lanes (the same bits: [`crate::lanes`]).
+    #[inline(always)]
+    fn bilinear_rows(&self, r0: [Self::Texel; 2], r1: [Self::Texel; 2], a: f32, b: f32) -> Vec4 {
+        blend(self.decode4([r0[0], r0[1], r1[0], r1[1]]), a, b)
     }
     /// The texels of `storage` if it holds this format.
     fn texels(storage: &Storage) -> Option<&[Self::Texel]>;
@@ -67,13 +76,16 @@ impl Decode for Table8 {
 /// [`unorm8_table`]. A decoder of its own, not a flag on [`Table8`]: a branch in the shared
 /// kernel measured 10 % slower sRGB trilinear frames. Single texels by arithmetic rather than
 /// four table loads: one-thread raw mip-nearest frames 5.87 -> 5.67 ms, trilinear 8.46 -> 8.09.
-#[derive(Clone, Copy)]
-pub(crate) struct Unorm8;
+/// Bilinear quads blend in eight lanes where `lanes` has them ([`crate::lanes`]).
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Unorm8 {
+    pub lanes: Lanes,
+}
 
 /// `1 / 255` split into a high part of 12 significant bits, so that `b * UNORM8_HI` is exact for
 /// every byte `b`, and the `f32` nearest to the rest.
-const UNORM8_HI: f32 = f32::from_bits((1.0f32 / 255.0).to_bits() & !((1 << 12) - 1));
-const UNORM8_LO: f32 = (1.0f64 / 255.0 - UNORM8_HI as f64) as f32;
+pub(crate) const UNORM8_HI: f32 = f32::from_bits((1.0f32 / 255.0).to_bits() & !((1 << 12) - 1));
+pub(crate) const UNORM8_LO: f32 = (1.0f64 / 255.0 - UNORM8_HI as f64) as f32;
 
 /// `b / 255` for the sixteen bytes of a quad, as `b * hi + b * lo` with `1 / 255 = hi + lo`
 /// (`hi` with 12 significant bits, so `b * hi` is exact and only the `b * lo` product and the sum
@@ -116,6 +128,13 @@ impl Decode for Unorm8 {
     #[inline(always)]
     fn decode4(&self, t: [[u8; 4]; 4]) -> [Vec4; 4] {
         quad_lanes(t, unorm8_lanes)
+    }
+    #[inline(always)]
+    fn bilinear_rows(&self, r0: [[u8; 4]; 2], r1: [[u8; 4]; 2], a: f32, b: f32) -> Vec4 {
+        match self.lanes.bilinear_unorm8((r0, r1), (a, b)) {
+            Some(v) => v,
+            None => blend(self.decode4([r0[0], r0[1], r1[0], r1[1]]), a, b),
+        }
     }
     fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
         Table8::texels(storage)
@@ -185,6 +204,17 @@ pub(crate) trait Fetch: Copy {
     fn size(&self) -> (u32, u32);
     /// Texel `(i, j)` in linear RGBA; `i < width`, `j < height`.
     fn texel(&self, i: u32, j: u32) -> Vec4;
+    /// The bilinear blend of [`Fetch::quad`] with fractions `a` (x) and `b` (y) ([`blend`]).
+    #[inline(always)]
+    fn bilinear_quad(&self, i: u32, j: u32, a: f32, b: f32) -> Vec4 {
+        blend(self.quad(i, j), a, b)
+    }
+    /// The bilinear blend of the texels at the already wrapped taps `i[0], i[1]` by `j[0], j[1]`
+    /// (each inside the level) with fractions `a` and `b`: [`wrapped_quad`] then [`blend`].
+    #[inline(always)]
+    fn bilinear_wrapped(&self, i: [u32; 2], j: [u32; 2], a: f32, b: f32) -> Vec4 {
+        blend(wrapped_quad(self, i, j), a, b)
+    }
     /// The 2x2 texels `[(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]`; `i + 1 < width`,
     /// `j + 1 < height` (no wrapping). The storage views read them as two 2-texel row slices,
     /// so a bilinear lookup inside the level pays two bounds checks instead of four.
@@ -221,6 +251,21 @@ impl<D: Decode> Fetch for Level<'_, D> {
     fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
         let (r0, r1) = rows2(self.texels, self.width, i, j);
         self.decode.decode4([r0[0], r0[1], r1[0], r1[1]])
+    }
+    #[inline(always)]
+    fn bilinear_quad(&self, i: u32, j: u32, a: f32, b: f32) -> Vec4 {
+        let (r0, r1) = rows2(self.texels, self.width, i, j);
+        self.decode
+            .bilinear_rows([r0[0], r0[1]], [r1[0], r1[1]], a, b)
+    }
+    #[inline(always)]
+    fn bilinear_wrapped(&self, i: [u32; 2], j: [u32; 2], a: f32, b: f32) -> Vec4 {
+        let w = self.width as usize;
+        let (row0, row1) = (j[0] as usize * w, j[1] as usize * w);
+        let (i0, i1) = (i[0] as usize, i[1] as usize);
+        let r0 = [self.texels[row0 + i0], self.texels[row0 + i1]];
+        let r1 = [self.texels[row1 + i0], self.texels[row1 + i1]];
+        self.decode.bilinear_rows(r0, r1, a, b)
     }
 }
 
@@ -357,10 +402,14 @@ impl<P: Pyramid> Pyramid for Counted<P> {
 }
 
 /// Call `$body` with `$p` bound to the texture's pyramid view (8-bit or float), monomorphising once
-/// per storage format.
+/// per storage format; with `$lanes`, the linear 8-bit view blends bilinear quads with that
+/// kernel ([`crate::lanes`]), else with the scalar one.
 macro_rules! with_pyramid {
     ($tex:expr, |$p:ident| $body:expr) => {
-        match $crate::fetch::pyramid_of($tex) {
+        $crate::fetch::with_pyramid!($tex, $crate::lanes::Lanes::scalar(), |$p| $body)
+    };
+    ($tex:expr, $lanes:expr, |$p:ident| $body:expr) => {
+        match $crate::fetch::pyramid_with($tex, $lanes) {
             $crate::fetch::AnyPyramid::U8($p) => $body,
             $crate::fetch::AnyPyramid::Unorm8($p) => $body,
             $crate::fetch::AnyPyramid::F32($p) => $body,
@@ -399,13 +448,15 @@ pub(crate) fn codes_of(tex: &Texture) -> Option<Stored<'_, Codes8>> {
     })
 }
 
-pub(crate) fn pyramid_of(tex: &Texture) -> AnyPyramid<'_> {
+/// The texture's pyramid view (8-bit sRGB, linear 8-bit or float), whose linear 8-bit view
+/// blends bilinear quads with `lanes`' kernel.
+pub(crate) fn pyramid_with(tex: &Texture, lanes: Lanes) -> AnyPyramid<'_> {
     match tex.storage() {
         Storage::U8(v) if tex.format() == Format::Rgba8Unorm => AnyPyramid::Unorm8(Stored {
             tex,
             levels: tex.levels(),
             texels: v,
-            decode: Unorm8,
+            decode: Unorm8 { lanes },
         }),
         Storage::U8(v) => AnyPyramid::U8(Stored {
             tex,
@@ -442,7 +493,7 @@ mod tests {
                 assert_eq!(f[k].to_bits(), (f32::from(b) / 255.0).to_bits());
             }
         }
-        let lin = Unorm8;
+        let lin = Unorm8::default();
         for b in 0..=255u8 {
             for k in 0..4 {
                 let mut t = [0u8; 4];

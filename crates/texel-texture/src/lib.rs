@@ -43,6 +43,7 @@ pub mod fixed8;
 pub mod floor;
 pub mod footprint;
 pub mod input;
+mod lanes;
 pub mod mip;
 mod nearest;
 pub mod pyramid;
@@ -58,6 +59,7 @@ pub use address::{Address, AddressMode, BorderColor};
 pub use bicubic::Cubic;
 pub use error::TextureError;
 pub use footprint::{Axes, Footprint};
+pub use lanes::Lanes;
 pub use ripmap::Ripmap;
 pub use sampler::{
     FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,

@@ -66,6 +66,7 @@ use crate::fetch::{codes_of, with_pyramid, Counted, Fetch, Pyramid};
 use crate::floor::integer_bytes4;
 pub use crate::footprint::UV_LIMIT;
 use crate::footprint::{finite_uv, lod_from_rho_squared, rho_squared, Footprint, Query};
+use crate::lanes::Lanes;
 use crate::mip::{filter_level, mip_nearest, trilinear};
 use crate::ripmap::ripmap;
 use crate::sat::summed_area;
@@ -507,12 +508,30 @@ impl Sampler {
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
     #[inline(always)]
     pub fn sample_batch(&self, texture: &Texture, footprints: &[Footprint], out: &mut [[f32; 4]]) {
+        self.sample_batch_lanes(Lanes::scalar(), texture, footprints, out)
+    }
+
+    /// [`Sampler::sample_batch`] with the bilinear quads of linear 8-bit textures
+    /// (`Rgba8Unorm`) blended by `lanes`' kernel: the same bits with every [`Lanes`]. Pass
+    /// [`Lanes::detect`] only from code compiled with AVX2 (the rasterizer's x86-64-v3 and -v4
+    /// copies): elsewhere each of the kernel's intrinsics stays a call ([`Lanes`]' module docs).
+    ///
+    /// # Panics
+    /// If `footprints.len() != out.len()` (a programming error, not bad input).
+    #[inline(always)]
+    pub fn sample_batch_lanes(
+        &self,
+        lanes: Lanes,
+        texture: &Texture,
+        footprints: &[Footprint],
+        out: &mut [[f32; 4]],
+    ) {
         assert_eq!(
             footprints.len(),
             out.len(),
             "sample_batch: footprints and out differ in length"
         );
-        with_pyramid!(texture, |p| {
+        with_pyramid!(texture, lanes, |p| {
             let size = p.level(0).size();
             let staged = size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE;
             if self.batched && staged {

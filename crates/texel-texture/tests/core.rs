@@ -3,8 +3,8 @@
 
 use proptest::prelude::*;
 use texel_texture::{
-    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Limits,
-    MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
+    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Lanes,
+    Limits, MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
 };
 
 const ADDRESS_MODES: [AddressMode; 5] = [
@@ -186,7 +186,8 @@ proptest! {
     /// `sample_batch` equals `sample` one by one, bit for bit (lengths beyond the 64-footprint
     /// chunk included): the staged kernels of the core filters (`batch.rs`) and the generic path,
     /// for every filter, mipmap mode and address mode, on 8-bit sRGB, 8-bit linear and float
-    /// textures of odd sizes (a 1-texel-wide one included).
+    /// textures of odd sizes (a 1-texel-wide one included); and with [`Lanes::detect`]'s quad
+    /// kernel (`sample_batch_lanes`), equal to `sample_batch`.
     #[test]
     fn batch_equals_single(
         fps in proptest::collection::vec(footprint_strategy(), 1..150),
@@ -209,12 +210,16 @@ proptest! {
             samplers.push(Sampler::new(d.with_address_mode(AddressMode::MirrorRepeat)).unwrap());
         }
         let mut out = vec![[0.0; 4]; fps.len()];
+        let mut wide = vec![[0.0; 4]; fps.len()];
         for tex in &textures {
             for s in &samplers {
                 s.sample_batch(tex, &fps, &mut out);
                 for (f, o) in fps.iter().zip(&out) {
                     prop_assert_eq!(s.sample(tex, f).map(f32::to_bits), o.map(f32::to_bits), "{:?} {:?}", s.descriptor(), f);
                 }
+                // The eight-lane quad kernel (where the CPU has it) gives the same bits.
+                s.sample_batch_lanes(Lanes::detect(), tex, &fps, &mut wide);
+                prop_assert_eq!(out.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>(), wide.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>(), "{:?}", s.descriptor());
             }
         }
     }

@@ -1,0 +1,182 @@
+//! Explicit 8-lane kernels for the batched sampler's hottest step, the bilinear blend of a quad of
+//! linear 8-bit texels, on AVX2 through [`pulp`]'s run-time tokens (safe: a token exists only on
+//! a CPU that has the features, and its intrinsics are safe methods), with the four-lane `glam`
+//! kernel as the fallback on every other CPU.
+//!
+//! Why. Written in plain Rust (`[f32; 16]` lanes, `Vec4` blends), LLVM's SLP vectoriser splits the
+//! quad into four texels and three four-lane lerps: per texel a broadcast, a byte shuffle, a
+//! conversion and the decode's two multiplies and add, then `3 x 3` four-lane operations, about 35
+//! vector operations a quad. The explicit kernel reads the quad as its two rows of 8 bytes, widens
+//! each row to eight `f32` lanes (`vpmovzxbd`, `vcvtdq2ps`), decodes both rows in eight lanes,
+//! and blends the two rows' x-lerps in one eight-lane lerp: about 15 operations. Measured
+//! stand-alone (a trilinear kernel over cache-resident samples): 5.0 -> 3.9 ns a sample
+//! (docs/perf-log.md, entry 35).
+//!
+//! Same bits. Each lane computes the scalar kernel's operations in its order: the decode
+//! `b * hi + b * lo` ([`crate::fetch`]'s `unorm8_lanes`: two multiplies and an add, never fused),
+//! then [`crate::bilinear::blend`]'s `lerp(lerp(t00, t10, a), lerp(t01, t11, a), b)` with
+//! `lerp(x, y, t) = x + (y - x) * t`. Only the grouping into registers differs, so the result is
+//! bit for bit the scalar kernel's (unit test below; `tests/core.rs` compares whole batches).
+//!
+//! Where it runs. The token is taken by the caller that knows it runs in a copy compiled with
+//! AVX2: the rasterizer's tiles on its x86-64-v3 and -v4 copies (`texel-raster`'s dispatch) pass
+//! [`Lanes::detect`] to [`crate::Sampler::sample_batch_lanes`]. Elsewhere ([`crate::Sampler::sample_batch`]
+//! and the one-sample path) the kernel is the scalar one: pulp's intrinsics carry
+//! `#[target_feature]`, so in code compiled for the x86-64 baseline each would stay a call.
+
+use glam::Vec4;
+
+/// Which quad kernel the batched sampler's bilinear blends of linear 8-bit texels use: AVX2's
+/// eight lanes (a token proving the CPU has them) or the four-lane scalar kernel. Both give the
+/// same bits. `Copy` and free to pass around (a zero-sized token or nothing).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Lanes {
+    #[cfg(target_arch = "x86_64")]
+    v3: Option<pulp::x86::V3>,
+}
+
+impl Lanes {
+    /// The four-lane scalar kernel, on every CPU.
+    pub fn scalar() -> Lanes {
+        Lanes::default()
+    }
+
+    /// The eight-lane AVX2 kernel if the CPU has x86-64-v3's features (pulp's `V3`: AVX, AVX2,
+    /// FMA, BMI1/2, LZCNT and SSE up to 4.2; detected once per process), else
+    /// [`Lanes::scalar`]. Worth it only in code compiled with those features (see the module
+    /// docs); the results are the same either way.
+    pub fn detect() -> Lanes {
+        Lanes {
+            #[cfg(target_arch = "x86_64")]
+            v3: pulp::x86::V3::try_new(),
+        }
+    }
+
+    /// Whether the eight-lane kernel is used.
+    pub fn is_wide(self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return self.v3.is_some();
+        #[cfg(not(target_arch = "x86_64"))]
+        false
+    }
+
+    /// The bilinear blend of the linear 8-bit quad whose rows are `r0 = [T00, T10]` and
+    /// `r1 = [T01, T11]`, with fractions `a` (along x) and `b` (along y), in eight lanes: each
+    /// byte decoded to `b / 255` (exactly [`crate::fetch`]'s `Unorm8`), then
+    /// `lerp(lerp(T00, T10, a), lerp(T01, T11, a), b)`, bit for bit the four-lane kernel.
+    /// `None` when this is [`Lanes::scalar`]: the caller then runs the four-lane kernel (an
+    /// `Option`, not a fallback closure: closures can stay outlined, compiled for the baseline).
+    #[inline(always)]
+    pub(crate) fn bilinear_unorm8(
+        self,
+        (r0, r1): ([[u8; 4]; 2], [[u8; 4]; 2]),
+        (a, b): (f32, f32),
+    ) -> Option<Vec4> {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = self.v3 {
+            return Some(bilinear_unorm8_v3(simd, (r0, r1), (a, b)));
+        }
+        let _ = (r0, r1, a, b);
+        None
+    }
+}
+
+/// [`Lanes::bilinear_unorm8`] in AVX2's eight lanes. A row of two texels (8 bytes) becomes eight
+/// `f32` lanes `[t.r, t.g, t.b, t.a, t'.r, ..]`; the decode runs on both rows; the rows are
+/// regrouped into `[T00 | T01]` and `[T10 | T11]` so that one eight-lane lerp by `a` gives both
+/// rows' x-lerps, whose halves the final four-lane lerp by `b` blends.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn bilinear_unorm8_v3(
+    simd: pulp::x86::V3,
+    (r0, r1): ([[u8; 4]; 2], [[u8; 4]; 2]),
+    (a, b): (f32, f32),
+) -> Vec4 {
+    let (avx, sse) = (simd.avx, simd.sse);
+    let (row0, row1) = (row_v3(simd, r0), row_v3(simd, r1));
+    // [T00 | T01] and [T10 | T11].
+    let left = avx._mm256_permute2f128_ps::<0x20>(row0, row1);
+    let right = avx._mm256_permute2f128_ps::<0x31>(row0, row1);
+    let x = avx._mm256_add_ps(
+        left,
+        avx._mm256_mul_ps(avx._mm256_sub_ps(right, left), avx._mm256_set1_ps(a)),
+    );
+    let (x0, x1) = (
+        avx._mm256_castps256_ps128(x),
+        avx._mm256_extractf128_ps::<1>(x),
+    );
+    let y = sse._mm_add_ps(
+        x0,
+        sse._mm_mul_ps(sse._mm_sub_ps(x1, x0), sse._mm_set1_ps(b)),
+    );
+    Vec4::from(y)
+}
+
+/// A row of two linear 8-bit texels as eight decoded `f32` lanes, `b * hi + b * lo` per byte
+/// ([`crate::fetch`]'s `unorm8_lanes`). A function, not a closure: a closure stays an outlined
+/// function compiled for the baseline, where every intrinsic is a call (docs/perf-log.md, 35).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn row_v3(simd: pulp::x86::V3, r: [[u8; 4]; 2]) -> std::arch::x86_64::__m256 {
+    use crate::fetch::{UNORM8_HI, UNORM8_LO};
+    let (avx, avx2, sse2) = (simd.avx, simd.avx2, simd.sse2);
+    let bytes = u64::from(u32::from_le_bytes(r[0])) | u64::from(u32::from_le_bytes(r[1])) << 32;
+    let x = sse2._mm_set_epi64x(0, bytes as i64);
+    let x = avx._mm256_cvtepi32_ps(avx2._mm256_cvtepu8_epi32(x));
+    avx._mm256_add_ps(
+        avx._mm256_mul_ps(x, avx._mm256_set1_ps(UNORM8_HI)),
+        avx._mm256_mul_ps(x, avx._mm256_set1_ps(UNORM8_LO)),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bilinear::blend;
+    use crate::fetch::{Decode, Unorm8};
+    use crate::rng::SplitMix64;
+
+    /// The eight-lane kernel equals the four-lane one bit for bit: random quads (every byte value
+    /// reached), fractions at the ends of `[0, 1)`, at halves, near 1, and random; both kernels
+    /// from the same bytes.
+    #[test]
+    fn wide_kernel_equals_the_scalar_one() {
+        let wide = Lanes::detect();
+        if !wide.is_wide() {
+            println!("skipped: this CPU has no AVX2 (x86-64-v3); only the scalar kernel runs");
+            return;
+        }
+        let scalar = Unorm8::default();
+        let mut rng = SplitMix64::new(7);
+        let mut fractions = vec![0.0, 0.5, 0.25, 1.0 - f32::EPSILON / 2.0, 1e-7, 0.999];
+        fractions.extend((0..26).map(|_| rng.next_f32()));
+        let mut compared = 0;
+        for q in 0..2000u32 {
+            let mut bytes = [0u8; 16];
+            for (k, b) in bytes.iter_mut().enumerate() {
+                // The first quads cover every byte value in every lane.
+                *b = if q < 256 {
+                    (q as usize + 17 * k) as u8
+                } else {
+                    rng.next_u64() as u8
+                };
+            }
+            let t: [[u8; 4]; 4] =
+                std::array::from_fn(|k| std::array::from_fn(|c| bytes[4 * k + c]));
+            for &a in &fractions {
+                for &b in fractions.iter().step_by(3) {
+                    let want = blend(scalar.decode4(t), a, b);
+                    let got = wide
+                        .bilinear_unorm8(([t[0], t[1]], [t[2], t[3]]), (a, b))
+                        .expect("the wide kernel");
+                    assert_eq!(
+                        got.to_array().map(f32::to_bits),
+                        want.to_array().map(f32::to_bits)
+                    );
+                    compared += 1;
+                }
+            }
+        }
+        assert_eq!(compared, 2000 * 32 * 11);
+    }
+}
