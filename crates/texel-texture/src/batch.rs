@@ -790,6 +790,7 @@ mod tests {
     use super::*;
     use crate::address::BorderColor;
     use crate::fetch::{Codes8, Level, Unorm8};
+    use crate::lanes::Lanes;
 
     const MODES: [AddressMode; 5] = [
         AddressMode::ClampToEdge,
@@ -830,7 +831,8 @@ mod tests {
     /// read exactly the texels the one-sample filters read through `AddressMode::wrap`: origins
     /// in steps of 1/8 texel (and just inside each texel boundary) from two texels before to two
     /// after the level along both axes, levels 1 to 5 texels a side, every pair of address modes,
-    /// nearest and bilinear, exact and fixed-point. Border modes never take the wrapped route;
+    /// nearest and bilinear, exact (also with [`Lanes::detect`]'s eight-lane quads) and
+    /// fixed-point. Border modes never take the wrapped route;
     /// the others take it for exactly the origins in `[-1, W) x [-1, H)` not inside the level.
     #[test]
     fn wrapped_taps_equal_the_one_sample_filter() {
@@ -850,6 +852,13 @@ mod tests {
                 height: h,
                 texels: &bytes,
                 decode: Unorm8::default(),
+            };
+            // The same level blending its quads in eight lanes where the CPU has them.
+            let wide = Level {
+                decode: Unorm8 {
+                    lanes: Lanes::detect(),
+                },
+                ..exact
             };
             let codes = Level {
                 width: w,
@@ -898,6 +907,7 @@ mod tests {
                         check_pass(Point, &exact, addr, &pt),
                         check_pass(Point8, &codes, addr, &pt),
                     ];
+                    assert_eq!(check_pass(Bilinear, &wide, addr, &bl), counts[0]);
                     let border =
                         mu == AddressMode::ClampToBorder || mv == AddressMode::ClampToBorder;
                     if border {

@@ -26,9 +26,21 @@
 
 use glam::Vec4;
 
-/// Which quad kernel the batched sampler's bilinear blends of linear 8-bit texels use: AVX2's
-/// eight lanes (a token proving the CPU has them) or the four-lane scalar kernel. Both give the
-/// same bits. `Copy` and free to pass around (a zero-sized token or nothing).
+/// Which quad kernel the batched sampler ([`crate::Sampler::sample_batch_lanes`]) uses for the
+/// bilinear blend of a 2x2 quad of linear 8-bit texels (`Rgba8Unorm`, its staged path: minifying
+/// and magnifying bilinear, mip-nearest, trilinear and the anisotropic probes): AVX2's eight
+/// lanes (a `pulp` token proving the CPU has them) or the four-lane scalar kernel. Both give the
+/// same bits. Ignored for other formats, for the one-sample path, and for textures above the
+/// staged path's side limit (2^22 texels). `Default` is [`Lanes::scalar`]. `Copy` and free to
+/// pass (a zero-sized token in an `Option`).
+///
+/// The eight-lane kernel reads each row of two texels as 8 bytes, widens and decodes them in
+/// eight lanes (`b * hi + b * lo` with `1/255 = hi + lo`, two multiplies and an add per lane,
+/// never fused), lerps both rows along x in one eight-lane step and the two halves along y:
+/// per lane the four-lane kernel's operations in its order. Its intrinsics carry
+/// `#[target_feature]`, so it is fast only in code compiled with AVX2 (the rasterizer's
+/// x86-64-v3 and -v4 copies); called from baseline code each intrinsic stays a call (correct,
+/// slower).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Lanes {
     #[cfg(target_arch = "x86_64")]
@@ -43,8 +55,8 @@ impl Lanes {
 
     /// The eight-lane AVX2 kernel if the CPU has x86-64-v3's features (pulp's `V3`: AVX, AVX2,
     /// FMA, BMI1/2, LZCNT and SSE up to 4.2; detected once per process), else
-    /// [`Lanes::scalar`]. Worth it only in code compiled with those features (see the module
-    /// docs); the results are the same either way.
+    /// [`Lanes::scalar`]. Worth it only in code compiled with those features (see [`Lanes`]);
+    /// the results are the same either way.
     pub fn detect() -> Lanes {
         Lanes {
             #[cfg(target_arch = "x86_64")]

@@ -502,13 +502,22 @@ impl Sampler {
     /// texture's format is dispatched once for the whole batch, and the lods of up to 64
     /// footprints are computed in one loop before any is filtered (independent iterations that
     /// pipeline, instead of one long dependency chain per sample). A rasterizer should hand it a
-    /// row span at a time.
+    /// row span at a time. In a build for AVX2 (`target_feature = "avx2"`) linear 8-bit quads
+    /// blend in eight lanes ([`Lanes::detect`]), else in four; code compiled for AVX2 inside a
+    /// default build passes the token itself ([`Sampler::sample_batch_lanes`]). Same bits.
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
     #[inline(always)]
     pub fn sample_batch(&self, texture: &Texture, footprints: &[Footprint], out: &mut [[f32; 4]]) {
-        self.sample_batch_lanes(Lanes::scalar(), texture, footprints, out)
+        // A build for AVX2 (`-C target-cpu=x86-64-v3` or newer) inlines the eight-lane kernel
+        // everywhere; the default build keeps the four-lane one here ([`Lanes`]).
+        let lanes = if cfg!(target_feature = "avx2") {
+            Lanes::detect()
+        } else {
+            Lanes::scalar()
+        };
+        self.sample_batch_lanes(lanes, texture, footprints, out)
     }
 
     /// [`Sampler::sample_batch`] with the bilinear quads of linear 8-bit textures
