@@ -30,8 +30,8 @@
 #![allow(unsafe_code)]
 
 use std::sync::atomic::{AtomicU8, Ordering};
-
 use std::sync::OnceLock;
+
 use texel_texture::Lanes;
 
 /// The instruction set the rasterizer's tiles run on, ordered from the least to the most.
@@ -149,7 +149,7 @@ pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
     k.run(Lanes::scalar())
 }
 
-/// `k.run()` compiled for x86-64-v3.
+/// `k.run(Lanes::detect())` compiled for x86-64-v3.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2"
@@ -158,7 +158,7 @@ unsafe fn v3<K: Kernel>(k: K) -> K::Output {
     k.run(Lanes::detect())
 }
 
-/// `k.run()` compiled for x86-64-v4.
+/// `k.run(Lanes::detect())` compiled for x86-64-v4.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
