@@ -644,9 +644,7 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             // it (stage 1's fill, the level scan) bilinear frames measured 5-7 % slower.
             let size = (dims_w[0], dims_h[0]);
             first.coordinates(|_| size, &chunk.u[..n], &chunk.v[..n]);
-            for (k, o) in out.iter_mut().enumerate() {
-                *o = first.filtered(&base, k, chunk.uv(k)).to_array();
-            }
+            filter_unblended(&first, &chunk, |_| base, out);
             continue;
         }
         // Stage 1: levels (u8: at most 32 levels for a 2^31 side; textures are far smaller).
@@ -673,30 +671,57 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             (dims_w[l], dims_h[l])
         };
         let l0 = first.level[0];
-        if first.level[..n].iter().all(|&l| l == l0) {
+        // A fold, not `all`: branch-free, it compares the chunk's levels in vector lanes (the
+        // early-exit `all` was a byte loop with a branch per sample, 2.5 % of a mip-nearest frame).
+        let one_level = first.level[..n]
+            .iter()
+            .fold(true, |one, &l| one & (l == l0));
+        if one_level {
             // The whole chunk in one level (neighbouring pixels' lods are close, so chunks along
             // a row often are): its view and size looked up once, the same arithmetic.
             let (fine, s0) = (view(l0), size(l0));
             first.coordinates(|_| s0, &chunk.u[..n], &chunk.v[..n]);
+            // As `mip::trilinear`: the coarser level only when it is weighed.
+            if !(trilinear && (l0 as usize) < last) {
+                filter_unblended(&first, &chunk, |_| fine, out);
+                continue;
+            }
             let l1 = second.level[0];
             let (coarse, s1) = (view(l1), size(l1));
-            if trilinear {
-                second.coordinates(|_| s1, &chunk.u[..n], &chunk.v[..n]);
-            }
-            let weighed = trilinear && (l0 as usize) < last;
+            second.coordinates(|_| s1, &chunk.u[..n], &chunk.v[..n]);
             let stages = (&first, &second, &chunk, &delta);
-            filter_chunk(stages, |_| weighed, |_| fine, |_| coarse, out);
+            filter_chunk(stages, |_| true, |_| fine, |_| coarse, out);
             continue;
         }
         first.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
-        if trilinear {
-            second.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
+        if !trilinear {
+            let fl = &first.level;
+            filter_unblended(&first, &chunk, |k| view(fl[k]), out);
+            continue;
         }
+        second.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
         let (fl, sl) = (&first.level, &second.level);
         // As `mip::trilinear`: the coarser level only when it is weighed.
-        let weighed = |k: usize| trilinear && (fl[k] as usize) < last;
+        let weighed = |k: usize| (fl[k] as usize) < last;
         let stages = (&first, &second, &chunk, &delta);
         filter_chunk(stages, weighed, |k| view(fl[k]), |k| view(sl[k]), out);
+    }
+}
+
+/// Stage 3 of [`run_in`] where no sample blends two levels (no mipmaps, nearest mip level, or a
+/// trilinear chunk wholly in the last level): each sample's value filtered in `level(k)`'s view.
+/// The same values as [`filter_chunk`] with nothing weighed, without its per-sample blend test:
+/// through that test the filtered value was stored to the stack and reloaded before the test
+/// resolved, and mip-nearest frames spent 11-13 % of their time on that reload (perf-log 36).
+#[inline(always)]
+fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
+    first: &Pass<N, T>,
+    chunk: &Chunk<N>,
+    level: impl Fn(usize) -> F,
+    out: &mut [[f32; 4]],
+) {
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = first.filtered(&level(k), k, chunk.uv(k)).to_array();
     }
 }
 

@@ -286,8 +286,10 @@ fn batch_equals_single_on_extreme_derivatives() {
 /// `sample_batch` equals `sample` bit for bit where whole chunks share one level (the batch's
 /// one-level path: the view and size looked up once per chunk) and where one sample of a chunk
 /// leaves it: footprints of one fractional lod (1.3; 0.6 for the nearest-mip rounding; 2.9, near
-/// the last level of a 64-texel side) at spread positions, 64-sample chunks with and without an
-/// outlier, every mipmap mode and filter, the three formats.
+/// the last level of a 64-texel side; 7.5, beyond every texture's last level, where a trilinear
+/// chunk blends nothing and takes the unblended path; -1, magnified, level 0 with a zero blend
+/// weight) at spread positions, 64-sample chunks with and without an outlier, every mipmap mode
+/// and filter, the three formats.
 #[test]
 fn batch_equals_single_when_a_chunk_shares_a_level() {
     let textures = [
@@ -295,7 +297,7 @@ fn batch_equals_single_when_a_chunk_shares_a_level() {
         noise_texture(64, 64, Format::Rgba8Unorm),
         noise_texture(61, 37, Format::Rgba32Float),
     ];
-    for lod in [1.3f32, 0.6, 2.9] {
+    for lod in [1.3f32, 0.6, 2.9, 7.5, -1.0] {
         // rho = 2^lod texels of the 64-texel side, along u.
         let d = lod.exp2() / 64.0;
         let mut fps: Vec<Footprint> = (0..200)
