@@ -672,7 +672,8 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
         };
         let l0 = first.level[0];
         // A fold, not `all`: branch-free, it compares the chunk's levels in vector lanes (the
-        // early-exit `all` was a byte loop with a branch per sample, 2.5 % of a mip-nearest frame).
+        // early-exit `all` was a byte loop with a branch per sample; that branch alone held 2.5 %
+        // of a one-thread mip-nearest profile's samples, perf-log 36).
         let one_level = first.level[..n]
             .iter()
             .fold(true, |one, &l| one & (l == l0));
@@ -690,7 +691,7 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             let (coarse, s1) = (view(l1), size(l1));
             second.coordinates(|_| s1, &chunk.u[..n], &chunk.v[..n]);
             let stages = (&first, &second, &chunk, &delta);
-            filter_chunk(stages, |_| true, |_| fine, |_| coarse, out);
+            filter_chunk(stages, |_| fine, |_| coarse, out);
             continue;
         }
         first.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
@@ -701,18 +702,17 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
         }
         second.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
         let (fl, sl) = (&first.level, &second.level);
-        // As `mip::trilinear`: the coarser level only when it is weighed.
-        let weighed = |k: usize| (fl[k] as usize) < last;
         let stages = (&first, &second, &chunk, &delta);
-        filter_chunk(stages, weighed, |k| view(fl[k]), |k| view(sl[k]), out);
+        filter_chunk(stages, |k| view(fl[k]), |k| view(sl[k]), out);
     }
 }
 
 /// Stage 3 of [`run_in`] where no sample blends two levels (no mipmaps, nearest mip level, or a
 /// trilinear chunk wholly in the last level): each sample's value filtered in `level(k)`'s view.
 /// The same values as [`filter_chunk`] with nothing weighed, without its per-sample blend test:
-/// through that test the filtered value was stored to the stack and reloaded before the test
-/// resolved, and mip-nearest frames spent 11-13 % of their time on that reload (perf-log 36).
+/// with that test in the loop, LLVM stored each filtered value to the stack and reloaded it after
+/// the test, and 11-13 % of a one-thread mip-nearest profile's samples sat on that reload
+/// (perf-log 35 and 36).
 #[inline(always)]
 fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
     first: &Pass<N, T>,
@@ -727,11 +727,11 @@ fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
 
 /// Stage 3 of [`run_in`] for a chunk's samples (`out.len()` of them): the finer level's value
 /// from `fine(k)`'s view, blended with the coarser one's from `coarse(k)` by `delta` where
-/// `weighed(k)` and `delta > 0`.
+/// `delta > 0`. That test is [`mip::trilinear`]'s `delta > 0 && k < last`: the level stage's
+/// `delta` ([`mip::linear_levels_staged`]) is 0 in the last level, whose lod is clamped to it.
 #[inline(always)]
 fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
     (first, second, chunk, delta): (&Pass<N, T>, &Pass<N, T>, &Chunk<N>, &[f32; N]),
-    weighed: impl Fn(usize) -> bool,
     fine: impl Fn(usize) -> F,
     coarse: impl Fn(usize) -> F,
     out: &mut [[f32; 4]],
@@ -739,7 +739,7 @@ fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
     for (k, o) in out.iter_mut().enumerate() {
         let uv = chunk.uv(k);
         let a = first.filtered(&fine(k), k, uv);
-        *o = if weighed(k) && delta[k] > 0.0 {
+        *o = if delta[k] > 0.0 {
             T::mix(a, second.filtered(&coarse(k), k, uv), delta[k])
         } else {
             a
