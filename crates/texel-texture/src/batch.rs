@@ -540,17 +540,37 @@ impl<const N: usize, T: Taps> Pass<N, T> {
         Some(([i0 as u32, i1 as u32], [j0 as u32, j1 as u32]))
     }
 
+    /// Whether the first `n` samples all lie inside their levels (their taps need no wrapping):
+    /// a fold over the flags, which compares them in vector lanes, no branch per sample.
+    #[inline(always)]
+    fn all_inside(&self, n: usize) -> bool {
+        self.inside[..n]
+            .iter()
+            .fold(true, |all, &inside| all & inside)
+    }
+
+    /// Stage 3 for sample `k`, which lies inside `level` ([`Pass::filtered`]'s first route).
+    /// Stage 3's loops take this route alone when every sample of the chunk is inside
+    /// ([`Pass::all_inside`]): without the per-sample test and the edge routes' code in the loop,
+    /// the loop keeps its invariants (the level's texels, width and length, the output) in
+    /// registers, where the three-route loop reloaded them from the stack for every sample
+    /// (docs/perf-log.md, entry 38).
+    #[inline(always)]
+    fn inside_value<F: Fetch>(&self, level: &F, k: usize) -> Vec4 {
+        let ab = (self.a[k], self.b[k]);
+        T::inside(level, self.i[k] as u32, self.j[k] as u32, ab)
+    }
+
     /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value. Three routes,
     /// the same value from each: every tap inside the level; within one texel of it
     /// ([`Pass::near`]: the taps wrapped by two selects each); elsewhere, or under
     /// `ClampToBorder`, the one-sample filter, which wraps its taps in `i64` (`rem_euclid`).
     #[inline(always)]
     fn filtered<F: Fetch>(&self, level: &F, k: usize, uv: Vec2) -> Vec4 {
-        let ab = (self.a[k], self.b[k]);
         if self.inside[k] {
-            T::inside(level, self.i[k] as u32, self.j[k] as u32, ab)
+            self.inside_value(level, k)
         } else if let Some((i, j)) = self.near(level.size(), k) {
-            T::wrapped(level, i, j, ab)
+            T::wrapped(level, i, j, (self.a[k], self.b[k]))
         } else {
             self.taps.filter(level, &self.addr, uv)
         }
@@ -712,7 +732,8 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
 /// The same values as [`filter_chunk`] with nothing weighed, without its per-sample blend test:
 /// with that test in the loop, LLVM stored each filtered value to the stack and reloaded it after
 /// the test, and 11-13 % of a one-thread mip-nearest profile's samples sat on that reload
-/// (perf-log 35 and 36).
+/// (perf-log 35 and 36). A chunk whose samples all lie inside their levels takes a loop of that
+/// route alone ([`Pass::inside_value`]).
 #[inline(always)]
 fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
     first: &Pass<N, T>,
@@ -720,6 +741,12 @@ fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
     level: impl Fn(usize) -> F,
     out: &mut [[f32; 4]],
 ) {
+    if first.all_inside(out.len()) {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = first.inside_value(&level(k), k).to_array();
+        }
+        return;
+    }
     for (k, o) in out.iter_mut().enumerate() {
         *o = first.filtered(&level(k), k, chunk.uv(k)).to_array();
     }
@@ -729,6 +756,8 @@ fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
 /// from `fine(k)`'s view, blended with the coarser one's from `coarse(k)` by `delta` where
 /// `delta > 0`. That test is [`mip::trilinear`]'s `delta > 0 && k < last`: the level stage's
 /// `delta` ([`mip::linear_levels_staged`]) is 0 in the last level, whose lod is clamped to it.
+/// A chunk whose samples all lie inside both their levels takes a loop of the inside route alone
+/// ([`Pass::inside_value`]).
 #[inline(always)]
 fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
     (first, second, chunk, delta): (&Pass<N, T>, &Pass<N, T>, &Chunk<N>, &[f32; N]),
@@ -736,6 +765,19 @@ fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
     coarse: impl Fn(usize) -> F,
     out: &mut [[f32; 4]],
 ) {
+    let n = out.len();
+    if first.all_inside(n) && second.all_inside(n) {
+        for (k, o) in out.iter_mut().enumerate() {
+            let a = first.inside_value(&fine(k), k);
+            *o = if delta[k] > 0.0 {
+                T::mix(a, second.inside_value(&coarse(k), k), delta[k])
+            } else {
+                a
+            }
+            .to_array();
+        }
+        return;
+    }
     for (k, o) in out.iter_mut().enumerate() {
         let uv = chunk.uv(k);
         let a = first.filtered(&fine(k), k, uv);

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Instructions a texel frame retires, counted by cachegrind: deterministic where wall-clock frames
+# are not (a shared VM's frames moved by 1.5x between rounds; docs/perf-log.md, entry 38). Counts
+# instructions, not cycles: a change that retires fewer may still not be faster.
+# Usage: scripts/frame_instructions.sh TEXEL_BINARY [FILTERS] [SCENE] [THREADS]
+#   e.g. scripts/frame_instructions.sh target/release/texel nearest,bilinear
+# Needs valgrind (apt-get install valgrind). Per filter: instructions of a bench run of 13 frames
+# minus those of a run of 3, over 10 (the difference removes start-up, texture and pyramid
+# preparation, and the bench's warm-up). One thread by default: with more, rayon's idle threads
+# spin and add instructions that depend on timing.
+set -euo pipefail
+bin=$1 filters=${2:-nearest,bilinear,mip-nearest,trilinear} scene=${3:-../shared/scenes/ground.toml}
+threads=${4:-1}
+command -v valgrind >/dev/null || { echo "valgrind is not installed (apt-get install valgrind)" >&2; exit 1; }
+refs() { # frames, filter -> instructions of the whole run
+  valgrind --tool=cachegrind --cache-sim=no --cachegrind-out-file=/dev/null \
+    "$bin" bench "$scene" --color raw --frames "$1" --threads "$threads" --size 1280x720 \
+    --filters "$2" 2>&1 >/dev/null | sed -n 's/.*I *refs: *//p' | tr -d ,
+}
+echo "| filter | instructions a frame (millions) |"
+echo "|---|--:|"
+for f in ${filters//,/ }; do
+  short=$(refs 3 "$f") long=$(refs 13 "$f")
+  [ -n "$short" ] && [ -n "$long" ] || { echo "cachegrind gave no count for $f" >&2; exit 1; }
+  awk -v a="$short" -v b="$long" -v f="$f" 'BEGIN { printf "| %s | %.2f |\n", f, (b - a) / 10 / 1e6 }'
+done
