@@ -6,8 +6,9 @@
 #   e.g. scripts/frame_instructions.sh target/release/texel nearest,bilinear
 # Needs valgrind (apt-get install valgrind). Per filter: instructions of a bench run of 13 frames
 # minus those of a run of 3, over 10 (the difference removes start-up, texture and pyramid
-# preparation, and the bench's warm-up). One thread by default: with more, rayon's idle threads
-# spin and add instructions that depend on timing.
+# preparation, and the bench's warm-up). One thread by default: with more, the count includes
+# the threads' waiting and hand-over, which depend on timing (the one-thread count was checked to
+# repeat within 0.03 %; more threads were not).
 set -euo pipefail
 bin=$1 filters=${2:-nearest,bilinear,mip-nearest,trilinear} scene=${3:-../shared/scenes/ground.toml}
 threads=${4:-1}

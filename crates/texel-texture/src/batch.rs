@@ -551,10 +551,9 @@ impl<const N: usize, T: Taps> Pass<N, T> {
 
     /// Stage 3 for sample `k`, which lies inside `level` ([`Pass::filtered`]'s first route).
     /// Stage 3's loops take this route alone when every sample of the chunk is inside
-    /// ([`Pass::all_inside`]): without the per-sample test and the edge routes' code in the loop,
-    /// the loop keeps its invariants (the level's texels, width and length, the output) in
-    /// registers, where the three-route loop reloaded them from the stack for every sample
-    /// (docs/perf-log.md, entry 38).
+    /// ([`Pass::all_inside`]): that loop has no per-sample test and no edge-route code, and
+    /// reloads fewer of its invariants from the stack per sample (four of the three-route loop's
+    /// six remain); about 51 instructions a sample against 57 (docs/perf-log.md, entry 38).
     #[inline(always)]
     fn inside_value<F: Fetch>(&self, level: &F, k: usize) -> Vec4 {
         let ab = (self.a[k], self.b[k]);
