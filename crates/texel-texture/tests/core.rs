@@ -336,6 +336,91 @@ fn batch_equals_single_when_a_chunk_shares_a_level() {
     }
 }
 
+/// `sample_batch` and `sample_batch_lanes` (the eight-lane kernel where the CPU has it) equal
+/// `sample` bit for bit on chunks whose samples all lie inside one level (the batch's loop of
+/// the inside route alone, docs/perf-log.md entry 38; the other tests' positions reach the
+/// level's edges, so few of their chunks are wholly inside) for each kind of trilinear chunk:
+/// every blend weight positive (lod 1.5), none (lod 1.0 exactly, and -1: magnified), and some
+/// (lods 1.0 and 1.5 alternating: one level, weights 0 and 0.5), plus one chunk with a sample near
+/// the edge; and without mipmaps and with the nearest level (the one-level runs of
+/// docs/perf-log.md entry 40). The lods are checked first, so that the footprints reach the cases
+/// they name.
+#[test]
+fn batch_equals_single_on_inside_runs() {
+    let textures = [
+        noise_texture(64, 64, Format::Rgba8Srgb),
+        noise_texture(64, 64, Format::Rgba8Unorm),
+        noise_texture(64, 64, Format::Rgba32Float),
+    ];
+    let lods: [&[f32]; 4] = [&[1.5], &[1.0], &[-1.0], &[1.0, 1.5]];
+    for lods in lods {
+        let fps: Vec<Footprint> = (0..200)
+            .map(|k| {
+                let t = k as f32 * 0.618;
+                // rho = 2^lod texels of the 64-texel side, along u.
+                let d = lods[k % lods.len()].exp2() / 64.0;
+                Footprint {
+                    u: 0.1 + 0.8 * t.fract(),
+                    v: 0.1 + 0.8 * (t * 0.37).fract(),
+                    dudx: d,
+                    dvdx: 0.0,
+                    dudy: 0.0,
+                    dvdy: d * 0.5,
+                }
+            })
+            .collect();
+        let mut near_edge = fps.clone();
+        near_edge[100].u = 0.001;
+        for tex in &textures {
+            for fp in &fps[..lods.len()] {
+                let want = (fp.dudx * 64.0).log2();
+                let s = sampler(
+                    FilterMode::Linear,
+                    FilterMode::Linear,
+                    MipmapFilterMode::Linear,
+                    AddressMode::Repeat,
+                );
+                // Whole lods are exact (`fast_log2` of a power of two); 1.5 lies strictly
+                // between levels 1 and 2 (within `fast_log2`'s 1.2 ulp of `log2`).
+                let lod = s.lod(tex, fp);
+                if want.fract() == 0.0 {
+                    assert_eq!(
+                        lod,
+                        want.max(0.0),
+                        "the footprint's lod (clamped at lod_min 0)"
+                    );
+                } else {
+                    assert!(lod > want.floor() && lod < want.ceil(), "lod {lod}");
+                }
+            }
+            let mips = [
+                MipmapFilterMode::None,
+                MipmapFilterMode::Nearest,
+                MipmapFilterMode::Linear,
+            ];
+            for mip in mips {
+                for f in [FilterMode::Nearest, FilterMode::Linear] {
+                    for addr in [AddressMode::Repeat, AddressMode::ClampToBorder] {
+                        let s = sampler(f, f, mip, addr);
+                        for fps in [&fps, &near_edge] {
+                            let mut out = vec![[0.0; 4]; fps.len()];
+                            let mut wide = out.clone();
+                            s.sample_batch(tex, fps, &mut out);
+                            s.sample_batch_lanes(Lanes::detect(), tex, fps, &mut wide);
+                            for ((fp, o), w) in fps.iter().zip(&out).zip(&wide) {
+                                let single = s.sample(tex, fp).map(f32::to_bits);
+                                let at = format!("lods {lods:?} {mip:?} {f:?} {addr:?} {fp:?}");
+                                assert_eq!(single, o.map(f32::to_bits), "{at}");
+                                assert_eq!(single, w.map(f32::to_bits), "lanes: {at}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The batched anisotropic path (probes of several samples filtered together, flushed when 256
 /// would overflow) equals `sample` bit for bit: chunks of strongly anisotropic footprints (16
 /// probes each, so a 64-sample chunk flushes four times, and a sample's probes land at any offset
@@ -403,6 +488,19 @@ fn batched_anisotropic_probes_equal_single_samples() {
             dvdy: 1.5 / 64.0,
         });
     }
+    // Then 300 of one shape whose probes all lie inside both levels (texel centres 13 to 51 of
+    // 64 along u), so that whole batches take the level-by-level runs (docs/perf-log.md, 40).
+    for k in 0..300 {
+        let t = k as f32 * 0.618;
+        fps.push(Footprint {
+            u: 0.2 + 0.6 * t.fract(),
+            v: 0.2 + 0.6 * (t * 0.37).fract(),
+            dudx: 8.0 / 64.0,
+            dvdx: 0.0,
+            dudy: 0.0,
+            dvdy: 1.5 / 64.0,
+        });
+    }
     let textures = [
         noise_texture(64, 64, Format::Rgba8Srgb),
         noise_texture(64, 64, Format::Rgba8Unorm),
@@ -415,13 +513,15 @@ fn batched_anisotropic_probes_equal_single_samples() {
                     .unwrap();
                 for len in [fps.len(), 64, 37] {
                     let mut out = vec![[0.0; 4]; len];
+                    let mut wide = out.clone();
                     s.sample_batch(tex, &fps[..len], &mut out);
-                    for (fp, o) in fps.iter().zip(&out) {
-                        assert_eq!(
-                            s.sample(tex, fp).map(f32::to_bits),
-                            o.map(f32::to_bits),
-                            "clamp {clamp} {addr:?} {fp:?}"
-                        );
+                    // The eight-lane kernel where the CPU has it (and its run kernel).
+                    s.sample_batch_lanes(Lanes::detect(), tex, &fps[..len], &mut wide);
+                    for ((fp, o), w) in fps.iter().zip(&out).zip(&wide) {
+                        let single = s.sample(tex, fp).map(f32::to_bits);
+                        assert_eq!(single, o.map(f32::to_bits), "clamp {clamp} {addr:?} {fp:?}");
+                        let at = format!("lanes: clamp {clamp} {addr:?} {fp:?}");
+                        assert_eq!(single, w.map(f32::to_bits), "{at}");
                     }
                 }
             }
