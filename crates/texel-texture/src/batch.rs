@@ -33,7 +33,7 @@ use glam::{Vec2, Vec4};
 
 use crate::address::{Address, AddressMode};
 use crate::bilinear::{lerp, Bilinear};
-use crate::fetch::{Fetch, Pyramid};
+use crate::fetch::{Fetch, Pyramid, Run};
 use crate::fixed8::{Bilinear8, Point8};
 use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
 use crate::footprint::{
@@ -188,6 +188,14 @@ pub(crate) trait Taps: LevelFilter {
     const REACH: f32;
     /// The value of a sample whose taps lie inside `level`: first tap `(i, j)`, fractions `ab`.
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, ab: (f32, f32)) -> Vec4;
+    /// [`Taps::inside`] of each sample of `run` (all inside `level`) into `out` (the run's
+    /// length), in one call: `true`, or `false` with `out` untouched where the filter and view
+    /// have no run kernel (the default), and the caller runs its per-sample loop.
+    #[inline(always)]
+    fn inside_run<F: Fetch>(level: &F, run: Run<'_>, out: &mut [[f32; 4]]) -> bool {
+        let _ = (level, run, out);
+        false
+    }
     /// The value of a sample near an edge whose taps the pass wrapped: first taps `i[0]`,
     /// `j[0]`, the next ones `i[1]`, `j[1]` (all inside `level`), fractions `ab`. Bit for bit the
     /// one-sample filter's, which reads the same texels (DESIGN.md: the address mode applies to
@@ -303,6 +311,10 @@ struct ProbeBatch {
     /// The first sample's levels in this batch, and whether a later sample's differ.
     pair: (u8, u8),
     mixed: bool,
+    /// Per probe, its value in the finer and the coarser level, when the batch is filtered
+    /// level by level ([`ProbeBatch::sum_runs`]).
+    fine_values: [[f32; 4]; PROBES],
+    next_values: [[f32; 4]; PROBES],
 }
 
 impl ProbeBatch {
@@ -318,6 +330,8 @@ impl ProbeBatch {
             coarse: [false; CHUNK],
             pair: (0, 0),
             mixed: false,
+            fine_values: [[0.0; 4]; PROBES],
+            next_values: [[0.0; 4]; PROBES],
         })
     }
 
@@ -358,7 +372,9 @@ impl ProbeBatch {
             self.fine.coordinates(|_| s0, us, vs);
             self.next.coordinates(|_| s1, us, vs);
             let (fine, next) = (level(l0), level(l1));
-            self.sum_into(m, |_| fine, |_| next, sums);
+            if !self.sum_runs(m, (fine, next), sums) {
+                self.sum_into(m, |_| fine, |_| next, sums);
+            }
         } else {
             for (k, &o) in self.owner[..m].iter().enumerate() {
                 (self.fine.level[k], self.next.level[k]) = self.levels[o as usize];
@@ -369,6 +385,47 @@ impl ProbeBatch {
             self.sum_into(m, |k| level(fine[k]), |k| level(next[k]), sums);
         }
         self.m = 0;
+    }
+
+    /// [`ProbeBatch::sum_into`] for a batch whose probes all read the views `fine` and `next`
+    /// (one pair of levels), level by level: where every probe lies inside the finer level (and
+    /// inside the coarser one when a sample of the batch weighs it) and the views have a run
+    /// kernel ([`Taps::inside_run`]: linear 8-bit texels on a CPU with AVX2), each level's
+    /// values in one call, then each probe's blend added in order to its sample's sum (the same
+    /// operations in the same order as `sum_into`, so the same bits). `false`, with `sums`
+    /// untouched, where it does not apply; the caller then runs `sum_into`. The coarser level is
+    /// read for every probe of the batch when any sample weighs it (values of unweighed probes
+    /// are computed and not used). The run kernel is compiled once for the program, not into
+    /// each of the rasterizer's tile copies (docs/perf-log.md, entry 40).
+    #[inline(always)]
+    fn sum_runs<F: Fetch>(
+        &mut self,
+        m: usize,
+        (fine, next): (&F, &F),
+        sums: &mut [Vec4; CHUNK],
+    ) -> bool {
+        let coarse = &self.coarse;
+        let any_coarse = self.owner[..m]
+            .iter()
+            .fold(false, |any, &o| any | coarse[o as usize % CHUNK]);
+        let inside = self.fine.all_inside(m) && (!any_coarse || self.next.all_inside(m));
+        if !(inside && Bilinear::inside_run(fine, self.fine.run(m), &mut self.fine_values[..m])) {
+            return false;
+        }
+        if any_coarse && !Bilinear::inside_run(next, self.next.run(m), &mut self.next_values[..m]) {
+            return false;
+        }
+        let values = self.fine_values[..m].iter().zip(&self.next_values[..m]);
+        for (&o, (&a, &b)) in self.owner[..m].iter().zip(values) {
+            let o = o as usize % CHUNK;
+            let a = Vec4::from_array(a);
+            sums[o] += if self.coarse[o] {
+                lerp(a, Vec4::from_array(b), self.delta[o])
+            } else {
+                a
+            };
+        }
+        true
     }
 
     /// Stage 3 of the first `m` probes, each probe's level view given by `fine(k)` and
@@ -560,6 +617,17 @@ impl<const N: usize, T: Taps> Pass<N, T> {
         T::inside(level, self.i[k] as u32, self.j[k] as u32, ab)
     }
 
+    /// Stage 2's results for the first `n` samples, as a [`Run`] for [`Taps::inside_run`].
+    #[inline(always)]
+    fn run(&self, n: usize) -> Run<'_> {
+        Run {
+            i: &self.i[..n],
+            j: &self.j[..n],
+            a: &self.a[..n],
+            b: &self.b[..n],
+        }
+    }
+
     /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value. Three routes,
     /// the same value from each: every tap inside the level; within one texel of it
     /// ([`Pass::near`]: the taps wrapped by two selects each); elsewhere, or under
@@ -650,6 +718,8 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     let mut first = Pass::<N, T>::new(taps, addr);
     let mut second = Pass::<N, T>::new(taps, addr);
     let mut delta = [0.0f32; N];
+    // The coarser level's values of a chunk filtered level by level (`filter_two_levels`).
+    let mut scratch = [[0.0f32; 4]; N];
     let mut chunk = Chunk::<N>::new();
     let last = levels - 1;
     let size0 = base.size();
@@ -663,7 +733,7 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             // it (stage 1's fill, the level scan) bilinear frames measured 5-7 % slower.
             let size = (dims_w[0], dims_h[0]);
             first.coordinates(|_| size, &chunk.u[..n], &chunk.v[..n]);
-            filter_unblended(&first, &chunk, |_| base, out);
+            filter_one_level(&first, &chunk, base, out);
             continue;
         }
         // Stage 1: levels (u8: at most 32 levels for a 2^31 side; textures are far smaller).
@@ -703,14 +773,14 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             first.coordinates(|_| s0, &chunk.u[..n], &chunk.v[..n]);
             // As `mip::trilinear`: the coarser level only when it is weighed.
             if !(trilinear && (l0 as usize) < last) {
-                filter_unblended(&first, &chunk, |_| fine, out);
+                filter_one_level(&first, &chunk, fine, out);
                 continue;
             }
             let l1 = second.level[0];
             let (coarse, s1) = (view(l1), size(l1));
             second.coordinates(|_| s1, &chunk.u[..n], &chunk.v[..n]);
             let stages = (&first, &second, &chunk, &delta);
-            filter_chunk(stages, |_| fine, |_| coarse, out);
+            filter_two_levels(stages, (fine, coarse), &mut scratch, out);
             continue;
         }
         first.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
@@ -749,6 +819,63 @@ fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
     for (k, o) in out.iter_mut().enumerate() {
         *o = first.filtered(&level(k), k, chunk.uv(k)).to_array();
     }
+}
+
+/// [`filter_unblended`] for a chunk whose samples all read the one view `level` (no mipmaps, or
+/// one mip level): where every sample lies inside it and the view has a run kernel
+/// ([`Taps::inside_run`]: linear 8-bit texels on a CPU with AVX2), the whole chunk in one call;
+/// otherwise [`filter_unblended`]. The run kernel is compiled once for the program, not into
+/// this function, which the rasterizer inlines into each of its tile copies: here it adds a test
+/// and a call (docs/perf-log.md, entry 40).
+#[inline(always)]
+fn filter_one_level<T: Taps, F: Fetch, const N: usize>(
+    first: &Pass<N, T>,
+    chunk: &Chunk<N>,
+    level: F,
+    out: &mut [[f32; 4]],
+) {
+    let n = out.len();
+    if first.all_inside(n) && T::inside_run(&level, first.run(n), out) {
+        return;
+    }
+    filter_unblended(first, chunk, |_| level, out);
+}
+
+/// [`filter_chunk`] for a chunk whose samples all read the views `fine` and `coarse` (one pair of
+/// levels). Where every sample lies inside both and the views have a run kernel
+/// ([`Taps::inside_run`]), level by level: with every blend weight positive, the finer level's
+/// run into `out`, the coarser one's into `scratch`, then the blends ([`Taps::mix`], as
+/// [`filter_chunk`] computes them); with none positive, the finer run alone. Otherwise
+/// [`filter_chunk`], which reads the coarser level only for the samples it weighs: a chunk never
+/// reads a texel the per-sample loop would not.
+#[inline(always)]
+fn filter_two_levels<T: Taps, F: Fetch, const N: usize>(
+    (first, second, chunk, delta): (&Pass<N, T>, &Pass<N, T>, &Chunk<N>, &[f32; N]),
+    (fine, coarse): (F, F),
+    scratch: &mut [[f32; 4]; N],
+    out: &mut [[f32; 4]],
+) {
+    let n = out.len();
+    if first.all_inside(n) && second.all_inside(n) {
+        // A fold, branch-free, as `Pass::all_inside`.
+        let (all, any) = delta[..n].iter().fold((true, false), |(all, any), &t| {
+            (all & (t > 0.0), any | (t > 0.0))
+        });
+        if !any && T::inside_run(&fine, first.run(n), out) {
+            return;
+        }
+        let coarse_values = &mut scratch[..n];
+        if all
+            && T::inside_run(&fine, first.run(n), out)
+            && T::inside_run(&coarse, second.run(n), coarse_values)
+        {
+            for ((o, c), &t) in out.iter_mut().zip(coarse_values.iter()).zip(delta) {
+                *o = T::mix(Vec4::from_array(*o), Vec4::from_array(*c), t).to_array();
+            }
+            return;
+        }
+    }
+    filter_chunk((first, second, chunk, delta), |_| fine, |_| coarse, out);
 }
 
 /// Stage 3 of [`run_in`] for a chunk's samples (`out.len()` of them): the finer level's value
