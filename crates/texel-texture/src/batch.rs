@@ -311,10 +311,6 @@ struct ProbeBatch {
     /// The first sample's levels in this batch, and whether a later sample's differ.
     pair: (u8, u8),
     mixed: bool,
-    /// Per probe, its value in the finer and the coarser level, when the batch is filtered
-    /// level by level ([`ProbeBatch::sum_runs`]).
-    fine_values: [[f32; 4]; PROBES],
-    next_values: [[f32; 4]; PROBES],
 }
 
 impl ProbeBatch {
@@ -330,8 +326,6 @@ impl ProbeBatch {
             coarse: [false; CHUNK],
             pair: (0, 0),
             mixed: false,
-            fine_values: [[0.0; 4]; PROBES],
-            next_values: [[0.0; 4]; PROBES],
         })
     }
 
@@ -372,9 +366,7 @@ impl ProbeBatch {
             self.fine.coordinates(|_| s0, us, vs);
             self.next.coordinates(|_| s1, us, vs);
             let (fine, next) = (level(l0), level(l1));
-            if !self.sum_runs(m, (fine, next), sums) {
-                self.sum_into(m, |_| fine, |_| next, sums);
-            }
+            self.sum_into(m, |_| fine, |_| next, sums);
         } else {
             for (k, &o) in self.owner[..m].iter().enumerate() {
                 (self.fine.level[k], self.next.level[k]) = self.levels[o as usize];
@@ -385,47 +377,6 @@ impl ProbeBatch {
             self.sum_into(m, |k| level(fine[k]), |k| level(next[k]), sums);
         }
         self.m = 0;
-    }
-
-    /// [`ProbeBatch::sum_into`] for a batch whose probes all read the views `fine` and `next`
-    /// (one pair of levels), level by level: where every probe lies inside the finer level (and
-    /// inside the coarser one when a sample of the batch weighs it) and the views have a run
-    /// kernel ([`Taps::inside_run`]: linear 8-bit texels on a CPU with AVX2), each level's
-    /// values in one call, then each probe's blend added in order to its sample's sum (the same
-    /// operations in the same order as `sum_into`, so the same bits). `false`, with `sums`
-    /// untouched, where it does not apply; the caller then runs `sum_into`. The coarser level is
-    /// read for every probe of the batch when any sample weighs it (values of unweighed probes
-    /// are computed and not used). The run kernel is compiled once for the program, not into
-    /// each of the rasterizer's tile copies (docs/perf-log.md, entry 40).
-    #[inline(always)]
-    fn sum_runs<F: Fetch>(
-        &mut self,
-        m: usize,
-        (fine, next): (&F, &F),
-        sums: &mut [Vec4; CHUNK],
-    ) -> bool {
-        let coarse = &self.coarse;
-        let any_coarse = self.owner[..m]
-            .iter()
-            .fold(false, |any, &o| any | coarse[o as usize % CHUNK]);
-        let inside = self.fine.all_inside(m) && (!any_coarse || self.next.all_inside(m));
-        if !(inside && Bilinear::inside_run(fine, self.fine.run(m), &mut self.fine_values[..m])) {
-            return false;
-        }
-        if any_coarse && !Bilinear::inside_run(next, self.next.run(m), &mut self.next_values[..m]) {
-            return false;
-        }
-        let values = self.fine_values[..m].iter().zip(&self.next_values[..m]);
-        for (&o, (&a, &b)) in self.owner[..m].iter().zip(values) {
-            let o = o as usize % CHUNK;
-            let a = Vec4::from_array(a);
-            sums[o] += if self.coarse[o] {
-                lerp(a, Vec4::from_array(b), self.delta[o])
-            } else {
-                a
-            };
-        }
-        true
     }
 
     /// Stage 3 of the first `m` probes, each probe's level view given by `fine(k)` and
@@ -821,12 +772,12 @@ fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
     }
 }
 
-/// [`filter_unblended`] for a chunk whose samples all read the one view `level` (no mipmaps, or
-/// one mip level): where every sample lies inside it and the view has a run kernel
-/// ([`Taps::inside_run`]: linear 8-bit texels on a CPU with AVX2), the whole chunk in one call;
-/// otherwise [`filter_unblended`]. The run kernel is compiled once for the program, not into
-/// this function, which the rasterizer inlines into each of its tile copies: here it adds a test
-/// and a call (docs/perf-log.md, entry 40).
+/// [`filter_unblended`] for a chunk whose samples all read the one view `level` (no mipmaps, or one
+/// mip level): where every sample lies inside it and the view has a run kernel
+/// ([`Taps::inside_run`]: linear 8-bit texels, sampled with an AVX2 `Lanes` token), the whole chunk
+/// in one call; otherwise [`filter_unblended`]. The run kernel is compiled once for the program,
+/// not into this function, which the rasterizer inlines into each of its tile copies: here it adds
+/// a test and a call (docs/perf-log.md, entry 40).
 #[inline(always)]
 fn filter_one_level<T: Taps, F: Fetch, const N: usize>(
     first: &Pass<N, T>,

@@ -125,7 +125,8 @@ impl Lanes {
 /// size, and loops inlined there multiplied the release build's time (perf-log 39). Here the
 /// loop is compiled once, inside `pulp`'s `vectorize` (a `#[target_feature]` function with
 /// AVX2, FMA and the rest of `V3`, which a function compiled without them cannot inline), so
-/// its intrinsics inline whatever copy calls it.
+/// the kernel's intrinsics inline into the loop, and every copy (baseline, v3, v4) calls this one
+/// compiled loop.
 #[cfg(target_arch = "x86_64")]
 #[inline(never)]
 fn unorm8_run_v3(

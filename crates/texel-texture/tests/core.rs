@@ -488,8 +488,10 @@ fn batched_anisotropic_probes_equal_single_samples() {
             dvdy: 1.5 / 64.0,
         });
     }
-    // Then 300 of one shape whose probes all lie inside both levels (texel centres 13 to 51 of
-    // 64 along u), so that whole batches take the level-by-level runs (docs/perf-log.md, 40).
+    // Then 300 of one shape whose probes all lie inside both levels (sample centres 13 to 51
+    // texels of 64 along u, probes within about 9.5 to 54.5), so that whole batches share one
+    // level pair with every probe inside (the route a level-by-level run would take: perf-log
+    // entry 40).
     for k in 0..300 {
         let t = k as f32 * 0.618;
         fps.push(Footprint {
