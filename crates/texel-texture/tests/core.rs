@@ -75,6 +75,27 @@ fn noise_texture(w: u32, h: u32, format: Format) -> Texture {
     .unwrap()
 }
 
+/// The `k`-th position of a low-discrepancy sequence in `[0, 1)^2` (steps of 0.618 along u, 0.37
+/// of that along v): neighbouring samples land apart, so each chunk spreads over the texture.
+fn spread(k: usize) -> (f32, f32) {
+    let t = k as f32 * 0.618;
+    (t.fract(), (t * 0.37).fract())
+}
+
+/// `sample_batch` and `sample_batch_lanes` with [`Lanes::detect`] (the eight-lane kernel where the
+/// CPU has it) of `fps` each equal `sample` bit for bit; `case` names the sampler in a failure.
+fn assert_batches_equal_single(s: &Sampler, tex: &Texture, fps: &[Footprint], case: &str) {
+    let mut out = vec![[0.0; 4]; fps.len()];
+    let mut wide = out.clone();
+    s.sample_batch(tex, fps, &mut out);
+    s.sample_batch_lanes(Lanes::detect(), tex, fps, &mut wide);
+    for ((fp, o), w) in fps.iter().zip(&out).zip(&wide) {
+        let single = s.sample(tex, fp).map(f32::to_bits);
+        assert_eq!(single, o.map(f32::to_bits), "{case} {fp:?}");
+        assert_eq!(single, w.map(f32::to_bits), "lanes: {case} {fp:?}");
+    }
+}
+
 fn footprint_strategy() -> impl Strategy<Value = Footprint> {
     let d = prop_oneof![Just(0.0f32), -0.5f32..0.5, -1e-3f32..1e-3, -20.0f32..20.0];
     (
@@ -302,10 +323,10 @@ fn batch_equals_single_when_a_chunk_shares_a_level() {
         let d = lod.exp2() / 64.0;
         let mut fps: Vec<Footprint> = (0..200)
             .map(|k| {
-                let t = k as f32 * 0.618;
+                let (x, y) = spread(k);
                 Footprint {
-                    u: t.fract() * 1.5 - 0.2,
-                    v: (t * 0.37).fract(),
+                    u: x * 1.5 - 0.2,
+                    v: y,
                     dudx: d,
                     dvdx: 0.0,
                     dudy: 0.0,
@@ -342,9 +363,8 @@ fn batch_equals_single_when_a_chunk_shares_a_level() {
 /// level's edges, so few of their chunks are wholly inside) for each kind of trilinear chunk:
 /// every blend weight positive (lod 1.5), none (lod 1.0 exactly, and -1: magnified), and some
 /// (lods 1.0 and 1.5 alternating: one level, weights 0 and 0.5), plus one chunk with a sample near
-/// the edge; and without mipmaps and with the nearest level (the one-level runs of
-/// docs/perf-log.md entry 40). The lods are checked first, so that the footprints reach the cases
-/// they name.
+/// the edge; and without mipmaps and with the nearest level (the routes entry 40's kept patch
+/// changes). The lods are checked first, so that the footprints reach the cases they name.
 #[test]
 fn batch_equals_single_on_inside_runs() {
     let textures = [
@@ -356,12 +376,12 @@ fn batch_equals_single_on_inside_runs() {
     for lods in lods {
         let fps: Vec<Footprint> = (0..200)
             .map(|k| {
-                let t = k as f32 * 0.618;
+                let (x, y) = spread(k);
                 // rho = 2^lod texels of the 64-texel side, along u.
                 let d = lods[k % lods.len()].exp2() / 64.0;
                 Footprint {
-                    u: 0.1 + 0.8 * t.fract(),
-                    v: 0.1 + 0.8 * (t * 0.37).fract(),
+                    u: 0.1 + 0.8 * x,
+                    v: 0.1 + 0.8 * y,
                     dudx: d,
                     dvdx: 0.0,
                     dudy: 0.0,
@@ -371,18 +391,18 @@ fn batch_equals_single_on_inside_runs() {
             .collect();
         let mut near_edge = fps.clone();
         near_edge[100].u = 0.001;
+        let trilinear = sampler(
+            FilterMode::Linear,
+            FilterMode::Linear,
+            MipmapFilterMode::Linear,
+            AddressMode::Repeat,
+        );
         for tex in &textures {
             for fp in &fps[..lods.len()] {
                 let want = (fp.dudx * 64.0).log2();
-                let s = sampler(
-                    FilterMode::Linear,
-                    FilterMode::Linear,
-                    MipmapFilterMode::Linear,
-                    AddressMode::Repeat,
-                );
                 // Whole lods are exact (`fast_log2` of a power of two); 1.5 lies strictly
                 // between levels 1 and 2 (within `fast_log2`'s 1.2 ulp of `log2`).
-                let lod = s.lod(tex, fp);
+                let lod = trilinear.lod(tex, fp);
                 if want.fract() == 0.0 {
                     assert_eq!(
                         lod,
@@ -402,17 +422,9 @@ fn batch_equals_single_on_inside_runs() {
                 for f in [FilterMode::Nearest, FilterMode::Linear] {
                     for addr in [AddressMode::Repeat, AddressMode::ClampToBorder] {
                         let s = sampler(f, f, mip, addr);
+                        let case = format!("lods {lods:?} {mip:?} {f:?} {addr:?}");
                         for fps in [&fps, &near_edge] {
-                            let mut out = vec![[0.0; 4]; fps.len()];
-                            let mut wide = out.clone();
-                            s.sample_batch(tex, fps, &mut out);
-                            s.sample_batch_lanes(Lanes::detect(), tex, fps, &mut wide);
-                            for ((fp, o), w) in fps.iter().zip(&out).zip(&wide) {
-                                let single = s.sample(tex, fp).map(f32::to_bits);
-                                let at = format!("lods {lods:?} {mip:?} {f:?} {addr:?} {fp:?}");
-                                assert_eq!(single, o.map(f32::to_bits), "{at}");
-                                assert_eq!(single, w.map(f32::to_bits), "lanes: {at}");
-                            }
+                            assert_batches_equal_single(&s, tex, fps, &case);
                         }
                     }
                 }
@@ -477,8 +489,8 @@ fn batched_anisotropic_probes_equal_single_samples() {
     // Then 200 of one shape (8 texels by 1.5, a fractional probe lod) at spread positions, so
     // that whole probe batches share their two levels (the batch's one-level path).
     for k in 0..200 {
-        let t = k as f32 * 0.618;
-        let (u, v) = (t.fract() * 1.5 - 0.2, (t * 0.37).fract());
+        let (x, v) = spread(k);
+        let u = x * 1.5 - 0.2;
         fps.push(Footprint {
             u,
             v,
@@ -490,13 +502,12 @@ fn batched_anisotropic_probes_equal_single_samples() {
     }
     // Then 300 of one shape whose probes all lie inside both levels (sample centres 13 to 51
     // texels of 64 along u, probes within about 9.5 to 54.5), so that whole batches share one
-    // level pair with every probe inside (the route a level-by-level run would take: perf-log
-    // entry 40).
+    // level pair with every probe inside (the route entry 40's kept patch filters level by level).
     for k in 0..300 {
-        let t = k as f32 * 0.618;
+        let (x, y) = spread(k);
         fps.push(Footprint {
-            u: 0.2 + 0.6 * t.fract(),
-            v: 0.2 + 0.6 * (t * 0.37).fract(),
+            u: 0.2 + 0.6 * x,
+            v: 0.2 + 0.6 * y,
             dudx: 8.0 / 64.0,
             dvdx: 0.0,
             dudy: 0.0,
@@ -513,18 +524,9 @@ fn batched_anisotropic_probes_equal_single_samples() {
             for addr in ADDRESS_MODES {
                 let s = Sampler::new(SamplerDescriptor::anisotropic(clamp).with_address_mode(addr))
                     .unwrap();
+                let case = format!("clamp {clamp} {addr:?}");
                 for len in [fps.len(), 64, 37] {
-                    let mut out = vec![[0.0; 4]; len];
-                    let mut wide = out.clone();
-                    s.sample_batch(tex, &fps[..len], &mut out);
-                    // The eight-lane kernel where the CPU has it (and its run kernel).
-                    s.sample_batch_lanes(Lanes::detect(), tex, &fps[..len], &mut wide);
-                    for ((fp, o), w) in fps.iter().zip(&out).zip(&wide) {
-                        let single = s.sample(tex, fp).map(f32::to_bits);
-                        assert_eq!(single, o.map(f32::to_bits), "clamp {clamp} {addr:?} {fp:?}");
-                        let at = format!("lanes: clamp {clamp} {addr:?} {fp:?}");
-                        assert_eq!(single, w.map(f32::to_bits), "{at}");
-                    }
+                    assert_batches_equal_single(&s, tex, &fps[..len], &case);
                 }
             }
         }
