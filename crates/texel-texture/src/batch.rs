@@ -236,7 +236,10 @@ pub(crate) fn anisotropic<P: Pyramid>(
     };
     let mut chunk = Chunk::<CHUNK>::new();
     let mut plans = [crate::aniso::Plan::default(); CHUNK];
-    let mut probes = ProbeBatch::new(s.address());
+    // The probe scratch (about 13 KB) is reused from the thread's last call: made and zeroed per
+    // call it was a quarter of the instructions of aniso16 on a mesh of small triangles, one call
+    // per triangle and tile (docs/perf-log.md, entries 40 and 41).
+    let mut probes = ProbeBatch::take(s.address());
     // Per sample of the chunk: its probes' sum, and `1 / N` (0: not a probed sample).
     let mut sums = [Vec4::ZERO; CHUNK];
     let mut inv = [0.0f32; CHUNK];
@@ -284,6 +287,13 @@ pub(crate) fn anisotropic<P: Pyramid>(
             }
         }
     }
+    probes.give_back();
+}
+
+thread_local! {
+    /// Each thread's probe scratch between [`anisotropic`] calls ([`ProbeBatch::take`]).
+    static PROBE_SCRATCH: std::cell::RefCell<Option<Box<ProbeBatch>>> =
+        const { std::cell::RefCell::new(None) };
 }
 
 /// [`anisotropic`]'s probe scratch: up to [`PROBES`] probes with their positions and the sample
@@ -306,6 +316,33 @@ struct ProbeBatch {
 }
 
 impl ProbeBatch {
+    /// The thread's probe scratch, empty and set to the address modes `addr`: the one the
+    /// thread's last [`anisotropic`] call gave back ([`ProbeBatch::give_back`]), or a new one.
+    /// Its arrays keep the last call's entries, which are stale and never read: every entry is
+    /// written before it is read (`m`, `mixed` and `pair` are reset here; a sample's levels,
+    /// weight and flag by [`ProbeBatch::sample`]; probes' positions, owners and levels as they
+    /// are added and flushed).
+    #[inline(always)]
+    fn take(addr: Address) -> Box<ProbeBatch> {
+        let cached = PROBE_SCRATCH.with(|c| c.borrow_mut().take());
+        match cached {
+            Some(mut p) => {
+                p.m = 0;
+                (p.pair, p.mixed) = ((0, 0), false);
+                p.fine.set_address(addr);
+                p.next.set_address(addr);
+                p
+            }
+            None => ProbeBatch::new(addr),
+        }
+    }
+
+    /// Keep this scratch for the thread's next [`anisotropic`] call.
+    #[inline(always)]
+    fn give_back(self: Box<Self>) {
+        PROBE_SCRATCH.with(|c| *c.borrow_mut() = Some(self));
+    }
+
     fn new(addr: Address) -> Box<ProbeBatch> {
         Box::new(ProbeBatch {
             m: 0,
@@ -486,6 +523,13 @@ fn wrap_pair(i: i32, n: i32, repeat: bool) -> (i32, i32) {
 }
 
 impl<const N: usize, T: Taps> Pass<N, T> {
+    /// Apply the address modes `addr` to later passes (as [`Pass::new`] does).
+    fn set_address(&mut self, addr: Address) {
+        self.addr = addr;
+        self.wraps = addr.u != AddressMode::ClampToBorder && addr.v != AddressMode::ClampToBorder;
+        self.repeat = (addr.u == AddressMode::Repeat, addr.v == AddressMode::Repeat);
+    }
+
     fn new(taps: T, addr: Address) -> Self {
         Pass {
             level: [0; N],

@@ -530,6 +530,22 @@ fn batched_anisotropic_probes_equal_single_samples() {
                 }
             }
         }
+        // The probe scratch is kept per thread between calls (`batch::anisotropic`): calls under
+        // one border colour and then another, each after a call with more probes, must read the
+        // new colour, not the last call's, and no stale probe of the longer call.
+        for border in [
+            BorderColor::OpaqueWhite,
+            BorderColor::TransparentBlack,
+            BorderColor::Custom([0.25, 0.5, 0.75, 1.0]),
+        ] {
+            let mut d =
+                SamplerDescriptor::anisotropic(16).with_address_mode(AddressMode::ClampToBorder);
+            d.border_color = border;
+            let s = Sampler::new(d).unwrap();
+            for len in [fps.len(), 37] {
+                assert_batches_equal_single(&s, tex, &fps[..len], &format!("{border:?}"));
+            }
+        }
     }
 }
 
