@@ -292,8 +292,8 @@ pub(crate) fn anisotropic<P: Pyramid>(
 
 thread_local! {
     /// Each thread's probe scratch between [`anisotropic`] calls ([`ProbeBatch::take`]).
-    static PROBE_SCRATCH: std::cell::RefCell<Option<Box<ProbeBatch>>> =
-        const { std::cell::RefCell::new(None) };
+    static PROBE_SCRATCH: std::cell::Cell<Option<Box<ProbeBatch>>> =
+        const { std::cell::Cell::new(None) };
 }
 
 /// [`anisotropic`]'s probe scratch: up to [`PROBES`] probes with their positions and the sample
@@ -318,13 +318,16 @@ struct ProbeBatch {
 impl ProbeBatch {
     /// The thread's probe scratch, empty and set to the address modes `addr`: the one the
     /// thread's last [`anisotropic`] call gave back ([`ProbeBatch::give_back`]), or a new one.
-    /// Its arrays keep the last call's entries, which are stale and never read: every entry is
-    /// written before it is read (`m`, `mixed` and `pair` are reset here; a sample's levels,
-    /// weight and flag by [`ProbeBatch::sample`]; probes' positions, owners and levels as they
-    /// are added and flushed).
+    /// Its arrays keep the last call's entries, which are stale and never used: `m`, `mixed` and
+    /// `pair` are reset here; a sample's levels, weight and flag are written by
+    /// [`ProbeBatch::sample`] and a probe's position and owner as it is added, before any read;
+    /// the passes' fractions, taps and inside flags by [`Pass::coordinates`] before stage 3; the
+    /// passes' per-probe levels are filled from their samples' in a batch that mixes levels, and
+    /// in one that does not they are read by `coordinates` but its size closure ignores them.
+    /// During thread-local teardown (no slot) the scratch is new, as before.
     #[inline(always)]
     fn take(addr: Address) -> Box<ProbeBatch> {
-        let cached = PROBE_SCRATCH.with(|c| c.borrow_mut().take());
+        let cached = PROBE_SCRATCH.try_with(std::cell::Cell::take).ok().flatten();
         match cached {
             Some(mut p) => {
                 p.m = 0;
@@ -337,10 +340,12 @@ impl ProbeBatch {
         }
     }
 
-    /// Keep this scratch for the thread's next [`anisotropic`] call.
+    /// Keep this scratch for the thread's next [`anisotropic`] call (dropped instead during
+    /// thread-local teardown).
     #[inline(always)]
     fn give_back(self: Box<Self>) {
-        PROBE_SCRATCH.with(|c| *c.borrow_mut() = Some(self));
+        // `try_with` fails only while the thread's locals are being destroyed.
+        let _ = PROBE_SCRATCH.try_with(|c| c.set(Some(self)));
     }
 
     fn new(addr: Address) -> Box<ProbeBatch> {
