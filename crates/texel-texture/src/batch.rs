@@ -318,8 +318,9 @@ struct ProbeBatch {
 impl ProbeBatch {
     /// The thread's probe scratch, empty and set to the address modes `addr`: the one the
     /// thread's last [`anisotropic`] call gave back ([`ProbeBatch::give_back`]), or a new one.
-    /// Its arrays keep the last call's entries, which are stale and never used: `m`, `mixed` and
-    /// `pair` are reset here; a sample's levels, weight and flag are written by
+    /// Its arrays keep the last call's entries, which are stale and never used: the count `m` is
+    /// reset here, and with it empty the batch's `pair` and `mixed` are set by the first
+    /// [`ProbeBatch::sample`]; a sample's levels, weight and flag are written by
     /// [`ProbeBatch::sample`] and a probe's position and owner as it is added, before any read;
     /// the passes' fractions, taps and inside flags by [`Pass::coordinates`] before stage 3; the
     /// passes' per-probe levels are filled from their samples' in a batch that mixes levels, and
@@ -331,7 +332,6 @@ impl ProbeBatch {
         match cached {
             Some(mut p) => {
                 p.m = 0;
-                (p.pair, p.mixed) = ((0, 0), false);
                 p.fine.set_address(addr);
                 p.next.set_address(addr);
                 p
@@ -528,7 +528,7 @@ fn wrap_pair(i: i32, n: i32, repeat: bool) -> (i32, i32) {
 }
 
 impl<const N: usize, T: Taps> Pass<N, T> {
-    /// Apply the address modes `addr` to later passes (as [`Pass::new`] does).
+    /// Apply the address modes `addr` (and the flags derived from them) to later passes.
     fn set_address(&mut self, addr: Address) {
         self.addr = addr;
         self.wraps = addr.u != AddressMode::ClampToBorder && addr.v != AddressMode::ClampToBorder;
@@ -536,7 +536,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
     }
 
     fn new(taps: T, addr: Address) -> Self {
-        Pass {
+        let mut pass = Pass {
             level: [0; N],
             i: [0; N],
             j: [0; N],
@@ -544,10 +544,12 @@ impl<const N: usize, T: Taps> Pass<N, T> {
             b: [0.0; N],
             inside: [false; N],
             addr,
-            wraps: addr.u != AddressMode::ClampToBorder && addr.v != AddressMode::ClampToBorder,
-            repeat: (addr.u == AddressMode::Repeat, addr.v == AddressMode::Repeat),
+            wraps: false,
+            repeat: (false, false),
             taps,
-        }
+        };
+        pass.set_address(addr);
+        pass
     }
 
     /// Stage 2 for the chunk's samples at their `level`s, whose sizes `size(level)` gives:
