@@ -43,7 +43,6 @@
 
 pub mod camera;
 pub mod clip;
-mod dispatch;
 mod draw;
 pub mod environment;
 mod error;
@@ -59,7 +58,6 @@ mod shade;
 pub mod tile;
 pub mod views;
 
-pub use dispatch::{level as simd_level, limit_level, SimdLevel};
 pub use draw::{DrawCall, UvEvaluation, UvMapping, Vertex};
 pub use environment::{Environment, EnvironmentMaps};
 pub use error::RasterError;
@@ -73,6 +71,7 @@ pub use settings::{
     ColorTarget, Derivatives, Perspective, Precision, RenderSettings, View, MAX_DIMENSION,
     MAX_PIXELS,
 };
+pub use texel_texture::dispatch::{level as simd_level, limit_level, SimdLevel};
 
 /// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].
 ///

@@ -54,9 +54,9 @@ use rayon::prelude::*;
 use texel_texture::color::{
     rgba_to_unorm8, rgba_to_unorm8_slice, srgb8_encoder, unorm8_table, Srgb8Encoder,
 };
+use texel_texture::dispatch::{self, Kernel};
 use texel_texture::{Footprint, Lanes};
 
-use crate::dispatch::Kernel;
 use crate::draw::DrawCall;
 use crate::environment::{Environment, ViewRays};
 use crate::frame::Frame;
@@ -319,9 +319,9 @@ fn band_slices<T>(buf: &mut [T], width: u32, bands: u32) -> impl Iterator<Item =
     buf.chunks_mut(len).chain(empty).take(bands as usize)
 }
 
-/// Rasterise one tile, on the best instruction set the CPU has ([`crate::dispatch`]).
+/// Rasterise one tile, on the best instruction set the CPU has ([`texel_texture::dispatch`]).
 fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
-    crate::dispatch::run(TileJob { ctx, tile, bin });
+    dispatch::run(TileJob { ctx, tile, bin });
     if let Some((env, rays)) = &ctx.background {
         background_tile(ctx, env, rays, tile);
     }

@@ -13,8 +13,9 @@
 //!
 //! The `fixed8/*` group compares, on a unorm copy of the texture, the exact `f32` path
 //! (`sample_batch`) with the GPU-style fixed-point one (`sample_batch_fixed8`, unorm8 codes out).
-//! Like every row here it runs the crate's baseline (SSE2) code: the rasterizer's run-time
-//! dispatch to x86-64-v3 does not apply to a direct call.
+//! The batched rows (`sample_batch`, `sample_batch_fixed8`) run the best instruction-set copy
+//! the CPU has (`texel_texture::dispatch`, as in the rasterizer); the one-sample rows the
+//! crate's baseline (SSE2) code.
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items
 

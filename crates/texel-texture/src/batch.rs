@@ -33,12 +33,14 @@ use glam::{Vec2, Vec4};
 
 use crate::address::{Address, AddressMode};
 use crate::bilinear::{lerp, Bilinear};
+use crate::dispatch::{self, Kernel};
 use crate::fetch::{Fetch, Pyramid};
 use crate::fixed8::{Bilinear8, Point8};
 use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
 use crate::footprint::{
     finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, Query,
 };
+use crate::lanes::Lanes;
 use crate::mip::{self, LevelFilter};
 use crate::nearest::Point;
 use crate::sampler::{FilterMode, MipmapFilterMode, Sampler};
@@ -445,8 +447,40 @@ impl ProbeBatch {
 /// bytes are copied, elsewhere [`Point`]'s one-sample filter (address wrapping, border codes
 /// in `addr`) gives the codes. The indices of a chunk are computed in one loop that vectorises,
 /// then the texels are copied.
-#[inline(always)]
+/// On the instruction set's copy for the CPU ([`crate::dispatch`]).
 pub(crate) fn point_bytes(
+    level: &crate::fetch::Level<'_, crate::fetch::Codes8>,
+    addr: &Address,
+    footprints: &[Footprint],
+    out: &mut [[u8; 4]],
+) {
+    dispatch::run(PointBytesJob {
+        level,
+        addr,
+        footprints,
+        out,
+    });
+}
+
+/// [`point_bytes`]' arguments, as the dispatcher's unit of work.
+struct PointBytesJob<'j, 'l> {
+    level: &'j crate::fetch::Level<'l, crate::fetch::Codes8>,
+    addr: &'j Address,
+    footprints: &'j [Footprint],
+    out: &'j mut [[u8; 4]],
+}
+
+impl Kernel for PointBytesJob<'_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self, _lanes: Lanes) {
+        point_bytes_in(self.level, self.addr, self.footprints, self.out);
+    }
+}
+
+/// [`point_bytes`]' body.
+#[inline(always)]
+fn point_bytes_in(
     level: &crate::fetch::Level<'_, crate::fetch::Codes8>,
     addr: &Address,
     footprints: &[Footprint],
@@ -650,7 +684,8 @@ pub(crate) fn run<P: Pyramid>(
     }
 }
 
-/// [`run`] with the within-level filter `T`.
+/// [`run`] with the within-level filter `T`, on the instruction set's copy for the CPU
+/// ([`crate::dispatch`]: one function per pyramid, filter and copy).
 #[inline(always)]
 fn run_with<P: Pyramid, T: Taps>(
     p: &P,
@@ -659,10 +694,39 @@ fn run_with<P: Pyramid, T: Taps>(
     addr: Address,
     (footprints, out): (&[Footprint], &mut [[f32; 4]]),
 ) {
-    if footprints.len() <= 16 {
-        run_in::<P, T, 16, 1>(p, taps, s, addr, (footprints, out));
-    } else {
-        run_in::<P, T, CHUNK, LEVELS>(p, taps, s, addr, (footprints, out));
+    let job = RunJob {
+        p,
+        taps,
+        s,
+        addr,
+        footprints,
+        out,
+    };
+    dispatch::run(job);
+}
+
+/// [`run_with`]'s arguments, as the dispatcher's unit of work.
+struct RunJob<'j, P, T> {
+    p: &'j P,
+    taps: T,
+    s: &'j Sampler,
+    addr: Address,
+    footprints: &'j [Footprint],
+    out: &'j mut [[f32; 4]],
+}
+
+impl<P: Pyramid, T: Taps> Kernel for RunJob<'_, P, T> {
+    type Output = ();
+    /// Ignores `lanes`: a linear 8-bit pyramid carries its quad kernel (`fetch::Unorm8`).
+    #[inline(always)]
+    fn run(self, _lanes: Lanes) {
+        let (p, taps, s, addr) = (self.p, self.taps, self.s, self.addr);
+        let io = (self.footprints, self.out);
+        if io.0.len() <= 16 {
+            run_in::<P, T, 16, 1>(p, taps, s, addr, io);
+        } else {
+            run_in::<P, T, CHUNK, LEVELS>(p, taps, s, addr, io);
+        }
     }
 }
 

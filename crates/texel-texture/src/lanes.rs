@@ -18,11 +18,12 @@
 //! `lerp(x, y, t) = x + (y - x) * t`. Only the grouping into registers differs, so the result is
 //! bit for bit the scalar kernel's (unit test below; `tests/core.rs` compares whole batches).
 //!
-//! Where it runs. The token is taken by the caller that knows it runs in a copy compiled with
-//! AVX2: the rasterizer's tiles on its x86-64-v3 and -v4 copies (`texel-raster`'s dispatch) pass
-//! [`Lanes::detect`] to [`crate::Sampler::sample_batch_lanes`]. Elsewhere ([`crate::Sampler::sample_batch`]
-//! and the one-sample path) the kernel is the scalar one: pulp's intrinsics carry
-//! `#[target_feature]`, so in code compiled for the x86-64 baseline each would stay a call.
+//! Where it runs. The batched sampler's kernels run on [`crate::dispatch`]'s instruction-set
+//! copies; [`crate::Sampler::sample_batch`] takes the token of the copy it runs on
+//! ([`crate::dispatch::lanes`]: [`Lanes::detect`] on x86-64-v3 and -v4), and
+//! [`crate::Sampler::sample_batch_lanes`] the caller's (the rasterizer's tiles pass their copy's).
+//! The one-sample path keeps the scalar kernel: pulp's intrinsics carry `#[target_feature]`, so in
+//! code compiled for the x86-64 baseline each would stay a call.
 
 use glam::Vec4;
 
@@ -38,7 +39,7 @@ use glam::Vec4;
 /// eight lanes (`b * hi + b * lo` with `1/255 = hi + lo`, two multiplies and an add per lane,
 /// never fused), lerps both rows along x in one eight-lane step and the two halves along y:
 /// per lane the four-lane kernel's operations in its order. Its intrinsics carry
-/// `#[target_feature]`, so it is fast only in code compiled with AVX2 (the rasterizer's
+/// `#[target_feature]`, so it is fast only in code compiled with AVX2 ([`crate::dispatch`]'s
 /// x86-64-v3 and -v4 copies); called from baseline code each intrinsic stays a call (correct,
 /// slower).
 #[derive(Clone, Copy, Debug, Default)]

@@ -36,6 +36,7 @@ mod batch;
 pub mod bicubic;
 mod bilinear;
 pub mod color;
+pub mod dispatch;
 mod error;
 pub mod ewa;
 mod fetch;

@@ -395,11 +395,8 @@ impl Sampler {
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
-    // Inlined into each copy of the tile rasterizer since the level-0 point path
-    // (`batch::point_bytes`): one-thread nearest frames on the x86-64-v3 copy 2.05 -> 1.86 ms
-    // (before that path, the generic kernel measured about 5 % faster as its own baseline
-    // function).
-    #[inline(always)]
+    // Not inlined into the tile rasterizer's copies: its kernels (`batch::point_bytes`,
+    // `batch::run`) run on their own instruction-set copies (`crate::dispatch`).
     pub fn sample_batch_stored(
         &self,
         texture: &Texture,
@@ -430,7 +427,6 @@ impl Sampler {
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
-    #[inline(always)]
     pub fn sample_batch_fixed8(
         &self,
         texture: &Texture,
@@ -502,32 +498,24 @@ impl Sampler {
     /// texture's format is dispatched once for the whole batch, and the lods of up to 64
     /// footprints are computed in one loop before any is filtered (independent iterations that
     /// pipeline, instead of one long dependency chain per sample). A rasterizer should hand it a
-    /// row span at a time. In a build for AVX2 (`target_feature = "avx2"`) linear 8-bit quads
-    /// blend in eight lanes ([`Lanes::detect`]), else in four; code compiled for AVX2 inside a
-    /// default build passes the token itself ([`Sampler::sample_batch_lanes`]). Same bits.
+    /// row span at a time. The kernels run on the best instruction-set copy the CPU has
+    /// ([`crate::dispatch`]); on x86-64-v3 and above linear 8-bit quads blend in eight lanes
+    /// ([`Lanes::detect`]), else in four. Same bits on every copy.
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
-    #[inline(always)]
     pub fn sample_batch(&self, texture: &Texture, footprints: &[Footprint], out: &mut [[f32; 4]]) {
-        // A build for AVX2 (`-C target-cpu=x86-64-v3` or newer) inlines the eight-lane kernel
-        // everywhere; the default build keeps the four-lane one here ([`Lanes`]).
-        let lanes = if cfg!(target_feature = "avx2") {
-            Lanes::detect()
-        } else {
-            Lanes::scalar()
-        };
-        self.sample_batch_lanes(lanes, texture, footprints, out)
+        self.sample_batch_lanes(crate::dispatch::lanes(), texture, footprints, out)
     }
 
     /// [`Sampler::sample_batch`] with the bilinear quads of linear 8-bit textures
-    /// (`Rgba8Unorm`) blended by `lanes`' kernel: the same bits with every [`Lanes`]. Pass
-    /// [`Lanes::detect`] only from code compiled with AVX2 (the rasterizer's x86-64-v3 and -v4
-    /// copies): elsewhere each of the kernel's intrinsics stays a call ([`Lanes`]' module docs).
+    /// (`Rgba8Unorm`) blended by `lanes`' kernel: the same bits with every [`Lanes`]. The
+    /// kernels run on the CPU's best instruction-set copy ([`crate::dispatch`]), where
+    /// [`Lanes::detect`]'s intrinsics inline on the x86-64-v3 and -v4 copies; under
+    /// [`crate::dispatch::limit_level`]`(Baseline)` they stay calls (correct, slower).
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
-    #[inline(always)]
     pub fn sample_batch_lanes(
         &self,
         lanes: Lanes,
@@ -544,54 +532,77 @@ impl Sampler {
             let size = p.level(0).size();
             let staged = size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE;
             if self.batched && staged {
+                // `batch::run` dispatches per within-level filter.
                 return batch::run(&p, self, (self.addr, false), footprints, out);
             }
-            if self.technique == Technique::Anisotropic && staged {
-                // Probes of several samples filtered together; the rest one by one, as
-                // `filter_planned` and `filter` do.
-                let mut probes = Probes::new(self.addr);
-                return batch::anisotropic(&p, self, (footprints, out), |q, plan| {
-                    if q.lod > 0.0 {
-                        filter_planned(&p, q, plan, &mut probes)
-                    } else {
-                        self.filter(&p, q)
-                    }
-                });
-            }
-            // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
-            // arithmetic vectorised), then all filters.
-            let mut chunk = Chunk::<{ batch::CHUNK }>::new();
-            let chunks = footprints
-                .chunks(batch::CHUNK)
-                .zip(out.chunks_mut(batch::CHUNK));
-            if self.technique == Technique::Anisotropic {
-                // A third stage between the two: every sample's probe plan (axes, probe count,
-                // probe lod), vectorised as the lods are; the probes' scratch is made once.
-                let mut plans = [Plan::default(); batch::CHUNK];
-                let mut probes = Probes::new(self.addr);
-                for (fps, outs) in chunks {
-                    batch::queries(self, size, fps, &mut chunk);
-                    plan_chunk(self, size, fps, &mut plans);
-                    for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
-                        let q = chunk.query(k, fp);
-                        // As `filter`: magnification first.
-                        *o = if q.lod > 0.0 {
-                            filter_planned(&p, &q, &plans[k], &mut probes)
-                        } else {
-                            self.filter(&p, &q)
-                        }
-                        .to_array();
-                    }
+            crate::dispatch::run(BatchJob {
+                s: self,
+                p: &p,
+                staged,
+                footprints,
+                out,
+            })
+        })
+    }
+
+    /// [`Sampler::sample_batch_lanes`] past the core kernels (`batched`): anisotropic probes
+    /// batched where `staged` (level 0 within the staged kernels' side), else every sample
+    /// through [`Sampler::filter`], with its query and (anisotropic) probe plan made a chunk at
+    /// a time.
+    #[inline(always)]
+    fn batch_in<P: Pyramid>(
+        &self,
+        p: &P,
+        staged: bool,
+        footprints: &[Footprint],
+        out: &mut [[f32; 4]],
+    ) {
+        let size = p.level(0).size();
+        if self.technique == Technique::Anisotropic && staged {
+            // Probes of several samples filtered together; the rest one by one, as
+            // `filter_planned` and `filter` do.
+            let mut probes = Probes::new(self.addr);
+            return batch::anisotropic(p, self, (footprints, out), |q, plan| {
+                if q.lod > 0.0 {
+                    filter_planned(p, q, plan, &mut probes)
+                } else {
+                    self.filter(p, q)
                 }
-                return;
-            }
+            });
+        }
+        // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
+        // arithmetic vectorised), then all filters.
+        let mut chunk = Chunk::<{ batch::CHUNK }>::new();
+        let chunks = footprints
+            .chunks(batch::CHUNK)
+            .zip(out.chunks_mut(batch::CHUNK));
+        if self.technique == Technique::Anisotropic {
+            // A third stage between the two: every sample's probe plan (axes, probe count,
+            // probe lod), vectorised as the lods are; the probes' scratch is made once.
+            let mut plans = [Plan::default(); batch::CHUNK];
+            let mut probes = Probes::new(self.addr);
             for (fps, outs) in chunks {
                 batch::queries(self, size, fps, &mut chunk);
+                plan_chunk(self, size, fps, &mut plans);
                 for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
-                    *o = self.filter(&p, &chunk.query(k, fp)).to_array();
+                    let q = chunk.query(k, fp);
+                    // As `filter`: magnification first.
+                    *o = if q.lod > 0.0 {
+                        filter_planned(p, &q, &plans[k], &mut probes)
+                    } else {
+                        self.filter(p, &q)
+                    }
+                    .to_array();
                 }
             }
-        })
+            return;
+        }
+        for (fps, outs) in chunks {
+            batch::queries(self, size, fps, &mut chunk);
+            for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
+                *o = self.filter(p, &chunk.query(k, fp)).to_array();
+            }
+        }
     }
 
     /// The whole per-sample path, generic over the texel storage (and the counting wrapper).
@@ -659,5 +670,25 @@ impl Sampler {
                 Err(_) => trilinear(p, Bilinear, addr, q),
             },
         }
+    }
+}
+
+/// [`Sampler::batch_in`]'s arguments, as the dispatcher's unit of work (one function per
+/// pyramid type and instruction-set copy).
+struct BatchJob<'j, P> {
+    s: &'j Sampler,
+    p: &'j P,
+    staged: bool,
+    footprints: &'j [Footprint],
+    out: &'j mut [[f32; 4]],
+}
+
+impl<P: Pyramid> crate::dispatch::Kernel for BatchJob<'_, P> {
+    type Output = ();
+    /// Ignores `lanes`: a linear 8-bit pyramid carries its quad kernel (`fetch::Unorm8`).
+    #[inline(always)]
+    fn run(self, _lanes: Lanes) {
+        self.s
+            .batch_in(self.p, self.staged, self.footprints, self.out)
     }
 }

@@ -1,38 +1,47 @@
 //! Run-time instruction-set dispatch: the one module of texel that uses `unsafe`.
 //!
-//! texel is compiled for the x86-64 baseline (SSE2), so one binary runs on every x86-64 CPU. The
-//! tile rasterizer (coverage, interpolation, sampling, shading, encoding: everything
-//! `tile::raster_tile` inlines) gets two more copies: one compiled for x86-64-v3 (AVX2, FMA,
-//! BMI1/2, F16C, LZCNT, MOVBE) and one for x86-64-v4 (v3 plus AVX-512 F, BW, CD, DQ and VL). Each
-//! tile runs on the best copy whose every feature the CPU has ([`level`]), unless capped
-//! ([`limit_level`]).
+//! texel is compiled for the x86-64 baseline (SSE2), so one binary runs on every x86-64 CPU. Work
+//! that implements [`Kernel`] gets two more copies: one compiled for x86-64-v3 (AVX2, FMA,
+//! BMI1/2, F16C, LZCNT, MOVBE) and one for x86-64-v4 (v3 plus AVX-512 F, BW, CD, DQ and VL).
+//! [`run`] runs the best copy whose every feature the CPU has ([`level`]), unless capped
+//! ([`limit_level`]). The kernels are the batched sampler's (`Sampler::sample_batch` and its
+//! stored-bytes and fixed-point forms: one per texel storage and within-level filter) and
+//! texel-raster's tile rasterizer (coverage, interpolation, shading, encoding).
+//!
+//! Each copy is its own function (`#[inline(never)]`): a kernel that runs another kernel calls
+//! that kernel's copy for the level, never inlines it. Why: when the tile rasterizer inlined the
+//! whole batched sampler, each of its three copies was one function of about 2.2 MB of machine
+//! code (480 000 instructions, nine tenths of them the sampler's), and LLVM's time on a function
+//! grows faster than its size: texel-raster's one `rustc` took most of a 50-minute release build
+//! (docs/perf-log.md, entry 42). A call per sampled span (up to 256 fragments) costs a few
+//! nanoseconds against microseconds of filtering.
 //!
 //! Images are bit for bit the same on every copy: Rust never fuses a multiply and an add unless
 //! asked (`mul_add`), and no code here asks, and without fast-math flags LLVM emits no
 //! approximate instruction (AVX-512's `vrcp14`, `vrsqrt14`, `vgetexp` are not used for `/`,
 //! `sqrt` or `log2`), so the wider instructions compute the same IEEE operations
-//! (`tests/targets.rs` renders every view on every copy the CPU has; `scripts/same_images.sh`
-//! compared 134 images of the v4 copy with the v3 copy, and earlier of a whole-program x86-64-v3
-//! build with the baseline build, all identical).
+//! (texel-raster's `tests/targets.rs` renders every view on every copy the CPU has;
+//! `scripts/same_images.sh` compared 134 images of the v4 copy with the v3 copy, and earlier of a
+//! whole-program x86-64-v3 build with the baseline build, all identical).
 //!
-//! The copies differ in one more way: [`v3`] and [`v4`] hand the tile work
-//! [`texel_texture::Lanes::detect`], the sampler's eight-lane AVX2 quad kernel (safe intrinsics
-//! through `pulp`'s run-time token, bit for bit the four-lane kernel), and the baseline copy
-//! [`texel_texture::Lanes::scalar`]: only inside a function compiled with AVX2 do that kernel's
-//! intrinsics inline (in baseline code each would stay a call).
+//! The copies differ in one more way: `v3` and `v4` hand the kernel [`Lanes::detect`], the
+//! sampler's eight-lane AVX2 quad kernel (safe intrinsics through `pulp`'s run-time token, bit for
+//! bit the four-lane kernel), and the baseline copy [`Lanes::scalar`]: only inside a function
+//! compiled with AVX2 do that kernel's intrinsics inline (in baseline code each would stay a
+//! call).
 //!
 //! Safety argument: calling a `#[target_feature]` function is `unsafe` because running its
-//! instructions on a CPU without the features is undefined behaviour. [`run`] calls [`v3`] only
-//! when [`level`] is [`SimdLevel::X86_64V3`] and [`v4`] only when it is [`SimdLevel::X86_64V4`].
-//! [`level`] is at most what [`detect`] found, and [`detect`] reports a level only when
+//! instructions on a CPU without the features is undefined behaviour. [`run`] calls `v3` only
+//! when [`level`] is [`SimdLevel::X86_64V3`] and `v4` only when it is [`SimdLevel::X86_64V4`].
+//! [`level`] is at most what `detect` found, and `detect` reports a level only when
 //! `is_x86_feature_detected!` reported every feature that level's function enables (the lists in
-//! [`detect`] are the ones the functions' attributes name; v4's includes v3's).
+//! `detect` are the ones the functions' attributes name; v4's includes v3's).
 #![allow(unsafe_code)]
 
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::OnceLock;
 
-use texel_texture::Lanes;
+use crate::Lanes;
 
 /// The instruction set the rasterizer's tiles run on, ordered from the least to the most.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -123,9 +132,11 @@ pub fn limit_level(max: SimdLevel) {
     LIMIT.store(max as u8, Ordering::Relaxed);
 }
 
-/// Work compiled once per instruction set. `run` must be `#[inline(always)]` (a closure's body
-/// would stay a separate function compiled for the baseline, which `v3` would merely call).
-pub(crate) trait Kernel {
+/// Work compiled once per instruction set ([`run`]). Implementations should mark
+/// [`Kernel::run`] `#[inline(always)]`, and so everything it calls that should be compiled with
+/// the copy's features: a function left out of line (a closure's body, often) stays compiled for
+/// the baseline, and the copy merely calls it.
+pub trait Kernel {
     /// What the work returns.
     type Output;
     /// Do the work, sampling with `lanes`: [`Lanes::detect`] on the copies compiled with AVX2
@@ -133,10 +144,21 @@ pub(crate) trait Kernel {
     fn run(self, lanes: Lanes) -> Self::Output;
 }
 
-/// Run `k` on the copy for [`level`]: its body (with everything it inlines) is compiled once for
-/// the baseline, once inside [`v3`] and once inside [`v4`].
+/// The sampler's quad kernel for the copy [`run`] picks now: [`Lanes::detect`] on x86-64-v3 and
+/// above, [`Lanes::scalar`] on the baseline copy.
+pub fn lanes() -> Lanes {
+    if level() >= SimdLevel::X86_64V3 {
+        Lanes::detect()
+    } else {
+        Lanes::scalar()
+    }
+}
+
+/// Run `k` on the copy for [`level`]: its body (with everything it inlines) is compiled once
+/// inside `baseline`, once inside `v3` and once inside `v4`, each a function of its own.
+/// Costs a call, an atomic load and a `OnceLock` read; the result does not depend on the copy.
 #[inline(always)]
-pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
+pub fn run<K: Kernel>(k: K) -> K::Output {
     #[cfg(target_arch = "x86_64")]
     match level() {
         // SAFETY: `level()` is `X86_64V4` only when `detect` saw every feature `v4` enables.
@@ -146,6 +168,12 @@ pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
         SimdLevel::X86_64V3 => return unsafe { v3(k) },
         SimdLevel::Baseline => {}
     }
+    baseline(k)
+}
+
+/// `k.run(Lanes::scalar())` compiled for the build's target, as a function of its own.
+#[inline(never)]
+fn baseline<K: Kernel>(k: K) -> K::Output {
     k.run(Lanes::scalar())
 }
 
@@ -154,6 +182,7 @@ pub(crate) fn run<K: Kernel>(k: K) -> K::Output {
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2"
 )]
+#[inline(never)]
 unsafe fn v3<K: Kernel>(k: K) -> K::Output {
     k.run(Lanes::detect())
 }
@@ -163,6 +192,7 @@ unsafe fn v3<K: Kernel>(k: K) -> K::Output {
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,f16c,lzcnt,movbe,popcnt,sse3,ssse3,sse4.1,sse4.2,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
 )]
+#[inline(never)]
 unsafe fn v4<K: Kernel>(k: K) -> K::Output {
     k.run(Lanes::detect())
 }
