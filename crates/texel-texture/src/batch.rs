@@ -34,7 +34,7 @@ use glam::{Vec2, Vec4};
 use crate::address::{Address, AddressMode};
 use crate::bilinear::{lerp, Bilinear};
 use crate::dispatch::{self, Kernel};
-use crate::fetch::{Fetch, Pyramid};
+use crate::fetch::{Fetch, Pyramid, Run};
 use crate::fixed8::{Bilinear8, Point8};
 use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
 use crate::footprint::{
@@ -190,6 +190,14 @@ pub(crate) trait Taps: LevelFilter {
     const REACH: f32;
     /// The value of a sample whose taps lie inside `level`: first tap `(i, j)`, fractions `ab`.
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, ab: (f32, f32)) -> Vec4;
+    /// [`Taps::inside`] of each sample of `run` (all inside `level`) into `out` (the run's
+    /// length), in one call: `true`, or `false` with `out` untouched where the filter and view
+    /// have no run kernel (the default), and the caller runs its per-sample loop.
+    #[inline(always)]
+    fn inside_run<F: Fetch>(level: &F, run: Run<'_>, out: &mut [[f32; 4]]) -> bool {
+        let _ = (level, run, out);
+        false
+    }
     /// The value of a sample near an edge whose taps the pass wrapped: first taps `i[0]`,
     /// `j[0]`, the next ones `i[1]`, `j[1]` (all inside `level`), fractions `ab`. Bit for bit the
     /// one-sample filter's, which reads the same texels (DESIGN.md: the address mode applies to
@@ -645,6 +653,17 @@ impl<const N: usize, T: Taps> Pass<N, T> {
         T::inside(level, self.i[k] as u32, self.j[k] as u32, ab)
     }
 
+    /// Stage 2's results for the first `n` samples, as a [`Run`] for [`Taps::inside_run`].
+    #[inline(always)]
+    fn run(&self, n: usize) -> Run<'_> {
+        Run {
+            i: &self.i[..n],
+            j: &self.j[..n],
+            a: &self.a[..n],
+            b: &self.b[..n],
+        }
+    }
+
     /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value. Three routes,
     /// the same value from each: every tap inside the level; within one texel of it
     /// ([`Pass::near`]: the taps wrapped by two selects each); elsewhere, or under
@@ -765,6 +784,8 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     let mut first = Pass::<N, T>::new(taps, addr);
     let mut second = Pass::<N, T>::new(taps, addr);
     let mut delta = [0.0f32; N];
+    // The coarser level's values of a chunk filtered level by level (`filter_two_levels`).
+    let mut scratch = [[0.0f32; 4]; N];
     let mut chunk = Chunk::<N>::new();
     let last = levels - 1;
     let size0 = base.size();
@@ -778,7 +799,7 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             // it (stage 1's fill, the level scan) bilinear frames measured 5-7 % slower.
             let size = (dims_w[0], dims_h[0]);
             first.coordinates(|_| size, &chunk.u[..n], &chunk.v[..n]);
-            filter_unblended(&first, &chunk, |_| base, out);
+            filter_one_level(&first, &chunk, base, out);
             continue;
         }
         // Stage 1: levels (u8: at most 32 levels for a 2^31 side; textures are far smaller).
@@ -818,14 +839,14 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
             first.coordinates(|_| s0, &chunk.u[..n], &chunk.v[..n]);
             // As `mip::trilinear`: the coarser level only when it is weighed.
             if !(trilinear && (l0 as usize) < last) {
-                filter_unblended(&first, &chunk, |_| fine, out);
+                filter_one_level(&first, &chunk, fine, out);
                 continue;
             }
             let l1 = second.level[0];
             let (coarse, s1) = (view(l1), size(l1));
             second.coordinates(|_| s1, &chunk.u[..n], &chunk.v[..n]);
             let stages = (&first, &second, &chunk, &delta);
-            filter_chunk(stages, |_| fine, |_| coarse, out);
+            filter_two_levels(stages, (fine, coarse), &mut scratch, out);
             continue;
         }
         first.coordinates(size, &chunk.u[..n], &chunk.v[..n]);
@@ -864,6 +885,64 @@ fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
     for (k, o) in out.iter_mut().enumerate() {
         *o = first.filtered(&level(k), k, chunk.uv(k)).to_array();
     }
+}
+
+/// [`filter_unblended`] for a chunk whose samples all read the one view `level` (no mipmaps, or one
+/// mip level): where every sample lies inside it and the view has a run kernel
+/// ([`Taps::inside_run`]: linear 8-bit texels, sampled with an AVX2 `Lanes` token), the whole chunk
+/// in one loop that tests the token once; otherwise [`filter_unblended`] (docs/perf-log.md,
+/// entries 40 and 43).
+#[inline(always)]
+fn filter_one_level<T: Taps, F: Fetch, const N: usize>(
+    first: &Pass<N, T>,
+    chunk: &Chunk<N>,
+    level: F,
+    out: &mut [[f32; 4]],
+) {
+    let n = out.len();
+    if first.all_inside(n) && T::inside_run(&level, first.run(n), out) {
+        return;
+    }
+    filter_unblended(first, chunk, |_| level, out);
+}
+
+/// [`filter_chunk`] for a chunk whose samples all read the views `fine` and `coarse` (one pair of
+/// levels). Where the views have a run kernel ([`Taps::inside_run`]), level by level: with every
+/// blend weight positive and every sample inside both levels, the finer level's run into `out`,
+/// the coarser one's into `scratch`, then the blends ([`Taps::mix`], as [`filter_chunk`]
+/// computes them); with none positive and every sample inside the finer level, the finer run
+/// alone. Otherwise [`filter_chunk`], which reads the coarser level only for the samples it
+/// weighs: a chunk never reads a texel the per-sample loop would not.
+#[inline(always)]
+fn filter_two_levels<T: Taps, F: Fetch, const N: usize>(
+    (first, second, chunk, delta): (&Pass<N, T>, &Pass<N, T>, &Chunk<N>, &[f32; N]),
+    (fine, coarse): (F, F),
+    scratch: &mut [[f32; 4]; N],
+    out: &mut [[f32; 4]],
+) {
+    let n = out.len();
+    if first.all_inside(n) {
+        // A fold, branch-free, as `Pass::all_inside`.
+        let (all, any) = delta[..n].iter().fold((true, false), |(all, any), &t| {
+            (all & (t > 0.0), any | (t > 0.0))
+        });
+        // No weight positive: the coarser level is not read, so need not be inside.
+        if !any && T::inside_run(&fine, first.run(n), out) {
+            return;
+        }
+        let coarse_values = &mut scratch[..n];
+        if all
+            && second.all_inside(n)
+            && T::inside_run(&fine, first.run(n), out)
+            && T::inside_run(&coarse, second.run(n), coarse_values)
+        {
+            for ((o, c), &t) in out.iter_mut().zip(coarse_values.iter()).zip(delta) {
+                *o = T::mix(Vec4::from_array(*o), Vec4::from_array(*c), t).to_array();
+            }
+            return;
+        }
+    }
+    filter_chunk((first, second, chunk, delta), |_| fine, |_| coarse, out);
 }
 
 /// Stage 3 of [`run_in`] for a chunk's samples (`out.len()` of them): the finer level's value

@@ -116,6 +116,10 @@ impl Taps for Bilinear {
         level.bilinear_quad(i, j, a, b)
     }
     #[inline(always)]
+    fn inside_run<F: Fetch>(level: &F, run: crate::fetch::Run<'_>, out: &mut [[f32; 4]]) -> bool {
+        level.bilinear_run(run, out)
+    }
+    #[inline(always)]
     fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], (a, b): (f32, f32)) -> Vec4 {
         level.bilinear_wrapped(i, j, a, b)
     }

@@ -39,6 +39,22 @@ pub(crate) trait Decode: Copy {
     fn bilinear_rows(&self, r0: [Self::Texel; 2], r1: [Self::Texel; 2], a: f32, b: f32) -> Vec4 {
         blend(self.decode4([r0[0], r0[1], r1[0], r1[1]]), a, b)
     }
+    /// [`Decode::bilinear_rows`] of each sample of `run` (every quad inside the `width`-wide
+    /// level `texels`) into `out` (the run's length), in one call: `true`, or `false` with `out`
+    /// untouched where the decoder has no run kernel (the default) and the caller's per-sample
+    /// loop runs instead. A `bool`, not a fallback loop here: the caller's loop is the fallback,
+    /// not compiled twice (docs/perf-log.md, entry 40).
+    #[inline(always)]
+    fn bilinear_run(
+        &self,
+        texels: &[Self::Texel],
+        width: u32,
+        run: Run<'_>,
+        out: &mut [[f32; 4]],
+    ) -> bool {
+        let _ = (texels, width, run, out);
+        false
+    }
     /// The texels of `storage` if it holds this format.
     fn texels(storage: &Storage) -> Option<&[Self::Texel]>;
 }
@@ -136,6 +152,18 @@ impl Decode for Unorm8 {
             None => blend(self.decode4([r0[0], r0[1], r1[0], r1[1]]), a, b),
         }
     }
+    /// The eight-lane kernel over the whole run, the token tested once
+    /// ([`Lanes::bilinear_unorm8_run`]); `false` on [`Lanes::scalar`].
+    #[inline(always)]
+    fn bilinear_run(
+        &self,
+        texels: &[[u8; 4]],
+        width: u32,
+        run: Run<'_>,
+        out: &mut [[f32; 4]],
+    ) -> bool {
+        self.lanes.bilinear_unorm8_run(texels, width, run, out)
+    }
     fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
         Table8::texels(storage)
     }
@@ -215,6 +243,15 @@ pub(crate) trait Fetch: Copy {
     fn bilinear_wrapped(&self, i: [u32; 2], j: [u32; 2], a: f32, b: f32) -> Vec4 {
         blend(wrapped_quad(self, i, j), a, b)
     }
+    /// [`Fetch::bilinear_quad`] of each sample of `run` (every first tap inside the level:
+    /// `i + 1 < width`, `j + 1 < height`) into `out` (the run's length), in one call: `true`, or
+    /// `false` with `out` untouched where the view has no run kernel (the default; the caller
+    /// then runs its per-sample loop).
+    #[inline(always)]
+    fn bilinear_run(&self, run: Run<'_>, out: &mut [[f32; 4]]) -> bool {
+        let _ = (run, out);
+        false
+    }
     /// The 2x2 texels `[(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]`; `i + 1 < width`,
     /// `j + 1 < height` (no wrapping). The storage views read them as two 2-texel row slices,
     /// so a bilinear lookup inside the level pays two bounds checks instead of four.
@@ -237,6 +274,28 @@ fn rows2<T>(texels: &[T], width: u32, i: u32, j: u32) -> (&[T], &[T]) {
     (&texels[k..k + 2], &texels[k + w..k + w + 2])
 }
 
+/// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level
+/// (`i + 1 < width`, `j + 1` below the height; out of bounds panics), by one range check: the
+/// rows lie in the `width + 2` texels from `(i, j)`, whose elements then need none.
+#[inline(always)]
+pub(crate) fn quad_rows<T: Copy>(texels: &[T], width: u32, i: u32, j: u32) -> ([T; 2], [T; 2]) {
+    let w = width as usize;
+    let k = j as usize * w + i as usize;
+    let q = &texels[k..k + w + 2];
+    ([q[0], q[1]], [q[w], q[w + 1]])
+}
+
+/// Stage 2's results for a run of samples whose taps all lie inside one level (the batched
+/// sampler's inside route, `batch.rs`): per sample its first tap `(i[k], j[k])` (non-negative)
+/// and fractions `a[k]`, `b[k]`. The four slices have the run's length.
+#[derive(Clone, Copy)]
+pub(crate) struct Run<'r> {
+    pub i: &'r [i32],
+    pub j: &'r [i32],
+    pub a: &'r [f32],
+    pub b: &'r [f32],
+}
+
 impl<D: Decode> Fetch for Level<'_, D> {
     #[inline(always)]
     fn size(&self) -> (u32, u32) {
@@ -257,6 +316,10 @@ impl<D: Decode> Fetch for Level<'_, D> {
         let (r0, r1) = rows2(self.texels, self.width, i, j);
         self.decode
             .bilinear_rows([r0[0], r0[1]], [r1[0], r1[1]], a, b)
+    }
+    #[inline(always)]
+    fn bilinear_run(&self, run: Run<'_>, out: &mut [[f32; 4]]) -> bool {
+        self.decode.bilinear_run(self.texels, self.width, run, out)
     }
     #[inline(always)]
     fn bilinear_wrapped(&self, i: [u32; 2], j: [u32; 2], a: f32, b: f32) -> Vec4 {

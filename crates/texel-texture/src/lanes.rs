@@ -27,6 +27,10 @@
 
 use glam::Vec4;
 
+#[cfg(target_arch = "x86_64")]
+use crate::fetch::quad_rows;
+use crate::fetch::Run;
+
 /// Which quad kernel the batched sampler ([`crate::Sampler::sample_batch_lanes`]) uses for the
 /// bilinear blend of a 2x2 quad of linear 8-bit texels (`Rgba8Unorm`, its staged path: minifying
 /// and magnifying bilinear, mip-nearest, trilinear and the anisotropic probes): AVX2's eight
@@ -91,6 +95,36 @@ impl Lanes {
         }
         let _ = (r0, r1, a, b);
         None
+    }
+
+    /// [`Lanes::bilinear_unorm8`] of each sample of `run` (every quad inside the `width`-wide
+    /// linear 8-bit level `texels`, read by [`crate::fetch::quad_rows`]) into `out` (the run's
+    /// length): `true`, or `false` with `out` untouched when this is [`Lanes::scalar`]. The
+    /// token is tested once for the run, and the loop runs the eight-lane kernel alone. It is
+    /// inlined into the batched sampler's instruction-set copies ([`crate::dispatch`]), where
+    /// the kernel's intrinsics inline on x86-64-v3 and -v4 (perf-log 40 and 43).
+    #[inline(always)]
+    pub(crate) fn bilinear_unorm8_run(
+        self,
+        texels: &[[u8; 4]],
+        width: u32,
+        run: Run<'_>,
+        out: &mut [[f32; 4]],
+    ) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = self.v3 {
+            // Plain zips: no closure in the loop (a closure can stay an outlined call, compiled
+            // for the baseline).
+            let taps = run.i.iter().zip(run.j);
+            let fractions = run.a.iter().zip(run.b);
+            for (o, ((&i, &j), (&a, &b))) in out.iter_mut().zip(taps.zip(fractions)) {
+                let rows = quad_rows(texels, width, i as u32, j as u32);
+                *o = bilinear_unorm8_v3(simd, rows, (a, b)).to_array();
+            }
+            return true;
+        }
+        let _ = (texels, width, run, out);
+        false
     }
 }
 
@@ -191,5 +225,56 @@ mod tests {
             }
         }
         assert_eq!(compared, 2000 * 32 * 11);
+    }
+
+    /// The run kernel ([`Lanes::bilinear_unorm8_run`]) equals the four-lane kernel sample by
+    /// sample over every quad of small levels, random texels and fractions; the last quad of each
+    /// level ends at its last texel (the edge of `quad_rows`' one range check). On
+    /// [`Lanes::scalar`] it declines and leaves the output untouched.
+    #[test]
+    fn run_kernel_equals_the_scalar_one() {
+        let mut rng = SplitMix64::new(11);
+        let scalar = Unorm8::default();
+        for (w, h) in [(2u32, 2u32), (7, 5), (3, 9), (16, 2)] {
+            let texels: Vec<[u8; 4]> = (0..w * h)
+                .map(|_| {
+                    let x = rng.next_u64().to_le_bytes();
+                    [x[0], x[1], x[2], x[3]]
+                })
+                .collect();
+            let (mut i, mut j, mut a, mut b) = (vec![], vec![], vec![], vec![]);
+            for jj in 0..h - 1 {
+                for ii in 0..w - 1 {
+                    i.push(ii as i32);
+                    j.push(jj as i32);
+                    a.push(rng.next_f32());
+                    b.push(rng.next_f32());
+                }
+            }
+            // The fraction ends, once each.
+            (a[0], b[0]) = (0.0, 1.0 - f32::EPSILON / 2.0);
+            let run = Run {
+                i: &i,
+                j: &j,
+                a: &a,
+                b: &b,
+            };
+            let mut out = vec![[f32::NAN; 4]; i.len()];
+            assert!(!Lanes::scalar().bilinear_unorm8_run(&texels, w, run, &mut out));
+            assert!(out.iter().flatten().all(|x| x.is_nan()));
+            let wide = Lanes::detect();
+            if !wide.is_wide() {
+                println!("skipped: this CPU has no AVX2 (x86-64-v3); only the scalar kernel runs");
+                return;
+            }
+            assert!(wide.bilinear_unorm8_run(&texels, w, run, &mut out));
+            for k in 0..i.len() {
+                let at = |di: i32, dj: i32| texels[((j[k] + dj) * w as i32 + i[k] + di) as usize];
+                let quad = [at(0, 0), at(1, 0), at(0, 1), at(1, 1)];
+                let want = blend(scalar.decode4(quad), a[k], b[k]);
+                let (got, want) = (out[k].map(f32::to_bits), want.to_array().map(f32::to_bits));
+                assert_eq!(got, want, "{w}x{h} quad {} {}", i[k], j[k]);
+            }
+        }
     }
 }
