@@ -655,9 +655,13 @@ impl Span {
 
     /// The footprints of the span's fragments from `uv`'s planes `p`: [`UvPlanes::footprint`]'s
     /// operations, stage by stage over the span in `f32` (eight lanes with AVX2), for a tile
-    /// whose top-left pixel is `origin`. Without `deriv` the derivatives are zero.
+    /// whose top-left pixel is `origin`. Without `deriv` the derivatives are zero where `shaded`
+    /// (shading reads the footprint), else left as an earlier span wrote them: then nothing
+    /// reads them (`deriv` is set where the sampler uses derivatives, footprints are captured or
+    /// a material may need them), and writing only `u` and `v` spares the interleaving of six
+    /// fields: nearest frames retire 10 % fewer instructions, bilinear 6.6 % (perf-log 44).
     #[inline(always)]
-    fn plane_footprints(&mut self, p: &UvPlanes, origin: [u32; 2], deriv: bool) {
+    fn plane_footprints(&mut self, p: &UvPlanes, origin: [u32; 2], deriv: bool, shaded: bool) {
         let n = self.n;
         // Tile-local anchor: `li - a` is the frame's `i - anchor`, exactly as `UvPlanes::offset`.
         let (ai, aj) = (
@@ -676,21 +680,29 @@ impl Span {
             self.u[k] = p.value(0, x, y, inv);
             self.v[k] = p.value(1, x, y, inv);
         }
-        for k in 0..n {
-            let (u, v, inv) = (self.u[k], self.v[k], self.inv[k]);
-            let fp = &mut self.fps[k];
-            (fp.dudx, fp.dudy) = if deriv {
-                p.derivatives(0, u, inv)
-            } else {
-                (0.0, 0.0)
-            };
-            (fp.dvdx, fp.dvdy) = if deriv {
-                p.derivatives(1, v, inv)
-            } else {
-                (0.0, 0.0)
-            };
-            fp.u = p.reduce(0, u);
-            fp.v = p.reduce(1, v);
+        if deriv || shaded {
+            for k in 0..n {
+                let (u, v, inv) = (self.u[k], self.v[k], self.inv[k]);
+                let fp = &mut self.fps[k];
+                (fp.dudx, fp.dudy) = if deriv {
+                    p.derivatives(0, u, inv)
+                } else {
+                    (0.0, 0.0)
+                };
+                (fp.dvdx, fp.dvdy) = if deriv {
+                    p.derivatives(1, v, inv)
+                } else {
+                    (0.0, 0.0)
+                };
+                fp.u = p.reduce(0, u);
+                fp.v = p.reduce(1, v);
+            }
+        } else {
+            for k in 0..n {
+                let fp = &mut self.fps[k];
+                fp.u = p.reduce(0, self.u[k]);
+                fp.v = p.reduce(1, self.v[k]);
+            }
         }
     }
 }
@@ -813,7 +825,7 @@ fn flush_span(
             if shaded {
                 span.barycentrics(t, ctx.settings.perspective, deriv, [tile.x0, tile.y0]);
             }
-            span.plane_footprints(p, [tile.x0, tile.y0], deriv);
+            span.plane_footprints(p, [tile.x0, tile.y0], deriv, shaded);
         }
     }
     let (fps, bytes) = (&span.fps[..n], &mut span.bytes[..n]);

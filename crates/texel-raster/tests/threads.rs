@@ -235,6 +235,40 @@ fn batched_equals_per_pixel_where_draws_cross_in_depth() {
     }
 }
 
+/// Draws with different samplers in the same tiles: the span scratch keeps its footprints
+/// between draws, and an unshaded draw whose sampler ignores derivatives (nearest, bilinear)
+/// writes only `u` and `v`, leaving the derivatives of an earlier draw (trilinear, mip-nearest)
+/// in place. Those are never read: the frames equal the per-pixel path's, bit for bit, in either
+/// order, with and without captured footprints (which write every field).
+#[test]
+fn batched_equals_per_pixel_when_samplers_alternate() {
+    let (w, h) = (300, 170);
+    let (mut sloped, triangles, texture) = screen_grid(w, h, 60, 40);
+    let mut flat = sloped.clone();
+    for v in &mut sloped {
+        v.position.z = 0.5 * v.position.x + 0.05 * v.position.y;
+    }
+    for v in &mut flat {
+        v.position.z = 0.1;
+        v.uv = Vec2::new(v.uv.y * 3.0, v.uv.x * 2.0);
+    }
+    for (first, second) in [(4, 2), (2, 4), (3, 1), (1, 4)] {
+        let (a, b) = (lab_sampler(first), lab_sampler(second));
+        let draw = |vertices, sampler| DrawCall {
+            vertices,
+            triangles: &triangles,
+            texture: &texture,
+            sampler,
+            clip_from_world: Mat4::IDENTITY,
+            material: None,
+            uv_mapping: None,
+        };
+        let draws = [draw(&sloped, &a), draw(&flat, &b), draw(&sloped, &b)];
+        let label = format!("lab modes {first} then {second}");
+        assert_draws_batched_equal_per_pixel(&RenderSettings::new(w, h), &draws, &label);
+    }
+}
+
 #[test]
 fn reference_is_identical_for_any_thread_count_and_deterministic() {
     let (w, h) = (140, 80);

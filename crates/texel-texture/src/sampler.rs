@@ -329,8 +329,9 @@ impl Sampler {
     }
 
     /// Whether samples depend on the footprint's derivatives. `false` when there is no
-    /// mipmapping and `mag_filter == min_filter` (the lod cannot change the result): a caller
-    /// may then pass zero derivatives and skip computing them.
+    /// mipmapping and `mag_filter == min_filter` (the lod cannot change the result): no sampling
+    /// path then reads the footprint's derivative fields, so a caller may skip computing them
+    /// and pass any values (the rasterizer leaves a reused scratch's earlier values in place).
     pub fn uses_derivatives(&self) -> bool {
         !self.lod_free
     }
