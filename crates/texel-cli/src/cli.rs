@@ -511,7 +511,8 @@ pub struct BenchArgs {
     pub adapter: Option<String>,
 }
 
-/// Which copy of the tile rasterizer runs (`texel_raster::simd_level`).
+/// Which instruction-set copy the tile rasterizer and the sampler's batch kernels run
+/// (`texel_raster::simd_level`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SimdArg {
     /// The best the CPU has.

@@ -273,7 +273,8 @@ fn cpu_model() -> String {
         .unwrap_or_else(|| std::env::consts::ARCH.to_string())
 }
 
-/// The instruction set the rasterizer's tiles run on (run-time dispatch, see
+/// The instruction set the rasterizer's tiles and the sampler's batch kernels run on (run-time
+/// dispatch, see
 /// `texel_raster::simd_level`).
 fn simd_level() -> String {
     format!("{}, run-time dispatch", texel_raster::simd_level().name())

@@ -24,7 +24,8 @@
 //!
 //! Row-span batching: in the colour view without texel counting, a triangle's covered,
 //! depth-passing fragments in a tile are gathered into structure-of-arrays scratch (`Span`, one
-//! per tile, reused, never cleared per triangle): up to 64 fragments over as many rows as fit,
+//! per thread, reused by every tile and frame it renders, never cleared per triangle): up to 256
+//! fragments over as many rows as fit,
 //! each fragment carrying its row. The span is then interpolated stage by stage (`1/w`, `u'` and
 //! `v'` and their derivatives from the triangle's `f32` `UvPlanes` re-anchored in the tile, eight
 //! lanes with AVX2; the `f64` barycentrics only where shading or a sphere mapping reads them;
@@ -41,8 +42,9 @@
 //! 16 footprints with 16-sample scratch). The periodic `uv` reduction multiplies by the exact
 //! reciprocal of the period instead of dividing. The planes' anchor is chosen from the triangle's
 //! box in the whole tile, not the scissored range, so a scissor never changes a pixel. When the sampler ignores derivatives
-//! (`Sampler::uses_derivatives`: nearest or bilinear without mipmaps) and footprints are not
-//! captured, the span skips them. Frames are reusable (`render_into`, `draw_into`).
+//! (`Sampler::uses_derivatives`: nearest, bilinear or a cubic filter without mipmaps, `mag_filter ==
+//! min_filter`) and footprints are not captured, the span skips them; unshaded, it leaves the
+//! footprints' derivative fields as an earlier span wrote them (nothing reads them). Frames are reusable (`render_into`, `draw_into`).
 //!
 //! Frame times, the mesh's triangle rate and the profiles are in README.md's Benchmarks section;
 //! how each of these decisions moved them is in docs/perf-log.md.
@@ -160,6 +162,16 @@ struct Context<'a> {
     background: Option<(Environment<'a>, ViewRays)>,
     /// Per draw: how its colour-view fragments are sampled ([`Route::of`]).
     routes: Vec<Route>,
+}
+
+impl Context<'_> {
+    /// Whether `dc`'s fragments are shaded (`shade` reads their barycentrics and footprints): a
+    /// material, vertex colours or lights. Where not, the colour is the sample, and a span may
+    /// leave the footprints' unread derivative fields unwritten (`Span::plane_footprints`).
+    #[inline(always)]
+    fn shades(&self, dc: &DrawContext) -> bool {
+        !dc.unshaded() || self.lighting.is_some()
+    }
 }
 
 /// How a draw's colour-view fragments get their texture colour.
@@ -659,7 +671,7 @@ impl Span {
     /// (shading reads the footprint), else left as an earlier span wrote them: then nothing
     /// reads them (`deriv` is set where the sampler uses derivatives, footprints are captured or
     /// a material may need them), and writing only `u` and `v` spares the interleaving of six
-    /// fields: nearest frames retire 10 % fewer instructions, bilinear 6.6 % (perf-log 44).
+    /// fields: nearest frames retire 10 % fewer instructions, bilinear 6.5 % (perf-log 44).
     #[inline(always)]
     fn plane_footprints(&mut self, p: &UvPlanes, origin: [u32; 2], deriv: bool, shaded: bool) {
         let n = self.n;
@@ -811,11 +823,11 @@ fn flush_span(
     if n == 0 {
         return;
     }
-    // Nearest or bilinear without mipmaps ignore the derivatives: skip them unless captured or a
-    // material's maps may need them.
+    // Samplers without mipmaps whose two filters agree ignore the derivatives: skip them unless
+    // captured or a material's maps may need them.
     let deriv = ctx.capture || dc.sampler.uses_derivatives() || dc.material.is_some();
     // Barycentrics only where something reads them: shading, or a sphere mapping.
-    let shaded = !dc.unshaded() || ctx.lighting.is_some();
+    let shaded = ctx.shades(dc);
     match source {
         UvSource::Mapped(m) => {
             span.barycentrics(t, ctx.settings.perspective, deriv, [tile.x0, tile.y0]);
@@ -875,7 +887,7 @@ fn shade_span(
     let verts = dc.vertices(t);
     // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).
     let lit = ctx.lighting.as_ref();
-    if !dc.unshaded() || lit.is_some() {
+    if ctx.shades(dc) {
         for k in 0..n {
             let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
             let dlambda = [

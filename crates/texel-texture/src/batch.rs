@@ -682,24 +682,46 @@ impl<const N: usize, T: Taps> Pass<N, T> {
 
 /// Filter `footprints` into `out` (same length) with `s`'s core kernel: `min_filter` Nearest or
 /// Linear (equal to `mag_filter`), any `mipmap_filter`, level 0 below [`MAX_SIDE`] per side
-/// (`Sampler::new` decides; see `Sampler::sample_batch`); with `fixed`, [`crate::fixed8`]'s
-/// fixed-point filters (on a pyramid of stored codes). Texels outside the level under
+/// (`Sampler::new` decides; see `Sampler::sample_batch`). Texels outside the level under
 /// `ClampToBorder` read `addr.border` (the sampler's own address, or for the stored-codes paths
 /// its border colour as codes).
 #[inline(always)]
 pub(crate) fn run<P: Pyramid>(
     p: &P,
     s: &Sampler,
-    (addr, fixed): (Address, bool),
+    addr: Address,
     footprints: &[Footprint],
     out: &mut [[f32; 4]],
 ) {
-    let io = (footprints, out);
-    match (s.descriptor().min_filter, fixed) {
-        (FilterMode::Nearest, false) => run_with(p, Point, s, addr, io),
-        (_, false) => run_with(p, Bilinear, s, addr, io),
-        (FilterMode::Nearest, true) => run_with(p, Point8, s, addr, io),
-        (_, true) => run_with(p, Bilinear8, s, addr, io),
+    run_taps(p, (Point, Bilinear), s, addr, (footprints, out));
+}
+
+/// [`run`] with [`crate::fixed8`]'s fixed-point filters, on a pyramid of stored codes. A function
+/// of its own, not a flag of [`run`]: each pairing of a pyramid with a filter is compiled as a
+/// kernel per instruction set, and the float pyramids never take these filters.
+#[inline(always)]
+pub(crate) fn run_fixed<P: Pyramid>(
+    p: &P,
+    s: &Sampler,
+    addr: Address,
+    footprints: &[Footprint],
+    out: &mut [[f32; 4]],
+) {
+    run_taps(p, (Point8, Bilinear8), s, addr, (footprints, out));
+}
+
+/// [`run`] with `near` where `min_filter` is Nearest, else `linear`.
+#[inline(always)]
+fn run_taps<P: Pyramid, N: Taps, L: Taps>(
+    p: &P,
+    (near, linear): (N, L),
+    s: &Sampler,
+    addr: Address,
+    io: (&[Footprint], &mut [[f32; 4]]),
+) {
+    match s.descriptor().min_filter {
+        FilterMode::Nearest => run_with(p, near, s, addr, io),
+        _ => run_with(p, linear, s, addr, io),
     }
 }
 

@@ -13,8 +13,9 @@
 //! whole batched sampler, each of its three copies was one function of about 2.2 MB of machine
 //! code (480 000 instructions, nine tenths of them the sampler's), and LLVM's time on a function
 //! grows faster than its size: texel-raster's one `rustc` took most of a 50-minute release build
-//! (docs/perf-log.md, entry 42). A call per sampled span (up to 256 fragments) costs a few
-//! nanoseconds against microseconds of filtering.
+//! (docs/perf-log.md, entry 42). A dispatch per sampled span of the rasterizer (up to 256
+//! fragments; per 64-footprint chunk on the stored-codes paths) costs a few nanoseconds against
+//! microseconds of filtering.
 //!
 //! Images are bit for bit the same on every copy: Rust never fuses a multiply and an add unless
 //! asked (`mul_add`), and no code here asks, and without fast-math flags LLVM emits no
@@ -43,7 +44,8 @@ use std::sync::OnceLock;
 
 use crate::Lanes;
 
-/// The instruction set the rasterizer's tiles run on, ordered from the least to the most.
+/// The instruction set the dispatched kernels (the sampler's batch kernels, the rasterizer's
+/// tiles) run on, ordered from the least to the most.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum SimdLevel {
     /// The build's own target (x86-64: SSE2; other architectures: their baseline).
@@ -118,14 +120,14 @@ fn detect() -> SimdLevel {
     SimdLevel::Baseline
 }
 
-/// The level tiles run on now: the best the CPU has (detected once), or the limit set by
+/// The level [`run`] picks now: the best the CPU has (detected once), or the limit set by
 /// [`limit_level`] when that is lower.
 pub fn level() -> SimdLevel {
     let limit = LIMIT.load(Ordering::Relaxed) as usize;
     detected().min(SimdLevel::ALL[limit.min(SimdLevel::ALL.len() - 1)])
 }
 
-/// Run every later tile on a copy no higher than `max` (`SimdLevel::Baseline`: the baseline copy;
+/// Run every later kernel (sampler batches, rasterizer tiles) on a copy no higher than `max` (`SimdLevel::Baseline`: the baseline copy;
 /// the highest level: the CPU's best again), for comparing the copies. A level above the CPU's
 /// runs the CPU's best. Process-wide; images do not depend on it.
 pub fn limit_level(max: SimdLevel) {

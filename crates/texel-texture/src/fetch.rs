@@ -277,6 +277,7 @@ fn rows2<T>(texels: &[T], width: u32, i: u32, j: u32) -> (&[T], &[T]) {
 /// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level
 /// (`i + 1 < width`, `j + 1` below the height; out of bounds panics), by one range check: the
 /// rows lie in the `width + 2` texels from `(i, j)`, whose elements then need none.
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 run kernel
 #[inline(always)]
 pub(crate) fn quad_rows<T: Copy>(texels: &[T], width: u32, i: u32, j: u32) -> ([T; 2], [T; 2]) {
     let w = width as usize;
@@ -289,6 +290,7 @@ pub(crate) fn quad_rows<T: Copy>(texels: &[T], width: u32, i: u32, j: u32) -> ([
 /// sampler's inside route, `batch.rs`): per sample its first tap `(i[k], j[k])` (non-negative)
 /// and fractions `a[k]`, `b[k]`. The four slices have the run's length.
 #[derive(Clone, Copy)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 run kernel
 pub(crate) struct Run<'r> {
     pub i: &'r [i32],
     pub j: &'r [i32],

@@ -485,7 +485,11 @@ impl Sampler {
             .zip(out.chunks_mut(batch::CHUNK))
         {
             let codes = &mut codes[..fps.len()];
-            batch::run(&p, self, (addr, fixed), fps, codes);
+            if fixed {
+                batch::run_fixed(&p, self, addr, fps, codes);
+            } else {
+                batch::run(&p, self, addr, fps, codes);
+            }
             for (o, c) in out.iter_mut().zip(codes.iter()) {
                 // Codes are integers in 0..=255: read from bits, without a saturating float
                 // conversion per channel.
@@ -534,7 +538,7 @@ impl Sampler {
             let staged = size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE;
             if self.batched && staged {
                 // `batch::run` dispatches per within-level filter.
-                return batch::run(&p, self, (self.addr, false), footprints, out);
+                return batch::run(&p, self, self.addr, footprints, out);
             }
             crate::dispatch::run(BatchJob {
                 s: self,

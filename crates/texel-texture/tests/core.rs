@@ -82,13 +82,15 @@ fn spread(k: usize) -> (f32, f32) {
     (t.fract(), (t * 0.37).fract())
 }
 
-/// `sample_batch` and `sample_batch_lanes` with [`Lanes::detect`] (the eight-lane kernel where the
-/// CPU has it) of `fps` each equal `sample` bit for bit; `case` names the sampler in a failure.
+/// `sample_batch` (on the CPU's best copy: the eight-lane quad kernel and its runs where the CPU
+/// has AVX2) and `sample_batch_lanes` with [`Lanes::scalar`] (the four-lane kernel, and the
+/// per-sample loops where the run kernel declines) of `fps` each equal `sample` bit for bit;
+/// `case` names the sampler in a failure.
 fn assert_batches_equal_single(s: &Sampler, tex: &Texture, fps: &[Footprint], case: &str) {
     let mut out = vec![[0.0; 4]; fps.len()];
     let mut wide = out.clone();
     s.sample_batch(tex, fps, &mut out);
-    s.sample_batch_lanes(Lanes::detect(), tex, fps, &mut wide);
+    s.sample_batch_lanes(Lanes::scalar(), tex, fps, &mut wide);
     for ((fp, o), w) in fps.iter().zip(&out).zip(&wide) {
         let single = s.sample(tex, fp).map(f32::to_bits);
         assert_eq!(single, o.map(f32::to_bits), "{case} {fp:?}");
@@ -207,8 +209,9 @@ proptest! {
     /// `sample_batch` equals `sample` one by one, bit for bit (lengths beyond the 64-footprint
     /// chunk included): the staged kernels of the core filters (`batch.rs`) and the generic path,
     /// for every filter, mipmap mode and address mode, on 8-bit sRGB, 8-bit linear and float
-    /// textures of odd sizes (a 1-texel-wide one included); and with [`Lanes::detect`]'s quad
-    /// kernel (`sample_batch_lanes`), equal to `sample_batch`.
+    /// textures of odd sizes (a 1-texel-wide one included); and with [`Lanes::scalar`]'s quad
+    /// kernel (`sample_batch_lanes`), equal to `sample_batch` (which takes the eight-lane
+    /// kernel where the CPU has AVX2).
     #[test]
     fn batch_equals_single(
         fps in proptest::collection::vec(footprint_strategy(), 1..150),
@@ -238,8 +241,9 @@ proptest! {
                 for (f, o) in fps.iter().zip(&out) {
                     prop_assert_eq!(s.sample(tex, f).map(f32::to_bits), o.map(f32::to_bits), "{:?} {:?}", s.descriptor(), f);
                 }
-                // The eight-lane quad kernel (where the CPU has it) gives the same bits.
-                s.sample_batch_lanes(Lanes::detect(), tex, &fps, &mut wide);
+                // The four-lane quad kernel gives the same bits as `sample_batch`'s (the
+                // eight-lane one where the CPU has AVX2).
+                s.sample_batch_lanes(Lanes::scalar(), tex, &fps, &mut wide);
                 prop_assert_eq!(out.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>(), wide.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>(), "{:?}", s.descriptor());
             }
         }
@@ -1293,4 +1297,75 @@ proptest! {
             }
         }
     }
+}
+
+/// `Sampler::uses_derivatives`' contract: where it is `false` (no mipmaps, `mag_filter ==
+/// min_filter`) no sampling path reads a footprint's derivative fields, so a caller may leave any
+/// values there (the rasterizer leaves a reused scratch's earlier ones). Footprints whose
+/// derivatives are NaN, infinite, huge or tiny sample bit for bit as with zero derivatives, through
+/// `sample`, `sample_batch` (both quad kernels), `sample_batch_stored` and `sample_batch_fixed8`,
+/// for every such sampler (nearest, bilinear and the cubic filters, every address mode) on every
+/// texel format. Samplers that do use derivatives are checked to be told apart.
+#[test]
+fn lod_free_samplers_never_read_derivatives() {
+    let junk = [
+        f32::NAN,
+        f32::INFINITY,
+        -f32::INFINITY,
+        1e30,
+        -3.5,
+        1e-30,
+        0.75,
+    ];
+    let zeroed: Vec<Footprint> = (0..150)
+        .map(|k| {
+            let (u, v) = spread(k);
+            Footprint::point(u * 3.0 - 1.0, v * 2.0 - 0.5)
+        })
+        .collect();
+    let junked: Vec<Footprint> = zeroed
+        .iter()
+        .enumerate()
+        .map(|(k, f)| Footprint {
+            dudx: junk[k % 7],
+            dudy: junk[(k + 1) % 7],
+            dvdx: junk[(k + 3) % 7],
+            dvdy: junk[(k + 5) % 7],
+            ..*f
+        })
+        .collect();
+    let bits = |v: &[[f32; 4]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let mut lod_free = 0;
+    for format in [Format::Rgba8Srgb, Format::Rgba8Unorm, Format::Rgba32Float] {
+        let tex = noise_texture(37, 21, format);
+        for s in every_sampler(BorderColor::OpaqueWhite) {
+            if s.uses_derivatives() {
+                assert_ne!(s.descriptor().mipmap_filter, MipmapFilterMode::None);
+                continue;
+            }
+            lod_free += 1;
+            let case = format!("{format:?} {:?}", s.descriptor());
+            for (z, j) in zeroed.iter().zip(&junked) {
+                let (a, b) = (s.sample(&tex, z), s.sample(&tex, j));
+                assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "sample {case}");
+            }
+            for lanes in [Lanes::scalar(), Lanes::detect()] {
+                let mut a = vec![[0.0; 4]; zeroed.len()];
+                let mut b = a.clone();
+                s.sample_batch_lanes(lanes, &tex, &zeroed, &mut a);
+                s.sample_batch_lanes(lanes, &tex, &junked, &mut b);
+                assert_eq!(bits(&a), bits(&b), "sample_batch {case}");
+            }
+            let mut a = vec![[0u8; 4]; zeroed.len()];
+            let mut b = a.clone();
+            let took = s.sample_batch_stored(&tex, &zeroed, &mut a);
+            assert_eq!(took, s.sample_batch_stored(&tex, &junked, &mut b), "{case}");
+            assert_eq!(a, b, "sample_batch_stored {case}");
+            let took = s.sample_batch_fixed8(&tex, &zeroed, &mut a);
+            assert_eq!(took, s.sample_batch_fixed8(&tex, &junked, &mut b), "{case}");
+            assert_eq!(a, b, "sample_batch_fixed8 {case}");
+        }
+    }
+    // Nearest, bilinear and three cubic filters under five address modes, three formats.
+    assert_eq!(lod_free, 3 * 5 * 5);
 }
