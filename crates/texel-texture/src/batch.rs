@@ -56,6 +56,12 @@ const LEVELS: usize = 32;
 /// take the one-sample path sample by sample.
 pub(crate) const MAX_SIDE: u32 = STAGED_F32_LIMIT as u32;
 
+/// Whether the staged kernels take a level 0 of `(width, height)`: both sides at most
+/// [`MAX_SIDE`].
+pub(crate) fn staged((w, h): (u32, u32)) -> bool {
+    w <= MAX_SIDE && h <= MAX_SIDE
+}
+
 /// A chunk of up to `N` queries, as arrays (so the stages vectorise); the first `n` are valid.
 /// Entries from `n` on hold stale values of earlier chunks (or their initial values): stage 0
 /// ([`queries`]) computes them too, so that its loops have no remainder, and nothing reads them.

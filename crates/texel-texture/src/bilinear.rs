@@ -13,8 +13,9 @@
 //! of samples, so the results are bit for bit equal.
 //!
 //! When all four texels lie inside the level (every address mode is the identity there) they are
-//! read as two 2-texel row slices ([`Fetch::quad`]), skipping the four wraps and the border test;
-//! only samples within half a texel of an edge wrap their indices. Results are the same either way.
+//! read as two 2-texel rows of one range ([`Fetch::quad`]), skipping the four wraps and the
+//! border test; only samples within half a texel of an edge wrap their indices. Results are the
+//! same either way.
 
 use glam::{Vec2, Vec4};
 

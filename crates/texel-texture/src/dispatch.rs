@@ -127,9 +127,10 @@ pub fn level() -> SimdLevel {
     detected().min(SimdLevel::ALL[limit.min(SimdLevel::ALL.len() - 1)])
 }
 
-/// Run every later kernel (sampler batches, rasterizer tiles) on a copy no higher than `max` (`SimdLevel::Baseline`: the baseline copy;
-/// the highest level: the CPU's best again), for comparing the copies. A level above the CPU's
-/// runs the CPU's best. Process-wide; images do not depend on it.
+/// Run every later kernel (sampler batches, rasterizer tiles) on a copy no higher than `max`
+/// (`SimdLevel::Baseline`: the baseline copy; the highest level: the CPU's best again), for
+/// comparing the copies. A level above the CPU's runs the CPU's best. Process-wide; images do
+/// not depend on it.
 pub fn limit_level(max: SimdLevel) {
     LIMIT.store(max as u8, Ordering::Relaxed);
 }

@@ -253,8 +253,9 @@ pub(crate) trait Fetch: Copy {
         false
     }
     /// The 2x2 texels `[(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]`; `i + 1 < width`,
-    /// `j + 1 < height` (no wrapping). The storage views read them as two 2-texel row slices,
-    /// so a bilinear lookup inside the level pays two bounds checks instead of four.
+    /// `j + 1 < height` (no wrapping). The storage views read them as two 2-texel rows of one
+    /// range ([`quad_rows`]), so a bilinear lookup inside the level pays one bounds check instead
+    /// of four.
     #[inline(always)]
     fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
         [
@@ -266,18 +267,9 @@ pub(crate) trait Fetch: Copy {
     }
 }
 
-/// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level.
-#[inline(always)]
-fn rows2<T>(texels: &[T], width: u32, i: u32, j: u32) -> (&[T], &[T]) {
-    let w = width as usize;
-    let k = j as usize * w + i as usize;
-    (&texels[k..k + 2], &texels[k + w..k + w + 2])
-}
-
 /// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level
 /// (`i + 1 < width`, `j + 1` below the height; out of bounds panics), by one range check: the
 /// rows lie in the `width + 2` texels from `(i, j)`, whose elements then need none.
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 run kernel
 #[inline(always)]
 pub(crate) fn quad_rows<T: Copy>(texels: &[T], width: u32, i: u32, j: u32) -> ([T; 2], [T; 2]) {
     let w = width as usize;
@@ -310,14 +302,13 @@ impl<D: Decode> Fetch for Level<'_, D> {
     }
     #[inline(always)]
     fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
-        let (r0, r1) = rows2(self.texels, self.width, i, j);
+        let (r0, r1) = quad_rows(self.texels, self.width, i, j);
         self.decode.decode4([r0[0], r0[1], r1[0], r1[1]])
     }
     #[inline(always)]
     fn bilinear_quad(&self, i: u32, j: u32, a: f32, b: f32) -> Vec4 {
-        let (r0, r1) = rows2(self.texels, self.width, i, j);
-        self.decode
-            .bilinear_rows([r0[0], r0[1]], [r1[0], r1[1]], a, b)
+        let (r0, r1) = quad_rows(self.texels, self.width, i, j);
+        self.decode.bilinear_rows(r0, r1, a, b)
     }
     #[inline(always)]
     fn bilinear_run(&self, run: Run<'_>, out: &mut [[f32; 4]]) -> bool {

@@ -414,8 +414,7 @@ impl Sampler {
     pub fn filters_fixed8(&self, texture: &Texture) -> bool {
         self.batched
             && texture.format() == Format::Rgba8Unorm
-            && texture.width() <= batch::MAX_SIDE
-            && texture.height() <= batch::MAX_SIDE
+            && batch::staged((texture.width(), texture.height()))
     }
 
     /// GPU-style fixed-point filtering ([`crate::fixed8`]): for each footprint the unorm8 code
@@ -462,8 +461,7 @@ impl Sampler {
         let Some(p) = codes_of(texture) else {
             return false;
         };
-        let (w, h) = p.level(0).size();
-        if w > batch::MAX_SIDE || h > batch::MAX_SIDE {
+        if !batch::staged(p.level(0).size()) {
             return false;
         }
         let border = match texture.format() {
@@ -534,16 +532,13 @@ impl Sampler {
             "sample_batch: footprints and out differ in length"
         );
         with_pyramid!(texture, lanes, |p| {
-            let size = p.level(0).size();
-            let staged = size.0 <= batch::MAX_SIDE && size.1 <= batch::MAX_SIDE;
-            if self.batched && staged {
+            if self.batched && batch::staged(p.level(0).size()) {
                 // `batch::run` dispatches per within-level filter.
                 return batch::run(&p, self, self.addr, footprints, out);
             }
             crate::dispatch::run(BatchJob {
                 s: self,
                 p: &p,
-                staged,
                 footprints,
                 out,
             })
@@ -551,19 +546,12 @@ impl Sampler {
     }
 
     /// [`Sampler::sample_batch_lanes`] past the core kernels (`batched`): anisotropic probes
-    /// batched where `staged` (level 0 within the staged kernels' side), else every sample
-    /// through [`Sampler::filter`], with its query and (anisotropic) probe plan made a chunk at
-    /// a time.
+    /// batched where level 0 is within the staged kernels' side, else every sample through
+    /// [`Sampler::filter`], with its query and (anisotropic) probe plan made a chunk at a time.
     #[inline(always)]
-    fn batch_in<P: Pyramid>(
-        &self,
-        p: &P,
-        staged: bool,
-        footprints: &[Footprint],
-        out: &mut [[f32; 4]],
-    ) {
+    fn batch_in<P: Pyramid>(&self, p: &P, footprints: &[Footprint], out: &mut [[f32; 4]]) {
         let size = p.level(0).size();
-        if self.technique == Technique::Anisotropic && staged {
+        if self.technique == Technique::Anisotropic && batch::staged(size) {
             // Probes of several samples filtered together; the rest one by one, as
             // `filter_planned` and `filter` do.
             let mut probes = Probes::new(self.addr);
@@ -683,7 +671,6 @@ impl Sampler {
 struct BatchJob<'j, P> {
     s: &'j Sampler,
     p: &'j P,
-    staged: bool,
     footprints: &'j [Footprint],
     out: &'j mut [[f32; 4]],
 }
@@ -693,7 +680,6 @@ impl<P: Pyramid> crate::dispatch::Kernel for BatchJob<'_, P> {
     /// Ignores `lanes`: a linear 8-bit pyramid carries its quad kernel (`fetch::Unorm8`).
     #[inline(always)]
     fn run(self, _lanes: Lanes) {
-        self.s
-            .batch_in(self.p, self.staged, self.footprints, self.out)
+        self.s.batch_in(self.p, self.footprints, self.out)
     }
 }
