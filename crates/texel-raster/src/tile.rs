@@ -58,7 +58,7 @@ use texel_texture::color::{
     rgba_to_unorm8, rgba_to_unorm8_slice, srgb8_encoder, unorm8_table, Srgb8Encoder,
 };
 use texel_texture::dispatch::{self, Kernel};
-use texel_texture::{Footprint, Lanes};
+use texel_texture::{Footprint, FootprintLanes, Lanes};
 
 use crate::draw::DrawCall;
 use crate::environment::{Environment, ViewRays};
@@ -509,17 +509,23 @@ struct Span {
     /// Their x and y derivatives (zero unless the footprint or a material needs them).
     ldx: [[f64; SPAN]; 3],
     ldy: [[f64; SPAN]; 3],
-    /// Their offsets from the [`UvPlanes`] anchor, `1 / r` and `u'`, `v'` ([`UvPlanes`]).
+    /// Their offsets from the [`UvPlanes`] anchor and `1 / r` ([`UvPlanes`]).
     ox: [f32; SPAN],
     oy: [f32; SPAN],
     inv: [f32; SPAN],
+    /// The sampler's input, as lanes ([`FootprintLanes`]): `u` and `v` (first `u'`, `v'` of
+    /// [`UvPlanes`], then reduced in place), and the derivatives `[dudx, dudy, dvdx, dvdy]`,
+    /// written only where `deriv` says they are read.
     u: [f32; SPAN],
     v: [f32; SPAN],
+    d: [[f32; SPAN]; 4],
+    /// Whether `d` holds the span's derivatives (else they are zero: the sampler ignores them
+    /// or nothing reads them).
+    deriv: bool,
     /// Rows gathered so far: `(first, end, contiguous)` fragment ranges, one per row, in order.
     run: [(u32, u32, bool); SPAN],
     runs: usize,
-    /// The sampler's input and output.
-    fps: [Footprint; SPAN],
+    /// The sampler's output.
     texs: [[f32; 4]; SPAN],
     /// The stored-bytes and fixed-point paths' output ([`Route`]).
     bytes: [[u8; 4]; SPAN],
@@ -563,11 +569,49 @@ impl Span {
             runs: 0,
             u: [0.0; SPAN],
             v: [0.0; SPAN],
-            fps: [Footprint::default(); SPAN],
+            d: [[0.0; SPAN]; 4],
+            deriv: false,
             texs: [[0.0; 4]; SPAN],
             bytes: [[0; 4]; SPAN],
             lanes: Lanes::scalar(),
         })
+    }
+
+    /// The span's footprints, as the sampler takes them: a function of the fields it reads, so
+    /// that the sampler's output fields can be borrowed beside it.
+    #[inline(always)]
+    fn footprints<'s>(
+        (n, deriv): (usize, bool),
+        u: &'s [f32; SPAN],
+        v: &'s [f32; SPAN],
+        d: &'s [[f32; SPAN]; 4],
+    ) -> FootprintLanes<'s> {
+        let (u, v) = (&u[..n], &v[..n]);
+        if deriv {
+            let [a, b, c, d] = d;
+            FootprintLanes::new(u, v, [&a[..n], &b[..n], &c[..n], &d[..n]])
+        } else {
+            FootprintLanes::points(u, v)
+        }
+    }
+
+    /// Fragment `k`'s footprint (zero derivatives unless `deriv`).
+    #[inline(always)]
+    fn footprint(&self, k: usize) -> Footprint {
+        // Indexed lane by lane: `self.d.map(..)` would copy the four lanes (4 KB) per call.
+        let d = if self.deriv {
+            [self.d[0][k], self.d[1][k], self.d[2][k], self.d[3][k]]
+        } else {
+            [0.0; 4]
+        };
+        Footprint {
+            u: self.u[k],
+            v: self.v[k],
+            dudx: d[0],
+            dudy: d[1],
+            dvdx: d[2],
+            dvdy: d[3],
+        }
     }
 
     /// Record the fragments from `k` to `self.n` as one row's run (none if empty); `contiguous`:
@@ -662,19 +706,27 @@ impl Span {
                 ]
             });
             let (uv, dx, dy) = m.uv(lambda, dlambda);
-            self.fps[k] = dc.footprint(uv, dx, dy);
+            let fp = dc.footprint(uv, dx, dy);
+            (self.u[k], self.v[k]) = (fp.u, fp.v);
+            if deriv {
+                self.d[0][k] = fp.dudx;
+                self.d[1][k] = fp.dudy;
+                self.d[2][k] = fp.dvdx;
+                self.d[3][k] = fp.dvdy;
+            }
         }
+        self.deriv = deriv;
     }
 
     /// The footprints of the span's fragments from `uv`'s planes `p`: [`UvPlanes::footprint`]'s
     /// operations, stage by stage over the span in `f32` (eight lanes with AVX2), for a tile
-    /// whose top-left pixel is `origin`. Without `deriv` the derivatives are zero where `shaded`
-    /// (shading reads the footprint), else left as an earlier span wrote them: then nothing
-    /// reads them (`deriv` is set where the sampler uses derivatives, footprints are captured or
-    /// a material may need them), and writing only `u` and `v` spares the interleaving of six
-    /// fields: nearest frames retire 10 % fewer instructions, bilinear 6.5 % (perf-log 44).
+    /// whose top-left pixel is `origin`, into the span's lanes ([`Span::footprints`]). The
+    /// derivatives only with `deriv` (set where the sampler uses derivatives, footprints are
+    /// captured or a material may need them); without it the span's footprints have zero
+    /// derivatives and the lanes are not written. The lanes go to the sampler as they are: no
+    /// six-field structs interleaved here and copied back out in the sampler (perf-log 45).
     #[inline(always)]
-    fn plane_footprints(&mut self, p: &UvPlanes, origin: [u32; 2], deriv: bool, shaded: bool) {
+    fn plane_footprints(&mut self, p: &UvPlanes, origin: [u32; 2], deriv: bool) {
         let n = self.n;
         // Tile-local anchor: `li - a` is the frame's `i - anchor`, exactly as `UvPlanes::offset`.
         let (ai, aj) = (
@@ -693,33 +745,21 @@ impl Span {
             self.u[k] = p.value(0, x, y, inv);
             self.v[k] = p.value(1, x, y, inv);
         }
-        // Two loops, each with no branch on `shaded` inside: one loop with `if deriv {..} else if
-        // shaded {..}` in its body did not vectorise (nearest 32.7 -> 52.2 million instructions
-        // a frame, trilinear 106.1 -> 124.2; perf-log 44's review).
-        if deriv || shaded {
+        // The derivatives from the unreduced `u'` and `v'` (reducing would break them at a
+        // period's edge), then `u` and `v` reduced in place; each loop free of branches.
+        if deriv {
+            let [dudx, dudy, dvdx, dvdy] = &mut self.d;
             for k in 0..n {
                 let (u, v, inv) = (self.u[k], self.v[k], self.inv[k]);
-                let fp = &mut self.fps[k];
-                (fp.dudx, fp.dudy) = if deriv {
-                    p.derivatives(0, u, inv)
-                } else {
-                    (0.0, 0.0)
-                };
-                (fp.dvdx, fp.dvdy) = if deriv {
-                    p.derivatives(1, v, inv)
-                } else {
-                    (0.0, 0.0)
-                };
-                fp.u = p.reduce(0, u);
-                fp.v = p.reduce(1, v);
-            }
-        } else {
-            for k in 0..n {
-                let fp = &mut self.fps[k];
-                fp.u = p.reduce(0, self.u[k]);
-                fp.v = p.reduce(1, self.v[k]);
+                (dudx[k], dudy[k]) = p.derivatives(0, u, inv);
+                (dvdx[k], dvdy[k]) = p.derivatives(1, v, inv);
             }
         }
+        for k in 0..n {
+            self.u[k] = p.reduce(0, self.u[k]);
+            self.v[k] = p.reduce(1, self.v[k]);
+        }
+        self.deriv = deriv;
     }
 }
 
@@ -841,10 +881,11 @@ fn flush_span(
             if shaded {
                 span.barycentrics(t, ctx.settings.perspective, deriv, [tile.x0, tile.y0]);
             }
-            span.plane_footprints(p, [tile.x0, tile.y0], deriv, shaded);
+            span.plane_footprints(p, [tile.x0, tile.y0], deriv);
         }
     }
-    let (fps, bytes) = (&span.fps[..n], &mut span.bytes[..n]);
+    let fps = Span::footprints((n, span.deriv), &span.u, &span.v, &span.d);
+    let bytes = &mut span.bytes[..n];
     match ctx.routes[t.draw as usize] {
         Route::Stored if dc.sampler.sample_batch_stored(dc.texture, fps, bytes) => {
             let (color8, depth) = (&mut tile.color8, &mut tile.depth);
@@ -865,7 +906,7 @@ fn flush_span(
     }
     if ctx.capture {
         for k in 0..n {
-            tile.footprints[span.lj[k] as usize][span.li[k] as usize] = span.fps[k];
+            tile.footprints[span.lj[k] as usize][span.li[k] as usize] = span.footprint(k);
         }
     }
     span.n = 0;
@@ -885,8 +926,9 @@ fn shade_span(
 ) {
     let n = span.n;
     if sample {
+        let fps = Span::footprints((n, span.deriv), &span.u, &span.v, &span.d);
         dc.sampler
-            .sample_batch_lanes(span.lanes, dc.texture, &span.fps[..n], &mut span.texs[..n]);
+            .sample_batch_lanes(span.lanes, dc.texture, fps, &mut span.texs[..n]);
     }
     let verts = dc.vertices(t);
     // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).
@@ -898,8 +940,8 @@ fn shade_span(
                 DVec3::new(span.ldx[0][k], span.ldx[1][k], span.ldx[2][k]),
                 DVec3::new(span.ldy[0][k], span.ldy[1][k], span.ldy[2][k]),
             ];
-            let (tex, fp) = (span.texs[k], &span.fps[k]);
-            span.texs[k] = shade(dc, verts, lambda, dlambda, tex, fp, lit, false).0;
+            let (tex, fp) = (span.texs[k], span.footprint(k));
+            span.texs[k] = shade(dc, verts, lambda, dlambda, tex, &fp, lit, false).0;
         }
     }
     // Fragments arrive row by row: look each row's buffers up once per run of equal rows, with

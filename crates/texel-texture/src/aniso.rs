@@ -137,18 +137,19 @@ pub(crate) fn plan(
 pub(crate) fn plan_chunk(
     s: &Sampler,
     size: (u32, u32),
-    fps: &[Footprint],
+    chunk: &batch::Chunk<{ batch::CHUNK }>,
     out: &mut [Plan; batch::CHUNK],
 ) {
+    let n = chunk.n;
     let mut special = false;
-    for (o, fp) in out.iter_mut().zip(fps) {
-        let (p, sub) = plan(s, size, fp, log2_normal);
+    for (k, o) in out[..n].iter_mut().enumerate() {
+        let (p, sub) = plan(s, size, &chunk.footprint(k), log2_normal);
         *o = p;
         special |= sub;
     }
     if special {
-        for (o, fp) in out.iter_mut().zip(fps) {
-            let (p, sub) = plan(s, size, fp, fast_log2);
+        for (k, o) in out[..n].iter_mut().enumerate() {
+            let (p, sub) = plan(s, size, &chunk.footprint(k), fast_log2);
             if sub {
                 *o = p;
             }

@@ -40,6 +40,7 @@ use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
 use crate::footprint::{
     finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, Query,
 };
+use crate::footprints::{chunks, Source};
 use crate::lanes::Lanes;
 use crate::mip::{self, LevelFilter};
 use crate::nearest::Point;
@@ -72,6 +73,10 @@ pub(crate) struct Chunk<const N: usize> {
     pub v: [f32; N],
     /// The isotropic lod (0 for a lod-free sampler).
     pub lod: [f32; N],
+    /// The derivatives' lanes `[du/dx, dv/dx, du/dy, dv/dy]`, for samplers that use them
+    /// ([`Sampler::uses_derivatives`]; for the others stale, and never read). Ones from `n` to
+    /// the next multiple of 16, so that those lanes have a normal rho^2.
+    pub d: [[f32; N]; 4],
     /// Valid entries.
     pub n: usize,
 }
@@ -82,19 +87,31 @@ impl<const N: usize> Chunk<N> {
             u: [0.0; N],
             v: [0.0; N],
             lod: [0.0; N],
+            d: [[1.0; N]; 4],
             n: 0,
         }
     }
 
-    /// Query `k` of the chunk, whose footprint (derivatives) is `fp`.
+    /// Footprint `k` of the chunk: finite `u` and `v`, and its derivatives (stale for a sampler
+    /// that does not use them, which then reads none: [`Sampler::uses_derivatives`]).
     #[inline(always)]
-    pub(crate) fn query(&self, k: usize, fp: &Footprint) -> Query {
+    pub(crate) fn footprint(&self, k: usize) -> Footprint {
+        let [dudx, dvdx, dudy, dvdy] = &self.d;
+        Footprint {
+            u: self.u[k],
+            v: self.v[k],
+            dudx: dudx[k],
+            dudy: dudy[k],
+            dvdx: dvdx[k],
+            dvdy: dvdy[k],
+        }
+    }
+
+    /// Query `k` of the chunk ([`Chunk::footprint`] and its lod).
+    #[inline(always)]
+    pub(crate) fn query(&self, k: usize) -> Query {
         Query {
-            fp: Footprint {
-                u: self.u[k],
-                v: self.v[k],
-                ..*fp
-            },
+            fp: self.footprint(k),
             lod: self.lod[k],
         }
     }
@@ -111,38 +128,39 @@ impl<const N: usize> Chunk<N> {
 /// vectorises. The inputs that path does not cover (`rho^2` zero or subnormal) are rare; a second
 /// loop recomputes those lanes with the scalar functions.
 ///
-/// The footprints are first copied into lanes (one array per field), and the arithmetic then
-/// runs over the lanes rounded up to a multiple of 16 (at most `N`; the entries beyond `n` are
-/// stale and unread), so that it vectorises at the full width with no remainder loop: read from
-/// the 24-byte structs, the lod loop ran four lanes wide plus a scalar remainder
-/// (docs/perf-log.md, entry 30).
+/// The footprints are first copied into the chunk's lanes (one array per field), and the lod arithmetic then runs over the lanes rounded up to a multiple
+/// of 16 (at most `N`; the entries beyond `n` are ones or stale and unread), so that it
+/// vectorises at the full width with no remainder loop: read from the 24-byte structs, the lod
+/// loop ran four lanes wide plus a scalar remainder (docs/perf-log.md, entry 30).
 #[inline(always)]
-pub(crate) fn queries<const N: usize>(
+pub(crate) fn queries<S: Source, const N: usize>(
     s: &Sampler,
     size: (u32, u32),
-    fps: &[Footprint],
+    fps: S,
     out: &mut Chunk<N>,
 ) {
     let n = fps.len().min(N);
     out.n = n;
     let deriv = s.uses_derivatives();
-    // The derivatives' lanes `(du/dx, dv/dx, du/dy, dv/dy)`: ones, not zeros, beyond `n`, so that
-    // those lanes have a normal rho^2 (zeros would send every chunk shorter than a multiple of
-    // 16 through the scalar recomputation below).
-    let mut d = [[1.0f32; N]; 4];
-    let [dudx, dvdx, dudy, dvdy] = &mut d;
+    let lanes = n.next_multiple_of(16).min(N);
+    let [dudx, dvdx, dudy, dvdy] = &mut out.d;
+    fps.uv_into(&mut out.u[..n], &mut out.v[..n]);
     if deriv {
-        for (k, f) in fps[..n].iter().enumerate() {
-            (out.u[k], out.v[k]) = (f.u, f.v);
-            (dudx[k], dvdx[k], dudy[k], dvdy[k]) = (f.dudx, f.dvdx, f.dudy, f.dvdy);
-        }
-    } else {
-        // Lod-free (bilinear frames measured 4-6 % slower copying the derivatives too).
-        for (k, f) in fps[..n].iter().enumerate() {
-            (out.u[k], out.v[k]) = (f.u, f.v);
+        // Lod-free samplers skip this (bilinear frames measured 4-6 % slower copying the
+        // derivatives too).
+        fps.derivatives_into([
+            &mut dudx[..n],
+            &mut dvdx[..n],
+            &mut dudy[..n],
+            &mut dvdy[..n],
+        ]);
+        // Ones, not zeros (nor an earlier chunk's values), up to `lanes`, so that those lanes
+        // have a normal rho^2 (zeros would send every chunk shorter than a multiple of 16
+        // through the scalar recomputation below).
+        for lane in [&mut *dudx, &mut *dvdx, &mut *dudy, &mut *dvdy] {
+            lane[n..lanes].fill(1.0);
         }
     }
-    let lanes = n.next_multiple_of(16).min(N);
     for (u, v) in out.u[..lanes].iter_mut().zip(&mut out.v[..lanes]) {
         *u = finite_uv(*u);
         *v = finite_uv(*v);
@@ -176,10 +194,10 @@ pub(crate) fn queries<const N: usize>(
         special |= finite & (rho2 < f32::MIN_POSITIVE);
     }
     if special {
-        for (f, lod) in fps.iter().zip(out.lod.iter_mut()) {
-            let rho2 = rho_squared(f, size.0, size.1);
+        for k in 0..n {
+            let rho2 = rho_squared(&out.footprint(k), size.0, size.1);
             if rho2 < f32::MIN_POSITIVE {
-                *lod = lod_from_rho_squared(rho2, bias, min, max);
+                out.lod[k] = lod_from_rho_squared(rho2, bias, min, max);
             }
         }
     }
@@ -230,10 +248,10 @@ const PROBES: usize = 256;
 /// magnification filter). Bit for bit [`crate::aniso::filter_planned`]: the same probe positions,
 /// levels and blends, each sample's probes summed in order from zero, times `1 / N`.
 #[inline(always)]
-pub(crate) fn anisotropic<P: Pyramid>(
+pub(crate) fn anisotropic<P: Pyramid, S: Source>(
     p: &P,
     s: &Sampler,
-    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
+    (footprints, out): (S, &mut [[f32; 4]]),
     mut single: impl FnMut(&Query, &crate::aniso::Plan) -> Vec4,
 ) {
     let size0 = p.level(0).size();
@@ -260,11 +278,11 @@ pub(crate) fn anisotropic<P: Pyramid>(
     let mut sums = [Vec4::ZERO; CHUNK];
     let mut inv = [0.0f32; CHUNK];
     let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
-    for (fps, out) in footprints.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+    for (fps, out) in chunks(footprints, CHUNK).zip(out.chunks_mut(CHUNK)) {
         queries(s, size0, fps, &mut chunk);
-        crate::aniso::plan_chunk(s, size0, fps, &mut plans);
-        for (k, fp) in fps.iter().enumerate() {
-            let (q, plan) = (chunk.query(k, fp), &plans[k]);
+        crate::aniso::plan_chunk(s, size0, &chunk, &mut plans);
+        for k in 0..fps.len() {
+            let (q, plan) = (chunk.query(k), &plans[k]);
             if !(q.lod > 0.0 && plan.n > 1) {
                 inv[k] = 0.0;
                 out[k] = single(&q, plan).to_array();
@@ -462,10 +480,10 @@ impl ProbeBatch {
 /// in `addr`) gives the codes. The indices of a chunk are computed in one loop that vectorises,
 /// then the texels are copied.
 /// On the instruction set's copy for the CPU ([`crate::dispatch`]).
-pub(crate) fn point_bytes(
+pub(crate) fn point_bytes<S: Source>(
     level: &crate::fetch::Level<'_, crate::fetch::Codes8>,
     addr: &Address,
-    footprints: &[Footprint],
+    footprints: S,
     out: &mut [[u8; 4]],
 ) {
     dispatch::run(PointBytesJob {
@@ -477,14 +495,14 @@ pub(crate) fn point_bytes(
 }
 
 /// [`point_bytes`]' arguments, as the dispatcher's unit of work.
-struct PointBytesJob<'j, 'l> {
+struct PointBytesJob<'j, 'l, S> {
     level: &'j crate::fetch::Level<'l, crate::fetch::Codes8>,
     addr: &'j Address,
-    footprints: &'j [Footprint],
+    footprints: S,
     out: &'j mut [[u8; 4]],
 }
 
-impl Kernel for PointBytesJob<'_, '_> {
+impl<S: Source> Kernel for PointBytesJob<'_, '_, S> {
     type Output = ();
     #[inline(always)]
     fn run(self, _lanes: Lanes) {
@@ -494,19 +512,22 @@ impl Kernel for PointBytesJob<'_, '_> {
 
 /// [`point_bytes`]' body.
 #[inline(always)]
-fn point_bytes_in(
+fn point_bytes_in<S: Source>(
     level: &crate::fetch::Level<'_, crate::fetch::Codes8>,
     addr: &Address,
-    footprints: &[Footprint],
+    footprints: S,
     out: &mut [[u8; 4]],
 ) {
     let (w, h) = level.size();
     let (wf, hf) = (w as f32, h as f32);
     let (mut ii, mut jj) = ([0i32; CHUNK], [0i32; CHUNK]);
+    let (mut us, mut vs) = ([0.0f32; CHUNK], [0.0f32; CHUNK]);
     let mut inside = [false; CHUNK];
-    for (fps, out) in footprints.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-        for (k, fp) in fps.iter().enumerate() {
-            let (u, v) = (finite_uv(fp.u), finite_uv(fp.v));
+    for (fps, out) in chunks(footprints, CHUNK).zip(out.chunks_mut(CHUNK)) {
+        let n = fps.len();
+        fps.uv_into(&mut us[..n], &mut vs[..n]);
+        for k in 0..n {
+            let (u, v) = (finite_uv(us[k]), finite_uv(vs[k]));
             let (x, y) = (u * wf - Point::HALF, v * hf - Point::HALF);
             let (i, fi) = floor_clamped(x, wf);
             let (j, fj) = floor_clamped(y, hf);
@@ -514,11 +535,11 @@ fn point_bytes_in(
             jj[k] = j;
             inside[k] = fi >= 0.0 && fi < wf - Point::REACH && fj >= 0.0 && fj < hf - Point::REACH;
         }
-        for (k, (o, fp)) in out.iter_mut().zip(fps).enumerate() {
+        for (k, o) in out.iter_mut().enumerate() {
             *o = if inside[k] {
                 level.texels[jj[k] as u32 as usize * w as usize + ii[k] as u32 as usize]
             } else {
-                let uv = Vec2::new(finite_uv(fp.u), finite_uv(fp.v));
+                let uv = Vec2::new(finite_uv(us[k]), finite_uv(vs[k]));
                 let c = Point.filter(level, addr, uv).to_array();
                 crate::floor::integer_bytes4(c)
             };
@@ -692,11 +713,11 @@ impl<const N: usize, T: Taps> Pass<N, T> {
 /// `ClampToBorder` read `addr.border` (the sampler's own address, or for the stored-codes paths
 /// its border colour as codes).
 #[inline(always)]
-pub(crate) fn run<P: Pyramid>(
+pub(crate) fn run<P: Pyramid, S: Source>(
     p: &P,
     s: &Sampler,
     addr: Address,
-    footprints: &[Footprint],
+    footprints: S,
     out: &mut [[f32; 4]],
 ) {
     run_taps(p, (Point, Bilinear), s, addr, (footprints, out));
@@ -706,11 +727,11 @@ pub(crate) fn run<P: Pyramid>(
 /// of its own, not a flag of [`run`]: each pairing of a pyramid with a filter is compiled as a
 /// kernel per instruction set, and the float pyramids never take these filters.
 #[inline(always)]
-pub(crate) fn run_fixed<P: Pyramid>(
+pub(crate) fn run_fixed<P: Pyramid, S: Source>(
     p: &P,
     s: &Sampler,
     addr: Address,
-    footprints: &[Footprint],
+    footprints: S,
     out: &mut [[f32; 4]],
 ) {
     run_taps(p, (Point8, Bilinear8), s, addr, (footprints, out));
@@ -718,12 +739,12 @@ pub(crate) fn run_fixed<P: Pyramid>(
 
 /// [`run`] with `near` where `min_filter` is Nearest, else `linear`.
 #[inline(always)]
-fn run_taps<P: Pyramid, N: Taps, L: Taps>(
+fn run_taps<P: Pyramid, S: Source, N: Taps, L: Taps>(
     p: &P,
     (near, linear): (N, L),
     s: &Sampler,
     addr: Address,
-    io: (&[Footprint], &mut [[f32; 4]]),
+    io: (S, &mut [[f32; 4]]),
 ) {
     match s.descriptor().min_filter {
         FilterMode::Nearest => run_with(p, near, s, addr, io),
@@ -734,12 +755,12 @@ fn run_taps<P: Pyramid, N: Taps, L: Taps>(
 /// [`run`] with the within-level filter `T`, on the instruction set's copy for the CPU
 /// ([`crate::dispatch`]: one function per pyramid, filter and copy).
 #[inline(always)]
-fn run_with<P: Pyramid, T: Taps>(
+fn run_with<P: Pyramid, S: Source, T: Taps>(
     p: &P,
     taps: T,
     s: &Sampler,
     addr: Address,
-    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
+    (footprints, out): (S, &mut [[f32; 4]]),
 ) {
     let job = RunJob {
         p,
@@ -753,16 +774,16 @@ fn run_with<P: Pyramid, T: Taps>(
 }
 
 /// [`run_with`]'s arguments, as the dispatcher's unit of work.
-struct RunJob<'j, P, T> {
+struct RunJob<'j, P, S, T> {
     p: &'j P,
     taps: T,
     s: &'j Sampler,
     addr: Address,
-    footprints: &'j [Footprint],
+    footprints: S,
     out: &'j mut [[f32; 4]],
 }
 
-impl<P: Pyramid, T: Taps> Kernel for RunJob<'_, P, T> {
+impl<P: Pyramid, S: Source, T: Taps> Kernel for RunJob<'_, P, S, T> {
     type Output = ();
     /// Ignores `lanes`: a linear 8-bit pyramid carries its quad kernel (`fetch::Unorm8`).
     #[inline(always)]
@@ -770,9 +791,9 @@ impl<P: Pyramid, T: Taps> Kernel for RunJob<'_, P, T> {
         let (p, taps, s, addr) = (self.p, self.taps, self.s, self.addr);
         let io = (self.footprints, self.out);
         if io.0.len() <= 16 {
-            run_in::<P, T, 16, 1>(p, taps, s, addr, io);
+            run_in::<P, S, T, 16, 1>(p, taps, s, addr, io);
         } else {
-            run_in::<P, T, CHUNK, LEVELS>(p, taps, s, addr, io);
+            run_in::<P, S, T, CHUNK, LEVELS>(p, taps, s, addr, io);
         }
     }
 }
@@ -781,12 +802,12 @@ impl<P: Pyramid, T: Taps> Kernel for RunJob<'_, P, T> {
 /// each sample's view made when it is read, which is cheaper for a handful of samples than making
 /// 32 views.
 #[inline(always)]
-fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
+fn run_in<P: Pyramid, S: Source, T: Taps, const N: usize, const V: usize>(
     p: &P,
     taps: T,
     s: &Sampler,
     addr: Address,
-    (footprints, out): (&[Footprint], &mut [[f32; 4]]),
+    (footprints, out): (S, &mut [[f32; 4]]),
 ) {
     // Level 0 is at most 2^22 per side (`MAX_SIDE`), so there are at most 23 levels.
     let levels = p.level_count().min(LEVELS);
@@ -818,7 +839,7 @@ fn run_in<P: Pyramid, T: Taps, const N: usize, const V: usize>(
     let last = levels - 1;
     let size0 = base.size();
     let trilinear = d.mipmap_filter == MipmapFilterMode::Linear;
-    for (fps, out) in footprints.chunks(N).zip(out.chunks_mut(N)) {
+    for (fps, out) in chunks(footprints, N).zip(out.chunks_mut(N)) {
         let n = fps.len();
         queries(s, size0, fps, &mut chunk);
         if d.mipmap_filter == MipmapFilterMode::None {

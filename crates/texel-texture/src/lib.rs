@@ -43,6 +43,7 @@ mod fetch;
 pub mod fixed8;
 pub mod floor;
 pub mod footprint;
+mod footprints;
 pub mod input;
 mod lanes;
 pub mod mip;
@@ -60,6 +61,7 @@ pub use address::{Address, AddressMode, BorderColor};
 pub use bicubic::Cubic;
 pub use error::TextureError;
 pub use footprint::{Axes, Footprint};
+pub use footprints::{FootprintBatch, FootprintLanes};
 pub use lanes::Lanes;
 pub use ripmap::Ripmap;
 pub use sampler::{

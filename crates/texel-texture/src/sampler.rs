@@ -66,6 +66,7 @@ use crate::fetch::{codes_of, with_pyramid, Counted, Fetch, Pyramid};
 use crate::floor::integer_bytes4;
 pub use crate::footprint::UV_LIMIT;
 use crate::footprint::{finite_uv, lod_from_rho_squared, rho_squared, Footprint, Query};
+use crate::footprints::{chunks, FootprintBatch, Source};
 use crate::lanes::Lanes;
 use crate::mip::{filter_level, mip_nearest, trilinear};
 use crate::ripmap::ripmap;
@@ -401,11 +402,11 @@ impl Sampler {
     pub fn sample_batch_stored(
         &self,
         texture: &Texture,
-        footprints: &[Footprint],
+        footprints: impl FootprintBatch,
         out: &mut [[u8; 4]],
     ) -> bool {
         let applies = self.reads_one_texel();
-        self.run_codes(applies, texture, footprints, out, false)
+        self.run_codes(applies, texture, footprints.source(), out, false)
     }
 
     /// Whether [`Sampler::sample_batch_fixed8`] filters `texture`: the core kernels (nearest or
@@ -430,23 +431,22 @@ impl Sampler {
     pub fn sample_batch_fixed8(
         &self,
         texture: &Texture,
-        footprints: &[Footprint],
+        footprints: impl FootprintBatch,
         out: &mut [[u8; 4]],
     ) -> bool {
         let applies = self.filters_fixed8(texture);
-        self.run_codes(applies, texture, footprints, out, true)
+        self.run_codes(applies, texture, footprints.source(), out, true)
     }
 
     /// Where the path `applies`, run the staged kernels (`fixed`: [`crate::fixed8`]'s) over
     /// `texture`'s stored codes ([`crate::fetch::Codes8`]) and narrow the results to bytes; the
     /// border colour enters as codes of the texture's format. `false` where it does not apply,
     /// for float storage or a level 0 beyond the staged kernels. Panics if the lengths differ.
-    #[inline(always)]
-    fn run_codes(
+    fn run_codes<S: Source>(
         &self,
         applies: bool,
         texture: &Texture,
-        footprints: &[Footprint],
+        footprints: S,
         out: &mut [[u8; 4]],
         fixed: bool,
     ) -> bool {
@@ -478,10 +478,7 @@ impl Sampler {
             return true;
         }
         let mut codes = [[0.0f32; 4]; batch::CHUNK];
-        for (fps, out) in footprints
-            .chunks(batch::CHUNK)
-            .zip(out.chunks_mut(batch::CHUNK))
-        {
+        for (fps, out) in chunks(footprints, batch::CHUNK).zip(out.chunks_mut(batch::CHUNK)) {
             let codes = &mut codes[..fps.len()];
             if fixed {
                 batch::run_fixed(&p, self, addr, fps, codes);
@@ -505,9 +502,19 @@ impl Sampler {
     /// ([`crate::dispatch`]); on x86-64-v3 and above linear 8-bit quads blend in eight lanes
     /// ([`Lanes::detect`]), else in four. Same bits on every copy.
     ///
+    /// `footprints` is any [`FootprintBatch`]: structs (`&[Footprint]`, `&Vec<Footprint>`,
+    /// `&[Footprint; N]`) or [`crate::FootprintLanes`], one slice per field, which a caller that
+    /// computes its footprints in lanes (a rasterizer) hands over without interleaving them into
+    /// structs. Both give the same bits.
+    ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
-    pub fn sample_batch(&self, texture: &Texture, footprints: &[Footprint], out: &mut [[f32; 4]]) {
+    pub fn sample_batch(
+        &self,
+        texture: &Texture,
+        footprints: impl FootprintBatch,
+        out: &mut [[f32; 4]],
+    ) {
         self.sample_batch_lanes(crate::dispatch::lanes(), texture, footprints, out)
     }
 
@@ -523,7 +530,18 @@ impl Sampler {
         &self,
         lanes: Lanes,
         texture: &Texture,
-        footprints: &[Footprint],
+        footprints: impl FootprintBatch,
+        out: &mut [[f32; 4]],
+    ) {
+        self.batch_source(lanes, texture, footprints.source(), out)
+    }
+
+    /// [`Sampler::sample_batch_lanes`] for either kind of batch (compiled once per kind).
+    fn batch_source<S: Source>(
+        &self,
+        lanes: Lanes,
+        texture: &Texture,
+        footprints: S,
         out: &mut [[f32; 4]],
     ) {
         assert_eq!(
@@ -549,7 +567,7 @@ impl Sampler {
     /// batched where level 0 is within the staged kernels' side, else every sample through
     /// [`Sampler::filter`], with its query and (anisotropic) probe plan made a chunk at a time.
     #[inline(always)]
-    fn batch_in<P: Pyramid>(&self, p: &P, footprints: &[Footprint], out: &mut [[f32; 4]]) {
+    fn batch_in<P: Pyramid, S: Source>(&self, p: &P, footprints: S, out: &mut [[f32; 4]]) {
         let size = p.level(0).size();
         if self.technique == Technique::Anisotropic && batch::staged(size) {
             // Probes of several samples filtered together; the rest one by one, as
@@ -566,19 +584,17 @@ impl Sampler {
         // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
         // arithmetic vectorised), then all filters.
         let mut chunk = Chunk::<{ batch::CHUNK }>::new();
-        let chunks = footprints
-            .chunks(batch::CHUNK)
-            .zip(out.chunks_mut(batch::CHUNK));
+        let parts = chunks(footprints, batch::CHUNK).zip(out.chunks_mut(batch::CHUNK));
         if self.technique == Technique::Anisotropic {
             // A third stage between the two: every sample's probe plan (axes, probe count,
             // probe lod), vectorised as the lods are; the probes' scratch is made once.
             let mut plans = [Plan::default(); batch::CHUNK];
             let mut probes = Probes::new(self.addr);
-            for (fps, outs) in chunks {
+            for (fps, outs) in parts {
                 batch::queries(self, size, fps, &mut chunk);
-                plan_chunk(self, size, fps, &mut plans);
-                for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
-                    let q = chunk.query(k, fp);
+                plan_chunk(self, size, &chunk, &mut plans);
+                for (k, o) in outs.iter_mut().enumerate() {
+                    let q = chunk.query(k);
                     // As `filter`: magnification first.
                     *o = if q.lod > 0.0 {
                         filter_planned(p, &q, &plans[k], &mut probes)
@@ -590,10 +606,10 @@ impl Sampler {
             }
             return;
         }
-        for (fps, outs) in chunks {
+        for (fps, outs) in parts {
             batch::queries(self, size, fps, &mut chunk);
-            for (k, (o, fp)) in outs.iter_mut().zip(fps).enumerate() {
-                *o = self.filter(p, &chunk.query(k, fp)).to_array();
+            for (k, o) in outs.iter_mut().enumerate() {
+                *o = self.filter(p, &chunk.query(k)).to_array();
             }
         }
     }
@@ -668,14 +684,14 @@ impl Sampler {
 
 /// [`Sampler::batch_in`]'s arguments, as the dispatcher's unit of work (one function per
 /// pyramid type and instruction-set copy).
-struct BatchJob<'j, P> {
+struct BatchJob<'j, P, S> {
     s: &'j Sampler,
     p: &'j P,
-    footprints: &'j [Footprint],
+    footprints: S,
     out: &'j mut [[f32; 4]],
 }
 
-impl<P: Pyramid> crate::dispatch::Kernel for BatchJob<'_, P> {
+impl<P: Pyramid, S: Source> crate::dispatch::Kernel for BatchJob<'_, P, S> {
     type Output = ();
     /// Ignores `lanes`: a linear 8-bit pyramid carries its quad kernel (`fetch::Unorm8`).
     #[inline(always)]

@@ -3,8 +3,8 @@
 
 use proptest::prelude::*;
 use texel_texture::{
-    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, Format, Lanes,
-    Limits, MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
+    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, FootprintLanes,
+    Format, Lanes, Limits, MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
 };
 
 const ADDRESS_MODES: [AddressMode; 5] = [
@@ -82,6 +82,34 @@ fn spread(k: usize) -> (f32, f32) {
     (t.fract(), (t * 0.37).fract())
 }
 
+/// `fps` as lanes: `u`, `v` and `[dudx, dudy, dvdx, dvdy]` (for [`FootprintLanes::new`]).
+fn lanes_of(fps: &[Footprint]) -> (Vec<f32>, Vec<f32>, [Vec<f32>; 4]) {
+    let field = |f: fn(&Footprint) -> f32| fps.iter().map(f).collect::<Vec<_>>();
+    let d = [
+        field(|f| f.dudx),
+        field(|f| f.dudy),
+        field(|f| f.dvdx),
+        field(|f| f.dvdy),
+    ];
+    (field(|f| f.u), field(|f| f.v), d)
+}
+
+/// The bits of a batch's output, for comparisons.
+fn bits(v: &[[f32; 4]]) -> Vec<u32> {
+    v.iter().flatten().map(|x| x.to_bits()).collect()
+}
+
+/// `sample_batch` of `fps` given as [`FootprintLanes`] equals it given as structs, bit for bit.
+fn assert_lanes_equal_structs(s: &Sampler, tex: &Texture, fps: &[Footprint], case: &str) {
+    let (u, v, d) = lanes_of(fps);
+    let lanes = FootprintLanes::new(&u, &v, [&d[0], &d[1], &d[2], &d[3]]);
+    let mut structs = vec![[0.0; 4]; fps.len()];
+    let mut from_lanes = vec![[1.0; 4]; fps.len()];
+    s.sample_batch(tex, fps, &mut structs);
+    s.sample_batch(tex, lanes, &mut from_lanes);
+    assert_eq!(bits(&structs), bits(&from_lanes), "lanes: {case}");
+}
+
 /// `sample_batch` (on the CPU's best copy: the eight-lane quad kernel and its runs where the CPU
 /// has AVX2) and `sample_batch_lanes` with [`Lanes::scalar`] (the four-lane kernel, and the
 /// per-sample loops where the run kernel declines) of `fps` each equal `sample` bit for bit;
@@ -96,6 +124,7 @@ fn assert_batches_equal_single(s: &Sampler, tex: &Texture, fps: &[Footprint], ca
         assert_eq!(single, o.map(f32::to_bits), "{case} {fp:?}");
         assert_eq!(single, w.map(f32::to_bits), "lanes: {case} {fp:?}");
     }
+    assert_lanes_equal_structs(s, tex, fps, case);
 }
 
 fn footprint_strategy() -> impl Strategy<Value = Footprint> {
@@ -244,7 +273,12 @@ proptest! {
                 // The four-lane quad kernel gives the same bits as `sample_batch`'s (the
                 // eight-lane one where the CPU has AVX2).
                 s.sample_batch_lanes(Lanes::scalar(), tex, &fps, &mut wide);
-                prop_assert_eq!(out.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>(), wide.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>(), "{:?}", s.descriptor());
+                prop_assert_eq!(bits(&out), bits(&wide), "{:?}", s.descriptor());
+                // The same footprints as lanes (`FootprintLanes`): the same bits.
+                let (u, v, d) = lanes_of(&fps);
+                let lanes = FootprintLanes::new(&u, &v, [&d[0], &d[1], &d[2], &d[3]]);
+                s.sample_batch(tex, lanes, &mut wide);
+                prop_assert_eq!(bits(&out), bits(&wide), "lanes {:?}", s.descriptor());
             }
         }
     }
@@ -1334,7 +1368,6 @@ fn lod_free_samplers_never_read_derivatives() {
             ..*f
         })
         .collect();
-    let bits = |v: &[[f32; 4]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
     let mut lod_free = 0;
     for format in [Format::Rgba8Srgb, Format::Rgba8Unorm, Format::Rgba32Float] {
         let tex = noise_texture(37, 21, format);
@@ -1368,4 +1401,79 @@ fn lod_free_samplers_never_read_derivatives() {
     }
     // Nearest, bilinear and three cubic filters under five address modes, three formats.
     assert_eq!(lod_free, 3 * 5 * 5);
+}
+
+/// Footprints given as lanes ([`FootprintLanes`]) sample as the same footprints given as structs,
+/// through every batched entry (`sample_batch`, both quad kernels, `sample_batch_stored`,
+/// `sample_batch_fixed8`), for every sampler (the core filters under every address mode, and the
+/// anisotropic, EWA, ripmap and summed-area filters) on every texel format, over several chunks
+/// and a short tail (150 footprints); and lanes without derivatives
+/// ([`FootprintLanes::points`]) as structs with zero derivatives.
+#[test]
+fn lanes_sample_as_structs() {
+    let fps: Vec<Footprint> = (0..150)
+        .map(|k| {
+            let (u, v) = spread(k);
+            let d = [0.0, 1e-3, 0.02, 0.3][k % 4];
+            Footprint {
+                u: u * 3.0 - 1.0,
+                v: v * 2.0 - 0.5,
+                dudx: d,
+                dudy: -0.5 * d,
+                dvdx: 0.25 * d,
+                dvdy: 1.5 * d,
+            }
+        })
+        .collect();
+    let points: Vec<Footprint> = fps.iter().map(|f| Footprint::point(f.u, f.v)).collect();
+    let (u, v, d) = lanes_of(&fps);
+    let lanes = FootprintLanes::new(&u, &v, [&d[0], &d[1], &d[2], &d[3]]);
+    let point_lanes = FootprintLanes::points(&u, &v);
+    let mut samplers = every_sampler(BorderColor::OpaqueWhite);
+    for d in [
+        SamplerDescriptor::anisotropic(16),
+        SamplerDescriptor::minification(FilterMode::Ewa),
+        SamplerDescriptor::minification(FilterMode::Ripmap),
+        SamplerDescriptor::minification(FilterMode::SummedArea),
+    ] {
+        samplers.push(Sampler::new(d.with_address_mode(AddressMode::Repeat)).unwrap());
+    }
+    let n = fps.len();
+    for format in [Format::Rgba8Srgb, Format::Rgba8Unorm, Format::Rgba32Float] {
+        let tex = noise_texture(37, 21, format);
+        for s in &samplers {
+            let case = format!("{format:?} {:?}", s.descriptor());
+            for lanes_kernel in [Lanes::scalar(), Lanes::detect()] {
+                for (structs, as_lanes) in [(&fps, lanes), (&points, point_lanes)] {
+                    let mut a = vec![[0.0; 4]; n];
+                    let mut b = vec![[1.0; 4]; n];
+                    s.sample_batch_lanes(lanes_kernel, &tex, structs, &mut a);
+                    s.sample_batch_lanes(lanes_kernel, &tex, as_lanes, &mut b);
+                    assert_eq!(bits(&a), bits(&b), "sample_batch {case}");
+                }
+            }
+            for (structs, as_lanes) in [(&fps, lanes), (&points, point_lanes)] {
+                let mut a = vec![[0u8; 4]; n];
+                let mut b = vec![[1u8; 4]; n];
+                let took = s.sample_batch_stored(&tex, structs, &mut a);
+                assert_eq!(
+                    took,
+                    s.sample_batch_stored(&tex, as_lanes, &mut b),
+                    "{case}"
+                );
+                if took {
+                    assert_eq!(a, b, "sample_batch_stored {case}");
+                }
+                let took = s.sample_batch_fixed8(&tex, structs, &mut a);
+                assert_eq!(
+                    took,
+                    s.sample_batch_fixed8(&tex, as_lanes, &mut b),
+                    "{case}"
+                );
+                if took {
+                    assert_eq!(a, b, "sample_batch_fixed8 {case}");
+                }
+            }
+        }
+    }
 }
