@@ -43,9 +43,11 @@
 //! reciprocal of the period instead of dividing. The planes' anchor is chosen from the triangle's
 //! box in the whole tile, not the scissored range, so a scissor never changes a pixel. When the
 //! sampler ignores derivatives (`Sampler::uses_derivatives`: nearest, bilinear or a cubic filter
-//! without mipmaps, `mag_filter == min_filter`) and footprints are not captured, the span skips
-//! them; unshaded, it leaves the footprints' derivative fields as an earlier span wrote them
-//! (nothing reads them). Frames are reusable (`render_into`, `draw_into`).
+//! without mipmaps, `mag_filter == min_filter`), footprints are not captured and no material may
+//! need them, the span skips them and hands the sampler `u` and `v` alone
+//! (`FootprintLanes::points`: zero derivatives). The span's footprints reach the sampler as
+//! lanes, one slice per field, never as structs (perf-log 45). Frames are reusable
+//! (`render_into`, `draw_into`).
 //!
 //! Frame times, the mesh's triangle rate and the profiles are in README.md's Benchmarks section;
 //! how each of these decisions moved them is in docs/perf-log.md.
@@ -167,8 +169,8 @@ struct Context<'a> {
 
 impl Context<'_> {
     /// Whether `dc`'s fragments are shaded (`shade` reads their barycentrics and footprints): a
-    /// material, vertex colours or lights. Where not, the colour is the sample, and a span may
-    /// leave the footprints' unread derivative fields unwritten (`Span::plane_footprints`).
+    /// material, vertex colours or lights. Where not, the colour is the sample, and a span skips
+    /// the barycentrics (`flush_span`).
     #[inline(always)]
     fn shades(&self, dc: &DrawContext) -> bool {
         !dc.unshaded() || self.lighting.is_some()
@@ -519,8 +521,9 @@ struct Span {
     u: [f32; SPAN],
     v: [f32; SPAN],
     d: [[f32; SPAN]; 4],
-    /// Whether `d` holds the span's derivatives (else they are zero: the sampler ignores them
-    /// or nothing reads them).
+    /// Whether `d` holds the span's derivatives. Else `d` holds stale values that nothing
+    /// reads: the span's footprints ([`Span::footprints`], [`Span::footprint`]) then have zero
+    /// derivatives. Set by both footprint stages, before anything reads the span.
     deriv: bool,
     /// Rows gathered so far: `(first, end, contiguous)` fragment ranges, one per row, in order.
     run: [(u32, u32, bool); SPAN],

@@ -73,9 +73,12 @@ pub(crate) struct Chunk<const N: usize> {
     pub v: [f32; N],
     /// The isotropic lod (0 for a lod-free sampler).
     pub lod: [f32; N],
-    /// The derivatives' lanes `[du/dx, dv/dx, du/dy, dv/dy]`, for samplers that use them
-    /// ([`Sampler::uses_derivatives`]; for the others stale, and never read). Ones from `n` to
-    /// the next multiple of 16, so that those lanes have a normal rho^2.
+    /// The derivatives' lanes `[du/dx, dv/dx, du/dy, dv/dy]`, written by [`queries`] for
+    /// samplers that use them ([`Sampler::uses_derivatives`]), with ones from `n` to the next
+    /// multiple of 16 so that those lanes have a normal rho^2. For the others they are not
+    /// written and never read: NaN from [`Chunk::new`] or an earlier chunk's, so that a filter
+    /// that read them by mistake would differ from `sample` with zero derivatives (the tests
+    /// compare the two).
     pub d: [[f32; N]; 4],
     /// Valid entries.
     pub n: usize,
@@ -87,7 +90,7 @@ impl<const N: usize> Chunk<N> {
             u: [0.0; N],
             v: [0.0; N],
             lod: [0.0; N],
-            d: [[1.0; N]; 4],
+            d: [[f32::NAN; N]; 4],
             n: 0,
         }
     }
@@ -128,8 +131,8 @@ impl<const N: usize> Chunk<N> {
 /// vectorises. The inputs that path does not cover (`rho^2` zero or subnormal) are rare; a second
 /// loop recomputes those lanes with the scalar functions.
 ///
-/// The footprints are first copied into the chunk's lanes (one array per field), and the lod arithmetic then runs over the lanes rounded up to a multiple
-/// of 16 (at most `N`; the entries beyond `n` are ones or stale and unread), so that it
+/// The footprints are first copied into the chunk's lanes (one array per field), and the lod
+/// arithmetic then runs over the lanes rounded up to a multiple of 16 (at most `N`; the entries beyond `n` are ones or stale and unread), so that it
 /// vectorises at the full width with no remainder loop: read from the 24-byte structs, the lod
 /// loop ran four lanes wide plus a scalar remainder (docs/perf-log.md, entry 30).
 #[inline(always)]
@@ -139,7 +142,8 @@ pub(crate) fn queries<S: Source, const N: usize>(
     fps: S,
     out: &mut Chunk<N>,
 ) {
-    let n = fps.len().min(N);
+    let n = fps.len();
+    debug_assert!(n <= N, "a chunk holds at most N footprints");
     out.n = n;
     let deriv = s.uses_derivatives();
     let lanes = n.next_multiple_of(16).min(N);

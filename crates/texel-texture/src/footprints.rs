@@ -119,13 +119,15 @@ pub(crate) mod sealed {
         fn len(self) -> usize;
         /// Footprints `start..end`.
         fn range(self, start: usize, end: usize) -> Self;
-        /// `u` and `v` of every footprint into the first `len()` entries of `u` and `v` (a copy
-        /// then a separate loop that makes them finite retired fewer instructions than one loop
-        /// doing both: the copy is a `memcpy`, the second loop runs at full width with no
-        /// remainder; perf-log 45).
+        /// `u` and `v` of every footprint into the first `len()` entries of `u` and `v`, which
+        /// are at least that long (the lanes panic otherwise; structs stop at the shorter).
+        /// A plain copy: `batch::queries` makes them finite in a second loop, which retired
+        /// fewer instructions than one loop doing both (the copy is a `memcpy`, the second loop
+        /// runs at full width with no remainder; perf-log 45).
         fn uv_into(self, u: &mut [f32], v: &mut [f32]);
         /// The derivatives of every footprint into the first `len()` entries of each lane of
-        /// `d` (`[dudx, dvdx, dudy, dvdy]`, the order of `batch::queries`' lanes).
+        /// `d` (`[dudx, dvdx, dudy, dvdy]`, the order of `batch::queries`' lanes), each at least
+        /// that long (as [`Source::uv_into`]); zeros for lanes given without derivatives.
         fn derivatives_into(self, d: [&mut [f32]; 4]);
     }
 
@@ -298,6 +300,12 @@ mod tests {
         assert!(d.iter().flatten().all(|&x| x == 0.0));
         assert_eq!(chunks(points, 64).count(), 2);
         assert_eq!(chunks(FootprintLanes::points(&[], &[]), 64).count(), 0);
+    }
+
+    #[test]
+    #[should_panic(expected = "differ in length")]
+    fn points_of_different_lengths_panic() {
+        let _ = FootprintLanes::points(&[0.0; 3], &[0.0; 2]);
     }
 
     #[test]

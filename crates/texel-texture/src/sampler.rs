@@ -332,7 +332,7 @@ impl Sampler {
     /// Whether samples depend on the footprint's derivatives. `false` when there is no
     /// mipmapping and `mag_filter == min_filter` (the lod cannot change the result): no sampling
     /// path then reads the footprint's derivative fields, so a caller may skip computing them
-    /// and pass any values (the rasterizer leaves a reused scratch's earlier values in place).
+    /// and pass any values (the rasterizer passes [`crate::FootprintLanes::points`]: none).
     pub fn uses_derivatives(&self) -> bool {
         !self.lod_free
     }
@@ -384,7 +384,7 @@ impl Sampler {
 
     /// The stored bytes of the texel each footprint reads: for a sampler that
     /// [reads one texel](Sampler::reads_one_texel) on an 8-bit texture, `out[k]` is the texel
-    /// whose decoding `sample(texture, footprints[k])` returns (the same query, level and texel,
+    /// whose decoding `sample(texture, f)` of footprint `k`, `f`, returns (the same query, level and texel,
     /// bit for bit), or, where `ClampToBorder` reads outside the texture, the border colour
     /// encoded in the texture's format (sRGB RGB and linear alpha for `Rgba8Srgb`, all linear
     /// for `Rgba8Unorm`; [`crate::color::rgba_to_srgb8`], [`crate::color::rgba_to_unorm8`]).
@@ -494,7 +494,8 @@ impl Sampler {
         true
     }
 
-    /// Sample many footprints at once: `out[k] = sample(texture, footprints[k])`, bit for bit. The
+    /// Sample many footprints at once: `out[k] = sample(texture, f)` for footprint `k`, `f`, bit
+    /// for bit. The
     /// texture's format is dispatched once for the whole batch, and the lods of up to 64
     /// footprints are computed in one loop before any is filtered (independent iterations that
     /// pipeline, instead of one long dependency chain per sample). A rasterizer should hand it a

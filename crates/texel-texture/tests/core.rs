@@ -1335,7 +1335,7 @@ proptest! {
 
 /// `Sampler::uses_derivatives`' contract: where it is `false` (no mipmaps, `mag_filter ==
 /// min_filter`) no sampling path reads a footprint's derivative fields, so a caller may leave any
-/// values there (the rasterizer leaves a reused scratch's earlier ones). Footprints whose
+/// values there (or, as lanes, give none). Footprints whose
 /// derivatives are NaN, infinite, huge or tiny sample bit for bit as with zero derivatives, through
 /// `sample`, `sample_batch` (both quad kernels), `sample_batch_stored` and `sample_batch_fixed8`,
 /// for every such sampler (nearest, bilinear and the cubic filters, every address mode) on every
@@ -1476,4 +1476,21 @@ fn lanes_sample_as_structs() {
             }
         }
     }
+}
+
+/// A lanes batch whose length differs from `out`'s is a programming error: a panic that says so,
+/// as for structs.
+#[test]
+#[should_panic(expected = "differ in length")]
+fn lanes_longer_than_out_panic() {
+    let tex = noise_texture(8, 8, Format::Rgba8Unorm);
+    let s = sampler(
+        FilterMode::Linear,
+        FilterMode::Linear,
+        MipmapFilterMode::None,
+        AddressMode::Repeat,
+    );
+    let (u, v) = ([0.25f32; 5], [0.5f32; 5]);
+    let mut out = [[0.0f32; 4]; 4];
+    s.sample_batch(&tex, FootprintLanes::points(&u, &v), &mut out);
 }
