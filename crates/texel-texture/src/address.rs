@@ -39,11 +39,11 @@ impl AddressMode {
                 if (0..n64).contains(&i) {
                     Some(i as u32)
                 } else {
-                    Some(i.rem_euclid(n64) as u32)
+                    Some(rem_euclid(i, n64) as u32)
                 }
             }
             AddressMode::MirrorRepeat => {
-                let r = i.rem_euclid(2 * n64);
+                let r = rem_euclid(i, 2 * n64);
                 Some(if r < n64 { r } else { 2 * n64 - 1 - r } as u32)
             }
             AddressMode::ClampToBorder => (0..n64).contains(&i).then_some(i as u32),
@@ -57,6 +57,19 @@ impl AddressMode {
     /// Whether the mode tiles the plane periodically (Repeat and MirrorRepeat).
     pub fn is_periodic(self) -> bool {
         matches!(self, AddressMode::Repeat | AddressMode::MirrorRepeat)
+    }
+}
+
+/// `i.rem_euclid(n)` for `n >= 1`: a mask where `n` is a power of two (two's complement makes
+/// `i & (n - 1)` the non-negative remainder, for negative `i` too), else the division. Textures
+/// are mostly powers of two on a side, and the division is tens of cycles where the mask is one
+/// (the anisotropic probes far outside a repeating texture wrap four taps each).
+#[inline(always)]
+fn rem_euclid(i: i64, n: i64) -> i64 {
+    if n & (n - 1) == 0 {
+        i & (n - 1)
+    } else {
+        i.rem_euclid(n)
     }
 }
 
@@ -170,6 +183,20 @@ mod tests {
                 .wrap(floor_index(u * w as f32), w)
                 .map(|i| i as f32 / w as f32);
             assert_eq!(got, want, "{mode:?} u={u}");
+        }
+    }
+
+    /// The mask for power-of-two sides equals the division's remainder: every side 1 to 70 (the
+    /// powers of two and the rest), indices around zero, around multiples of the side and at
+    /// `i64`'s ends.
+    #[test]
+    fn rem_euclid_equals_the_division() {
+        for n in 1..=70i64 {
+            let mut indices: Vec<i64> = (-3 * n - 2..=3 * n + 2).collect();
+            indices.extend([i64::MIN, i64::MIN + 1, i64::MAX, i64::MAX - 1]);
+            for i in indices {
+                assert_eq!(rem_euclid(i, n), i.rem_euclid(n), "{i} mod {n}");
+            }
         }
     }
 

@@ -243,20 +243,23 @@ pub(crate) trait Taps: LevelFilter {
 const PROBES: usize = 256;
 
 /// Anisotropic filtering of `footprints` into `out` for a sampler whose technique is
-/// anisotropic, on a pyramid whose level 0 is at most [`MAX_SIDE`] per side: per chunk the
-/// queries ([`queries`]) and probe plans ([`crate::aniso::plan_chunk`]); every sample with more
-/// than one probe (and a positive lod) lays its probes out in shared scratch, up to [`PROBES`]
-/// from several samples, which are then filtered together, stage by stage, as [`run`] filters
-/// trilinear samples (so the lods, floors and texel loads of many probes pipeline, where one
-/// sample's few probes did not); the other samples go to `single` (plain trilinear or the
-/// magnification filter). Bit for bit [`crate::aniso::filter_planned`]: the same probe positions,
-/// levels and blends, each sample's probes summed in order from zero, times `1 / N`.
+/// anisotropic (its mag, min and mipmap filters all `Linear`: `Sampler::new`), on a pyramid whose
+/// level 0 is at most [`MAX_SIDE`] per side: per chunk the queries ([`queries`]) and probe plans
+/// ([`crate::aniso::plan_chunk`]); every sample then lays its probes out in shared scratch, up to
+/// [`PROBES`] from several samples, which are filtered together, stage by stage, as [`run`]
+/// filters trilinear samples (so the lods, floors and texel loads of many probes pipeline, where
+/// one sample's few probes did not). A sample with more than one probe (and a positive lod) has
+/// [`crate::aniso::filter_planned`]'s probes; one with a single probe (an isotropic footprint) is
+/// one probe at its `uv` and isotropic lod (`mip::trilinear`); a magnified one (`lod <= 0`) is
+/// one probe in level 0 alone (the `Linear` mag filter, bilinear). Bit for bit
+/// [`crate::Sampler::filter`]: the same probe positions, levels and blends, each sample's probes
+/// summed in order from zero (a single probe from `-0.0`, which adds as the identity), times
+/// `1 / N`.
 #[inline(always)]
 pub(crate) fn anisotropic<P: Pyramid, S: Source>(
     p: &P,
     s: &Sampler,
     (footprints, out): (S, &mut [[f32; 4]]),
-    mut single: impl FnMut(&Query, &crate::aniso::Plan) -> Vec4,
 ) {
     let size0 = p.level(0).size();
     let last = p.level_count() - 1;
@@ -278,7 +281,7 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
     // call it was a quarter of the instructions of aniso16 on a mesh of small triangles, one call
     // per triangle and tile (docs/perf-log.md, entries 40 and 41).
     let mut probes = ProbeBatch::take(s.address());
-    // Per sample of the chunk: its probes' sum, and `1 / N` (0: not a probed sample).
+    // Per sample of the chunk: its probes' sum, and `1 / N`.
     let mut sums = [Vec4::ZERO; CHUNK];
     let mut inv = [0.0f32; CHUNK];
     let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
@@ -288,8 +291,27 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
         for k in 0..fps.len() {
             let (q, plan) = (chunk.query(k), &plans[k]);
             if !(q.lod > 0.0 && plan.n > 1) {
-                inv[k] = 0.0;
-                out[k] = single(&q, plan).to_array();
+                // One probe at the sample's `uv` (finite: `queries`): magnified, the `Linear`
+                // mag filter in level 0 (`Sampler::filter`); else trilinear at the isotropic lod
+                // (`filter_planned` with `N = 1`). Its sum starts at `-0.0`, so that it is the
+                // probe's value bit for bit (`+0.0 + -0.0` would be `+0.0`).
+                if probes.m + 1 > PROBES {
+                    probes.flush(&views, size, &mut sums);
+                }
+                let (l, delta) = if q.lod > 0.0 {
+                    mip::linear_levels(q.lod, last)
+                } else {
+                    (0, 0.0)
+                };
+                let coarse = delta > 0.0 && l < last;
+                let pair = (l as u8, if coarse { l + 1 } else { l } as u8);
+                inv[k] = 1.0;
+                sums[k] = Vec4::splat(-0.0);
+                let p = &mut *probes;
+                p.sample(k, pair, (delta, coarse));
+                let m = p.m;
+                (p.at.u[m], p.at.v[m], p.owner[m]) = (q.fp.u, q.fp.v, k as u8);
+                p.m = m + 1;
                 continue;
             }
             // `filter_planned`'s probes (`n <= 64`: `plan`).
@@ -320,9 +342,7 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
         }
         probes.flush(&views, size, &mut sums);
         for (k, o) in out.iter_mut().enumerate().take(fps.len()) {
-            if inv[k] > 0.0 {
-                *o = (sums[k] * inv[k]).to_array();
-            }
+            *o = (sums[k] * inv[k]).to_array();
         }
     }
     probes.give_back();
@@ -344,6 +364,10 @@ struct ProbeBatch {
     fine: Pass<PROBES, Bilinear>,
     next: Pass<PROBES, Bilinear>,
     owner: [u8; PROBES],
+    /// Stage 3's values of the probes in the finer and the coarser level
+    /// ([`ProbeBatch::sum_runs`]; written before they are read).
+    values: [[f32; 4]; PROBES],
+    coarse_values: [[f32; 4]; PROBES],
     /// Per sample: the finer and the coarser level read.
     levels: [(u8, u8); CHUNK],
     delta: [f32; CHUNK],
@@ -393,6 +417,8 @@ impl ProbeBatch {
             fine: Pass::new(Bilinear, addr),
             next: Pass::new(Bilinear, addr),
             owner: [0; PROBES],
+            values: [[0.0; 4]; PROBES],
+            coarse_values: [[0.0; 4]; PROBES],
             levels: [(0, 0); CHUNK],
             delta: [0.0; CHUNK],
             coarse: [false; CHUNK],
@@ -438,7 +464,9 @@ impl ProbeBatch {
             self.fine.coordinates(|_| s0, us, vs);
             self.next.coordinates(|_| s1, us, vs);
             let (fine, next) = (level(l0), level(l1));
-            self.sum_into(m, |_| fine, |_| next, sums);
+            if !self.sum_runs(m, (fine, next), sums) {
+                self.sum_into(m, |_| fine, |_| next, sums);
+            }
         } else {
             for (k, &o) in self.owner[..m].iter().enumerate() {
                 (self.fine.level[k], self.next.level[k]) = self.levels[o as usize];
@@ -449,6 +477,50 @@ impl ProbeBatch {
             self.sum_into(m, |k| level(fine[k]), |k| level(next[k]), sums);
         }
         self.m = 0;
+    }
+
+    /// Stage 3 of the first `m` probes, all in the levels `fine` and `next` (the same for every
+    /// sample of the batch, so that every sample weighs the coarser level, or none does: a
+    /// sample's pair is `(l, l + 1)` exactly when it is weighed), through the views' run
+    /// kernels ([`Taps::inside_run`]) where every probe lies inside both levels read: the finer
+    /// level's values, the coarser level's where weighed, then each probe's blend added in order
+    /// to its sample's sum. The values of [`ProbeBatch::sum_into`] bit for bit (the run kernels
+    /// are the inside route's, [`lerp`] the same blend), without its per-probe route and blend
+    /// tests. `false`, with nothing added, where a probe lies outside or the views have no run
+    /// kernel; the caller then runs [`ProbeBatch::sum_into`] (taking runs of inside probes
+    /// through the kernel and the rest through their routes measured slower: 645 -> 682 million
+    /// instructions an aniso16 ground frame, 3 ms a frame more, docs/perf-log.md entry 46).
+    #[inline(always)]
+    fn sum_runs<F: Fetch>(
+        &mut self,
+        m: usize,
+        (fine, next): (&F, &F),
+        sums: &mut [Vec4; CHUNK],
+    ) -> bool {
+        let coarse = self.pair.0 != self.pair.1;
+        if !(self.fine.all_inside(m) && (!coarse || self.next.all_inside(m))) {
+            return false;
+        }
+        let values = &mut self.values[..m];
+        if !Bilinear::inside_run(fine, self.fine.run(m), values) {
+            return false;
+        }
+        if coarse {
+            let coarse_values = &mut self.coarse_values[..m];
+            // Both levels are views of one pyramid: the second has a run kernel too.
+            Bilinear::inside_run(next, self.next.run(m), coarse_values);
+            let probes = self.owner[..m].iter().zip(values.iter());
+            for ((&o, a), b) in probes.zip(coarse_values.iter()) {
+                let o = o as usize % CHUNK;
+                let (a, b) = (Vec4::from_array(*a), Vec4::from_array(*b));
+                sums[o] += lerp(a, b, self.delta[o]);
+            }
+        } else {
+            for (&o, a) in self.owner[..m].iter().zip(values.iter()) {
+                sums[o as usize % CHUNK] += Vec4::from_array(*a);
+            }
+        }
+        true
     }
 
     /// Stage 3 of the first `m` probes, each probe's level view given by `fine(k)` and

@@ -571,16 +571,9 @@ impl Sampler {
     fn batch_in<P: Pyramid, S: Source>(&self, p: &P, footprints: S, out: &mut [[f32; 4]]) {
         let size = p.level(0).size();
         if self.technique == Technique::Anisotropic && batch::staged(size) {
-            // Probes of several samples filtered together; the rest one by one, as
-            // `filter_planned` and `filter` do.
-            let mut probes = Probes::new(self.addr);
-            return batch::anisotropic(p, self, (footprints, out), |q, plan| {
-                if q.lod > 0.0 {
-                    filter_planned(p, q, plan, &mut probes)
-                } else {
-                    self.filter(p, q)
-                }
-            });
+            // Every sample's probes (one for a magnified or isotropic sample) filtered
+            // together with those of its neighbours.
+            return batch::anisotropic(p, self, (footprints, out));
         }
         // Two stages per chunk: all queries first (`batch::queries`, `Sampler::query`'s
         // arithmetic vectorised), then all filters.

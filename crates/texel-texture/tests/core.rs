@@ -284,6 +284,67 @@ proptest! {
     }
 }
 
+/// The anisotropic batch routes every sample through its probe batches (perf-log 46): a
+/// magnified sample as one bilinear probe in level 0, an isotropic one as one trilinear probe,
+/// an anisotropic one as its `N` probes, and a batch whose probes all lie inside both levels
+/// through the run kernels. Rows like the ground's (magnified near the viewer, ever more
+/// anisotropic towards the horizon, each row's samples in the same levels) on a linear 8-bit
+/// texture (the run kernels), an sRGB one and a float one, under Repeat, ClampToEdge and
+/// ClampToBorder, and with probes far outside the texture; `sample_batch` equals `sample` bit
+/// for bit.
+#[test]
+fn anisotropic_batch_equals_single_across_its_kinds_of_sample() {
+    let textures = [
+        noise_texture(256, 128, Format::Rgba8Unorm),
+        noise_texture(96, 80, Format::Rgba8Srgb),
+        noise_texture(64, 64, Format::Rgba32Float),
+    ];
+    let mut fps = Vec::new();
+    for row in 0..40 {
+        // Derivatives per pixel, in uv: from a tenth of a texel (magnified) to 64 texels along u
+        // with up to a 20:1 ratio.
+        let scale = 0.0004 * 1.25f32.powi(row);
+        let ratio = 1.0 + (row % 20) as f32;
+        for k in 0..70 {
+            let (u, v) = spread(row as usize * 70 + k);
+            let (u, v) = (u * 0.5 + 0.25, v * 0.5 + 0.25);
+            fps.push(Footprint {
+                u,
+                v,
+                dudx: scale * ratio,
+                dudy: 0.0,
+                dvdx: 0.0,
+                dvdy: scale,
+            });
+        }
+    }
+    // Probes far outside the texture too.
+    fps.extend((0..50).map(|k| Footprint {
+        u: 3.5 - k as f32 * 0.15,
+        v: -2.25,
+        dudx: 0.05,
+        dudy: 0.001,
+        dvdx: -0.002,
+        dvdy: 0.003,
+    }));
+    let mut out = vec![[f32::NAN; 4]; fps.len()];
+    for addr in [
+        AddressMode::Repeat,
+        AddressMode::ClampToEdge,
+        AddressMode::ClampToBorder,
+    ] {
+        let d = SamplerDescriptor::anisotropic(16).with_address_mode(addr);
+        let s = Sampler::new(d).unwrap();
+        for (t, tex) in textures.iter().enumerate() {
+            s.sample_batch(tex, &fps, &mut out);
+            for (f, o) in fps.iter().zip(&out) {
+                let want = s.sample(tex, f).map(f32::to_bits);
+                assert_eq!(o.map(f32::to_bits), want, "texture {t} {addr:?} {f:?}");
+            }
+        }
+    }
+}
+
 /// `sample_batch` equals `sample` bit for bit on the lod's edge cases: zero, subnormal, huge,
 /// infinite and NaN derivatives (the batch lod stage's scalar fix-up and its non-finite select),
 /// with lod biases large enough that a subnormal `rho^2` does not clamp to `lod_min`.
