@@ -199,9 +199,19 @@ mod tests {
 
     /// The staged probes (`Probes::trilinear_sum`) equal the formula's plain loop bit for bit:
     /// each probe a bilinear-in-two-levels trilinear sample in the shared levels, summed in order.
+    /// On an odd-sized texture under Repeat and MirrorRepeat, and on a power-of-two one under
+    /// Repeat on both axes (the staged probes' mask-wrapped route for probes far outside,
+    /// `Pass::far_repeat`), with positions up to a texture away from it.
     #[test]
     fn staged_probes_equal_the_probe_loop() {
-        let tex = Texture::from_fn(61, 34, Format::Rgba8Srgb, &Limits::default(), |i, j| {
+        use crate::address::AddressMode::{MirrorRepeat, Repeat};
+        for (w, h, v_mode) in [(61, 34, MirrorRepeat), (64, 32, Repeat)] {
+            check_staged_probes(w, h, v_mode);
+        }
+    }
+
+    fn check_staged_probes(w: u32, h: u32, v_mode: crate::address::AddressMode) {
+        let tex = Texture::from_fn(w, h, Format::Rgba8Srgb, &Limits::default(), |i, j| {
             let x = (i * 7 + j * 13) % 256;
             [
                 x as f32 / 255.0,
@@ -216,7 +226,7 @@ mod tests {
         };
         let d = SamplerDescriptor {
             address_mode_u: crate::address::AddressMode::Repeat,
-            address_mode_v: crate::address::AddressMode::MirrorRepeat,
+            address_mode_v: v_mode,
             ..SamplerDescriptor::anisotropic(16)
         };
         let sampler = Sampler::new(d).unwrap();
@@ -232,7 +242,7 @@ mod tests {
                 dvdx: 0.01 * (f(9) - 0.5),
                 dvdy: 0.2 * f(11) * (f(13) - 0.5),
             };
-            let axes = fp.axes(61, 34);
+            let axes = fp.axes(w, h);
             let major = axes.major.length();
             let n = probe_count(major, axes.minor.length(), 16);
             if n == 1 {

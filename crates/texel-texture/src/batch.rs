@@ -36,7 +36,7 @@ use crate::bilinear::{lerp, Bilinear};
 use crate::dispatch::{self, Kernel};
 use crate::fetch::{Fetch, Pyramid, Run};
 use crate::fixed8::{Bilinear8, Point8};
-use crate::floor::{floor_clamped, STAGED_F32_LIMIT};
+use crate::floor::{floor_clamped, floor_index, STAGED_F32_LIMIT};
 use crate::footprint::{
     finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, Query,
 };
@@ -767,19 +767,48 @@ impl<const N: usize, T: Taps> Pass<N, T> {
         }
     }
 
-    /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value. Three routes,
+    /// Stage 3 for sample `k` at `uv`, in its level `level`: the filtered value. Four routes,
     /// the same value from each: every tap inside the level; within one texel of it
-    /// ([`Pass::near`]: the taps wrapped by two selects each); elsewhere, or under
-    /// `ClampToBorder`, the one-sample filter, which wraps its taps in `i64` (`rem_euclid`).
+    /// ([`Pass::near`]: the taps wrapped by two selects each); farther out under `Repeat` on both
+    /// axes of a power-of-two level ([`Pass::far_repeat`]: the taps wrapped by masks);
+    /// elsewhere, or under `ClampToBorder`, the one-sample filter, which wraps its taps in `i64`
+    /// (`rem_euclid`).
     #[inline(always)]
     fn filtered<F: Fetch>(&self, level: &F, k: usize, uv: Vec2) -> Vec4 {
         if self.inside[k] {
             self.inside_value(level, k)
         } else if let Some((i, j)) = self.near(level.size(), k) {
             T::wrapped(level, i, j, (self.a[k], self.b[k]))
+        } else if let Some((i, j, ab)) = self.far_repeat(level.size(), uv) {
+            T::wrapped(level, i, j, ab)
         } else {
             self.taps.filter(level, &self.addr, uv)
         }
+    }
+
+    /// The wrapped taps `([i, i + 1], [j, j + 1])` and fractions of a sample at `uv` in a level of
+    /// `w` x `h` texels when both address modes are `Repeat` and both sides powers of two (every
+    /// level of a power-of-two texture), else `None`: the one-sample filter's own arithmetic
+    /// (origin `uv * size - HALF`, [`floor_index`], the fraction `x - floor`, the next tap by
+    /// `saturating_add`), with `Repeat`'s `rem_euclid` as a mask (`i & (w - 1)` is the remainder
+    /// for a power-of-two `w`, for negative `i` too). So the value is the one-sample filter's bit
+    /// for bit, without its four divisions and border tests. Reached by samples more than a
+    /// texel outside the level: anisotropic probes spread half a major axis beyond their sample,
+    /// over several periods of a repeating texture near the ground's horizon (docs/perf-log.md,
+    /// entry 46).
+    #[inline(always)]
+    fn far_repeat(&self, (w, h): (u32, u32), uv: Vec2) -> Option<([u32; 2], [u32; 2], (f32, f32))> {
+        let pow2 = w.is_power_of_two() && h.is_power_of_two();
+        if !(self.repeat.0 && self.repeat.1 && pow2) {
+            return None;
+        }
+        let (x, y) = (uv.x * w as f32 - T::HALF, uv.y * h as f32 - T::HALF);
+        let (i0, j0) = (floor_index(x), floor_index(y));
+        let ab = (x - i0 as f32, y - j0 as f32);
+        let (mw, mh) = (i64::from(w) - 1, i64::from(h) - 1);
+        let i = [i0 & mw, i0.saturating_add(1) & mw].map(|i| i as u32);
+        let j = [j0 & mh, j0.saturating_add(1) & mh].map(|j| j as u32);
+        Some((i, j, ab))
     }
 }
 
