@@ -797,7 +797,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
     /// over several periods of a repeating texture near the ground's horizon (docs/perf-log.md,
     /// entry 46).
     #[inline(always)]
-    fn far_repeat(&self, (w, h): (u32, u32), uv: Vec2) -> Option<([u32; 2], [u32; 2], (f32, f32))> {
+    fn far_repeat(&self, (w, h): (u32, u32), uv: Vec2) -> Option<WrappedTaps> {
         let pow2 = w.is_power_of_two() && h.is_power_of_two();
         if !(self.repeat.0 && self.repeat.1 && pow2) {
             return None;
@@ -811,6 +811,10 @@ impl<const N: usize, T: Taps> Pass<N, T> {
         Some((i, j, ab))
     }
 }
+
+/// A sample's taps wrapped into a level, `([i, i + 1], [j, j + 1])`, and its fractions `(a, b)`
+/// ([`Pass::far_repeat`]).
+type WrappedTaps = ([u32; 2], [u32; 2], (f32, f32));
 
 /// Filter `footprints` into `out` (same length) with `s`'s core kernel: `min_filter` Nearest or
 /// Linear (equal to `mag_filter`), any `mipmap_filter`, level 0 below [`MAX_SIDE`] per side
