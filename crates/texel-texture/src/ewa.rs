@@ -64,8 +64,10 @@
 //! paying a square root, a floor and a ceil. Along a line `r^2` ([`LevelEllipse::r2`]) is a
 //! quadratic in the offset, carried in `f64` by forward differences ([`Weights`]), and weights and
 //! texels are read in the same loop, so a line has a single loop exit. Lines inside the level read
-//! texels without address wrapping. Alternatives measured and not adopted (two accumulators,
-//! `r^2` evaluated directly per texel, one bounds check per run): docs/perf-log.md.
+//! texels without address wrapping; lines crossing the edge of a power-of-two side under `Repeat`
+//! wrap each index by a mask (docs/perf-log.md, entry 46). Alternatives measured and not adopted
+//! (two accumulators, `r^2` evaluated directly per texel, one bounds check per run):
+//! docs/perf-log.md.
 //!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
@@ -432,6 +434,20 @@ fn ewa_level<F: Fetch>(level: &F, addr: &Address, q: &LevelEllipse, uv: Vec2) ->
             Some(j) if inside => {
                 let i0 = line.i0 as u32;
                 add_line(line, |k| level.texel(i0 + k as u32, j), &mut acc);
+            }
+            // A line crossing the level's edge along a `Repeat` axis of a power-of-two side:
+            // `Repeat`'s `rem_euclid` is a mask there, so each texel's index is wrapped by one
+            // `and` (the index `Line::texel` gives, wrapped as `AddressMode::wrap` does), not by
+            // the general route's two wraps and border test. Same texels, same order.
+            Some(i) if line.vertical && addr.v == AddressMode::Repeat && h.is_power_of_two() => {
+                let (j0, mask) = (line.j0, i64::from(h) - 1);
+                let texel = |k: usize| level.texel(i, (j0.saturating_add(k as i64) & mask) as u32);
+                add_line(line, texel, &mut acc);
+            }
+            Some(j) if !line.vertical && addr.u == AddressMode::Repeat && w.is_power_of_two() => {
+                let (i0, mask) = (line.i0, i64::from(w) - 1);
+                let texel = |k: usize| level.texel((i0.saturating_add(k as i64) & mask) as u32, j);
+                add_line(line, texel, &mut acc);
             }
             _ => add_line(
                 line,

@@ -746,3 +746,57 @@ fn descriptor_validation() {
     let sixteen = Sampler::new(SamplerDescriptor::minification(FilterMode::Ewa)).unwrap();
     assert_eq!(one.sample(&tex, &fp), sixteen.sample(&tex, &fp));
 }
+
+/// Under `Repeat` a texture is periodic, so moving a footprint's centre by whole periods leaves
+/// trilinear and EWA samples unchanged, bit for bit, where the shift is exact in `f32` (centres on
+/// multiples of 1/1024, periods of a power-of-two texture): the shifted samples wrap every tap
+/// (trilinear's staged route for taps more than a texel outside, `Pass::far_repeat`; EWA's lines
+/// wrapped by a mask), the unshifted ones read inside the texture. Tall, wide and rotated
+/// ellipses (EWA scans columns for the tall ones, rows for the others), one sample at a time and
+/// batched.
+#[test]
+fn whole_period_shifts_under_repeat_change_nothing() {
+    let textures = [
+        noise_texture(64, 64, Format::Rgba8Unorm, 5),
+        noise_texture(128, 32, Format::Rgba8Srgb, 6),
+    ];
+    let shifts = [(1.0f32, 0.0f32), (0.0, 1.0), (-2.0, 3.0), (5.0, -4.0)];
+    for tex in &textures {
+        let (w, h) = (tex.width(), tex.height());
+        let mut fps = Vec::new();
+        for k in 0..60u32 {
+            // Centres in [0.375, 0.625) on multiples of 1/1024; axes up to 8 x 1.5 texels.
+            let (u, v) = (
+                (384 + (k * 37) % 256) as f32 / 1024.0,
+                (384 + (k * 91) % 256) as f32 / 1024.0,
+            );
+            let (px, py) = axes(1.5, 1.0 + (k % 5) as f32, k as f32 * 0.4);
+            fps.push(footprint(u, v, px, py, w, h));
+        }
+        for name in ["trilinear", "ewa"] {
+            let s = sampler(name, AddressMode::Repeat);
+            let mut want = vec![[0.0f32; 4]; fps.len()];
+            s.sample_batch(tex, &fps, &mut want);
+            for (f, o) in fps.iter().zip(&want) {
+                assert_eq!(s.sample(tex, f).map(f32::to_bits), o.map(f32::to_bits));
+            }
+            for (du, dv) in shifts {
+                let moved: Vec<Footprint> = fps
+                    .iter()
+                    .map(|f| Footprint {
+                        u: f.u + du,
+                        v: f.v + dv,
+                        ..*f
+                    })
+                    .collect();
+                let mut got = vec![[0.0f32; 4]; fps.len()];
+                s.sample_batch(tex, &moved, &mut got);
+                for ((f, g), o) in moved.iter().zip(&got).zip(&want) {
+                    let bits = o.map(f32::to_bits);
+                    assert_eq!(g.map(f32::to_bits), bits, "{name} batch {f:?}");
+                    assert_eq!(s.sample(tex, f).map(f32::to_bits), bits, "{name} {f:?}");
+                }
+            }
+        }
+    }
+}
