@@ -248,7 +248,9 @@ const PROBES: usize = 256;
 /// ([`crate::aniso::plan_chunk`]); every sample then lays its probes out in shared scratch, up to
 /// [`PROBES`] from several samples, which are filtered together, stage by stage, as [`run`]
 /// filters trilinear samples (so the lods, floors and texel loads of many probes pipeline, where
-/// one sample's few probes did not). A sample with more than one probe (and a positive lod) has
+/// one sample's few probes did not). Two such batches are kept, each for the probes of one pair
+/// of levels, so that samples alternating between two pairs (lods near an integer) do not make
+/// one batch of mixed levels. A sample with more than one probe (and a positive lod) has
 /// [`crate::aniso::filter_planned`]'s probes; one with a single probe (an isotropic footprint) is
 /// one probe at its `uv` and isotropic lod (`mip::trilinear`); a magnified one (`lod <= 0`) is
 /// one probe in level 0 alone (the `Linear` mag filter, bilinear). Bit for bit
@@ -280,7 +282,12 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
     // The probe scratch (about 13 KB) is reused from the thread's last call: made and zeroed per
     // call it was a quarter of the instructions of aniso16 on a mesh of small triangles, one call
     // per triangle and tile (docs/perf-log.md, entries 40 and 41).
-    let mut probes = ProbeBatch::take(s.address());
+    // Two batches, each for the probes of one pair of levels: neighbouring samples whose lods
+    // straddle a level (a lod near an integer) alternate between two pairs, and one batch would
+    // mix them, which takes the per-probe level path (docs/perf-log.md, entry 46).
+    let mut slots = [ProbeBatch::take(s.address()), ProbeBatch::take(s.address())];
+    // Which slot's batch began first: the one flushed when neither holds a sample's pair.
+    let mut older = 0usize;
     // Per sample of the chunk: its probes' sum, and `1 / N`.
     let mut sums = [Vec4::ZERO; CHUNK];
     let mut inv = [0.0f32; CHUNK];
@@ -290,45 +297,61 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
         crate::aniso::plan_chunk(s, size0, &chunk, &mut plans);
         for k in 0..fps.len() {
             let (q, plan) = (chunk.query(k), &plans[k]);
-            if !(q.lod > 0.0 && plan.n > 1) {
-                // One probe at the sample's `uv` (finite: `queries`): magnified, the `Linear`
-                // mag filter in level 0 (`Sampler::filter`); else trilinear at the isotropic lod
-                // (`filter_planned` with `N = 1`). Its sum starts at `-0.0`, so that it is the
-                // probe's value bit for bit (`+0.0 + -0.0` would be `+0.0`).
-                if probes.m + 1 > PROBES {
-                    probes.flush(&views, size, &mut sums);
-                }
-                let (l, delta) = if q.lod > 0.0 {
+            // A sample with one probe at its `uv` (finite: `queries`): magnified, the `Linear`
+            // mag filter in level 0 (`Sampler::filter`); else trilinear at the isotropic lod
+            // (`filter_planned` with `N = 1`). Its sum starts at `-0.0`, so that it is the
+            // probe's value bit for bit (`+0.0 + -0.0` would be `+0.0`). Otherwise
+            // `filter_planned`'s probes (`n <= 64`: `plan`), summed from zero.
+            let single = !(q.lod > 0.0 && plan.n > 1);
+            let (n, (l, delta)) = if !single {
+                inv[k] = 1.0 / plan.n as f32;
+                sums[k] = Vec4::ZERO;
+                let n = (plan.n as usize).min(CHUNK);
+                (n, mip::linear_levels(plan.lod, last))
+            } else {
+                inv[k] = 1.0;
+                sums[k] = Vec4::splat(-0.0);
+                let levels = if q.lod > 0.0 {
                     mip::linear_levels(q.lod, last)
                 } else {
                     (0, 0.0)
                 };
-                let coarse = delta > 0.0 && l < last;
-                let pair = (l as u8, if coarse { l + 1 } else { l } as u8);
-                inv[k] = 1.0;
-                sums[k] = Vec4::splat(-0.0);
-                let p = &mut *probes;
-                p.sample(k, pair, (delta, coarse));
-                let m = p.m;
+                (1, levels)
+            };
+            let coarse = delta > 0.0 && l < last;
+            let pair = (l as u8, if coarse { l + 1 } else { l } as u8);
+            // The slot holding this pair, or an empty one; else the older batch is flushed.
+            let holds = |b: &ProbeBatch| b.m > 0 && b.pair == pair;
+            let slot = if holds(&slots[0]) {
+                0
+            } else if holds(&slots[1]) {
+                1
+            } else if slots[0].m == 0 {
+                0
+            } else if slots[1].m == 0 {
+                1
+            } else {
+                slots[older].flush(&views, size, &mut sums);
+                older
+            };
+            let p = &mut *slots[slot];
+            if p.m + n > PROBES {
+                p.flush(&views, size, &mut sums);
+            }
+            if p.m == 0 {
+                // A new batch: the other slot's (if any) began first.
+                older = 1 - slot;
+            }
+            p.sample(k, pair, (delta, coarse));
+            let m = p.m;
+            if single {
                 (p.at.u[m], p.at.v[m], p.owner[m]) = (q.fp.u, q.fp.v, k as u8);
                 p.m = m + 1;
                 continue;
             }
-            // `filter_planned`'s probes (`n <= 64`: `plan`).
-            let n = (plan.n as usize).min(CHUNK);
-            if probes.m + n > PROBES {
-                probes.flush(&views, size, &mut sums);
-            }
-            inv[k] = 1.0 / plan.n as f32;
-            sums[k] = Vec4::ZERO;
-            let (l, delta) = mip::linear_levels(plan.lod, last);
-            let coarse = delta > 0.0 && l < last;
-            let pair = (l as u8, if coarse { l + 1 } else { l } as u8);
-            let p = &mut *probes;
-            p.sample(k, pair, (delta, coarse));
             // The probes' positions and owners in one loop over lanes; the sample's levels,
             // weight and coarse flag are recorded once, above, not per probe (perf-log 33).
-            let (m, invk) = (p.m, inv[k]);
+            let invk = inv[k];
             let (us, vs) = (&mut p.at.u[m..m + n], &mut p.at.v[m..m + n]);
             let lanes = us.iter_mut().zip(vs).zip(&mut p.owner[m..m + n]);
             // `i` counts in `i32` (exact, as `usize` was) so that the conversion vectorises.
@@ -340,18 +363,23 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
             }
             p.m = m + n;
         }
-        probes.flush(&views, size, &mut sums);
+        for p in &mut slots {
+            p.flush(&views, size, &mut sums);
+        }
         for (k, o) in out.iter_mut().enumerate().take(fps.len()) {
             *o = (sums[k] * inv[k]).to_array();
         }
     }
-    probes.give_back();
+    let [a, b] = slots;
+    a.give_back();
+    b.give_back();
 }
 
 thread_local! {
-    /// Each thread's probe scratch between [`anisotropic`] calls ([`ProbeBatch::take`]).
-    static PROBE_SCRATCH: std::cell::Cell<Option<Box<ProbeBatch>>> =
-        const { std::cell::Cell::new(None) };
+    /// Each thread's probe scratch between [`anisotropic`] calls ([`ProbeBatch::take`]): the
+    /// batches the last call gave back (two).
+    static PROBE_SCRATCH: std::cell::RefCell<Vec<Box<ProbeBatch>>> =
+        const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// [`anisotropic`]'s probe scratch: up to [`PROBES`] probes with their positions and the sample
@@ -378,7 +406,7 @@ struct ProbeBatch {
 }
 
 impl ProbeBatch {
-    /// The thread's probe scratch, empty and set to the address modes `addr`: the one the
+    /// The thread's probe scratch, empty and set to the address modes `addr`: one of the two the
     /// thread's last [`anisotropic`] call gave back ([`ProbeBatch::give_back`]), or a new one.
     /// Its arrays keep the last call's entries, which are stale and never used: the count `m` is
     /// reset here, and with it empty the batch's `pair` and `mixed` are set by the first
@@ -390,7 +418,10 @@ impl ProbeBatch {
     /// During thread-local teardown (no slot) the scratch is new, as before.
     #[inline(always)]
     fn take(addr: Address) -> Box<ProbeBatch> {
-        let cached = PROBE_SCRATCH.try_with(std::cell::Cell::take).ok().flatten();
+        let cached = PROBE_SCRATCH
+            .try_with(|c| c.borrow_mut().pop())
+            .ok()
+            .flatten();
         match cached {
             Some(mut p) => {
                 p.m = 0;
@@ -406,8 +437,14 @@ impl ProbeBatch {
     /// thread-local teardown).
     #[inline(always)]
     fn give_back(self: Box<Self>) {
-        // `try_with` fails only while the thread's locals are being destroyed.
-        let _ = PROBE_SCRATCH.try_with(|c| c.set(Some(self)));
+        // `try_with` fails only while the thread's locals are being destroyed. At most two are
+        // kept (what one call takes).
+        let _ = PROBE_SCRATCH.try_with(|c| {
+            let mut kept = c.borrow_mut();
+            if kept.len() < 2 {
+                kept.push(self);
+            }
+        });
     }
 
     fn new(addr: Address) -> Box<ProbeBatch> {

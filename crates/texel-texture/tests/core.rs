@@ -345,6 +345,44 @@ fn anisotropic_batch_equals_single_across_its_kinds_of_sample() {
     }
 }
 
+/// Neighbouring anisotropic samples whose probes read different pairs of levels (lods just
+/// below and above an integer, a third pair, magnified and isotropic samples), in every order the
+/// cycle gives: the batch keeps a probe batch per pair of levels and flushes the older one when
+/// a third pair comes (perf-log 46); `sample_batch` equals `sample` bit for bit.
+#[test]
+fn anisotropic_batch_equals_single_when_neighbours_alternate_levels() {
+    let tex = noise_texture(128, 128, Format::Rgba8Unorm);
+    // Minor axes in texels: probe lods about 1 - 1e-6, 1 + 1e-6, 2.5; a magnified sample; an
+    // isotropic one.
+    let minors = [2.0 * (1.0 - 1e-6f32), 2.0 * (1.0 + 1e-6), 5.66, 0.25, 3.0];
+    let ratios = [4.0f32, 4.0, 8.0, 4.0, 1.0];
+    let fps: Vec<Footprint> = (0..300)
+        .map(|k| {
+            let c = (k * 7 + k / 5) % minors.len();
+            let (u, v) = spread(k);
+            let d = minors[c] / 128.0;
+            Footprint {
+                u: u * 0.6 + 0.2,
+                v: v * 0.6 + 0.2,
+                dudx: d * ratios[c],
+                dudy: 0.0,
+                dvdx: 0.0,
+                dvdy: d,
+            }
+        })
+        .collect();
+    let s = Sampler::new(SamplerDescriptor::anisotropic(16)).unwrap();
+    let mut out = vec![[f32::NAN; 4]; fps.len()];
+    s.sample_batch(&tex, &fps, &mut out);
+    for (f, o) in fps.iter().zip(&out) {
+        assert_eq!(
+            o.map(f32::to_bits),
+            s.sample(&tex, f).map(f32::to_bits),
+            "{f:?}"
+        );
+    }
+}
+
 /// `sample_batch` equals `sample` bit for bit on the lod's edge cases: zero, subnormal, huge,
 /// infinite and NaN derivatives (the batch lod stage's scalar fix-up and its non-finite select),
 /// with lod biases large enough that a subnormal `rho^2` does not clamp to `lod_min`.
