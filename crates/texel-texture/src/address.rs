@@ -63,8 +63,8 @@ impl AddressMode {
 /// `i.rem_euclid(n)` for `n >= 1`: a mask where `n` is a power of two (two's complement makes
 /// `i & (n - 1)` the non-negative remainder, for negative `i` too), else the division. Textures
 /// are mostly powers of two on a side, and the division is tens of cycles where the mask is one
-/// (a one-sample bilinear sample outside a repeating texture wraps four taps; EWA's lines across
-/// its edge wrap every texel).
+/// (a one-sample bilinear sample outside a repeating texture wraps four taps; EWA's general
+/// route wraps every texel of a line across the edge).
 #[inline(always)]
 fn rem_euclid(i: i64, n: i64) -> i64 {
     if n & (n - 1) == 0 {
