@@ -501,6 +501,12 @@ pub struct BenchArgs {
     /// level that ran.
     #[arg(long, value_enum, default_value_t = SimdArg::Best)]
     pub simd: SimdArg,
+    /// How frames are written (`texel_raster::Streaming`): `auto` draws the tiles of a frame
+    /// larger than half the last-level cache in scratch and streams them out with non-temporal
+    /// stores (and clears it so); `always` and `never` force either way, to measure the
+    /// difference (images are the same).
+    #[arg(long, value_enum, default_value_t = StreamingArg::Auto)]
+    pub streaming: StreamingArg,
     /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has):
     /// wall time per frame (submission, rendering, reading the frame back) and, where the device
     /// has timestamp queries, the render pass's device time (the last column; `device_ms` in JSON).
@@ -509,6 +515,37 @@ pub struct BenchArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
+}
+
+/// How frames are written (`texel_raster::Streaming`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum StreamingArg {
+    /// Stream frames larger than half the last-level cache.
+    Auto,
+    /// Stream every frame.
+    Always,
+    /// Draw every frame in place.
+    Never,
+}
+
+impl StreamingArg {
+    /// The library's policy for this choice.
+    pub fn policy(self) -> texel_raster::Streaming {
+        match self {
+            StreamingArg::Auto => texel_raster::Streaming::Auto,
+            StreamingArg::Always => texel_raster::Streaming::Always,
+            StreamingArg::Never => texel_raster::Streaming::Never,
+        }
+    }
+
+    /// The name the report prints.
+    pub fn name(self) -> &'static str {
+        match self {
+            StreamingArg::Auto => "auto",
+            StreamingArg::Always => "always",
+            StreamingArg::Never => "never",
+        }
+    }
 }
 
 /// Which instruction-set copy the tile rasterizer and the sampler's batch kernels run

@@ -32,6 +32,9 @@ pub struct Timing {
     pub max_ms: f64,
     /// Median of the untimed clears before the timed frames.
     pub clear_ms: f64,
+    /// Whether the timed frames were drawn in scratch and streamed out
+    /// ([`Frame::draw_streams`]).
+    pub streamed: bool,
 }
 
 /// Times of one filter's frames in milliseconds.
@@ -40,6 +43,8 @@ pub struct FrameTimes {
     pub draw_ms: Vec<f64>,
     /// The clear ([`Frame::reset`]) before each timed frame.
     pub clear_ms: Vec<f64>,
+    /// Whether the timed draws streamed their tiles out ([`Frame::draw_streams`]).
+    pub streamed: bool,
 }
 
 /// Shortest warm-up when any is asked for: fast frames (a few ms) ran measurably slower while the
@@ -64,6 +69,7 @@ pub fn time_frames(
     let mut times = FrameTimes {
         draw_ms: Vec::new(),
         clear_ms: Vec::new(),
+        streamed: false,
     };
     let start = Instant::now();
     let mut k = 0u32;
@@ -77,6 +83,7 @@ pub fn time_frames(
         let t0 = Instant::now();
         frame.reset(settings);
         let t1 = Instant::now();
+        times.streamed = frame.draw_streams(settings);
         draw_into(settings, draws, &mut frame)?;
         let t2 = Instant::now();
         std::hint::black_box(&frame);
@@ -148,6 +155,7 @@ fn time_gpu(
             } else {
                 median(&mut device)
             },
+            streamed: false,
         });
     }
     Ok(out)
@@ -158,6 +166,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let filters = parse_list(&args.filters)?;
     let budget = &mut input.budget;
     texel_raster::limit_level(args.simd.limit());
+    texel_raster::set_streaming(args.streaming.policy());
     let timings = if args.gpu {
         time_gpu(args, &scene, &filters)?
     } else {
@@ -183,12 +192,15 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
                     min_ms,
                     max_ms,
                     clear_ms: median(&mut times.clear_ms),
+                    streamed: times.streamed,
                 });
             }
             Ok(out)
         })??
     };
     let threads = thread_count(args.threads);
+    // Every filter's frames have the same size and target, so all stream or none does.
+    let streamed = timings.iter().any(|t| t.streamed);
     let renderer = if args.gpu { "texel-gpu" } else { "texel" };
     let second = if args.gpu { "device_ms" } else { "clear_ms" };
     let mut stdout = std::io::stdout().lock();
@@ -202,11 +214,13 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         };
         writeln!(
             stdout,
-            "{{\n \"renderer\": \"{renderer}\",\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
+            "{{\n \"renderer\": \"{renderer}\",\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"streaming\": \"{}\",\n \"streamed\": {},\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
             serde_json::Value::from(cpu_model()),
             simd_level(),
             target_name(args.target),
             precision_name(args.scene.precision),
+            args.streaming.name(),
+            streamed,
             scene.width,
             scene.height,
             args.frames,
@@ -227,10 +241,12 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         )?;
         writeln!(
             stdout,
-            "cpu: {}; simd: {}; precision: {}",
+            "cpu: {}; simd: {}; precision: {}; streaming: {} ({})",
             cpu_model(),
             simd_level(),
-            precision_name(args.scene.precision)
+            precision_name(args.scene.precision),
+            args.streaming.name(),
+            if streamed { "streamed" } else { "in place" }
         )?;
         writeln!(
             stdout,

@@ -101,6 +101,8 @@ fn bench_json_has_the_llvmpipe_shape() {
             "precision",
             "renderer",
             "simd",
+            "streamed",
+            "streaming",
             "target",
             "threads",
             "width"
@@ -109,6 +111,8 @@ fn bench_json_has_the_llvmpipe_shape() {
     assert_eq!(v["renderer"], "texel");
     assert_eq!(v["target"], "rgba8");
     assert_eq!(v["precision"], "exact");
+    assert_eq!(v["streaming"], "auto");
+    assert!(v["streamed"].is_boolean());
     assert!(v["cpu"].as_str().is_some_and(|c| !c.is_empty()));
     assert!(v["simd"]
         .as_str()

@@ -3,23 +3,32 @@
 use std::borrow::Cow;
 
 use rayon::prelude::*;
-use texel_texture::Footprint;
+use texel_texture::{dispatch, Footprint};
 
 use crate::settings::{ColorTarget, RenderSettings};
 
 /// Elements per parallel chunk when clearing a buffer (large enough that rayon's overhead is noise).
 const CLEAR_CHUNK: usize = 1 << 15;
 
-/// Set every element of `buf` to `value`, in parallel on the current rayon pool.
-fn fill<T: Copy + Send + Sync>(buf: &mut [T], value: T) {
-    buf.par_chunks_mut(CLEAR_CHUNK).for_each(|c| c.fill(value));
+/// Set every element of `buf` to `value`, in parallel on the current rayon pool; with
+/// non-temporal stores when `stream` (see [`crate::Streaming`]).
+fn fill<T: Copy + Send + Sync>(buf: &mut [T], value: T, stream: bool) {
+    if stream {
+        buf.par_chunks_mut(CLEAR_CHUNK).for_each(|c| {
+            dispatch::stream_fill(c, value);
+            dispatch::stream_fence();
+        });
+    } else {
+        buf.par_chunks_mut(CLEAR_CHUNK).for_each(|c| c.fill(value));
+    }
 }
 
 /// Resize `buf` to `n` elements of `value` (`n = 0` frees nothing but empties it), reusing its
-/// allocation when it is large enough.
-fn reset_buffer<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, value: T) {
+/// allocation when it is large enough; a reused buffer is written with non-temporal stores when
+/// `stream`.
+fn reset_buffer<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, value: T, stream: bool) {
     if buf.len() == n {
-        fill(buf, value);
+        fill(buf, value, stream);
     } else {
         buf.clear();
         buf.resize(n, value);
@@ -58,6 +67,20 @@ pub struct Frame {
     /// The footprint handed to the sampler for the visible fragment (zeroes for background). Filled
     /// when [`crate::RenderSettings::capture_footprints`] is on; empty otherwise.
     pub footprints: Vec<Footprint>,
+    /// Whether the buffers hold what [`Frame::reset`] wrote and nothing since (see
+    /// [`Frame::forget_clear`]).
+    pub(crate) cleared: ClearMark,
+}
+
+/// [`Frame`]'s record that its buffers hold the clear: the load operation of its next draw
+/// (clear, or load what is there), not part of the image, so every two marks compare equal.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct ClearMark(pub(crate) bool);
+
+impl PartialEq for ClearMark {
+    fn eq(&self, _: &ClearMark) -> bool {
+        true
+    }
 }
 
 impl Frame {
@@ -73,6 +96,7 @@ impl Frame {
             texels_read: Vec::new(),
             depth: Vec::new(),
             footprints: Vec::new(),
+            cleared: ClearMark(false),
         };
         frame.reset(settings);
         frame
@@ -83,8 +107,16 @@ impl Frame {
     /// counts (when [`RenderSettings::counts_texels`]) and footprints (when
     /// [`RenderSettings::capture_footprints`]) to zero, and emptied otherwise. Runs on the current
     /// rayon pool. This is the "clear" of a GPU frame: [`crate::draw_into`] then draws on top.
+    ///
+    /// Like a GPU's fast clear, the frame remembers that it holds the clear until the next draw,
+    /// and that draw may then write a tile it reaches from the clear values rather than from the
+    /// buffers (see [`crate::Streaming`]; large frames only). Writing the buffers by hand between
+    /// `reset` and a draw therefore needs [`Frame::forget_clear`] first. A frame larger than half
+    /// the last-level cache is written with non-temporal stores, so the clear does not fill the
+    /// cache with lines the draw would first have to write back.
     pub fn reset(&mut self, settings: &RenderSettings) {
         let n = settings.width as usize * settings.height as usize;
+        let stream = crate::stream::streams(Frame::bytes(settings));
         self.width = settings.width;
         self.height = settings.height;
         self.target = settings.target;
@@ -93,14 +125,44 @@ impl Frame {
         } else {
             (n, 0)
         };
-        reset_buffer(&mut self.color, n_float, settings.background);
+        reset_buffer(&mut self.color, n_float, settings.background, stream);
         let background8 = settings.target.encode(settings.background);
-        reset_buffer(&mut self.color8, n_8, background8);
-        reset_buffer(&mut self.depth, n, f32::INFINITY);
+        reset_buffer(&mut self.color8, n_8, background8, stream);
+        reset_buffer(&mut self.depth, n, f32::INFINITY, stream);
         let counted = if settings.counts_texels() { n } else { 0 };
-        reset_buffer(&mut self.texels_read, counted, 0);
+        reset_buffer(&mut self.texels_read, counted, 0, false);
         let captured = if settings.capture_footprints { n } else { 0 };
-        reset_buffer(&mut self.footprints, captured, Footprint::default());
+        reset_buffer(&mut self.footprints, captured, Footprint::default(), false);
+        self.cleared = ClearMark(true);
+    }
+
+    /// Forget that the frame holds its clear ([`Frame::reset`]): the next draw then loads every
+    /// tile from the buffers, so hand-written pixels survive it. A draw does this itself.
+    pub fn forget_clear(&mut self) {
+        self.cleared = ClearMark(false);
+    }
+
+    /// Whether the frame holds what [`Frame::reset`] wrote, no draw having run since and
+    /// [`Frame::forget_clear`] not called.
+    pub fn holds_clear(&self) -> bool {
+        self.cleared.0
+    }
+
+    /// Whether a draw into this frame with `settings` now writes its tiles from per-thread
+    /// scratch with non-temporal stores ([`crate::Streaming`]): the frame holds its clear, has no
+    /// side channels (texel counts, footprints), and streaming applies to its size.
+    pub fn draw_streams(&self, settings: &RenderSettings) -> bool {
+        self.holds_clear()
+            && self.texels_read.is_empty()
+            && self.footprints.is_empty()
+            && crate::stream::streams(Frame::bytes(settings))
+    }
+
+    /// Bytes of colour and depth in a frame for `settings` (4 a pixel of depth, 4 or 16 of
+    /// colour).
+    fn bytes(settings: &RenderSettings) -> usize {
+        let colour = if settings.target.is_8bit() { 4 } else { 16 };
+        settings.width as usize * settings.height as usize * (colour + 4)
     }
 
     /// Whether the frame's buffers have the size, target and side channels a render with
@@ -198,6 +260,7 @@ mod tests {
             texels_read: vec![],
             depth: vec![0.5, f32::INFINITY],
             footprints: vec![],
+            cleared: ClearMark(false),
         }
     }
 

@@ -55,6 +55,7 @@ mod relief;
 mod settings;
 pub mod setup;
 mod shade;
+mod stream;
 pub mod tile;
 pub mod views;
 
@@ -71,6 +72,7 @@ pub use settings::{
     ColorTarget, Derivatives, Perspective, Precision, RenderSettings, View, MAX_DIMENSION,
     MAX_PIXELS,
 };
+pub use stream::{last_level_cache_bytes, set_streaming, streaming, Streaming};
 pub use texel_texture::dispatch::{level as simd_level, limit_level, SimdLevel};
 
 /// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].

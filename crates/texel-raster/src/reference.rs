@@ -229,6 +229,7 @@ fn reference_frame(
         texels_read: Vec::new(),
         depth: vec![f32::INFINITY; pixels],
         footprints: Vec::new(),
+        cleared: Default::default(),
     };
     let ref_draws: Vec<DrawCall> = draws
         .iter()

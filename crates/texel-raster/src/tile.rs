@@ -165,6 +165,17 @@ struct Context<'a> {
     background: Option<(Environment<'a>, ViewRays)>,
     /// Per draw: how its colour-view fragments are sampled ([`Route::of`]).
     routes: Vec<Route>,
+    /// The frame's clear (colour as the target stores it, depth `+inf`) when its tiles are drawn
+    /// in scratch and streamed out ([`Frame::draw_streams`]); `None` to draw in place.
+    stream: Option<Clear>,
+}
+
+/// What a cleared frame holds in every pixel: the background in the float and in the 8-bit
+/// target's encoding (one of the two is used), depth `+inf`.
+#[derive(Clone, Copy)]
+struct Clear {
+    color: [f32; 4],
+    color8: [u8; 4],
 }
 
 impl Context<'_> {
@@ -240,6 +251,12 @@ pub(crate) fn draw_frame(
         .iter()
         .map(|dc| Route::of(settings, lighting.is_some(), frame.target, dc))
         .collect();
+    let stream = frame.draw_streams(settings).then(|| Clear {
+        color: settings.background,
+        color8: settings.target.encode(settings.background),
+    });
+    // From here the frame's buffers are written: the next draw must load them.
+    frame.forget_clear();
     let ctx = Context {
         settings,
         draws,
@@ -247,6 +264,7 @@ pub(crate) fn draw_frame(
         counting,
         capture,
         routes,
+        stream,
         background: settings
             .environment
             .filter(|_| settings.view == View::Color)
@@ -334,8 +352,84 @@ fn band_slices<T>(buf: &mut [T], width: u32, bands: u32) -> impl Iterator<Item =
     buf.chunks_mut(len).chain(empty).take(bands as usize)
 }
 
-/// Rasterise one tile, on the best instruction set the CPU has ([`texel_texture::dispatch`]).
+/// Rasterise one tile: in place, or in scratch streamed out when the frame holds its clear and
+/// streams ([`Context::stream`]).
 fn raster_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
+    match ctx.stream {
+        Some(clear) => streamed_tile(ctx, tile, bin, clear),
+        None => tile_in_place(ctx, tile, bin),
+    }
+}
+
+/// Per-thread scratch for one streamed tile ([`streamed_tile`]): colour (the target's buffer;
+/// the other stays empty) and depth, `TILE * TILE` pixels at most, row-major at the tile's width.
+#[derive(Default)]
+struct TileScratch {
+    color: Vec<[f32; 4]>,
+    color8: Vec<[u8; 4]>,
+    depth: Vec<f32>,
+}
+
+thread_local! {
+    /// Each thread's [`TileScratch`], reused by every streamed tile it draws.
+    static TILE_SCRATCH: std::cell::RefCell<TileScratch> = std::cell::RefCell::default();
+}
+
+/// `buf` as `n` copies of `value`, reusing its allocation.
+fn refill<T: Copy>(buf: &mut Vec<T>, n: usize, value: T) {
+    if buf.len() == n {
+        buf.fill(value);
+    } else {
+        buf.clear();
+        buf.resize(n, value);
+    }
+}
+
+/// Draw a tile of a frame that holds `clear` as a GPU does a cleared target: in the thread's
+/// scratch filled with the clear (no read of the frame), then copied into the frame with
+/// non-temporal stores (no read either, and the frame's lines do not push the textures out of
+/// the cache). A tile no triangle and no background reaches is left alone: the frame holds the
+/// clear there already. Bit for bit what [`tile_in_place`] writes into a cleared frame.
+fn streamed_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup], clear: Clear) {
+    if bin.is_empty() && ctx.background.is_none() {
+        return;
+    }
+    let (w, h) = (tile.w as usize, tile.h as usize);
+    let eight = tile.target.is_8bit();
+    TILE_SCRATCH.with_borrow_mut(|s| {
+        refill(&mut s.color, if eight { 0 } else { w * h }, clear.color);
+        refill(&mut s.color8, if eight { w * h } else { 0 }, clear.color8);
+        refill(&mut s.depth, w * h, f32::INFINITY);
+        let mut scratch = TileTarget {
+            x0: tile.x0,
+            y0: tile.y0,
+            w: tile.w,
+            h: tile.h,
+            target: tile.target,
+            color: s.color.chunks_mut(w.max(1)).collect(),
+            color8: s.color8.chunks_mut(w.max(1)).collect(),
+            depth: s.depth.chunks_mut(w.max(1)).collect(),
+            texels: Vec::new(),
+            footprints: Vec::new(),
+        };
+        tile_in_place(ctx, &mut scratch, bin);
+        for (dst, src) in tile.color.iter_mut().zip(&scratch.color) {
+            dispatch::stream_copy(dst, src);
+        }
+        for (dst, src) in tile.color8.iter_mut().zip(&scratch.color8) {
+            dispatch::stream_copy(dst, src);
+        }
+        for (dst, src) in tile.depth.iter_mut().zip(&scratch.depth) {
+            dispatch::stream_copy(dst, src);
+        }
+        // Before the band's join hands the frame to another thread.
+        dispatch::stream_fence();
+    });
+}
+
+/// Rasterise one tile into `tile`'s buffers, on the best instruction set the CPU has
+/// ([`texel_texture::dispatch`]), then show the environment where nothing was drawn.
+fn tile_in_place(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
     dispatch::run(TileJob { ctx, tile, bin });
     if let Some((env, rays)) = &ctx.background {
         background_tile(ctx, env, rays, tile);

@@ -489,3 +489,35 @@ fn cube_and_octahedral_backgrounds_have_no_seam() {
         }
     }
 }
+
+/// A streamed frame ([`texel_raster::Streaming`]) draws the environment background into every
+/// tile, though no triangle reaches any: bit for bit the frame drawn in place.
+#[test]
+fn a_streamed_background_equals_one_drawn_in_place() {
+    use texel_raster::{draw_into, set_streaming, ColorTarget, Frame, Streaming};
+    let m = maps(64, |d| {
+        [d.x as f32 * 0.5 + 0.5, 0.25, d.y as f32 * 0.5 + 0.5]
+    });
+    let s = sampler(4);
+    for target in [ColorTarget::Srgb8, ColorTarget::Float] {
+        let mut settings = RenderSettings::new(150, 70);
+        settings.target = target;
+        settings.environment = Some(env(&m, &s, camera(Vec3::new(0.3, 0.2, -1.0))));
+        let draw = |policy| {
+            set_streaming(policy);
+            let mut frame = Frame::new(&settings);
+            assert_eq!(frame.draw_streams(&settings), policy == Streaming::Always);
+            draw_into(&settings, &[], &mut frame).unwrap();
+            frame
+        };
+        let (in_place, streamed) = (draw(Streaming::Never), draw(Streaming::Always));
+        set_streaming(Streaming::Auto);
+        let bits = |f: &Frame| -> Vec<u32> {
+            f.color.as_flattened().iter().map(|x| x.to_bits()).collect()
+        };
+        assert_eq!(bits(&in_place), bits(&streamed), "{target:?}");
+        assert_eq!(in_place.color8, streamed.color8, "{target:?}");
+        let background = [0.0, 0.0, 0.0, 1.0];
+        assert!(in_place.linear().iter().all(|c| *c != background));
+    }
+}

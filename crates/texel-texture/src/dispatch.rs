@@ -199,3 +199,117 @@ unsafe fn v3<K: Kernel>(k: K) -> K::Output {
 unsafe fn v4<K: Kernel>(k: K) -> K::Output {
     k.run(Lanes::detect())
 }
+
+/// Copy `src` into `dst` (equal lengths) with non-temporal stores where the CPU has them
+/// (x86-64: SSE2's `movntdq`, 64 bytes a step, then 16; plain copies for the bytes before `dst`'s
+/// first 16-byte boundary and after its last): the destination's cache lines are written
+/// without first being read from memory, and are not kept in the cache. For writing out a frame
+/// larger than the cache, which nothing reads again soon. Elsewhere a plain copy.
+///
+/// The stores are weakly ordered: call [`stream_fence`] on the same thread before another
+/// thread may read `dst` (before the work that wrote it is joined).
+///
+/// # Panics
+/// If the lengths differ.
+pub fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
+    assert_eq!(dst.len(), src.len(), "stream_copy: lengths differ");
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{__m128i, _mm_loadu_si128, _mm_stream_si128};
+        let bytes = std::mem::size_of_val(src);
+        let d = dst.as_mut_ptr().cast::<u8>();
+        let s = src.as_ptr().cast::<u8>();
+        let head = d.align_offset(16).min(bytes);
+        let end = head + (bytes - head) / 16 * 16;
+        // SAFETY: `dst` and `src` do not overlap (one is borrowed mutably) and both span `bytes`
+        // bytes; every access below lies in `[0, bytes)`: the head `[0, head)`, 16-byte blocks
+        // in `[head, end)` with `end <= bytes`, the tail `[k, bytes)`. Each `_mm_stream_si128`
+        // address is `d + head + 16 m`, 16-byte aligned as it requires (`align_offset`);
+        // `_mm_loadu_si128` takes any alignment. SSE2 is part of the x86-64 baseline. Copying a
+        // `T: Copy` byte for byte from valid `T`s gives valid `T`s (as `copy_from_slice` does).
+        unsafe {
+            std::ptr::copy_nonoverlapping(s, d, head);
+            let block = |k: usize| {
+                let v = _mm_loadu_si128(s.add(k).cast::<__m128i>());
+                _mm_stream_si128(d.add(k).cast::<__m128i>(), v);
+            };
+            let mut k = head;
+            while k + 64 <= end {
+                block(k);
+                block(k + 16);
+                block(k + 32);
+                block(k + 48);
+                k += 64;
+            }
+            while k < end {
+                block(k);
+                k += 16;
+            }
+            std::ptr::copy_nonoverlapping(s.add(k), d.add(k), bytes - k);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    dst.copy_from_slice(src);
+}
+
+/// Set every element of `dst` to `value` with non-temporal stores ([`stream_copy`] from a
+/// 4 KiB buffer of copies of `value`). Call [`stream_fence`] as after [`stream_copy`].
+pub fn stream_fill<T: Copy>(dst: &mut [T], value: T) {
+    let n = (4096 / std::mem::size_of::<T>().max(1)).clamp(1, dst.len().max(1));
+    let src = vec![value; n];
+    for c in dst.chunks_mut(n) {
+        stream_copy(c, &src[..c.len()]);
+    }
+}
+
+/// Order this thread's earlier [`stream_copy`] and [`stream_fill`] stores before its later
+/// stores (`sfence` on x86-64; nothing elsewhere, where those are plain copies), so a thread
+/// that sees the later stores (through a join or a lock) sees the streamed data too.
+pub fn stream_fence() {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: `sfence` takes no operands and touches no memory; SSE is part of the x86-64
+    // baseline.
+    unsafe {
+        std::arch::x86_64::_mm_sfence();
+    }
+}
+
+#[cfg(test)]
+mod stream_tests {
+    use super::*;
+
+    /// Every length and alignment of the head, body and tail copies what `copy_from_slice` does.
+    #[test]
+    fn stream_copy_equals_a_plain_copy() {
+        let src: Vec<u8> = (0..300u32).map(|i| (i * 37 % 251) as u8).collect();
+        for off in 0..20 {
+            for len in 0..(src.len() - off).min(200) {
+                let mut dst = vec![0xAAu8; 300];
+                stream_copy(&mut dst[off..off + len], &src[..len]);
+                stream_fence();
+                assert_eq!(
+                    &dst[off..off + len],
+                    &src[..len],
+                    "offset {off}, length {len}"
+                );
+                assert!(dst[..off].iter().all(|&b| b == 0xAA));
+                assert!(dst[off + len..].iter().all(|&b| b == 0xAA));
+            }
+        }
+    }
+
+    #[test]
+    fn stream_fill_sets_every_element() {
+        for len in [0, 1, 3, 1023, 1024, 1025, 5000] {
+            let mut f = vec![0f32; len + 1];
+            stream_fill(&mut f[1..], f32::INFINITY);
+            stream_fence();
+            assert_eq!(f[0], 0.0);
+            assert!(f[1..].iter().all(|&z| z == f32::INFINITY), "length {len}");
+            let mut c = vec![[0u8; 4]; len];
+            stream_fill(&mut c, [1, 2, 3, 4]);
+            stream_fence();
+            assert!(c.iter().all(|&p| p == [1, 2, 3, 4]));
+        }
+    }
+}
