@@ -228,7 +228,11 @@ pub fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
         // `_mm_loadu_si128` takes any alignment. SSE2 is part of the x86-64 baseline. Copying a
         // `T: Copy` byte for byte from valid `T`s gives valid `T`s (as `copy_from_slice` does).
         unsafe {
-            std::ptr::copy_nonoverlapping(s, d, head);
+            // The head and tail are empty for rows of 16-byte multiples on 16-byte boundaries
+            // (most frame rows): skip `memcpy`'s call and size dispatch.
+            if head > 0 {
+                std::ptr::copy_nonoverlapping(s, d, head);
+            }
             let block = |k: usize| {
                 let v = _mm_loadu_si128(s.add(k).cast::<__m128i>());
                 _mm_stream_si128(d.add(k).cast::<__m128i>(), v);
@@ -245,7 +249,9 @@ pub fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
                 block(k);
                 k += 16;
             }
-            std::ptr::copy_nonoverlapping(s.add(k), d.add(k), bytes - k);
+            if k < bytes {
+                std::ptr::copy_nonoverlapping(s.add(k), d.add(k), bytes - k);
+            }
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
