@@ -502,7 +502,7 @@ pub struct BenchArgs {
     #[arg(long, value_enum, default_value_t = SimdArg::Best)]
     pub simd: SimdArg,
     /// How frames are written (`texel_raster::Streaming`): `auto` draws the tiles of a frame
-    /// larger than half the last-level cache in scratch and streams them out with non-temporal
+    /// larger than the last-level cache in scratch and streams them out with non-temporal
     /// stores (and clears it so); `always` and `never` force either way, to measure the
     /// difference (images are the same).
     #[arg(long, value_enum, default_value_t = StreamingArg::Auto)]
@@ -520,7 +520,7 @@ pub struct BenchArgs {
 /// How frames are written (`texel_raster::Streaming`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum StreamingArg {
-    /// Stream frames larger than half the last-level cache.
+    /// Stream frames larger than the last-level cache.
     Auto,
     /// Stream every frame.
     Always,

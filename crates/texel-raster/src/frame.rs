@@ -111,9 +111,9 @@ impl Frame {
     /// Like a GPU's fast clear, the frame remembers that it holds the clear until the next draw,
     /// and that draw may then write a tile it reaches from the clear values rather than from the
     /// buffers (see [`crate::Streaming`]; large frames only). Writing the buffers by hand between
-    /// `reset` and a draw therefore needs [`Frame::forget_clear`] first. A frame larger than half
-    /// the last-level cache is written with non-temporal stores, so the clear does not fill the
-    /// cache with lines the draw would first have to write back.
+    /// `reset` and a draw therefore needs [`Frame::forget_clear`] first. A frame larger than the
+    /// last-level cache is written with non-temporal stores (under [`crate::Streaming::Auto`]),
+    /// so the clear does not fill the cache with lines the draw would first have to write back.
     pub fn reset(&mut self, settings: &RenderSettings) {
         let n = settings.width as usize * settings.height as usize;
         let stream = crate::stream::streams(Frame::bytes(settings));

@@ -5,7 +5,7 @@
 //! in memory traffic on every draw, and pushes the textures out of the cache on the way. A GPU
 //! does not read a cleared target: it knows the clear (fast-clear state) and stores whole tiles.
 //! texel does the same for a frame that holds its clear ([`crate::Frame::reset`]) and is larger
-//! than half the last-level cache: each tile some triangle (or the environment background)
+//! than the last-level cache: each tile some triangle (or the environment background)
 //! reaches is drawn in per-thread scratch filled with the clear, then copied out with
 //! non-temporal stores ([`texel_texture::dispatch::stream_copy`]); a tile nothing reaches keeps
 //! the clear the frame already holds. `reset` writes such a frame with non-temporal stores too,
@@ -20,7 +20,10 @@ use std::sync::OnceLock;
 /// its clear use non-temporal stores. Process-wide ([`set_streaming`]); images do not depend on it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Streaming {
-    /// Stream frames larger than half the last-level cache ([`last_level_cache_bytes`]).
+    /// Stream frames larger than the last-level cache ([`last_level_cache_bytes`]): on the Zen 5
+    /// machine of docs/perf-log.md entry 47, frames of 16.6 MB (1920 x 1080) and 29.5 MB
+    /// (2560 x 1440) drew no faster streamed against a 32 MiB cache, and 66 MB (3840 x 2160)
+    /// drew 7-24 % faster.
     #[default]
     Auto,
     /// Stream every frame (for measuring: a frame that fits the cache draws slower this way).
@@ -82,7 +85,7 @@ fn parse_cache_size(s: &str) -> Option<usize> {
 /// the current policy.
 pub(crate) fn streams(bytes: usize) -> bool {
     match streaming() {
-        Streaming::Auto => bytes > last_level_cache_bytes() / 2,
+        Streaming::Auto => bytes > last_level_cache_bytes(),
         Streaming::Always => true,
         Streaming::Never => false,
     }

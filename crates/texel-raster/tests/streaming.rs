@@ -167,14 +167,14 @@ fn streamed_frames_equal_frames_drawn_in_place() {
         assert!(!Frame::new(&settings).draw_streams(&settings));
     }
 
-    // `Auto` streams a frame larger than half the last-level cache, not one that fits.
+    // `Auto` streams a frame larger than the last-level cache, not one that fits.
     set_streaming(Streaming::Auto);
     let small = RenderSettings::new(64, 64);
     assert!(!Frame::new(&small).draw_streams(&small));
-    let half = last_level_cache_bytes() / 2;
-    if half <= 256 << 20 {
+    let cache = last_level_cache_bytes();
+    if cache <= 256 << 20 {
         // 8 bytes a pixel (RGBA8 and depth), 1024 pixels a row.
-        let rows = (half / 8 / 1024 + 1) as u32;
+        let rows = (cache / 8 / 1024 + 1) as u32;
         let eight = |rows| RenderSettings {
             target: ColorTarget::Srgb8,
             ..RenderSettings::new(1024, rows)
