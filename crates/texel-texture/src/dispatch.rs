@@ -1,4 +1,5 @@
-//! Run-time instruction-set dispatch: the one module of texel that uses `unsafe`.
+//! Run-time instruction-set dispatch, and the non-temporal copies of streamed frames
+//! ([`stream_copy`]): the one module of texel that uses `unsafe`.
 //!
 //! texel is compiled for the x86-64 baseline (SSE2), so one binary runs on every x86-64 CPU. Work
 //! that implements [`Kernel`] gets two more copies: one compiled for x86-64-v3 (AVX2, FMA,
