@@ -112,7 +112,8 @@ fn bench_json_has_the_llvmpipe_shape() {
     assert_eq!(v["target"], "rgba8");
     assert_eq!(v["precision"], "exact");
     assert_eq!(v["streaming"], "auto");
-    assert!(v["streamed"].is_boolean());
+    // A 64 x 36 frame fits every cache: drawn in place.
+    assert_eq!(v["streamed"], false);
     assert!(v["cpu"].as_str().is_some_and(|c| !c.is_empty()));
     assert!(v["simd"]
         .as_str()
@@ -150,5 +151,48 @@ fn bench_json_has_the_llvmpipe_shape() {
     assert!(
         text.contains("median ms") && text.contains("\nbilinear ") && text.contains("\nsat "),
         "{text}"
+    );
+}
+
+/// `--streaming always|never` forces either way of writing the frame, and the report says which
+/// ran (`texel_raster::Streaming`).
+#[test]
+fn bench_streaming_is_reported() {
+    for (policy, streamed) in [("always", true), ("never", false)] {
+        let run = ok(&[
+            "bench",
+            "--size",
+            "64x36",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+            "--filters",
+            "bilinear",
+            "--streaming",
+            policy,
+            "--json",
+        ]);
+        let v: serde_json::Value = serde_json::from_str(&stdout(&run)).unwrap();
+        assert_eq!(v["streaming"], policy);
+        assert_eq!(v["streamed"], streamed, "{policy}");
+    }
+    let run = ok(&[
+        "bench",
+        "--size",
+        "64x36",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--filters",
+        "nearest",
+        "--streaming",
+        "always",
+    ]);
+    assert!(
+        stdout(&run).contains("streaming: always (streamed)"),
+        "{}",
+        stdout(&run)
     );
 }
