@@ -8,6 +8,11 @@
 //! (`clear ms`). No file I/O, no PNG encoding. The median of `--frames` timed frames after
 //! `--warmup` untimed ones (lasting at least [`MIN_WARMUP`] unless `--warmup 0`), on a pool of
 //! `--threads` workers built once.
+//!
+//! The clear leaves the frame marked as holding it ([`Frame::holds_clear`]), as a GPU's fast
+//! clear does, so a frame larger than the last-level cache is drawn tile by tile in scratch and
+//! streamed out without reading the frame (`--streaming`, [`texel_raster::Streaming`]); the report
+//! says whether the timed frames were (`streamed`).
 
 use std::io::Write;
 use std::time::{Duration, Instant};
