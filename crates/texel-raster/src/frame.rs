@@ -3,32 +3,42 @@
 use std::borrow::Cow;
 
 use rayon::prelude::*;
-use texel_texture::{dispatch, Footprint};
+use texel_texture::dispatch::{self, StreamElement};
+use texel_texture::Footprint;
 
 use crate::settings::{ColorTarget, RenderSettings};
 
 /// Elements per parallel chunk when clearing a buffer (large enough that rayon's overhead is noise).
 const CLEAR_CHUNK: usize = 1 << 15;
 
-/// Set every element of `buf` to `value`, in parallel on the current rayon pool; with
-/// non-temporal stores when `stream` (see [`crate::Streaming`]).
-fn fill<T: Copy + Send + Sync>(buf: &mut [T], value: T, stream: bool) {
-    if stream {
+/// Set every element of `buf` to `value`, in parallel on the current rayon pool.
+fn fill<T: Copy + Send + Sync>(buf: &mut [T], value: T) {
+    buf.par_chunks_mut(CLEAR_CHUNK).for_each(|c| c.fill(value));
+}
+
+/// [`reset_buffer`] for the colour and depth buffers: a reused buffer is written with
+/// non-temporal stores when `stream` (see [`crate::Streaming`]), each thread fencing its chunk.
+fn reset_streamed<T: StreamElement + Send + Sync>(
+    buf: &mut Vec<T>,
+    n: usize,
+    value: T,
+    stream: bool,
+) {
+    if stream && buf.len() == n {
         buf.par_chunks_mut(CLEAR_CHUNK).for_each(|c| {
             dispatch::stream_fill(c, value);
             dispatch::stream_fence();
         });
     } else {
-        buf.par_chunks_mut(CLEAR_CHUNK).for_each(|c| c.fill(value));
+        reset_buffer(buf, n, value);
     }
 }
 
 /// Resize `buf` to `n` elements of `value` (`n = 0` frees nothing but empties it), reusing its
-/// allocation when it is large enough; a reused buffer is written with non-temporal stores when
-/// `stream`.
-fn reset_buffer<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, value: T, stream: bool) {
+/// allocation when it is large enough.
+fn reset_buffer<T: Copy + Send + Sync>(buf: &mut Vec<T>, n: usize, value: T) {
     if buf.len() == n {
-        fill(buf, value, stream);
+        fill(buf, value);
     } else {
         buf.clear();
         buf.resize(n, value);
@@ -72,10 +82,18 @@ pub struct Frame {
     pub(crate) cleared: ClearMark,
 }
 
-/// [`Frame`]'s record that its buffers hold the clear: the load operation of its next draw
-/// (clear, or load what is there), not part of the image, so every two marks compare equal.
+/// [`Frame`]'s record that its buffers hold the clear, and which: the load operation of its next
+/// draw (clear, or load what is there), not part of the image, so every two marks compare equal.
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct ClearMark(pub(crate) bool);
+pub(crate) struct ClearMark(pub(crate) Option<Clear>);
+
+/// What [`Frame::reset`] wrote in every pixel: the background as a float and in the 8-bit
+/// target's encoding (the buffer the target keeps holds one of them), depth `+inf`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Clear {
+    pub(crate) color: [f32; 4],
+    pub(crate) color8: [u8; 4],
+}
 
 impl PartialEq for ClearMark {
     fn eq(&self, _: &ClearMark) -> bool {
@@ -96,7 +114,7 @@ impl Frame {
             texels_read: Vec::new(),
             depth: Vec::new(),
             footprints: Vec::new(),
-            cleared: ClearMark(false),
+            cleared: ClearMark(None),
         };
         frame.reset(settings);
         frame
@@ -111,9 +129,11 @@ impl Frame {
     /// Like a GPU's fast clear, the frame remembers that it holds the clear until the next draw,
     /// and that draw may then write a tile it reaches from the clear values rather than from the
     /// buffers (see [`crate::Streaming`]; large frames only). Writing the buffers by hand between
-    /// `reset` and a draw therefore needs [`Frame::forget_clear`] first. A frame larger than the
-    /// last-level cache is written with non-temporal stores (under [`crate::Streaming::Auto`]),
-    /// so the clear does not fill the cache with lines the draw would first have to write back.
+    /// `reset` and a draw therefore needs [`Frame::forget_clear`] first. The colour and depth of a
+    /// frame larger than the last-level cache (under [`crate::Streaming::Auto`]) whose buffers
+    /// are reused at their size are written with non-temporal stores, so the clear does not fill
+    /// the cache with lines the draw would first have to write back (a new or resized buffer is
+    /// filled as it is allocated).
     pub fn reset(&mut self, settings: &RenderSettings) {
         let n = settings.width as usize * settings.height as usize;
         let stream = crate::stream::streams(Frame::bytes(settings));
@@ -125,27 +145,35 @@ impl Frame {
         } else {
             (n, 0)
         };
-        reset_buffer(&mut self.color, n_float, settings.background, stream);
+        reset_streamed(&mut self.color, n_float, settings.background, stream);
         let background8 = settings.target.encode(settings.background);
-        reset_buffer(&mut self.color8, n_8, background8, stream);
-        reset_buffer(&mut self.depth, n, f32::INFINITY, stream);
+        reset_streamed(&mut self.color8, n_8, background8, stream);
+        reset_streamed(&mut self.depth, n, f32::INFINITY, stream);
         let counted = if settings.counts_texels() { n } else { 0 };
-        reset_buffer(&mut self.texels_read, counted, 0, false);
+        reset_buffer(&mut self.texels_read, counted, 0);
         let captured = if settings.capture_footprints { n } else { 0 };
-        reset_buffer(&mut self.footprints, captured, Footprint::default(), false);
-        self.cleared = ClearMark(true);
+        reset_buffer(&mut self.footprints, captured, Footprint::default());
+        self.cleared = ClearMark(Some(Clear {
+            color: settings.background,
+            color8: background8,
+        }));
     }
 
     /// Forget that the frame holds its clear ([`Frame::reset`]): the next draw then loads every
     /// tile from the buffers, so hand-written pixels survive it. A draw does this itself.
     pub fn forget_clear(&mut self) {
-        self.cleared = ClearMark(false);
+        self.cleared = ClearMark(None);
     }
 
     /// Whether the frame holds what [`Frame::reset`] wrote, no draw having run since and
     /// [`Frame::forget_clear`] not called.
     pub fn holds_clear(&self) -> bool {
-        self.cleared.0
+        self.cleared.0.is_some()
+    }
+
+    /// The clear the frame holds when a draw with `settings` streams ([`Frame::draw_streams`]).
+    pub(crate) fn streamed_clear(&self, settings: &RenderSettings) -> Option<Clear> {
+        self.cleared.0.filter(|_| self.draw_streams(settings))
     }
 
     /// Whether a draw into this frame with `settings` now writes its tiles from per-thread
@@ -260,7 +288,7 @@ mod tests {
             texels_read: vec![],
             depth: vec![0.5, f32::INFINITY],
             footprints: vec![],
-            cleared: ClearMark(false),
+            cleared: ClearMark(None),
         }
     }
 

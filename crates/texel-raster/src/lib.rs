@@ -117,7 +117,10 @@ pub fn render_into(
 /// fragments are depth-tested against the frame's depth and overwrite its colour. Use
 /// [`Frame::reset`] (the clear) first for a fresh image; `reset` then `draw_into` equals
 /// [`render_into`] bit for bit. This is what `texel bench` times, as the llvmpipe comparison
-/// script times the draw after an untimed clear.
+/// script times the draw after an untimed clear. A frame that still holds its clear
+/// ([`Frame::holds_clear`]) may be drawn from the clear rather than from its buffers, as a GPU
+/// draws into a fast-cleared target: pixels written by hand after [`Frame::reset`] need
+/// [`Frame::forget_clear`] first.
 ///
 /// # Errors
 /// As [`render`], and [`RasterError::FrameMismatch`] when the frame was not reset for these

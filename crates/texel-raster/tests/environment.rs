@@ -491,7 +491,9 @@ fn cube_and_octahedral_backgrounds_have_no_seam() {
 }
 
 /// A streamed frame ([`texel_raster::Streaming`]) draws the environment background into every
-/// tile, though no triangle reaches any: bit for bit the frame drawn in place.
+/// tile, though no triangle reaches any: bit for bit the frame drawn in place. The only test of
+/// this binary that sets the process-wide policy: the others may run under either way meanwhile,
+/// which changes no image (the property checked here and in `tests/streaming.rs`).
 #[test]
 fn a_streamed_background_equals_one_drawn_in_place() {
     use texel_raster::{draw_into, set_streaming, ColorTarget, Frame, Streaming};

@@ -241,3 +241,48 @@ fn hand_written_pixels_need_forget_clear() {
     }
     set_streaming(Streaming::Auto);
 }
+
+/// `render` and `render_into` (which reset and draw) give the same bits streamed and in place, and
+/// a draw whose settings name another background than the reset's keeps the reset's clear in the
+/// pixels it does not cover, streamed as in place: the clear is what the frame holds.
+#[test]
+fn render_paths_and_the_resets_clear_stream_alike() {
+    use texel_raster::render_into;
+    let _turn = POLICY.lock().unwrap_or_else(|e| e.into_inner());
+    let (w, h) = (260, 150);
+    let scene = Ground::new(w, h);
+    let sampler = lab_sampler(4);
+    for target in [ColorTarget::Srgb8, ColorTarget::Float] {
+        let settings = RenderSettings {
+            target,
+            threads: Some(2),
+            background: [0.25, 0.5, 0.75, 1.0],
+            ..RenderSettings::new(w, h)
+        };
+        let mut frames = Vec::new();
+        for policy in [Streaming::Never, Streaming::Always] {
+            set_streaming(policy);
+            let fresh = render(&settings, &[scene.draw(&sampler)]).unwrap();
+            let mut reused = Frame::new(&settings);
+            render_into(&settings, &[scene.draw(&sampler)], &mut reused).unwrap();
+            assert!(bits(&fresh) == bits(&reused), "{target:?} {policy:?}");
+            // Reset with one background, draw with another.
+            let other = RenderSettings {
+                background: [1.0, 0.0, 0.0, 1.0],
+                ..settings
+            };
+            let mut mixed = Frame::new(&settings);
+            assert_eq!(mixed.draw_streams(&other), policy == Streaming::Always);
+            draw_into(&other, &[scene.draw(&sampler)], &mut mixed).unwrap();
+            frames.push((fresh, mixed));
+        }
+        let ((fresh, mixed), (fresh_s, mixed_s)) = (&frames[0], &frames[1]);
+        assert!(bits(fresh) == bits(fresh_s), "render, {target:?}");
+        assert!(bits(mixed) == bits(mixed_s), "reset A, draw B, {target:?}");
+        // The uncovered pixels hold the reset's background.
+        let sky = mixed.index(w / 2, 1);
+        assert!(!mixed.covered(sky));
+        assert_eq!(mixed.linear()[sky], fresh.linear()[sky]);
+    }
+    set_streaming(Streaming::Auto);
+}

@@ -201,6 +201,24 @@ unsafe fn v4<K: Kernel>(k: K) -> K::Output {
     k.run(Lanes::detect())
 }
 
+/// Element types [`stream_copy`] and [`stream_fill`] accept: plain data whose every byte is
+/// initialised (no padding), so reading them as 16-byte vectors is defined. Sealed: `u8`, `u32`,
+/// `f32`, `[u8; 4]` (an RGBA8 pixel) and `[f32; 4]` (an RGBA32F pixel).
+pub trait StreamElement: Copy + sealed::Sealed {}
+
+mod sealed {
+    /// Keeps [`super::StreamElement`] to the types listed there.
+    pub trait Sealed {}
+}
+
+macro_rules! stream_elements {
+    ($($t:ty),*) => {$(
+        impl sealed::Sealed for $t {}
+        impl StreamElement for $t {}
+    )*};
+}
+stream_elements!(u8, u32, f32, [u8; 4], [f32; 4]);
+
 /// Copy `src` into `dst` (equal lengths) with non-temporal stores where the CPU has them
 /// (x86-64: SSE2's `movntdq`, 64 bytes a step, then 16; plain copies for the bytes before `dst`'s
 /// first 16-byte boundary and after its last): the destination's cache lines are written
@@ -212,7 +230,7 @@ unsafe fn v4<K: Kernel>(k: K) -> K::Output {
 ///
 /// # Panics
 /// If the lengths differ.
-pub fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
+pub fn stream_copy<T: StreamElement>(dst: &mut [T], src: &[T]) {
     assert_eq!(dst.len(), src.len(), "stream_copy: lengths differ");
     #[cfg(target_arch = "x86_64")]
     {
@@ -226,8 +244,10 @@ pub fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
         // bytes; every access below lies in `[0, bytes)`: the head `[0, head)`, 16-byte blocks
         // in `[head, end)` with `end <= bytes`, the tail `[k, bytes)`. Each `_mm_stream_si128`
         // address is `d + head + 16 m`, 16-byte aligned as it requires (`align_offset`);
-        // `_mm_loadu_si128` takes any alignment. SSE2 is part of the x86-64 baseline. Copying a
-        // `T: Copy` byte for byte from valid `T`s gives valid `T`s (as `copy_from_slice` does).
+        // `_mm_loadu_si128` takes any alignment. SSE2 is part of the x86-64 baseline. Every byte
+        // of `src` is initialised (`StreamElement` types have no padding), so its 16-byte loads
+        // read defined values; and any bytes of a `StreamElement` form a valid one (integers,
+        // floats and arrays of them), so `dst` holds valid `T`s, the same as `copy_from_slice`.
         unsafe {
             // The head and tail are empty for rows of 16-byte multiples on 16-byte boundaries
             // (most frame rows): skip `memcpy`'s call and size dispatch.
@@ -261,7 +281,7 @@ pub fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
 
 /// Set every element of `dst` to `value` with non-temporal stores ([`stream_copy`] from a
 /// 4 KiB buffer of copies of `value`). Call [`stream_fence`] as after [`stream_copy`].
-pub fn stream_fill<T: Copy>(dst: &mut [T], value: T) {
+pub fn stream_fill<T: StreamElement>(dst: &mut [T], value: T) {
     let n = (4096 / std::mem::size_of::<T>().max(1)).clamp(1, dst.len().max(1));
     let src = vec![value; n];
     for c in dst.chunks_mut(n) {

@@ -469,6 +469,8 @@ impl FrameContext<'_, '_> {
                         ..settings
                     })?;
                     copy_rect(&out.color, &mut frame.color, w, rect);
+                    // Written by hand: later draws must load it, not redraw from the clear.
+                    frame.forget_clear();
                 }
                 Mode::Filter(_) => {
                     for band in bands(rect, self.cost(mode, state.view, false), req.moving) {
