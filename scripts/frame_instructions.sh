@@ -6,16 +6,18 @@
 #   e.g. scripts/frame_instructions.sh target/release/texel nearest,bilinear
 # Needs valgrind (apt-get install valgrind). Per filter: instructions of a bench run of 13 frames
 # minus those of a run of 3, over 10 (the difference removes start-up, texture and pyramid
-# preparation, and the bench's warm-up). One thread by default: with more, the count includes
-# the threads' waiting and hand-over, which depend on timing (the one-thread count was checked to
-# repeat within 0.03 %; more threads were not).
+# preparation). `--warmup 0`: the bench's warm-up lasts at least 0.2 s, so under valgrind the
+# number of warm-up frames depended on timing and a fast filter's figure moved by a tenth of a
+# frame (nearest 24.85 and 27.59 million for two builds of the same code). One thread by
+# default: with more, the count includes the threads' waiting and hand-over, which depend on
+# timing (the one-thread count was checked to repeat within 0.03 %; more threads were not).
 set -euo pipefail
 bin=$1 filters=${2:-nearest,bilinear,mip-nearest,trilinear} scene=${3:-../shared/scenes/ground.toml}
 threads=${4:-1}
 command -v valgrind >/dev/null || { echo "valgrind is not installed (apt-get install valgrind)" >&2; exit 1; }
 refs() { # frames, filter -> instructions of the whole run
   valgrind --tool=cachegrind --cache-sim=no --cachegrind-out-file=/dev/null \
-    "$bin" bench "$scene" --color raw --frames "$1" --threads "$threads" --size 1280x720 \
+    "$bin" bench "$scene" --color raw --frames "$1" --warmup 0 --threads "$threads" --size 1280x720 \
     --filters "$2" 2>&1 >/dev/null | sed -n 's/.*I *refs: *//p' | tr -d ,
 }
 echo "| filter | instructions a frame (millions) |"
