@@ -88,7 +88,7 @@ pub fn time_frames(
         let t0 = Instant::now();
         frame.reset(settings);
         let t1 = Instant::now();
-        times.streamed = frame.draw_streams(settings);
+        times.streamed = frame.draw_streams();
         draw_into(settings, draws, &mut frame)?;
         let t2 = Instant::now();
         std::hint::black_box(&frame);

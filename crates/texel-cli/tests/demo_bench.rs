@@ -158,8 +158,8 @@ fn bench_json_has_the_llvmpipe_shape() {
 /// ran (`texel_raster::Streaming`).
 #[test]
 fn bench_streaming_is_reported() {
-    for (policy, streamed) in [("always", true), ("never", false)] {
-        let run = ok(&[
+    let bench = |filter: &str, policy: &str, json: bool| {
+        let mut args = vec![
             "bench",
             "--size",
             "64x36",
@@ -168,31 +168,20 @@ fn bench_streaming_is_reported() {
             "--warmup",
             "0",
             "--filters",
-            "bilinear",
+            filter,
             "--streaming",
             policy,
-            "--json",
-        ]);
-        let v: serde_json::Value = serde_json::from_str(&stdout(&run)).unwrap();
+        ];
+        if json {
+            args.push("--json");
+        }
+        stdout(&ok(&args))
+    };
+    for (policy, streamed) in [("always", true), ("never", false)] {
+        let v: serde_json::Value = serde_json::from_str(&bench("bilinear", policy, true)).unwrap();
         assert_eq!(v["streaming"], policy);
         assert_eq!(v["streamed"], streamed, "{policy}");
     }
-    let run = ok(&[
-        "bench",
-        "--size",
-        "64x36",
-        "--frames",
-        "1",
-        "--warmup",
-        "0",
-        "--filters",
-        "nearest",
-        "--streaming",
-        "always",
-    ]);
-    assert!(
-        stdout(&run).contains("streaming: always (streamed)"),
-        "{}",
-        stdout(&run)
-    );
+    let text = bench("nearest", "always", false);
+    assert!(text.contains("streaming: always (streamed)"), "{text}");
 }

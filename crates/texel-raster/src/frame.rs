@@ -136,10 +136,10 @@ impl Frame {
     /// filled as it is allocated).
     pub fn reset(&mut self, settings: &RenderSettings) {
         let n = settings.width as usize * settings.height as usize;
-        let stream = crate::stream::streams(Frame::bytes(settings));
         self.width = settings.width;
         self.height = settings.height;
         self.target = settings.target;
+        let stream = crate::stream::streams(self.bytes());
         let (n_float, n_8) = if settings.target.is_8bit() {
             (0, n)
         } else {
@@ -171,26 +171,26 @@ impl Frame {
         self.cleared.0.is_some()
     }
 
-    /// The clear the frame holds when a draw with `settings` streams ([`Frame::draw_streams`]).
-    pub(crate) fn streamed_clear(&self, settings: &RenderSettings) -> Option<Clear> {
-        self.cleared.0.filter(|_| self.draw_streams(settings))
+    /// The clear the frame holds when its next draw streams ([`Frame::draw_streams`]).
+    pub(crate) fn streamed_clear(&self) -> Option<Clear> {
+        self.cleared.0.filter(|_| self.draw_streams())
     }
 
-    /// Whether a draw into this frame with `settings` now writes its tiles from per-thread
-    /// scratch with non-temporal stores ([`crate::Streaming`]): the frame holds its clear, has no
-    /// side channels (texel counts, footprints), and streaming applies to its size.
-    pub fn draw_streams(&self, settings: &RenderSettings) -> bool {
+    /// Whether a draw into this frame now writes its tiles from per-thread scratch with
+    /// non-temporal stores ([`crate::Streaming`]): the frame holds its clear, has no side
+    /// channels (texel counts, footprints), and streaming applies to its size.
+    pub fn draw_streams(&self) -> bool {
         self.holds_clear()
             && self.texels_read.is_empty()
             && self.footprints.is_empty()
-            && crate::stream::streams(Frame::bytes(settings))
+            && crate::stream::streams(self.bytes())
     }
 
-    /// Bytes of colour and depth in a frame for `settings` (4 a pixel of depth, 4 or 16 of
-    /// colour).
-    fn bytes(settings: &RenderSettings) -> usize {
-        let colour = if settings.target.is_8bit() { 4 } else { 16 };
-        settings.width as usize * settings.height as usize * (colour + 4)
+    /// Bytes of colour and depth in the frame's size and target (4 a pixel of depth, 4 or 16
+    /// of colour), whether or not its buffers have been allocated yet.
+    fn bytes(&self) -> usize {
+        let colour = if self.target.is_8bit() { 4 } else { 16 };
+        self.width as usize * self.height as usize * (colour + 4)
     }
 
     /// Whether the frame's buffers have the size, target and side channels a render with

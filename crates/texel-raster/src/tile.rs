@@ -61,7 +61,7 @@ use rayon::prelude::*;
 use texel_texture::color::{
     rgba_to_unorm8, rgba_to_unorm8_slice, srgb8_encoder, unorm8_table, Srgb8Encoder,
 };
-use texel_texture::dispatch::{self, Kernel};
+use texel_texture::dispatch::{self, Kernel, StreamElement};
 use texel_texture::{Footprint, FootprintLanes, Lanes};
 
 use crate::draw::DrawCall;
@@ -143,6 +143,16 @@ struct TileTarget<'f> {
 }
 
 impl TileTarget<'_> {
+    /// The tile's pixels inside `settings`' scissor, `[i0, j0, i1, j1]` with exclusive ends;
+    /// `None` when the tile lies outside it.
+    #[inline(always)]
+    fn scissored(&self, settings: &RenderSettings) -> Option<[u32; 4]> {
+        let [sx0, sy0, sx1, sy1] = settings.scissor_rect();
+        let (i0, j0) = (self.x0.max(sx0), self.y0.max(sy0));
+        let (i1, j1) = ((self.x0 + self.w).min(sx1), (self.y0 + self.h).min(sy1));
+        (i0 < i1 && j0 < j1).then_some([i0, j0, i1, j1])
+    }
+
     /// Write a fragment's colour and depth at tile pixel `(li, lj)`, encoding the colour for an
     /// 8-bit target.
     #[inline(always)]
@@ -246,7 +256,7 @@ pub(crate) fn draw_frame(
         .map(|dc| Route::of(settings, lighting.is_some(), frame.target, dc))
         .collect();
     // The clear the frame holds (that of its reset, whatever `settings.background` says now).
-    let stream = frame.streamed_clear(settings);
+    let stream = frame.streamed_clear();
     // From here the frame's buffers are written: the next draw must load them.
     frame.forget_clear();
     let ctx = Context {
@@ -367,13 +377,10 @@ thread_local! {
     static TILE_SCRATCH: std::cell::RefCell<TileScratch> = std::cell::RefCell::default();
 }
 
-/// `buf` as `n` copies of `value`, reusing its allocation.
-fn refill<T: Copy>(buf: &mut Vec<T>, n: usize, value: T) {
-    if buf.len() == n {
-        buf.fill(value);
-    } else {
-        buf.clear();
-        buf.resize(n, value);
+/// Copy each scratch row of `src` into the frame row of `dst` with non-temporal stores.
+fn stream_rows<T: StreamElement>(dst: &mut [&mut [T]], src: &[&mut [T]]) {
+    for (dst, src) in dst.iter_mut().zip(src) {
+        dispatch::stream_copy(dst, src);
     }
 }
 
@@ -384,18 +391,19 @@ fn refill<T: Copy>(buf: &mut Vec<T>, n: usize, value: T) {
 /// clear there already. Bit for bit what [`tile_in_place`] writes into a cleared frame.
 fn streamed_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup], clear: Clear) {
     // Nothing is drawn outside the scissor: such a tile keeps the clear.
-    let [sx0, sy0, sx1, sy1] = ctx.settings.scissor_rect();
-    let outside = tile.x0.max(sx0) >= (tile.x0 + tile.w).min(sx1)
-        || tile.y0.max(sy0) >= (tile.y0 + tile.h).min(sy1);
-    if outside || (bin.is_empty() && ctx.background.is_none()) {
+    if tile.scissored(ctx.settings).is_none() || (bin.is_empty() && ctx.background.is_none()) {
         return;
     }
     let (w, h) = (tile.w as usize, tile.h as usize);
     let eight = tile.target.is_8bit();
     TILE_SCRATCH.with_borrow_mut(|s| {
-        refill(&mut s.color, if eight { 0 } else { w * h }, clear.color);
-        refill(&mut s.color8, if eight { w * h } else { 0 }, clear.color8);
-        refill(&mut s.depth, w * h, f32::INFINITY);
+        // Each buffer as `n` copies of the clear, in its allocation (`clear` keeps it).
+        s.color.clear();
+        s.color.resize(if eight { 0 } else { w * h }, clear.color);
+        s.color8.clear();
+        s.color8.resize(if eight { w * h } else { 0 }, clear.color8);
+        s.depth.clear();
+        s.depth.resize(w * h, f32::INFINITY);
         let mut scratch = TileTarget {
             x0: tile.x0,
             y0: tile.y0,
@@ -409,15 +417,9 @@ fn streamed_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup], c
             footprints: Vec::new(),
         };
         tile_in_place(ctx, &mut scratch, bin);
-        for (dst, src) in tile.color.iter_mut().zip(&scratch.color) {
-            dispatch::stream_copy(dst, src);
-        }
-        for (dst, src) in tile.color8.iter_mut().zip(&scratch.color8) {
-            dispatch::stream_copy(dst, src);
-        }
-        for (dst, src) in tile.depth.iter_mut().zip(&scratch.depth) {
-            dispatch::stream_copy(dst, src);
-        }
+        stream_rows(&mut tile.color, &scratch.color);
+        stream_rows(&mut tile.color8, &scratch.color8);
+        stream_rows(&mut tile.depth, &scratch.depth);
         // Before the band's join hands the frame to another thread.
         dispatch::stream_fence();
     });
@@ -435,9 +437,11 @@ fn tile_in_place(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
 /// Show the environment in the tile's pixels (inside the scissor) that no fragment covers; their
 /// depth stays `+inf`. Texels are counted and footprints captured as for fragments.
 fn background_tile(ctx: &Context, env: &Environment, rays: &ViewRays, tile: &mut TileTarget) {
-    let [sx0, sy0, sx1, sy1] = ctx.settings.scissor_rect();
-    for j in tile.y0.max(sy0)..(tile.y0 + tile.h).min(sy1) {
-        for i in tile.x0.max(sx0)..(tile.x0 + tile.w).min(sx1) {
+    let Some([i0, j0, i1, j1]) = tile.scissored(ctx.settings) else {
+        return;
+    };
+    for j in j0..j1 {
+        for i in i0..i1 {
             let (li, lj) = ((i - tile.x0) as usize, (j - tile.y0) as usize);
             if tile.depth[lj][li] < f32::INFINITY {
                 continue;
@@ -481,13 +485,10 @@ impl Kernel for TileJob<'_, '_, '_, '_> {
 /// [`raster_tile`]'s work, inlined into each instruction set's copy.
 #[inline(always)]
 fn raster_tile_body(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup], lanes: Lanes) {
-    // The tile's pixels inside the scissor, inclusive: [i0, j0, i1, j1].
-    let [sx0, sy0, sx1, sy1] = ctx.settings.scissor_rect();
-    let (ti0, tj0) = (tile.x0.max(sx0), tile.y0.max(sy0));
-    let (ti1, tj1) = ((tile.x0 + tile.w).min(sx1), (tile.y0 + tile.h).min(sy1));
-    if ti0 >= ti1 || tj0 >= tj1 {
+    // The tile's pixels inside the scissor, ends exclusive.
+    let Some([ti0, tj0, ti1, tj1]) = tile.scissored(ctx.settings) else {
         return;
-    }
+    };
     let batched = ctx.settings.view == View::Color && !ctx.counting;
     let mut span = if batched {
         let mut span = Span::take();

@@ -36,7 +36,7 @@ fn reset_and_draw(
     assert_eq!(streaming(), policy);
     frame.reset(settings);
     assert!(frame.holds_clear());
-    let streams = frame.draw_streams(settings);
+    let streams = frame.draw_streams();
     let sampler = lab_sampler(mode);
     draw_into(settings, &[scene.draw(&sampler)], frame).unwrap();
     assert!(!frame.holds_clear(), "a draw forgets the clear");
@@ -138,7 +138,7 @@ fn streamed_frames_equal_frames_drawn_in_place() {
                     assert!(bits(&in_place) == bits(&streamed), "{label}");
                     // A second draw on top loads the frame (it no longer holds the clear).
                     let sampler = lab_sampler(mode);
-                    assert!(!streamed.draw_streams(&settings));
+                    assert!(!streamed.draw_streams());
                     draw_into(&settings, &[scene.draw(&sampler)], &mut streamed).unwrap();
                     assert!(bits(&in_place) == bits(&streamed), "{label}, drawn twice");
                     compared += 1;
@@ -164,13 +164,13 @@ fn streamed_frames_equal_frames_drawn_in_place() {
             ..RenderSettings::new(64, 64)
         },
     ] {
-        assert!(!Frame::new(&settings).draw_streams(&settings));
+        assert!(!Frame::new(&settings).draw_streams());
     }
 
     // `Auto` streams a frame larger than the last-level cache, not one that fits.
     set_streaming(Streaming::Auto);
     let small = RenderSettings::new(64, 64);
-    assert!(!Frame::new(&small).draw_streams(&small));
+    assert!(!Frame::new(&small).draw_streams());
     let cache = last_level_cache_bytes();
     if cache <= 256 << 20 {
         // 8 bytes a pixel (RGBA8 and depth), 1024 pixels a row.
@@ -180,9 +180,9 @@ fn streamed_frames_equal_frames_drawn_in_place() {
             ..RenderSettings::new(1024, rows)
         };
         let large = eight(rows);
-        assert!(Frame::new(&large).draw_streams(&large), "{rows} rows");
+        assert!(Frame::new(&large).draw_streams(), "{rows} rows");
         let fits = eight(rows - 1);
-        assert!(!Frame::new(&fits).draw_streams(&fits), "{} rows", rows - 1);
+        assert!(!Frame::new(&fits).draw_streams(), "{} rows", rows - 1);
     }
     set_streaming(Streaming::Auto);
 }
@@ -227,7 +227,7 @@ fn hand_written_pixels_need_forget_clear() {
         if forget {
             frame.forget_clear();
         }
-        assert_eq!(frame.draw_streams(&settings), !forget);
+        assert_eq!(frame.draw_streams(), !forget);
         draw_into(&settings, &[scene.draw(&sampler)], &mut frame).unwrap();
         if forget {
             // Loaded: the hand-written pixels are nearer than the ground and stay.
@@ -272,7 +272,7 @@ fn render_paths_and_the_resets_clear_stream_alike() {
                 ..settings
             };
             let mut mixed = Frame::new(&settings);
-            assert_eq!(mixed.draw_streams(&other), policy == Streaming::Always);
+            assert_eq!(mixed.draw_streams(), policy == Streaming::Always);
             draw_into(&other, &[scene.draw(&sampler)], &mut mixed).unwrap();
             frames.push((fresh, mixed));
         }
