@@ -88,7 +88,7 @@ use glam::{DVec2, Vec2, Vec4};
 use crate::address::{Address, AddressMode};
 use crate::bilinear::{bilinear, lerp, texel_or_border, Bilinear};
 use crate::fetch::{Fetch, Pyramid};
-use crate::floor::{ceil_f64, floor_f64};
+use crate::floor::{ceil_f64, floor_f64, floor_staged_f64};
 use crate::footprint::{lod_from_rho, Query};
 use crate::mip::{linear_levels, trilinear};
 use crate::sampler::Sampler;
@@ -247,6 +247,7 @@ impl LevelEllipse {
     /// and the set-up of its differences, and a tall, thin ellipse (the ground plane's footprints
     /// near the horizon stretch along v) has many rows of one to four texels but few long
     /// columns. Timings: docs/perf-log.md.
+    #[inline(always)]
     pub fn scan(&self, x: f32, y: f32, mut f: impl FnMut(&Line)) -> u32 {
         let lut = weight_lut();
         let (wide, det) = (self.q00 >= self.q11, self.det);
@@ -275,49 +276,166 @@ impl LevelEllipse {
         }
         // Integer loop counters (an f64 `m += 1` would stall at 2^53); lines count as visits too.
         let lines = (m1 - m0 + 1.0).clamp(0.0, f64::from(MAX_VISITS)) as u32;
+        let at = LineSetup {
+            m0,
+            fa,
+            fb,
+            det,
+            qbb,
+            q01,
+            inv_qbb: 1.0 / qbb,
+            ca,
+            cb,
+            cc,
+        };
+        // The staged floor is exact below 2^51; every span end lies within twice the ellipse's
+        // extent along a, `sqrt(qaa)`, of the centre, so extents below 2^40 keep it exact.
+        let staged = qaa < STAGED_EXTENT_SQUARED;
+        let mut block = LineBlock::default();
         let mut visits = 0u32;
-        let inv_qbb = 1.0 / qbb;
-        for r in 0..lines {
-            if visits >= MAX_VISITS {
-                break;
+        for first in (0..lines).step_by(LINE_BLOCK) {
+            let n = (lines - first).min(LINE_BLOCK as u32) as usize;
+            if staged {
+                at.block::<true>(first, n, &mut block);
+            } else {
+                at.block::<false>(first, n, &mut block);
             }
-            visits += 1;
-            let m = m0 + f64::from(r);
-            let db = m + 0.5 - fb;
-            // The span along a: r^2 < 1 between the quadratic's roots.
-            let disc = det * (qbb - db * db);
-            // Also skips NaN (a non-finite centre).
-            if disc.is_nan() || disc < 0.0 {
-                continue;
+            for k in 0..n {
+                if visits >= MAX_VISITS {
+                    return visits;
+                }
+                visits += 1;
+                let disc = block.disc[k];
+                // Also skips NaN (a non-finite centre).
+                if disc.is_nan() || disc < 0.0 {
+                    continue;
+                }
+                let len = block.count[k].clamp(0.0, f64::from(MAX_VISITS - visits)) as u32;
+                if len == 0 {
+                    continue;
+                }
+                visits += len;
+                let m = m0 + f64::from(first + k as u32);
+                let n0 = block.n0[k];
+                let (a0, b) = (ai.saturating_add(n0 as i64), bi.saturating_add(m as i64));
+                let (i0, j0) = if wide { (a0, b) } else { (b, a0) };
+                f(&Line {
+                    i0,
+                    j0,
+                    vertical: !wide,
+                    weights: Weights {
+                        r2: block.r2[k],
+                        step: block.step[k],
+                        step2: 2.0 * ca,
+                        left: len,
+                        lut,
+                    },
+                });
             }
-            let sd = disc.sqrt();
-            let lo = (q01 * db - sd) * inv_qbb;
-            let hi = (q01 * db + sd) * inv_qbb;
-            let n0 = ceil_f64(fa - 0.5 + lo);
-            let n1 = floor_f64(fa - 0.5 + hi);
-            let len = (n1 - n0 + 1.0).clamp(0.0, f64::from(MAX_VISITS - visits)) as u32;
-            if len == 0 {
-                continue;
-            }
-            visits += len;
-            let (a0, b) = (ai.saturating_add(n0 as i64), bi.saturating_add(m as i64));
-            // r^2 at the first texel, and its forward differences along the line (exact in f64).
-            let da = n0 + 0.5 - fa;
-            let (i0, j0) = if wide { (a0, b) } else { (b, a0) };
-            f(&Line {
-                i0,
-                j0,
-                vertical: !wide,
-                weights: Weights {
-                    r2: ca * da * da + cb * da * db + cc * db * db,
-                    step: ca * (2.0 * da + 1.0) + cb * db,
-                    step2: 2.0 * ca,
-                    left: len,
-                    lut,
-                },
-            });
         }
         visits
+    }
+}
+
+/// Lines whose set-up [`LineSetup::block`] computes in one loop.
+const LINE_BLOCK: usize = 16;
+
+/// `2^80`: [`LevelEllipse::scan`] takes its span ends with [`floor_staged_f64`] (exact below
+/// `2^51`) when `qaa`, the square of the ellipse's extent along its lines, is below this.
+const STAGED_EXTENT_SQUARED: f64 = 1_208_925_819_614_629_174_706_176.0;
+
+/// What every line of one [`LevelEllipse::scan`] shares: the first line's offset `m0`, the
+/// centre's fractions `fa`, `fb`, `det Q`, `qbb`, `q01`, `1 / qbb`, and `r^2`'s coefficients.
+struct LineSetup {
+    m0: f64,
+    fa: f64,
+    fb: f64,
+    det: f64,
+    qbb: f64,
+    q01: f64,
+    inv_qbb: f64,
+    ca: f64,
+    cb: f64,
+    cc: f64,
+}
+
+/// The set-up of up to [`LINE_BLOCK`] lines ([`LineSetup::block`]), one entry a line.
+struct LineBlock {
+    /// `det Q (qbb - db^2)`: negative or NaN for a line that misses the ellipse.
+    disc: [f64; LINE_BLOCK],
+    /// The first texel's offset `n0` along the line (a whole number).
+    n0: [f64; LINE_BLOCK],
+    /// `n1 - n0 + 1`: the line's texels, before the visit cap.
+    count: [f64; LINE_BLOCK],
+    /// `r^2` at the first texel.
+    r2: [f64; LINE_BLOCK],
+    /// `r^2`'s first forward difference at the first texel.
+    step: [f64; LINE_BLOCK],
+}
+
+impl Default for LineBlock {
+    fn default() -> Self {
+        LineBlock {
+            disc: [0.0; LINE_BLOCK],
+            n0: [0.0; LINE_BLOCK],
+            count: [0.0; LINE_BLOCK],
+            r2: [0.0; LINE_BLOCK],
+            step: [0.0; LINE_BLOCK],
+        }
+    }
+}
+
+impl LineSetup {
+    /// Lines `first .. first + n` (`n <= LINE_BLOCK`): each line's span where `r^2 < 1` (the
+    /// quadratic's roots), its first texel's `r^2` and forward difference, in one loop without
+    /// branches or integer conversions, so that it runs in vector lanes on the x86-64-v3 and v4
+    /// copies (the line-by-line form spent about 100 instructions a line, about half of EWA's
+    /// instructions on the ground scene: docs/perf-log.md, entry 48). The arithmetic is the
+    /// line-by-line form's, operation for operation (Rust fuses no multiply-add), and the floors
+    /// are exact ([`floor_staged_f64`] when `STAGED`, which the caller checks the range for), so
+    /// the values are the same bit for bit.
+    #[inline(always)]
+    fn block<const STAGED: bool>(&self, first: u32, n: usize, out: &mut LineBlock) {
+        let floor = |x: f64| {
+            if STAGED {
+                floor_staged_f64(x)
+            } else {
+                floor_f64(x)
+            }
+        };
+        let out = (
+            &mut out.disc[..n],
+            &mut out.n0[..n],
+            &mut out.count[..n],
+            &mut out.r2[..n],
+            &mut out.step[..n],
+        );
+        for (k, ((((disc, n0), count), r2), step)) in out
+            .0
+            .iter_mut()
+            .zip(out.1.iter_mut())
+            .zip(out.2.iter_mut())
+            .zip(out.3.iter_mut())
+            .zip(out.4.iter_mut())
+            .enumerate()
+        {
+            let m = self.m0 + f64::from(first + k as u32);
+            let db = m + 0.5 - self.fb;
+            let d = self.det * (self.qbb - db * db);
+            // NaN where `d < 0`; such lines are skipped by the caller.
+            let sd = d.sqrt();
+            let lo = (self.q01 * db - sd) * self.inv_qbb;
+            let hi = (self.q01 * db + sd) * self.inv_qbb;
+            // ceil(x) = -floor(-x).
+            let a0 = -floor(-(self.fa - 0.5 + lo));
+            let a1 = floor(self.fa - 0.5 + hi);
+            let da = a0 + 0.5 - self.fa;
+            *disc = d;
+            *n0 = a0;
+            *count = a1 - a0 + 1.0;
+            *r2 = self.ca * da * da + self.cb * da * db + self.cc * db * db;
+            *step = self.ca * (2.0 * da + 1.0) + self.cb * db;
+        }
     }
 }
 
@@ -408,7 +526,7 @@ fn add_line(line: &Line, texel: impl Fn(usize) -> Vec4, acc: &mut (Vec4, f32)) {
 
 /// EWA in one level at normalised `uv`: `sum(w T) / sum(w)` over the ellipse `q`'s scan; `None`
 /// if no texel got a weight.
-#[inline]
+#[inline(always)]
 fn ewa_level<F: Fetch>(level: &F, addr: &Address, q: &LevelEllipse, uv: Vec2) -> Option<Vec4> {
     let (w, h) = level.size();
     let (x, y) = (uv.x * w as f32, uv.y * h as f32);
@@ -466,6 +584,7 @@ fn ewa_level<F: Fetch>(level: &F, addr: &Address, q: &LevelEllipse, uv: Vec2) ->
 /// EWA filtering of query `q` (lod `> 0`), eccentricity clamped to `max`: the ellipse of the
 /// footprint's axes, its level `floor(lod)` and the next blended by `fract(lod)` ([`linear_levels`])
 /// with `lod = log2(minor semi-axis) + bias`; non-finite axes fall back to trilinear at `q.lod`.
+#[inline(always)]
 pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Sampler, q: &Query, max: f32) -> Vec4 {
     let addr = s.address();
     let d = s.descriptor();
@@ -647,6 +766,78 @@ mod tests {
             assert_eq!(got, brute);
         }
         assert!(weighed > 5_000, "{weighed}");
+    }
+
+    /// [`LineSetup::block`] (a loop that runs in vector lanes) gives each line the values the
+    /// line-by-line form computed, bit for bit, with the staged floor and with libm's: the span
+    /// ends from `ceil`/`floor` of the roots, `r^2` at the first texel and its difference.
+    #[test]
+    fn line_blocks_equal_the_line_by_line_setup() {
+        let mut rng = crate::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
+        let mut checked = 0;
+        for case in 0..2000 {
+            let r = |rng: &mut crate::rng::SplitMix64, s: f64| (rng.next_f64() * 2.0 - 1.0) * s;
+            // Thin and round, small and large (up to a few hundred lines: several blocks).
+            let size = [0.5, 4.0, 40.0, 300.0][case % 4];
+            let px = Vec2::new(r(&mut rng, size) as f32, r(&mut rng, size) as f32);
+            let py = Vec2::new(r(&mut rng, 3.0) as f32, r(&mut rng, 3.0) as f32);
+            let e = Ellipse::from_axes(px, py, 64.0).unwrap();
+            let q = e.in_level(DVec2::ONE, false);
+            let (x, y) = (r(&mut rng, 1e4), r(&mut rng, 1e4));
+            let (qaa, qbb) = (q.q00, q.q11);
+            let (det, q01) = (q.det, q.q01);
+            let (ca, cb, cc) = (qbb / det, -2.0 * q01 / det, qaa / det);
+            let (fa, fb) = (x - x.floor(), y - y.floor());
+            let hb = qbb.sqrt();
+            let m0 = (fb - 0.5 - hb).ceil();
+            let lines = ((fb - 0.5 + hb).floor() - m0 + 1.0) as u32;
+            let at = LineSetup {
+                m0,
+                fa,
+                fb,
+                det,
+                qbb,
+                q01,
+                inv_qbb: 1.0 / qbb,
+                ca,
+                cb,
+                cc,
+            };
+            let (mut staged, mut plain) = (LineBlock::default(), LineBlock::default());
+            for first in (0..lines).step_by(LINE_BLOCK) {
+                let n = (lines - first).min(LINE_BLOCK as u32) as usize;
+                at.block::<true>(first, n, &mut staged);
+                at.block::<false>(first, n, &mut plain);
+                for k in 0..n {
+                    // The line-by-line form (libm's ceil and floor).
+                    let db = m0 + f64::from(first + k as u32) + 0.5 - fb;
+                    let disc = det * (qbb - db * db);
+                    assert_eq!(staged.disc[k].to_bits(), disc.to_bits());
+                    if disc.is_nan() || disc < 0.0 {
+                        continue;
+                    }
+                    let sd = disc.sqrt();
+                    let (lo, hi) = ((q01 * db - sd) * (1.0 / qbb), (q01 * db + sd) * (1.0 / qbb));
+                    let (n0, n1) = ((fa - 0.5 + lo).ceil(), (fa - 0.5 + hi).floor());
+                    let da = n0 + 0.5 - fa;
+                    let want = [
+                        n0,
+                        n1 - n0 + 1.0,
+                        ca * da * da + cb * da * db + cc * db * db,
+                        ca * (2.0 * da + 1.0) + cb * db,
+                    ];
+                    for b in [&staged, &plain] {
+                        let got = [b.n0[k], b.count[k], b.r2[k], b.step[k]];
+                        // `==` on the floors (a staged floor may give +0 for -0), bits elsewhere.
+                        assert!(got[0] == want[0] && got[1] == want[1], "{got:?} {want:?}");
+                        assert_eq!(got[2].to_bits(), want[2].to_bits());
+                        assert_eq!(got[3].to_bits(), want[3].to_bits());
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 20_000, "{checked}");
     }
 
     #[test]
