@@ -419,7 +419,8 @@ impl LineSetup {
             .zip(out.4.iter_mut())
             .enumerate()
         {
-            let m = self.m0 + f64::from(first + k as u32);
+            // Through i32 (`first + k < MAX_VISITS`): a packed u32-to-f64 conversion needs AVX-512.
+            let m = self.m0 + f64::from((first + k as u32) as i32);
             let db = m + 0.5 - self.fb;
             let d = self.det * (self.qbb - db * db);
             // NaN where `d < 0`; such lines are skipped by the caller.
