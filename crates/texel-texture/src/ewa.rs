@@ -61,13 +61,19 @@
 //! runs one scan ([`LevelEllipse::scan`]) and one weighted-sum loop over the scan's lines. The scan
 //! follows the ellipse's wider side (columns for a tall ellipse, rows otherwise): footprints near
 //! the ground's horizon are long in v, and rows would give many lines one to four texels long, each
-//! paying a square root, a floor and a ceil. Along a line `r^2` ([`LevelEllipse::r2`]) is a
+//! paying a square root, a floor and a ceil. Those set-ups run 16 lines at a time in one loop
+//! without branches or integer conversions (`LineSetup::block`; the floors are exact, so the
+//! values are the line-by-line form's bit for bit): on the ground scene a sample has about 34
+//! lines of 2.3 texels, the line-by-line set-up was half of EWA's instructions, and the block
+//! form made its frames 18 % faster on every instruction-set copy, the baseline one too
+//! (docs/perf-log.md, entry 48). Along a line `r^2` ([`LevelEllipse::r2`]) is a
 //! quadratic in the offset, carried in `f64` by forward differences ([`Weights`]), and weights and
 //! texels are read in the same loop, so a line has a single loop exit. Lines inside the level read
 //! texels without address wrapping; lines crossing the edge of a power-of-two side under `Repeat`
 //! wrap each index by a mask (docs/perf-log.md, entry 46). Alternatives measured and not adopted
-//! (two accumulators, `r^2` evaluated directly per texel, one bounds check per run):
-//! docs/perf-log.md.
+//! (two accumulators, `r^2` evaluated directly per texel, one bounds check per run, weights in
+//! lanes across a block's lines, one bounds check per line, short lines' terms summed in one loop
+//! per block): docs/perf-log.md.
 //!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
@@ -388,12 +394,12 @@ impl Default for LineBlock {
 impl LineSetup {
     /// Lines `first .. first + n` (`n <= LINE_BLOCK`): each line's span where `r^2 < 1` (the
     /// quadratic's roots), its first texel's `r^2` and forward difference, in one loop without
-    /// branches or integer conversions, so that it runs in vector lanes on the x86-64-v3 and v4
-    /// copies (the line-by-line form spent about 100 instructions a line, about half of EWA's
-    /// instructions on the ground scene: docs/perf-log.md, entry 48). The arithmetic is the
-    /// line-by-line form's, operation for operation (Rust fuses no multiply-add), and the floors
-    /// are exact ([`floor_staged_f64`] when `STAGED`, which the caller checks the range for), so
-    /// the values are the same bit for bit.
+    /// branches or integer conversions, which the compiler may also run in vector lanes (the
+    /// line-by-line form spent about 100 instructions a line, about half of EWA's instructions
+    /// on the ground scene, with two data-dependent branches in its floors: docs/perf-log.md,
+    /// entry 48). The arithmetic is the line-by-line form's, operation for operation (Rust fuses
+    /// no multiply-add), and the floors are exact ([`floor_staged_f64`] when `STAGED`, which the
+    /// caller checks the range for), so the values are the same bit for bit.
     #[inline(always)]
     fn block<const STAGED: bool>(&self, first: u32, n: usize, out: &mut LineBlock) {
         let floor = |x: f64| {
