@@ -62,8 +62,10 @@
 //! follows the ellipse's wider side (columns for a tall ellipse, rows otherwise): footprints near
 //! the ground's horizon are long in v, and rows would give many lines one to four texels long, each
 //! paying a square root, a floor and a ceil. Those set-ups run 16 lines at a time in one loop
-//! without branches or integer conversions (`LineSetup::block`; the floors are exact, so the
-//! values are the line-by-line form's bit for bit): on the ground scene a sample has about 34
+//! (`LineSetup::block`), without branches or integer conversions where the staged floor is exact
+//! for every span end (checked per scan; elsewhere with the conversion floor); the values are the
+//! line-by-line form's bit for bit (tested against it, verbatim, for degenerate ellipses and
+//! centres too). On the ground scene a sample has about 34
 //! lines of 2.3 texels, the line-by-line set-up was half of EWA's instructions, and the block
 //! form made its frames 18 % faster on every instruction-set copy, the baseline one too
 //! (docs/perf-log.md, entry 48). Along a line `r^2` ([`LevelEllipse::r2`]) is a
@@ -294,9 +296,21 @@ impl LevelEllipse {
             cb,
             cc,
         };
-        // The staged floor is exact below 2^51; every span end lies within twice the ellipse's
-        // extent along a, `sqrt(qaa)`, of the centre, so extents below 2^40 keep it exact.
-        let staged = qaa < STAGED_EXTENT_SQUARED;
+        // The staged floor is exact below 2^51, and the span ends stay far below that when
+        // (checked here, so any other input takes the conversion floor and the old values):
+        // - the centre is within 2^40 of the origin, so `fa`, `fb` are its fractions in [0, 1)
+        //   and the line offsets `db` lie within `sqrt(qbb)` (plus rounding) of 0;
+        // - `Q` is consistent and positive definite as `in_level` makes it
+        //   (`det <= qaa qbb`, `q01^2 <= qaa qbb`), and `qbb >= 2^-20`:
+        //   then `|q01 db| / qbb <= sqrt(qaa)` plus rounding and `sd / qbb <= sqrt(det / qbb)
+        //   <= sqrt(qaa)`, so `|fa - 0.5 + lo|` and `|fa - 0.5 + hi|` stay below
+        //   `1.5 + 3 sqrt(qaa) < 2^51` for `qaa < 2^80`.
+        let staged = qaa < STAGED_EXTENT_SQUARED
+            && qbb >= STAGED_MIN_QBB
+            && det <= qaa * qbb
+            && q01 * q01 <= qaa * qbb
+            && f64::from(xa).abs() < STAGED_CENTRE
+            && f64::from(xb).abs() < STAGED_CENTRE;
         let mut block = LineBlock::default();
         let mut visits = 0u32;
         for first in (0..lines).step_by(LINE_BLOCK) {
@@ -347,8 +361,16 @@ impl LevelEllipse {
 const LINE_BLOCK: usize = 16;
 
 /// `2^80`: [`LevelEllipse::scan`] takes its span ends with [`floor_staged_f64`] (exact below
-/// `2^51`) when `qaa`, the square of the ellipse's extent along its lines, is below this.
+/// `2^51`) only when `qaa`, the square of the ellipse's extent along its lines, is below this
+/// (and the other conditions there hold).
 const STAGED_EXTENT_SQUARED: f64 = 1_208_925_819_614_629_174_706_176.0;
+
+/// `2^-20`: the smallest `qbb` for the staged floor (`in_level`'s ellipses have `qbb >= 1` unless
+/// shrunk at the last level).
+const STAGED_MIN_QBB: f64 = 1.0 / 1_048_576.0;
+
+/// `2^40`: the largest centre coordinate (texels) for the staged floor.
+const STAGED_CENTRE: f64 = 1_099_511_627_776.0;
 
 /// What every line of one [`LevelEllipse::scan`] shares: the first line's offset `m0`, the
 /// centre's fractions `fa`, `fb`, `det Q`, `qbb`, `q01`, `1 / qbb`, and `r^2`'s coefficients.
@@ -393,8 +415,9 @@ impl Default for LineBlock {
 
 impl LineSetup {
     /// Lines `first .. first + n` (`n <= LINE_BLOCK`): each line's span where `r^2 < 1` (the
-    /// quadratic's roots), its first texel's `r^2` and forward difference, in one loop without
-    /// branches or integer conversions, which the compiler may also run in vector lanes (the
+    /// quadratic's roots), its first texel's `r^2` and forward difference, in one loop; with
+    /// `STAGED` without branches or integer conversions, which the compiler may also run in
+    /// vector lanes (the
     /// line-by-line form spent about 100 instructions a line, about half of EWA's instructions
     /// on the ground scene, with two data-dependent branches in its floors: docs/perf-log.md,
     /// entry 48). The arithmetic is the line-by-line form's, operation for operation (Rust fuses
@@ -775,9 +798,151 @@ mod tests {
         assert!(weighed > 5_000, "{weighed}");
     }
 
-    /// [`LineSetup::block`] (a loop that runs in vector lanes) gives each line the values the
-    /// line-by-line form computed, bit for bit, with the staged floor and with libm's: the span
-    /// ends from `ceil`/`floor` of the roots, `r^2` at the first texel and its difference.
+    /// The line-by-line scan as it was before the set-ups moved into blocks (359a835, verbatim
+    /// but for its name and `self` passed as `q`): the reference [`LevelEllipse::scan`] must
+    /// equal bit for bit.
+    fn line_by_line_scan(q: &LevelEllipse, x: f32, y: f32, mut f: impl FnMut(&Line)) -> u32 {
+        let lut = weight_lut();
+        let (wide, det) = (q.q00 >= q.q11, q.det);
+        // Axes (a, b): lines of constant b, texels along a; qaa and qbb are Q's diagonal entries
+        // for them (a = x for rows; transposed for columns, where x and y swap roles).
+        let (qaa, qbb, xa, xb) = if wide {
+            (q.q00, q.q11, x, y)
+        } else {
+            (q.q11, q.q00, y, x)
+        };
+        let q01 = q.q01;
+        if !(det > 0.0 && qbb > 0.0 && qaa > 0.0 && det.is_finite()) {
+            return 0;
+        }
+        // r^2 = ca da^2 + cb da db + cc db^2 ([`LevelEllipse::r2`] in the line's axes).
+        let (ca, cb, cc) = (qbb / det, -2.0 * q01 / det, qaa / det);
+        let (af, bf) = (floor_f64(f64::from(xa)), floor_f64(f64::from(xb)));
+        let (fa, fb) = (f64::from(xa) - af, f64::from(xb) - bf);
+        let (ai, bi) = (af as i64, bf as i64);
+        // Lines: centre offset db = m + 0.5 - fb with |db| <= sqrt(qbb).
+        let hb = qbb.sqrt();
+        let m0 = ceil_f64(fb - 0.5 - hb);
+        let m1 = floor_f64(fb - 0.5 + hb);
+        if !(m0.is_finite() && m1.is_finite()) {
+            return 0;
+        }
+        // Integer loop counters (an f64 `m += 1` would stall at 2^53); lines count as visits too.
+        let lines = (m1 - m0 + 1.0).clamp(0.0, f64::from(MAX_VISITS)) as u32;
+        let mut visits = 0u32;
+        let inv_qbb = 1.0 / qbb;
+        for r in 0..lines {
+            if visits >= MAX_VISITS {
+                break;
+            }
+            visits += 1;
+            let m = m0 + f64::from(r);
+            let db = m + 0.5 - fb;
+            // The span along a: r^2 < 1 between the quadratic's roots.
+            let disc = det * (qbb - db * db);
+            // Also skips NaN (a non-finite centre).
+            if disc.is_nan() || disc < 0.0 {
+                continue;
+            }
+            let sd = disc.sqrt();
+            let lo = (q01 * db - sd) * inv_qbb;
+            let hi = (q01 * db + sd) * inv_qbb;
+            let n0 = ceil_f64(fa - 0.5 + lo);
+            let n1 = floor_f64(fa - 0.5 + hi);
+            let len = (n1 - n0 + 1.0).clamp(0.0, f64::from(MAX_VISITS - visits)) as u32;
+            if len == 0 {
+                continue;
+            }
+            visits += len;
+            let (a0, b) = (ai.saturating_add(n0 as i64), bi.saturating_add(m as i64));
+            // r^2 at the first texel, and its forward differences along the line (exact in f64).
+            let da = n0 + 0.5 - fa;
+            let (i0, j0) = if wide { (a0, b) } else { (b, a0) };
+            f(&Line {
+                i0,
+                j0,
+                vertical: !wide,
+                weights: Weights {
+                    r2: ca * da * da + cb * da * db + cc * db * db,
+                    step: ca * (2.0 * da + 1.0) + cb * db,
+                    step2: 2.0 * ca,
+                    left: len,
+                    lut,
+                },
+            });
+        }
+        visits
+    }
+
+    /// [`LevelEllipse::scan`] hands out the same lines (indices, direction, texel count, every
+    /// weight's bits) and returns the same visit count as the line-by-line scan, for
+    /// `in_level`'s ellipses (shrunk or not) at centres near and far (beyond 2^40, where the
+    /// staged floor is not used, and up to 1e30, where the old floors saturate), for infinite and
+    /// NaN centres, and for hand-built ellipses the staged floor must refuse: `det` inconsistent
+    /// with the entries, `qbb` tiny, `qaa` beyond 2^80, huge off-diagonals.
+    #[test]
+    fn scan_equals_the_line_by_line_scan() {
+        type Seen = (i64, i64, bool, u32, Vec<u32>);
+        type Scan<'s> = &'s dyn Fn(&mut dyn FnMut(&Line)) -> u32;
+        let lines = |scan: Scan| {
+            let mut seen: Vec<Seen> = Vec::new();
+            let visits = scan(&mut |l: &Line| {
+                let w = l.weights().map(f32::to_bits).collect();
+                seen.push((l.i0, l.j0, l.vertical, l.texels(), w));
+            });
+            (visits, seen)
+        };
+        let mut rng = crate::rng::SplitMix64::new(0x5851_f42d_4c95_7f2d);
+        let mut ellipses = Vec::new();
+        for case in 0..300 {
+            let r = |rng: &mut crate::rng::SplitMix64, s: f64| (rng.next_f64() * 2.0 - 1.0) * s;
+            let size = [0.5, 4.0, 40.0, 3000.0][case % 4];
+            let px = Vec2::new(r(&mut rng, size) as f32, r(&mut rng, size) as f32);
+            let py = Vec2::new(r(&mut rng, 3.0) as f32, r(&mut rng, 3.0) as f32);
+            let e = Ellipse::from_axes(px, py, 64.0).unwrap();
+            let scale = DVec2::splat([1.0, 0.25, 0.01][case % 3]);
+            ellipses.push(e.in_level(scale, case % 2 == 0));
+        }
+        let hand = |q00: f64, q01: f64, q11: f64, det: f64| LevelEllipse { q00, q01, q11, det };
+        ellipses.extend([
+            hand(1.0, 0.0, 1.0, 1e200),
+            hand(1.0, 0.0, 1.0, 1e-200),
+            hand(4.0, 0.0, 1e-30, 4e-30),
+            hand(1e-30, 0.0, 9.0, 9e-30),
+            hand(2e24, 0.0, 3.0, 6e24),
+            hand(3.0, 1e30, 5.0, 14.0),
+            hand(7.0, 2.0, 5.0, 31.0),
+        ]);
+        let mut centres: Vec<(f32, f32)> = vec![
+            (f32::INFINITY, 0.5),
+            (0.5, f32::NEG_INFINITY),
+            (f32::NAN, 3.0),
+            (1e30, -2.5),
+            (-7.25, 1e30),
+            (1.5e12, 2.0),
+            (3.0, -1.2e12),
+            (1e20, 1e20),
+        ];
+        for _ in 0..40 {
+            let x = (rng.next_f64() * 2.0 - 1.0) * [10.0, 1e4, 1e9][centres.len() % 3];
+            let y = (rng.next_f64() * 2.0 - 1.0) * 300.0;
+            centres.push((x as f32, y as f32));
+        }
+        let mut handed = 0;
+        for q in &ellipses {
+            for &(x, y) in &centres {
+                let new = lines(&|f| q.scan(x, y, f));
+                let old = lines(&|f| line_by_line_scan(q, x, y, f));
+                assert_eq!(new, old, "{q:?} at ({x}, {y})");
+                handed += new.1.len();
+            }
+        }
+        assert!(handed > 50_000, "{handed}");
+    }
+
+    /// [`LineSetup::block`] gives each line the values the line-by-line form computed (with
+    /// [`ceil_f64`] and [`floor_f64`]), bit for bit, with either floor: the discriminant, the
+    /// span ends from the roots, `r^2` at the first texel and its difference.
     #[test]
     fn line_blocks_equal_the_line_by_line_setup() {
         let mut rng = crate::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
@@ -820,12 +985,13 @@ mod tests {
                     let db = m0 + f64::from(first + k as u32) + 0.5 - fb;
                     let disc = det * (qbb - db * db);
                     assert_eq!(staged.disc[k].to_bits(), disc.to_bits());
+                    assert_eq!(plain.disc[k].to_bits(), disc.to_bits());
                     if disc.is_nan() || disc < 0.0 {
                         continue;
                     }
                     let sd = disc.sqrt();
                     let (lo, hi) = ((q01 * db - sd) * (1.0 / qbb), (q01 * db + sd) * (1.0 / qbb));
-                    let (n0, n1) = ((fa - 0.5 + lo).ceil(), (fa - 0.5 + hi).floor());
+                    let (n0, n1) = (ceil_f64(fa - 0.5 + lo), floor_f64(fa - 0.5 + hi));
                     let da = n0 + 0.5 - fa;
                     let want = [
                         n0,
@@ -835,10 +1001,7 @@ mod tests {
                     ];
                     for b in [&staged, &plain] {
                         let got = [b.n0[k], b.count[k], b.r2[k], b.step[k]];
-                        // `==` on the floors (a staged floor may give +0 for -0), bits elsewhere.
-                        assert!(got[0] == want[0] && got[1] == want[1], "{got:?} {want:?}");
-                        assert_eq!(got[2].to_bits(), want[2].to_bits());
-                        assert_eq!(got[3].to_bits(), want[3].to_bits());
+                        assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits));
                     }
                     checked += 1;
                 }
