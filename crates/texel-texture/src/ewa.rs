@@ -67,7 +67,7 @@
 //! line-by-line form's bit for bit (tested against it, verbatim, for degenerate ellipses and
 //! centres too). On the ground scene a sample has about 34
 //! lines of 2.3 texels, the line-by-line set-up was half of EWA's instructions, and the block
-//! form made its frames 18 % faster on every instruction-set copy, the baseline one too
+//! form made its frames 18-24 % faster on every instruction-set copy, the baseline one too
 //! (docs/perf-log.md, entry 48). Along a line `r^2` ([`LevelEllipse::r2`]) is a
 //! quadratic in the offset, carried in `f64` by forward differences ([`Weights`]), and weights and
 //! texels are read in the same loop, so a line has a single loop exit. Lines inside the level read
