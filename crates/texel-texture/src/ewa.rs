@@ -65,14 +65,14 @@
 //! (`LineSetup::block`), without branches or integer conversions where the staged floor is exact
 //! for every span end (checked per scan; elsewhere with the conversion floor); the values are the
 //! line-by-line form's bit for bit (tested against it, verbatim, for degenerate ellipses and
-//! centres too). On the ground scene a sample has about 34
-//! lines of 2.3 texels, the line-by-line set-up was half of EWA's instructions, and the block
-//! form made its frames 18-24 % faster on every instruction-set copy, the baseline one too
-//! (docs/perf-log.md, entry 48). Along a line `r^2` ([`LevelEllipse::r2`]) is a
-//! quadratic in the offset, carried in `f64` by forward differences ([`Weights`]), and weights and
-//! texels are read in the same loop, so a line has a single loop exit. Lines inside the level read
-//! texels without address wrapping; lines crossing the edge of a power-of-two side under `Repeat`
-//! wrap each index by a mask (docs/perf-log.md, entry 46). Alternatives measured and not adopted
+//! centres too). On the ground scene a sample has about 34 lines of 2.3 texels, the line-by-line
+//! set-up was half of EWA's instructions, and the block form made its frames 23-24 % faster
+//! (18-20 % in a first version, on the baseline copy as on v3 and v4: the gain is the branches
+//! removed, not vector lanes; docs/perf-log.md, entry 48). Along a line `r^2`
+//! ([`LevelEllipse::r2`]) is a quadratic in the offset, carried in `f64` by forward differences
+//! ([`Weights`]), and weights and texels are read in the same loop, so a line has a single loop
+//! exit. Lines inside the level read texels without address wrapping; lines crossing the edge of
+//! a power-of-two side under `Repeat` wrap each index by a mask (docs/perf-log.md, entry 46). Alternatives measured and not adopted
 //! (two accumulators, `r^2` evaluated directly per texel, one bounds check per run, weights in
 //! lanes across a block's lines, one bounds check per line, short lines' terms summed in one loop
 //! per block): docs/perf-log.md.
@@ -417,10 +417,9 @@ impl LineSetup {
     /// Lines `first .. first + n` (`n <= LINE_BLOCK`): each line's span where `r^2 < 1` (the
     /// quadratic's roots), its first texel's `r^2` and forward difference, in one loop; with
     /// `STAGED` without branches or integer conversions, which the compiler may also run in
-    /// vector lanes (the
-    /// line-by-line form spent about 100 instructions a line, about half of EWA's instructions
-    /// on the ground scene, with two data-dependent branches in its floors: docs/perf-log.md,
-    /// entry 48). The arithmetic is the line-by-line form's, operation for operation (Rust fuses
+    /// vector lanes (the line-by-line form spent about 100 instructions a line, about half of
+    /// EWA's instructions on the ground scene, with two data-dependent branches in its floors:
+    /// docs/perf-log.md, entry 48). The arithmetic is the line-by-line form's, operation for operation (Rust fuses
     /// no multiply-add), and the floors are exact ([`floor_staged_f64`] when `STAGED`, which the
     /// caller checks the range for), so the values are the same bit for bit.
     #[inline(always)]
