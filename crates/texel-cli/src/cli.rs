@@ -507,9 +507,11 @@ pub struct BenchArgs {
     /// difference (images are the same).
     #[arg(long, value_enum, default_value_t = StreamingArg::Auto)]
     pub streaming: StreamingArg,
-    /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has):
-    /// wall time per frame (submission, rendering, reading the frame back) and, where the device
-    /// has timestamp queries, the render pass's device time (the last column; `device_ms` in JSON).
+    /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has, and
+    /// the device's own sampler as `hw-trilinear` and `hw-aniso16` in `--filters`; `all` is all of
+    /// them): wall time per frame (submission, rendering, reading the frame back) and, where the
+    /// device has timestamp queries, the render pass's device time (the last column; `device_ms`
+    /// in JSON, which also names the adapter).
     #[arg(long)]
     pub gpu: bool,
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).

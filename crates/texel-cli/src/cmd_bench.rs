@@ -18,6 +18,7 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
+use texel_gpu::GpuFilter;
 use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
 use crate::cli::{BenchArgs, PrecisionArg, TargetArg};
@@ -109,20 +110,73 @@ pub fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// Run `texel bench`.
-/// `--gpu`: per filter, upload once, then time whole frames (render and read back) on the device.
+/// The device's own sampler as `texel bench --gpu` and `texel compare --gpu` name it: label, the
+/// texel filter whose samplers and pyramid it is given, and the GPU mode.
+pub const HARDWARE_ROWS: [(&str, texel::Filter, GpuFilter); 2] = [
+    (
+        "hw-trilinear",
+        texel::Filter::Trilinear,
+        GpuFilter::HwTrilinear,
+    ),
+    ("hw-aniso16", texel::Filter::Trilinear, GpuFilter::HwAniso16),
+];
+
+/// What `texel bench --gpu` times, from `--filters`: texel's shaders for the named filters (an
+/// error names one the GPU path lacks) and the device's own sampler for `hw-trilinear` and
+/// `hw-aniso16`, in the list's order, each once. `all` is every filter the GPU path has and both
+/// hardware rows.
+fn gpu_jobs(list: &str) -> Result<Vec<(&'static str, texel::Filter, GpuFilter)>> {
+    if list.trim() == "all" {
+        let mut jobs: Vec<_> = GpuFilter::filters()
+            .filter_map(|f| GpuFilter::of(f).map(|g| (f.name(), f, g)))
+            .collect();
+        jobs.extend(HARDWARE_ROWS);
+        return Ok(jobs);
+    }
+    let mut jobs: Vec<(&'static str, texel::Filter, GpuFilter)> = Vec::new();
+    for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let job = match HARDWARE_ROWS
+            .iter()
+            .find(|(label, ..)| label.eq_ignore_ascii_case(item))
+        {
+            Some(&row) => row,
+            None => {
+                let filter = parse_list(item)?[0];
+                let Some(gpu) = GpuFilter::of(filter) else {
+                    anyhow::bail!(
+                        "--gpu has no {} filter (it has {}, hw-trilinear and hw-aniso16)",
+                        filter.name(),
+                        GpuFilter::filters()
+                            .map(|f| f.name())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    );
+                };
+                (filter.name(), filter, gpu)
+            }
+        };
+        if !jobs.iter().any(|j| j.0 == job.0) {
+            jobs.push(job);
+        }
+    }
+    if jobs.is_empty() {
+        // parse_list's own error for an empty list.
+        parse_list(list)?;
+    }
+    Ok(jobs)
+}
+
+/// `--gpu`: per job, upload once, then time whole frames (render and read back) on the device;
+/// the device time of each frame's render pass where the adapter has timestamp queries.
 fn time_gpu(
     args: &BenchArgs,
+    gpu: &texel_gpu::Gpu,
     scene: &texel::PreparedScene,
-    filters: &[texel::Filter],
+    jobs: &[(&'static str, texel::Filter, GpuFilter)],
 ) -> Result<Vec<Timing>> {
-    let gpu = texel_gpu::Gpu::new(args.adapter.as_deref())?;
     let mut out = Vec::new();
-    for filter in filters {
-        let Some(gpu_filter) = texel_gpu::GpuFilter::of(*filter) else {
-            anyhow::bail!("--gpu has no {} filter", filter.name());
-        };
-        let samplers = scene.samplers(*filter)?;
+    for &(label, filter, gpu_filter) in jobs {
+        let samplers = scene.samplers(filter)?;
         let draws = scene.draws(&samplers);
         let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
         settings.derivatives = texel_raster::Derivatives::Quad;
@@ -149,7 +203,7 @@ fn time_gpu(
             .iter()
             .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
         out.push(Timing {
-            filter: filter.name(),
+            filter: label,
             median_ms: median(&mut times),
             min_ms,
             max_ms,
@@ -166,14 +220,25 @@ fn time_gpu(
     Ok(out)
 }
 
+/// Run `texel bench`.
 pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let scene = load_scene(&args.scene, input)?;
-    let filters = parse_list(&args.filters)?;
+    // The GPU's rows are checked before the (slower) adapter start; the CPU's list as before.
+    let (filters, jobs) = if args.gpu {
+        (Vec::new(), gpu_jobs(&args.filters)?)
+    } else {
+        (parse_list(&args.filters)?, Vec::new())
+    };
     let budget = &mut input.budget;
     texel_raster::limit_level(args.simd.limit());
     texel_raster::set_streaming(args.streaming.policy());
-    let timings = if args.gpu {
-        time_gpu(args, &scene, &filters)?
+    let gpu = if args.gpu {
+        Some(texel_gpu::Gpu::new(args.adapter.as_deref())?)
+    } else {
+        None
+    };
+    let timings = if let Some(gpu) = &gpu {
+        time_gpu(args, gpu, &scene, &jobs)?
     } else {
         with_threads(args.threads, || -> Result<Vec<Timing>> {
             let mut out = Vec::new();
@@ -210,6 +275,13 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let second = if args.gpu { "device_ms" } else { "clear_ms" };
     let mut stdout = std::io::stdout().lock();
     if args.json {
+        // With --gpu, the adapter the frames ran on (the CPU's fields stay: they describe the host).
+        let adapter = gpu.as_ref().map_or(String::new(), |g| {
+            format!(
+                "\n \"adapter\": {},",
+                serde_json::Value::from(g.info().to_string())
+            )
+        });
         let entries = |value: fn(&Timing) -> f64| {
             timings
                 .iter()
@@ -219,7 +291,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         };
         writeln!(
             stdout,
-            "{{\n \"renderer\": \"{renderer}\",\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"streaming\": \"{}\",\n \"streamed\": {},\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
+            "{{\n \"renderer\": \"{renderer}\",{adapter}\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"streaming\": \"{}\",\n \"streamed\": {},\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
             serde_json::Value::from(cpu_model()),
             simd_level(),
             target_name(args.target),
@@ -253,6 +325,9 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
             args.streaming.name(),
             if streamed { "streamed" } else { "in place" }
         )?;
+        if let Some(gpu) = &gpu {
+            writeln!(stdout, "gpu: {}", gpu.info())?;
+        }
         writeln!(
             stdout,
             "{:<12} {:>10} {:>10} {:>10} {:>10}",

@@ -157,12 +157,11 @@ fn gpu_rows(
         .iter()
         .filter_map(|&f| GpuFilter::of(f).map(|g| (format!("gpu-{}", f.name()), f, g)))
         .collect();
-    jobs.push((
-        "hw-trilinear".into(),
-        Filter::Trilinear,
-        GpuFilter::HwTrilinear,
-    ));
-    jobs.push(("hw-aniso16".into(), Filter::Trilinear, GpuFilter::HwAniso16));
+    jobs.extend(
+        crate::cmd_bench::HARDWARE_ROWS
+            .iter()
+            .map(|&(label, f, g)| (label.to_string(), f, g)),
+    );
     let mut rows = Vec::new();
     for (label, filter, gpu_filter) in jobs {
         budget.take(

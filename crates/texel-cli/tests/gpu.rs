@@ -132,3 +132,51 @@ fn compare_gpu_scores_shader_and_hardware_rows() {
     }
     assert!(psnr("hw-trilinear (extra)") > 0.0 && psnr("hw-aniso16 (extra)") > 0.0);
 }
+
+#[test]
+fn bench_gpu_times_shaders_and_the_hardware_sampler() {
+    // The list is checked before an adapter is looked for: no Vulkan needed for the refusal.
+    let out = texel(&["bench", "--gpu", "--filters", "trilinear,sat"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--gpu has no sat filter") && err.contains("hw-trilinear and hw-aniso16"),
+        "{err}"
+    );
+    if !have_adapter() {
+        return;
+    }
+    let out = texel(&[
+        "bench",
+        "builtin:ground",
+        "--gpu",
+        "--size",
+        "96x64",
+        "--frames",
+        "2",
+        "--warmup",
+        "0",
+        "--filters",
+        "hw-aniso16,trilinear,HW-trilinear,hw-aniso16",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    // Once in `median_ms` and once in `device_ms`: the repeated names ran once.
+    for row in ["\"hw-trilinear\":", "\"hw-aniso16\":", "\"trilinear\":"] {
+        assert_eq!(text.matches(row).count(), 2, "{row} in {text}");
+    }
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["renderer"], "texel-gpu");
+    assert!(
+        json["adapter"].as_str().unwrap().contains("Vulkan"),
+        "{json}"
+    );
+    let mut rows: Vec<&String> = json["median_ms"].as_object().unwrap().keys().collect();
+    rows.sort();
+    // Each row once, the hardware label's case ignored.
+    assert_eq!(rows, ["hw-aniso16", "hw-trilinear", "trilinear"], "{json}");
+    for row in rows {
+        assert!(json["median_ms"][row].as_f64().unwrap() > 0.0, "{json}");
+    }
+}
