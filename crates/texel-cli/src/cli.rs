@@ -510,8 +510,9 @@ pub struct BenchArgs {
     /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has, and
     /// the device's own sampler as `hw-trilinear` and `hw-aniso16` in `--filters`; `all` is all of
     /// them): wall time per frame (submission, rendering, reading the frame back) and, where the
-    /// device has timestamp queries, the render pass's device time (the last column; `device_ms`
-    /// in JSON, which also names the adapter).
+    /// device has timestamp queries, the device time of a render pass, from as many passes again
+    /// recorded back to back so that the device does not idle between them (the last column;
+    /// `device_ms` in JSON, which also names the adapter).
     #[arg(long)]
     pub gpu: bool,
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).

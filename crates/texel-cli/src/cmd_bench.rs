@@ -166,8 +166,9 @@ fn gpu_jobs(list: &str) -> Result<Vec<(&'static str, texel::Filter, GpuFilter)>>
     Ok(jobs)
 }
 
-/// `--gpu`: per job, upload once, then time whole frames (render and read back) on the device;
-/// the device time of each frame's render pass where the adapter has timestamp queries.
+/// `--gpu`: per job, upload once, then time whole frames (render and read back) on the device,
+/// and where the adapter has timestamp queries the device time of as many render passes recorded
+/// back to back ([`texel_gpu::GpuDraws::pass_times`]).
 fn time_gpu(
     args: &BenchArgs,
     gpu: &texel_gpu::Gpu,
@@ -191,14 +192,16 @@ fn time_gpu(
             k += 1;
         }
         let mut times = Vec::new();
-        let mut device = Vec::new();
         for _ in 0..args.frames {
             let t0 = Instant::now();
-            let (frame, ms) = prepared.render_timed(&settings)?;
-            std::hint::black_box(frame);
+            std::hint::black_box(prepared.render(&settings)?);
             times.push(t0.elapsed().as_secs_f64() * 1e3);
-            device.extend(ms);
         }
+        // Device time of as many passes, back to back: between read-back frames the device
+        // idles and may clock down (README.md, "On an NVIDIA H200").
+        let mut device = prepared
+            .pass_times(&settings, args.frames)?
+            .unwrap_or_default();
         let (min_ms, max_ms) = times
             .iter()
             .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));

@@ -682,128 +682,37 @@ impl GpuDraws<'_> {
     /// [`GpuDraws::render`], with the render pass's device time in milliseconds from timestamps
     /// written at its beginning and end (`None` where the device has no timestamp queries).
     ///
+    /// The device idles while the frame is read back, and may lower its clock meanwhile (an
+    /// H200's fell from 1980 to 345 MHz between 4K frames: README.md), so this time is one
+    /// frame's as an application that waits for each frame sees it; [`GpuDraws::pass_times`]
+    /// measures passes back to back.
+    ///
     /// # Errors
     /// As [`GpuDraws::render`].
     pub fn render_timed(
         &self,
         settings: &RenderSettings,
     ) -> Result<(Frame, Option<f64>), GpuError> {
-        settings.validate()?;
-        if settings.is_lit() {
-            return Err(GpuError::Unsupported("lighting"));
-        }
-        if settings.view != View::Color {
-            return Err(GpuError::Unsupported("debug views"));
-        }
-        if settings.counts_texels() {
-            return Err(GpuError::Unsupported("counting texels"));
-        }
+        self.check(settings)?;
         let gpu = self.gpu;
-        let (w, h) = (settings.width, settings.height);
-        gpu.check_size("the frame", w, h)?;
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut cached = self.targets.borrow_mut();
-        let targets = match cached.take() {
-            Some(t) if t.size == (w, h) => t,
-            _ => Targets::new(device, w, h),
-        };
-        let (color, frag_depth, depth) = (&targets.color, &targets.frag_depth, &targets.depth);
+        let targets = self.take_targets(settings);
         let mut encoder = device.create_command_encoder(&Default::default());
-        let queries = gpu.timestamps.then(|| {
-            device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("pass time"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2,
-            })
-        });
-        {
-            let color_view = color.create_view(&Default::default());
-            let frag_depth_view = frag_depth.create_view(&Default::default());
-            let depth_view = depth.create_view(&Default::default());
-            // The integer targets are cleared to the f32 bits of the background and of +inf (a
-            // u32 is exact in f64; the backends convert the clear colour to u32 for uint targets).
-            let [r, g, b, a] = settings.background.map(|c| f64::from(c.to_bits()));
-            let attachment = |view, clear| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(clear),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
-            };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("texel frame"),
-                color_attachments: &[
-                    attachment(&color_view, wgpu::Color { r, g, b, a }),
-                    attachment(
-                        &frag_depth_view,
-                        wgpu::Color {
-                            r: f64::from(f32::INFINITY.to_bits()),
-                            ..wgpu::Color::TRANSPARENT
-                        },
-                    ),
-                ],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: queries.as_ref().map(|q| wgpu::RenderPassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                }),
-                ..Default::default()
-            });
-            pass.set_pipeline(&self.pipeline);
-            let [x0, y0, x1, y1] = settings.scissor_rect();
-            let draws = if x0 < x1 && y0 < y1 {
-                pass.set_scissor_rect(x0, y0, x1 - x0, y1 - y0);
-                &self.draws[..]
-            } else {
-                &[]
-            };
-            for (bind, vb, ib, count) in draws {
-                pass.set_bind_group(0, bind, &[]);
-                pass.set_vertex_buffer(0, vb.slice(..));
-                pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..*count, 0, 0..1);
-            }
-        }
-        let color_bytes = read_back(gpu, &mut encoder, color, 16);
-        let frag_depth_bytes = read_back(gpu, &mut encoder, frag_depth, 4);
-        let time_bytes = queries.as_ref().map(|q| {
-            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
-                label: None,
-                size: 16,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            encoder.resolve_query_set(q, 0..2, &resolve, 0);
-            let out = device.create_buffer(&wgpu::BufferDescriptor {
-                label: None,
-                size: 16,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            });
-            encoder.copy_buffer_to_buffer(&resolve, 0, &out, 0, 16);
-            ReadBack {
-                buffer: out,
-                row: 16,
-                padded: 16,
-                rows: 1,
-            }
-        });
+        let queries = gpu.timestamps.then(|| query_set(device, 1));
+        self.encode_pass(
+            &mut encoder,
+            &targets,
+            settings,
+            queries.as_ref().map(|q| (q, 0)),
+        );
+        let color_bytes = read_back(gpu, &mut encoder, &targets.color, 16);
+        let frag_depth_bytes = read_back(gpu, &mut encoder, &targets.frag_depth, 4);
+        let time_bytes = queries
+            .as_ref()
+            .map(|q| resolve_queries(device, &mut encoder, q, 1));
         gpu.queue.submit([encoder.finish()]);
-        *cached = Some(targets);
-        drop(cached);
+        *self.targets.borrow_mut() = Some(targets);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Failed(e.to_string()));
         }
@@ -826,17 +735,210 @@ impl GpuDraws<'_> {
             *z = f32_at(b, 0);
         }
         let ms = match time_bytes {
-            Some(t) => {
-                let b = t.wait(gpu)?;
-                let tick =
-                    |k: usize| u64::from_le_bytes(b[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]));
-                let ticks = tick(1).saturating_sub(tick(0));
-                Some(ticks as f64 * f64::from(gpu.queue.get_timestamp_period()) * 1e-6)
-            }
+            Some(t) => Some(pass_milliseconds(gpu, &t.wait(gpu)?)[0]),
             None => None,
         };
         Ok((frame, ms))
     }
+
+    /// Device time in milliseconds of each of `passes` render passes of the frame
+    /// [`GpuDraws::render`] draws, recorded back to back (at most [`PASSES_PER_SUBMIT`] to a
+    /// submission, submitted without waiting) with nothing read back between them, so that the
+    /// device does not idle between passes; in order. `None` where the device has no timestamp
+    /// queries. What a GPU benchmark's frame rate reflects; a frame that is read back before the
+    /// next is drawn is [`GpuDraws::render_timed`]'s.
+    ///
+    /// # Errors
+    /// As [`GpuDraws::render`].
+    pub fn pass_times(
+        &self,
+        settings: &RenderSettings,
+        passes: u32,
+    ) -> Result<Option<Vec<f64>>, GpuError> {
+        self.check(settings)?;
+        let gpu = self.gpu;
+        if !gpu.timestamps {
+            return Ok(None);
+        }
+        let device = &gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let targets = self.take_targets(settings);
+        let mut pending = Vec::new();
+        let mut left = passes;
+        while left > 0 {
+            let n = left.min(PASSES_PER_SUBMIT);
+            left -= n;
+            let queries = query_set(device, n);
+            let mut encoder = device.create_command_encoder(&Default::default());
+            for k in 0..n {
+                self.encode_pass(&mut encoder, &targets, settings, Some((&queries, k)));
+            }
+            pending.push(resolve_queries(device, &mut encoder, &queries, n));
+            gpu.queue.submit([encoder.finish()]);
+        }
+        *self.targets.borrow_mut() = Some(targets);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Failed(e.to_string()));
+        }
+        let mut out = Vec::with_capacity(passes as usize);
+        for t in pending {
+            out.extend(pass_milliseconds(gpu, &t.wait(gpu)?));
+        }
+        Ok(Some(out))
+    }
+
+    /// The settings' refusals shared by every way of rendering: invalid settings, lighting,
+    /// debug views, texel counting, a frame over the device's limits.
+    fn check(&self, settings: &RenderSettings) -> Result<(), GpuError> {
+        settings.validate()?;
+        if settings.is_lit() {
+            return Err(GpuError::Unsupported("lighting"));
+        }
+        if settings.view != View::Color {
+            return Err(GpuError::Unsupported("debug views"));
+        }
+        if settings.counts_texels() {
+            return Err(GpuError::Unsupported("counting texels"));
+        }
+        self.gpu
+            .check_size("the frame", settings.width, settings.height)
+    }
+
+    /// The last frame's targets if they have the settings' size, else new ones; the caller puts
+    /// them back.
+    fn take_targets(&self, settings: &RenderSettings) -> Targets {
+        let (w, h) = (settings.width, settings.height);
+        match self.targets.borrow_mut().take() {
+            Some(t) if t.size == (w, h) => t,
+            _ => Targets::new(&self.gpu.device, w, h),
+        }
+    }
+
+    /// Record one render pass of the frame into `targets`: cleared to the background, every draw
+    /// inside the scissor; timestamps `2k` and `2k + 1` of `queries` at its beginning and end.
+    fn encode_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &Targets,
+        settings: &RenderSettings,
+        queries: Option<(&wgpu::QuerySet, u32)>,
+    ) {
+        let color_view = targets.color.create_view(&Default::default());
+        let frag_depth_view = targets.frag_depth.create_view(&Default::default());
+        let depth_view = targets.depth.create_view(&Default::default());
+        // The integer targets are cleared to the f32 bits of the background and of +inf (a u32 is
+        // exact in f64; the backends convert the clear colour to u32 for uint targets).
+        let [r, g, b, a] = settings.background.map(|c| f64::from(c.to_bits()));
+        let attachment = |view, clear| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("texel frame"),
+            color_attachments: &[
+                attachment(&color_view, wgpu::Color { r, g, b, a }),
+                attachment(
+                    &frag_depth_view,
+                    wgpu::Color {
+                        r: f64::from(f32::INFINITY.to_bits()),
+                        ..wgpu::Color::TRANSPARENT
+                    },
+                ),
+            ],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: queries.map(|(q, k)| wgpu::RenderPassTimestampWrites {
+                query_set: q,
+                beginning_of_pass_write_index: Some(2 * k),
+                end_of_pass_write_index: Some(2 * k + 1),
+            }),
+            ..Default::default()
+        });
+        pass.set_pipeline(&self.pipeline);
+        let [x0, y0, x1, y1] = settings.scissor_rect();
+        let draws = if x0 < x1 && y0 < y1 {
+            pass.set_scissor_rect(x0, y0, x1 - x0, y1 - y0);
+            &self.draws[..]
+        } else {
+            &[]
+        };
+        for (bind, vb, ib, count) in draws {
+            pass.set_bind_group(0, bind, &[]);
+            pass.set_vertex_buffer(0, vb.slice(..));
+            pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..*count, 0, 0..1);
+        }
+    }
+}
+
+/// Most render passes [`GpuDraws::pass_times`] records into one submission (their `2 n`
+/// timestamps in one query set; wgpu allows 4096 queries a set).
+pub const PASSES_PER_SUBMIT: u32 = 256;
+
+/// A timestamp query set for `passes` render passes (two queries each).
+fn query_set(device: &wgpu::Device, passes: u32) -> wgpu::QuerySet {
+    device.create_query_set(&wgpu::QuerySetDescriptor {
+        label: Some("pass times"),
+        ty: wgpu::QueryType::Timestamp,
+        count: 2 * passes,
+    })
+}
+
+/// Resolve `passes` passes' timestamps into a buffer to read back.
+fn resolve_queries(
+    device: &wgpu::Device,
+    encoder: &mut wgpu::CommandEncoder,
+    queries: &wgpu::QuerySet,
+    passes: u32,
+) -> ReadBack {
+    let bytes = 16 * u64::from(passes);
+    let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: bytes,
+        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    encoder.resolve_query_set(queries, 0..2 * passes, &resolve, 0);
+    let out = device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: bytes,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.copy_buffer_to_buffer(&resolve, 0, &out, 0, bytes);
+    ReadBack {
+        buffer: out,
+        row: bytes as usize,
+        padded: bytes as usize,
+        rows: 1,
+    }
+}
+
+/// Milliseconds of each pass from resolved timestamp pairs (begin, end ticks; the queue's
+/// timestamp period converts ticks to nanoseconds). An end before its begin counts as 0.
+fn pass_milliseconds(gpu: &Gpu, bytes: &[u8]) -> Vec<f64> {
+    let period = f64::from(gpu.queue.get_timestamp_period());
+    bytes
+        .chunks_exact(16)
+        .map(|pair| {
+            let tick =
+                |k: usize| u64::from_le_bytes(pair[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]));
+            tick(1).saturating_sub(tick(0)) as f64 * period * 1e-6
+        })
+        .collect()
 }
 
 /// A frame's render targets: linear colour (f32 bits in `Rgba32Uint`), fragment depth and the

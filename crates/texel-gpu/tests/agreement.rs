@@ -147,6 +147,43 @@ fn device_time_is_measured_when_the_device_can() {
     }
 }
 
+/// Passes timed back to back: one positive time per pass across more than one submission
+/// (`PASSES_PER_SUBMIT` a submission), together no longer than the call; the targets they drew
+/// into are reused by the next frame, which equals the one before them bit for bit.
+#[test]
+fn passes_timed_back_to_back() {
+    let Some(gpu) = gpu() else { return };
+    let prepared = small("builtin:ground");
+    let samplers = prepared.samplers(Filter::Trilinear).unwrap();
+    let draws = prepared.draws(&samplers);
+    let gpu_draws = gpu.prepare(&draws, GpuFilter::Lab(4)).unwrap();
+    let mut settings = prepared.settings();
+    settings.target = ColorTarget::Float;
+    let before = gpu_draws.render(&settings).unwrap();
+    let passes = texel_gpu::PASSES_PER_SUBMIT + 3;
+    let t0 = std::time::Instant::now();
+    let times = gpu_draws.pass_times(&settings, passes).unwrap();
+    let wall = t0.elapsed().as_secs_f64() * 1e3;
+    match times {
+        Some(times) => {
+            assert!(gpu.has_timestamps());
+            assert_eq!(times.len(), passes as usize);
+            assert!(times.iter().all(|&ms| ms > 0.0), "{times:?}");
+            let sum: f64 = times.iter().sum();
+            assert!(sum <= wall, "device {sum} ms in all, wall {wall} ms");
+        }
+        None => assert!(!gpu.has_timestamps()),
+    }
+    let after = gpu_draws.render(&settings).unwrap();
+    assert_eq!(before.covered_pixels(), after.covered_pixels());
+    assert!(before.color == after.color && before.depth == after.depth);
+    // Nothing to time is no time.
+    assert_eq!(
+        gpu_draws.pass_times(&settings, 0).unwrap().map(|t| t.len()),
+        gpu.has_timestamps().then_some(0)
+    );
+}
+
 /// `set_clip_from_world` moves the camera of prepared draws: the frame equals the one prepared
 /// with the new camera, bit for bit. A scissor keeps the pixels inside (bit for bit the whole
 /// frame's) and leaves the background outside.
