@@ -121,10 +121,10 @@ pub const HARDWARE_ROWS: [(&str, texel::Filter, GpuFilter); 2] = [
     ("hw-aniso16", texel::Filter::Trilinear, GpuFilter::HwAniso16),
 ];
 
-/// What `texel bench --gpu` times, from `--filters`: texel's shaders for the named filters (an
-/// error names one the GPU path lacks) and the device's own sampler for `hw-trilinear` and
-/// `hw-aniso16`, in the list's order, each once. `all` is every filter the GPU path has and both
-/// hardware rows.
+/// What `texel bench --gpu` times, from `--filters`: texel's shaders for the named filters and
+/// the device's own sampler for `hw-trilinear` and `hw-aniso16`, names' case ignored, in the
+/// list's order, each once. `all` alone is every filter the GPU path has and both hardware rows.
+/// An error names an unknown name, or a filter the GPU path lacks, with what it has.
 fn gpu_jobs(list: &str) -> Result<Vec<(&'static str, texel::Filter, GpuFilter)>> {
     if list.trim() == "all" {
         let mut jobs: Vec<_> = GpuFilter::filters()
@@ -133,6 +133,13 @@ fn gpu_jobs(list: &str) -> Result<Vec<(&'static str, texel::Filter, GpuFilter)>>
         jobs.extend(HARDWARE_ROWS);
         return Ok(jobs);
     }
+    let has = || {
+        GpuFilter::filters()
+            .map(|f| f.name())
+            .chain(HARDWARE_ROWS.iter().map(|r| r.0))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     let mut jobs: Vec<(&'static str, texel::Filter, GpuFilter)> = Vec::new();
     for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let job = match HARDWARE_ROWS
@@ -141,16 +148,14 @@ fn gpu_jobs(list: &str) -> Result<Vec<(&'static str, texel::Filter, GpuFilter)>>
         {
             Some(&row) => row,
             None => {
-                let filter = parse_list(item)?[0];
-                let Some(gpu) = GpuFilter::of(filter) else {
+                let Ok(filter) = item.parse::<texel::Filter>() else {
                     anyhow::bail!(
-                        "--gpu has no {} filter (it has {}, hw-trilinear and hw-aniso16)",
-                        filter.name(),
-                        GpuFilter::filters()
-                            .map(|f| f.name())
-                            .collect::<Vec<_>>()
-                            .join(", ")
+                        "unknown filter {item:?} for --gpu: valid are {}, or all alone",
+                        has()
                     );
+                };
+                let Some(gpu) = GpuFilter::of(filter) else {
+                    anyhow::bail!("--gpu has no {} filter (it has {})", filter.name(), has());
                 };
                 (filter.name(), filter, gpu)
             }
@@ -198,7 +203,20 @@ fn time_gpu(
             times.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         // Device time of as many passes, back to back: between read-back frames the device
-        // idles and may clock down (README.md, "On an NVIDIA H200").
+        // idles and may clock down (README.md, "On an NVIDIA H200"), so warm-up passes run
+        // back to back first, as the frames' warm-up does (`--warmup` of them and at least
+        // MIN_WARMUP unless 0).
+        if gpu.has_timestamps() && args.warmup > 0 {
+            let (start, batch) = (
+                Instant::now(),
+                args.warmup.min(texel_gpu::PASSES_PER_SUBMIT),
+            );
+            let mut k = 0;
+            while k < args.warmup || (k < MAX_WARMUP_FRAMES && start.elapsed() < MIN_WARMUP) {
+                prepared.pass_times(&settings, batch)?;
+                k += batch;
+            }
+        }
         let mut device = prepared
             .pass_times(&settings, args.frames)?
             .unwrap_or_default();

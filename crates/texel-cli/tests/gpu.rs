@@ -140,9 +140,19 @@ fn bench_gpu_times_shaders_and_the_hardware_sampler() {
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("--gpu has no sat filter") && err.contains("hw-trilinear and hw-aniso16"),
+        err.contains("--gpu has no sat filter") && err.contains("ewa, hw-trilinear, hw-aniso16)"),
         "{err}"
     );
+    // `all` only alone; an unknown name gets the GPU's own list.
+    for list in ["hw-trilinear,all", "hw-aniso8"] {
+        let out = texel(&["bench", "--gpu", "--filters", list]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("for --gpu: valid are nearest,") && err.contains("hw-aniso16, or all"),
+            "{err}"
+        );
+    }
     if !have_adapter() {
         return;
     }
@@ -176,7 +186,11 @@ fn bench_gpu_times_shaders_and_the_hardware_sampler() {
     rows.sort();
     // Each row once, the hardware label's case ignored.
     assert_eq!(rows, ["hw-aniso16", "hw-trilinear", "trilinear"], "{json}");
+    // lavapipe has timestamp queries: every row has a device time from its passes.
+    let timestamps = json["adapter"].as_str().unwrap().contains("llvmpipe");
     for row in rows {
         assert!(json["median_ms"][row].as_f64().unwrap() > 0.0, "{json}");
+        let device = json["device_ms"][row].as_f64().unwrap();
+        assert!(device > 0.0 || (!timestamps && device == 0.0), "{json}");
     }
 }

@@ -313,7 +313,8 @@ impl Gpu {
         Ok(())
     }
 
-    /// Whether [`GpuDraws::render_timed`] can measure device time (timestamp queries).
+    /// Whether [`GpuDraws::render_timed`] and [`GpuDraws::pass_times`] can measure device time
+    /// (timestamp queries).
     pub fn has_timestamps(&self) -> bool {
         self.timestamps
     }
@@ -683,9 +684,9 @@ impl GpuDraws<'_> {
     /// written at its beginning and end (`None` where the device has no timestamp queries).
     ///
     /// The device idles while the frame is read back, and may lower its clock meanwhile (an
-    /// H200's fell from 1980 to 345 MHz between 4K frames: README.md), so this time is one
-    /// frame's as an application that waits for each frame sees it; [`GpuDraws::pass_times`]
-    /// measures passes back to back.
+    /// H200's SM clock moved between 345 and 1980 MHz during such runs: README.md), so this time
+    /// is one frame's as an application that waits for each frame sees it;
+    /// [`GpuDraws::pass_times`] measures passes back to back.
     ///
     /// # Errors
     /// As [`GpuDraws::render`].

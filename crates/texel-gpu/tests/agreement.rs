@@ -147,9 +147,9 @@ fn device_time_is_measured_when_the_device_can() {
     }
 }
 
-/// Passes timed back to back: one positive time per pass across more than one submission
-/// (`PASSES_PER_SUBMIT` a submission), together no longer than the call; the targets they drew
-/// into are reused by the next frame, which equals the one before them bit for bit.
+/// Passes timed back to back: one positive time per pass, in two submissions (more passes than
+/// `PASSES_PER_SUBMIT`), together no longer than the call; the frame drawn after them equals
+/// the one drawn before them bit for bit.
 #[test]
 fn passes_timed_back_to_back() {
     let Some(gpu) = gpu() else { return };
