@@ -74,8 +74,8 @@
 //! exit. Lines inside the level read texels without address wrapping; lines crossing the edge of
 //! a power-of-two side under `Repeat` wrap each index by a mask (docs/perf-log.md, entry 46). Alternatives measured and not adopted
 //! (two accumulators, `r^2` evaluated directly per texel, one bounds check per run, weights in
-//! lanes across a block's lines, one bounds check per line, short lines' terms summed in one loop
-//! per block): docs/perf-log.md.
+//! lanes across a block's lines, their table indices in such lanes, one bounds check per line,
+//! short lines' terms summed in one loop per block): docs/perf-log.md.
 //!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
