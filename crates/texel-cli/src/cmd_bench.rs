@@ -18,11 +18,10 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use texel_gpu::GpuFilter;
 use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
 use crate::cli::{BenchArgs, PrecisionArg, TargetArg};
-use crate::filters::parse_list;
+use crate::filters::{parse_gpu_list, parse_list, GpuJob};
 use crate::input::{load_scene, Input};
 use crate::threads::{thread_count, with_threads};
 
@@ -110,67 +109,6 @@ pub fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// The device's own sampler as `texel bench --gpu` and `texel compare --gpu` name it: label, the
-/// texel filter whose samplers and pyramid it is given, and the GPU mode.
-pub const HARDWARE_ROWS: [(&str, texel::Filter, GpuFilter); 2] = [
-    (
-        "hw-trilinear",
-        texel::Filter::Trilinear,
-        GpuFilter::HwTrilinear,
-    ),
-    ("hw-aniso16", texel::Filter::Trilinear, GpuFilter::HwAniso16),
-];
-
-/// What `texel bench --gpu` times, from `--filters`: texel's shaders for the named filters and
-/// the device's own sampler for `hw-trilinear` and `hw-aniso16`, names' case ignored, in the
-/// list's order, each once. `all` alone is every filter the GPU path has and both hardware rows.
-/// An error names an unknown name, or a filter the GPU path lacks, with what it has.
-fn gpu_jobs(list: &str) -> Result<Vec<(&'static str, texel::Filter, GpuFilter)>> {
-    if list.trim() == "all" {
-        let mut jobs: Vec<_> = GpuFilter::filters()
-            .filter_map(|f| GpuFilter::of(f).map(|g| (f.name(), f, g)))
-            .collect();
-        jobs.extend(HARDWARE_ROWS);
-        return Ok(jobs);
-    }
-    let has = || {
-        GpuFilter::filters()
-            .map(|f| f.name())
-            .chain(HARDWARE_ROWS.iter().map(|r| r.0))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let mut jobs: Vec<(&'static str, texel::Filter, GpuFilter)> = Vec::new();
-    for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let job = match HARDWARE_ROWS
-            .iter()
-            .find(|(label, ..)| label.eq_ignore_ascii_case(item))
-        {
-            Some(&row) => row,
-            None => {
-                let Ok(filter) = item.parse::<texel::Filter>() else {
-                    anyhow::bail!(
-                        "unknown filter {item:?} for --gpu: valid are {}, or all alone",
-                        has()
-                    );
-                };
-                let Some(gpu) = GpuFilter::of(filter) else {
-                    anyhow::bail!("--gpu has no {} filter (it has {})", filter.name(), has());
-                };
-                (filter.name(), filter, gpu)
-            }
-        };
-        if !jobs.iter().any(|j| j.0 == job.0) {
-            jobs.push(job);
-        }
-    }
-    if jobs.is_empty() {
-        // parse_list's own error for an empty list.
-        parse_list(list)?;
-    }
-    Ok(jobs)
-}
-
 /// `--gpu`: per job, upload once, then time whole frames (render and read back) on the device,
 /// and where the adapter has timestamp queries the device time of as many render passes recorded
 /// back to back ([`texel_gpu::GpuDraws::pass_times`]).
@@ -178,7 +116,7 @@ fn time_gpu(
     args: &BenchArgs,
     gpu: &texel_gpu::Gpu,
     scene: &texel::PreparedScene,
-    jobs: &[(&'static str, texel::Filter, GpuFilter)],
+    jobs: &[GpuJob],
 ) -> Result<Vec<Timing>> {
     let mut out = Vec::new();
     for &(label, filter, gpu_filter) in jobs {
@@ -246,7 +184,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let scene = load_scene(&args.scene, input)?;
     // The GPU's rows are checked before the (slower) adapter start; the CPU's list as before.
     let (filters, jobs) = if args.gpu {
-        (Vec::new(), gpu_jobs(&args.filters)?)
+        (Vec::new(), parse_gpu_list(&args.filters)?)
     } else {
         (parse_list(&args.filters)?, Vec::new())
     };
@@ -296,7 +234,8 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let second = if args.gpu { "device_ms" } else { "clear_ms" };
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        // With --gpu, the adapter the frames ran on (the CPU's fields stay: they describe the host).
+        // With --gpu, the adapter the frames ran on (the CPU's fields stay: they describe the
+        // host).
         let adapter = gpu.as_ref().map_or(String::new(), |g| {
             format!(
                 "\n \"adapter\": {},",

@@ -158,7 +158,7 @@ fn gpu_rows(
         .filter_map(|&f| GpuFilter::of(f).map(|g| (format!("gpu-{}", f.name()), f, g)))
         .collect();
     jobs.extend(
-        crate::cmd_bench::HARDWARE_ROWS
+        crate::filters::HARDWARE_ROWS
             .iter()
             .map(|&(label, f, g)| (label.to_string(), f, g)),
     );

@@ -6,8 +6,9 @@
 //!   copy. Except for a frame that holds its clear and is larger than the last-level cache
 //!   ([`crate::Streaming`]): its tiles are drawn in per-thread scratch and copied into their row
 //!   slices with non-temporal stores (`texel_texture::dispatch::stream_copy`). The split is made
-//!   per band of `TILE` rows by the thread that renders the band's tiles: made serially up front, the row lists of a 4K frame (2 040 tiles) held its two-thread nearest
-//!   frame at 11.2 ms against 8.5.
+//!   per band of `TILE` rows by the thread that renders the band's tiles: made serially up front,
+//!   the row lists of a 4K frame (2 040 tiles) held its two-thread nearest frame at 11.2 ms
+//!   against 8.5.
 //! - Each tile processes its triangles in submission order (draw, then triangle, then sub-triangle)
 //!   and every per-pixel computation depends only on the pixel, the triangle and the tile (the
 //!   `UvPlanes` anchor), never on the thread or the order tiles run in, so the image is bit for bit

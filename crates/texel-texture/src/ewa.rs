@@ -72,10 +72,11 @@
 //! ([`LevelEllipse::r2`]) is a quadratic in the offset, carried in `f64` by forward differences
 //! ([`Weights`]), and weights and texels are read in the same loop, so a line has a single loop
 //! exit. Lines inside the level read texels without address wrapping; lines crossing the edge of
-//! a power-of-two side under `Repeat` wrap each index by a mask (docs/perf-log.md, entry 46). Alternatives measured and not adopted
-//! (two accumulators, `r^2` evaluated directly per texel, one bounds check per run, weights in
-//! lanes across a block's lines, their table indices in such lanes, one bounds check per line,
-//! short lines' terms summed in one loop per block): docs/perf-log.md.
+//! a power-of-two side under `Repeat` wrap each index by a mask (docs/perf-log.md, entry 46).
+//! Alternatives measured and not adopted (two accumulators, `r^2` evaluated directly per texel,
+//! one bounds check per run, weights in lanes across a block's lines, their table indices in such
+//! lanes, one bounds check per line, short lines' terms summed in one loop per block):
+//! docs/perf-log.md.
 //!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
@@ -419,9 +420,10 @@ impl LineSetup {
     /// `STAGED` without branches or integer conversions, which the compiler may also run in
     /// vector lanes (the line-by-line form spent about 100 instructions a line, about half of
     /// EWA's instructions on the ground scene, with two data-dependent branches in its floors:
-    /// docs/perf-log.md, entry 48). The arithmetic is the line-by-line form's, operation for operation (Rust fuses
-    /// no multiply-add), and the floors are exact ([`floor_staged_f64`] when `STAGED`, which the
-    /// caller checks the range for), so the values are the same bit for bit.
+    /// docs/perf-log.md, entry 48). The arithmetic is the line-by-line form's, operation for
+    /// operation (Rust fuses no multiply-add), and the floors are exact ([`floor_staged_f64`]
+    /// when `STAGED`, which the caller checks the range for), so the values are the same bit for
+    /// bit.
     #[inline(always)]
     fn block<const STAGED: bool>(&self, first: u32, n: usize, out: &mut LineBlock) {
         let floor = |x: f64| {
