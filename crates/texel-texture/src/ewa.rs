@@ -239,22 +239,23 @@ pub struct LevelEllipse {
 
 impl LevelEllipse {
     /// Whether every texel [`LevelEllipse::scan`] visits around `(x, y)` lies inside a `w x h`
-    /// level, with a texel to spare: the ellipse's extents `sqrt(q00)` along x and `sqrt(q11)`
-    /// along y bound every span the scan computes (for a consistent `Q`: `det <= q00 q11` and
-    /// `q01^2 <= q00 q11`, checked here), and a visited texel's centre lies inside the ellipse,
-    /// so its index is within half a texel of that box; the margin of a whole texel covers the
-    /// spans' rounding. False for non-finite or inconsistent ellipses and centres.
+    /// level: the ellipse's box `x +- sqrt(q00)`, `y +- sqrt(q11)` lies in `[0, w] x [0, h]`, and
+    /// `q01^2 + det <= q00 q11` (up to a relative `2^-40` for `det`'s rounding), which holds
+    /// for [`Ellipse::in_level`]'s `det = q00 q11 - q01^2`. Then, by Cauchy-Schwarz, every span's
+    /// ends `(q01 db +- sqrt(det (qbb - db^2))) / qbb` lie within `sqrt(qaa)` of the centre along
+    /// the line, and the lines themselves within `sqrt(qbb)` across it; a visited texel's centre
+    /// lies inside that box, so its index lies in the level with half a texel to spare for the
+    /// spans' rounding. False for non-finite values, for a centre or box outside the level, and
+    /// for a `det` too large for the other entries (whose spans could reach further).
     #[inline(always)]
     pub fn inside(&self, x: f32, y: f32, w: u32, h: u32) -> bool {
         let (x, y) = (f64::from(x), f64::from(y));
         let (ex, ey) = (self.q00.sqrt(), self.q11.sqrt());
-        let diag = self.q00 * self.q11;
-        x - ex >= 1.0
-            && x + ex + 1.0 <= f64::from(w)
-            && y - ey >= 1.0
-            && y + ey + 1.0 <= f64::from(h)
-            && self.det <= diag
-            && self.q01 * self.q01 <= diag
+        x - ex >= 0.0
+            && x + ex <= f64::from(w)
+            && y - ey >= 0.0
+            && y + ey <= f64::from(h)
+            && self.q01 * self.q01 + self.det <= self.q00 * self.q11 * INSIDE_SLACK
     }
 
     /// Area in texels of the level: `pi sqrt(det Q)`.
@@ -379,6 +380,11 @@ impl LevelEllipse {
         visits
     }
 }
+
+/// `1 + 2^-40`: the relative slack [`LevelEllipse::inside`] allows `q01^2 + det` over
+/// `q00 q11` (in_level's `det` is their difference, rounded); it widens the spans by at most
+/// `2^-41` of the extent, far below the half texel `inside` keeps for rounding.
+const INSIDE_SLACK: f64 = 1.0 + 1.0 / 1_099_511_627_776.0;
 
 /// Lines whose set-up [`LineSetup::block`] computes in one loop.
 const LINE_BLOCK: usize = 16;
@@ -1048,43 +1054,53 @@ mod tests {
     }
 
     /// `LevelEllipse::inside` holds only where every texel the scan visits lies in the level
-    /// (the condition under which `ewa_level` skips the per-line address test), over ellipses
-    /// of every orientation, eccentricity and size, centred on and around a small level's edges;
-    /// and it is not vacuous: it holds for most of the centres well inside.
+    /// (the condition under which `ewa_level` skips the per-line address test): over `in_level`
+    /// ellipses (eccentricity up to the clamp of 16, extents about 1 to 10 texels) centred on
+    /// and around a 64 x 16 level's edges, counting rows and columns apart so that both scan
+    /// directions are exercised; over hand-built ellipses whose `det` is unrelated to the other
+    /// entries (too large for them, or smaller); and for non-finite values and a `det` whose
+    /// spans reach beyond `sqrt(q00)`.
     #[test]
     fn inside_ellipses_scan_only_texels_of_the_level() {
         let mut rng = crate::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
-        let mut rnd = || rng.next_f64() as f32;
+        let mut rnd = || rng.next_f64();
         let (w, h) = (64u32, 16u32);
-        let (mut held, mut crossed) = (0, 0);
+        let in_level =
+            |i: i64, j: i64| (0..i64::from(w)).contains(&i) && (0..i64::from(h)).contains(&j);
+        // [held with rows, held with columns, crossed].
+        let mut seen = [0u32; 3];
+        let check = |q: &LevelEllipse, x: f32, y: f32, seen: &mut [u32; 3]| {
+            let within = scanned(q, x, y).iter().all(|&(i, j, _)| in_level(i, j));
+            if q.inside(x, y, w, h) {
+                assert!(within, "ellipse {q:?} at ({x}, {y}) scans a texel outside");
+                seen[usize::from(q.q00 < q.q11)] += 1;
+            } else if !within {
+                seen[2] += 1;
+            }
+        };
         for _ in 0..20_000 {
-            let size = 0.2 + 6.0 * rnd();
-            let px = Vec2::new(rnd() - 0.5, rnd() - 0.5) * size * 4.0;
-            let py = Vec2::new(rnd() - 0.5, rnd() - 0.5) * size;
+            let size = 0.2 + 6.0 * rnd() as f32;
+            let mut v = || rnd() as f32 - 0.5;
+            let (px, py) = (Vec2::new(v(), v()) * size * 4.0, Vec2::new(v(), v()) * size);
             let Some(e) = Ellipse::from_axes(px, py, 16.0) else {
                 continue;
             };
             let q = e.in_level(DVec2::splat(0.5), true);
-            let (x, y) = (
-                rnd() * (w as f32 + 8.0) - 4.0,
-                rnd() * (h as f32 + 8.0) - 4.0,
-            );
-            let texels = scanned(&q, x, y);
-            let within = texels
-                .iter()
-                .all(|&(i, j, _)| (0..i64::from(w)).contains(&i) && (0..i64::from(h)).contains(&j));
-            if q.inside(x, y, w, h) {
-                assert!(within, "ellipse {q:?} at ({x}, {y}) scans a texel outside");
-                held += 1;
-            } else if !within {
-                crossed += 1;
-            }
+            let x = rnd() as f32 * (w as f32 + 8.0) - 4.0;
+            let y = rnd() as f32 * (h as f32 + 8.0) - 4.0;
+            check(&q, x, y, &mut seen);
         }
-        assert!(
-            held > 2_000 && crossed > 2_000,
-            "held {held}, crossed {crossed}"
-        );
-        // Non-finite centres and inconsistent ellipses are never inside.
+        assert!(seen.iter().all(|&n| n > 1_000), "{seen:?}");
+        // Hand-built: `det` from 0 to twice the consistent value.
+        for _ in 0..20_000 {
+            let (q00, q11) = (1.0 + 40.0 * rnd(), 1.0 + 40.0 * rnd());
+            let q01 = (2.0 * rnd() - 1.0) * (q00 * q11).sqrt();
+            let det = (q00 * q11 - q01 * q01) * 2.0 * rnd();
+            let q = LevelEllipse { q00, q01, q11, det };
+            let x = rnd() as f32 * (w as f32 + 8.0) - 4.0;
+            let y = rnd() as f32 * (h as f32 + 8.0) - 4.0;
+            check(&q, x, y, &mut seen);
+        }
         let q = LevelEllipse {
             q00: 4.0,
             q01: 0.0,
@@ -1094,9 +1110,18 @@ mod tests {
         assert!(q.inside(32.0, 8.0, w, h));
         assert!(!q.inside(f32::NAN, 8.0, w, h));
         assert!(!q.inside(32.0, f32::INFINITY, w, h));
-        assert!(!LevelEllipse { det: 17.0, ..q }.inside(32.0, 8.0, w, h));
-        assert!(!LevelEllipse { q01: 5.0, ..q }.inside(32.0, 8.0, w, h));
         assert!(!LevelEllipse { q00: f64::NAN, ..q }.inside(32.0, 8.0, w, h));
+        assert!(!LevelEllipse { det: f64::NAN, ..q }.inside(32.0, 8.0, w, h));
+        // Both `det <= q00 q11` and `q01^2 <= q00 q11` hold, but `q01^2 + det` does not: a row
+        // of this ellipse reaches 111.8 texels left of the centre, beyond `sqrt(q00) = 100`.
+        let far = LevelEllipse {
+            q00: 1e4,
+            q01: 5e3,
+            q11: 1e4,
+            det: 1e8,
+        };
+        assert!(!far.inside(102.0, 102.0, 1024, 1024));
+        assert!(scanned(&far, 102.0, 102.0).iter().any(|&(i, _, _)| i < 0));
     }
 
     #[test]
