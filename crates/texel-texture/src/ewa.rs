@@ -71,14 +71,15 @@
 //! removed, not vector lanes; docs/perf-log.md, entry 48). Along a line `r^2`
 //! ([`LevelEllipse::r2`]) is a quadratic in the offset, carried in `f64` by forward differences
 //! ([`Weights`]), and weights and texels are read in the same loop, so a line has a single loop
-//! exit. An ellipse whose extent lies inside the level with a texel to spare
-//! ([`LevelEllipse::inside`], one test a level) reads every line directly, with no per-line address
-//! decision (frames 5 % faster, docs/perf-log.md, entry 50); otherwise lines inside the level read
-//! texels without address wrapping, and lines crossing the edge of a power-of-two side under
-//! `Repeat` wrap each index by a mask (docs/perf-log.md, entry 46).
-//! Alternatives measured and not adopted (two accumulators, `r^2` evaluated directly per texel,
-//! one bounds check per run, weights in lanes across a block's lines, their table indices in such
-//! lanes, one bounds check per line, short lines' terms summed in one loop per block):
+//! exit. An ellipse whose box lies inside the level ([`LevelEllipse::inside`], one test a level)
+//! reads every line directly, with no per-line address decision (frames 3-7 % faster,
+//! docs/perf-log.md, entry 50); otherwise lines inside the level read texels without address
+//! wrapping, and lines crossing the edge of a power-of-two side under `Repeat` wrap each index by
+//! a mask (docs/perf-log.md, entry 46). Alternatives measured and not adopted (two accumulators,
+//! `r^2` evaluated directly per texel, one bounds check per run, weights in lanes across a block's
+//! lines, their table indices in such lanes, one bounds check per line, short lines' terms summed
+//! in one loop per block, a block's set-up over all 16 lanes, one loop over a block's lines with
+//! the line switch as a select, masks for every line under `Repeat` on power-of-two sides):
 //! docs/perf-log.md.
 //!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
