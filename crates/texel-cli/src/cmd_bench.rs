@@ -60,6 +60,24 @@ pub const MIN_WARMUP: Duration = Duration::from_millis(200);
 /// Most warm-up frames [`MIN_WARMUP`] can add (a bound for very fast frames).
 const MAX_WARMUP_FRAMES: u32 = 10_000;
 
+/// Untimed warm-up: call `step`, which does `per_call` units of work (frames, passes), until at
+/// least `warmup` units are done and, unless `warmup` is 0, until `min_warmup` has passed or
+/// [`MAX_WARMUP_FRAMES`] units are done.
+fn warm_up<E>(
+    warmup: u32,
+    min_warmup: Duration,
+    per_call: u32,
+    mut step: impl FnMut() -> Result<(), E>,
+) -> Result<(), E> {
+    let start = Instant::now();
+    let mut k = 0u32;
+    while k < warmup || (warmup > 0 && k < MAX_WARMUP_FRAMES && start.elapsed() < min_warmup) {
+        step()?;
+        k = k.saturating_add(per_call.max(1));
+    }
+    Ok(())
+}
+
 /// Draw untimed frames (at least `warmup`, and while `warmup > 0` until `min_warmup` has passed),
 /// then `frames` timed ones into one reused frame, clearing it before each; the timed frames'
 /// clear and draw times in milliseconds.
@@ -76,14 +94,12 @@ pub fn time_frames(
         clear_ms: Vec::new(),
         streamed: false,
     };
-    let start = Instant::now();
-    let mut k = 0u32;
-    while k < warmup || (warmup > 0 && k < MAX_WARMUP_FRAMES && start.elapsed() < min_warmup) {
+    warm_up(warmup, min_warmup, 1, || {
         frame.reset(settings);
         draw_into(settings, draws, &mut frame)?;
         std::hint::black_box(&frame);
-        k += 1;
-    }
+        Ok::<_, RasterError>(())
+    })?;
     for _ in 0..frames {
         let t0 = Instant::now();
         frame.reset(settings);
@@ -128,12 +144,10 @@ fn time_gpu(
             settings.target = texel::ColorTarget::Float;
         }
         let prepared = gpu.prepare(&draws, gpu_filter)?;
-        let start = Instant::now();
-        let mut k = 0;
-        while k < args.warmup || (args.warmup > 0 && start.elapsed() < MIN_WARMUP) {
+        warm_up(args.warmup, MIN_WARMUP, 1, || {
             std::hint::black_box(prepared.render(&settings)?);
-            k += 1;
-        }
+            Ok::<_, texel_gpu::GpuError>(())
+        })?;
         let mut times = Vec::new();
         for _ in 0..args.frames {
             let t0 = Instant::now();
@@ -144,16 +158,11 @@ fn time_gpu(
         // idles and may clock down (README.md, "On an NVIDIA H200"), so warm-up passes run
         // back to back first, as the frames' warm-up does (`--warmup` of them and at least
         // MIN_WARMUP unless 0).
-        if gpu.has_timestamps() && args.warmup > 0 {
-            let (start, batch) = (
-                Instant::now(),
-                args.warmup.min(texel_gpu::PASSES_PER_SUBMIT),
-            );
-            let mut k = 0;
-            while k < args.warmup || (k < MAX_WARMUP_FRAMES && start.elapsed() < MIN_WARMUP) {
-                prepared.pass_times(&settings, batch)?;
-                k += batch;
-            }
+        if gpu.has_timestamps() {
+            let batch = args.warmup.min(texel_gpu::PASSES_PER_SUBMIT);
+            warm_up(args.warmup, MIN_WARMUP, batch, || {
+                prepared.pass_times(&settings, batch).map(drop)
+            })?;
         }
         let mut device = prepared
             .pass_times(&settings, args.frames)?
