@@ -6,7 +6,7 @@ Usage (from anywhere; runs in the repository root):
   scripts/bench_tables.py aniso     # README "Anisotropic filters" and the structures' memory/build
   scripts/bench_tables.py threads [SCENE]
                                     # README "Frame times by thread count": texel bench, 1 and 2
-                                    # threads (default scene ../shared/scenes/ground.toml)
+                                    # threads (default scene scenes/ground.toml)
   scripts/bench_tables.py demo      # README's first table: texel demo's ground report
 
 sampler and aniso take `--exe PATH`: run an already built bench executable (e.g. an older commit's,
@@ -139,7 +139,7 @@ if __name__ == "__main__":
     elif what == "aniso":
         aniso()
     elif what == "threads":
-        threads(sys.argv[2] if len(sys.argv) > 2 else "../shared/scenes/ground.toml")
+        threads(sys.argv[2] if len(sys.argv) > 2 else "scenes/ground.toml")
     elif what == "demo":
         demo()
     else:

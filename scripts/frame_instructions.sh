@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Instructions a texel frame retires, counted by cachegrind: deterministic where wall-clock frames
-# are not (a shared VM's frames moved by 1.5x between rounds; docs/perf-log.md, entry 38). Counts
+# are not (on a shared VM the same frame can move by 1.5x between rounds; docs/decisions.md). Counts
 # instructions, not cycles: a change that retires fewer may still not be faster.
 # Usage: scripts/frame_instructions.sh TEXEL_BINARY [FILTERS] [SCENE] [THREADS]
 #   e.g. scripts/frame_instructions.sh target/release/texel nearest,bilinear
@@ -12,7 +12,7 @@
 # default: with more, the count includes the threads' waiting and hand-over, which depend on
 # timing (the one-thread count was checked to repeat within 0.03 %; more threads were not).
 set -euo pipefail
-bin=$1 filters=${2:-nearest,bilinear,mip-nearest,trilinear} scene=${3:-../shared/scenes/ground.toml}
+bin=$1 filters=${2:-nearest,bilinear,mip-nearest,trilinear} scene=${3:-scenes/ground.toml}
 threads=${4:-1}
 command -v valgrind >/dev/null || { echo "valgrind is not installed (apt-get install valgrind)" >&2; exit 1; }
 refs() { # frames, filter -> instructions of the whole run

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Do two texel binaries render the same images, byte for byte? For refactors that must not change
 # a pixel. Usage: scripts/same_images.sh OLD_TEXEL NEW_TEXEL [OUT_DIR]
-# Renders every filter on every built-in scene and ../shared/scenes/ground.toml at 320x180, the
+# Renders every filter on every built-in scene and scenes/ground.toml at 320x180, the
 # 16-spp reference and five debug views at 160x90, the lit built-ins and raw colour (134 images),
 # and compares the PNG files.
 # A binary of an older commit: git worktree add /tmp/base REV && cargo build --release
@@ -11,7 +11,7 @@ old=$1 new=$2 out=${3:-$(mktemp -d)}
 cd "$(dirname "$0")/.."
 mkdir -p "$out/old" "$out/new"
 scenes=(builtin:ground builtin:ground-rotated builtin:zoneplate builtin:cube builtin:sphere builtin:triangle)
-[ -f ../shared/scenes/ground.toml ] && scenes+=(../shared/scenes/ground.toml)
+scenes+=(scenes/ground.toml)
 n=0 differ=0
 check() { # name, then the arguments after the scene
   local name=$1; shift

@@ -1,15 +1,14 @@
 #!/usr/bin/env python3
-"""texel vs Mesa's llvmpipe on the same scene, same machine, same run (issue 6).
+"""texel vs Mesa's llvmpipe on the same scene, same machine, same run.
 
-Alternates `texel bench --json` and `../shared/peers/llvmpipe_bench.py` for a few rounds (the
+Alternates `texel bench --json` and `scripts/peers/llvmpipe_bench.py` for a few rounds (the
 machine is shared and noisy: alternating keeps both under the same conditions) and prints a
 Markdown table of the medians of each round's medians, the texel / llvmpipe ratio per round, and
 texel's aniso16 and EWA frames as multiples of its own trilinear frame.
 
-Run from the repository root after `cargo build --release` and the peer set-up of
-`../shared/peers/README.md`:
+Run from the repository root after `cargo build --release` and `scripts/peers/setup.sh`:
 
-    ../peers-venv/bin/python scripts/vs_llvmpipe.py [--rounds 3] [--frames 10] [--threads 2]
+    .venv-peers/bin/python scripts/vs_llvmpipe.py [--rounds 3] [--frames 10] [--threads 2]
 
 texel runs with `--color raw` (texture bytes are linear, as a GPU samples a plain RGBA8 texture),
 which is what llvmpipe does with the scene's textures. llvmpipe's 16x anisotropic filter (an EWA
@@ -35,12 +34,12 @@ def run_json(cmd):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--scene", default="../shared/scenes/ground.toml")
+    ap.add_argument("--scene", default="scenes/ground.toml")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--frames", type=int, default=10)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--texel", default="target/release/texel")
-    ap.add_argument("--peer", default="../shared/peers/llvmpipe_bench.py")
+    ap.add_argument("--peer", default="scripts/peers/llvmpipe_bench.py")
     ap.add_argument("--llvmpipe-aniso", action="store_true",
                     help="also time one llvmpipe aniso16 frame (tens of seconds)")
     ap.add_argument("--gpu-precision", action="store_true",

@@ -32,7 +32,7 @@ pub enum Command {
     ///
     /// Example: texel render builtin:ground --filter trilinear -o ground.png
     ///
-    /// Example: texel render ../shared/scenes/ground.toml --lab-mode 8 --view aniso -o aniso.png
+    /// Example: texel render scenes/ground.toml --lab-mode 8 --view aniso -o aniso.png
     Render(RenderArgs),
     /// Render the supersampled reference (ground truth) of a scene.
     ///
@@ -66,7 +66,7 @@ pub enum Command {
     Demo(DemoArgs),
     /// Time whole frames per filter (median over frames, textures and pyramids prepared beforehand).
     ///
-    /// Example: texel bench ../shared/scenes/ground.toml --frames 10 --threads 2 --json
+    /// Example: texel bench scenes/ground.toml --frames 10 --threads 2 --json
     Bench(BenchArgs),
     /// An interactive window: the lab's keys 1-8 switch the filter while you fly over the scene;
     /// split screen compares two filters on one frame; 0 accumulates the reference.
@@ -488,7 +488,7 @@ pub struct BenchArgs {
     /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
-    /// Print JSON in the shape of ../shared/peers/llvmpipe_bench.py (plus the CPU, the SIMD level
+    /// Print JSON in the shape of scripts/peers/llvmpipe_bench.py (plus the CPU, the SIMD level
     /// and the colour target).
     #[arg(long)]
     pub json: bool,

@@ -148,7 +148,7 @@ pub(crate) fn temp_files(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// The shipped ground scene (identical to `../shared/scenes/ground.toml`).
+/// The shipped ground scene (identical to `scenes/ground.toml`).
 pub(crate) fn ground_toml() -> String {
     concat!(
         env!("CARGO_MANIFEST_DIR"),

@@ -1,6 +1,6 @@
 // texel's filters as a fragment shader that reads the texture only through textureLoad,
 // textureDimensions and textureNumLevels (the filtering lab's rule), with the conventions of
-// ../shared/DESIGN.md: texel (i, j) covers [i, i+1) x [j, j+1) of xy = uv * (W, H); address modes
+// the conventions page: texel (i, j) covers [i, i+1) x [j, j+1) of xy = uv * (W, H); address modes
 // act on integer texel indices; 8-bit sRGB texels are decoded through the same 256-entry table as
 // the CPU path (uploaded), alpha as b / 255.
 
@@ -190,7 +190,7 @@ fn trilinear(uv: vec2<f32>, lod: f32) -> vec4<f32> {
     return a;
 }
 
-// Anisotropic (DESIGN.md, EXT_texture_filter_anisotropic): N = min(ceil(|Pmax| / |Pmin|), max)
+// Anisotropic (conventions.md, EXT_texture_filter_anisotropic): N = min(ceil(|Pmax| / |Pmin|), max)
 // trilinear probes along the longer axis at lod log2(|Pmax| / N):
 // c = 1/N sum_i trilinear(uv + ((i + 0.5) / N - 0.5) Pmax_uv).
 fn anisotropic(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, px: vec2<f32>, py: vec2<f32>,

@@ -4,7 +4,8 @@
 //! `textureDimensions` and `textureNumLevels` — the filtering lab's rule — so every filter's
 //! arithmetic is written out: one function per technique (nearest, bilinear, mip-nearest,
 //! trilinear, anisotropic 2x-16x, bicubic, EWA), address modes on integer texel indices and the sRGB
-//! decode through the CPU's own 256-entry table, as `../shared/DESIGN.md` fixes them. The pyramid is
+//! decode through the CPU's own 256-entry table, as `docs/guide/conventions.md` fixes them. The
+//! pyramid is
 //! texel-texture's, uploaded level by level in the texture's own format (`Rgba8Unorm` codes or
 //! `Rgba32Float`), so both paths filter the same texels. The hardware sampler is the peer
 //! ([`GpuFilter::HwTrilinear`], [`GpuFilter::HwAniso16`]: `textureSampleGrad`).

@@ -1,6 +1,6 @@
 //! The horizon band: where minification and anisotropy are extreme.
 //!
-//! Rule (DESIGN.md asks for "the band just below the horizon"): in every column `x`, find the
+//! Rule (conventions.md asks for "the band just below the horizon"): in every column `x`, find the
 //! topmost covered row `y0(x)` of the coverage mask; the band holds the covered pixels
 //! `(x, y)` with `y0(x) <= y < y0(x) + rows`. Columns without coverage contribute nothing.
 //! The default depth is [`default_band_rows`]: 10% of the image height, at least 8 rows (and never

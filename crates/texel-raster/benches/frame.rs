@@ -1,4 +1,4 @@
-//! Frame-time benchmarks: the ground scene (`shared/scenes/ground.toml`) at 1280 x 720 with the
+//! Frame-time benchmarks: the ground scene (`scenes/ground.toml`) at 1280 x 720 with the
 //! four core filters, on 1 and 2 threads; triangle throughput on a 100k-triangle mesh.
 //!
 //! Run: `CARGO_TARGET_DIR=/work/target-shared cargo bench -p texel-raster --bench frame`.

@@ -1,4 +1,4 @@
-//! Render the ground scene (`shared/scenes/ground.toml`) with several filters, debug views and the
+//! Render the ground scene (`scenes/ground.toml`) with several filters, debug views and the
 //! reference renderer, write PNGs and print the time each took.
 //!
 //! `cargo run --release -p texel-raster --example ground -- OUT_DIR [WIDTH HEIGHT SPP_SIDE]`

@@ -1,6 +1,6 @@
 //! Camera matrices: look-at and OpenGL perspective, thin documented wrappers over glam.
 //!
-//! Conventions (DESIGN.md, "Coordinates"): right-handed world, the camera looks down its `-z`,
+//! Conventions (conventions.md, "Coordinates"): right-handed world, the camera looks down its `-z`,
 //! OpenGL clip space with NDC `z` in `[-1, 1]` (near maps to -1, far to +1). `clip_from_world` is
 //! `perspective(..) * look_at(..) * world_from_model`.
 
@@ -27,7 +27,7 @@ pub fn perspective(fovy_rad: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
     Mat4::perspective_rh_gl(fovy_rad, aspect, near, far)
 }
 
-/// The viewport transform of DESIGN.md: NDC `(x, y)` to continuous pixel coordinates of a
+/// The viewport transform of conventions.md: NDC `(x, y)` to continuous pixel coordinates of a
 /// `width x height` frame, `x = (x_ndc + 1) / 2 * W`, `y = (1 - y_ndc) / 2 * H` (row 0 at the top;
 /// pixel `(i, j)` has its centre at `(i + 0.5, j + 0.5)`).
 pub fn viewport(x_ndc: f64, y_ndc: f64, width: u32, height: u32) -> (f64, f64) {

@@ -11,8 +11,8 @@ use crate::material::Material;
 pub struct Vertex {
     /// World-space position.
     pub position: Vec3,
-    /// Normalised texture coordinate (DESIGN.md: `(0, 0)` is the top-left of the image file; values
-    /// outside `[0, 1)` are resolved by the sampler's address modes).
+    /// Normalised texture coordinate (docs/guide/conventions.md: `(0, 0)` is the top-left of the
+    /// image file; values outside `[0, 1)` are resolved by the sampler's address modes).
     pub uv: Vec2,
     /// Linear RGBA colour multiplied into the texture colour (white for a plain textured mesh).
     pub color: Vec4,

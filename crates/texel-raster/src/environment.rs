@@ -1,7 +1,7 @@
 //! Environment maps: light from every direction, stored equirectangular (latitude-longitude), as
 //! a cube or octahedral, seen as the background and reflected by surfaces.
 //!
-//! Directions become texture coordinates through [`texel_texture::sphere`] (DESIGN.md's
+//! Directions become texture coordinates through [`texel_texture::sphere`] (the conventions'
 //! conventions: equirect `u = 0.5 + atan2(d.x, -d.z) / (2 pi)`, `v = acos(d.y / |d|) / pi`;
 //! Vulkan's cube faces; pbrt-v4's equal-area octahedral square).
 //!
@@ -732,7 +732,7 @@ pub struct ViewRays {
 }
 
 impl ViewRays {
-    /// The unit direction of the ray through continuous pixel position `(x, y)` (DESIGN.md's
+    /// The unit direction of the ray through continuous pixel position `(x, y)` (the conventions'
     /// viewport: `x_ndc = 2x / W - 1`, `y_ndc = 1 - 2y / H`), from the point at NDC depth 0 to the
     /// one at depth 1; `None` where they coincide or are not finite.
     pub fn direction(&self, x: f64, y: f64) -> Option<DVec3> {

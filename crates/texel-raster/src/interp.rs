@@ -1,8 +1,9 @@
 //! Per-pixel interpolation: barycentrics (perspective-correct or affine), their analytic screen
 //! derivatives, and the GPU-style 2x2 quad differences.
 //!
-//! Perspective-correct (DESIGN.md): with `q_k = lambda_k / w` and `r = 1 / w` linear in screen space
-//! (planes from [`crate::setup`]), `lambda_k = q_k / r` and, by the quotient rule,
+//! Perspective-correct (docs/guide/conventions.md): with `q_k = lambda_k / w` and `r = 1 / w`
+//! linear in screen space (planes from [`crate::setup`]), `lambda_k = q_k / r` and, by the
+//! quotient rule,
 //! `d lambda_k / dx = (q_k,x r - q_k r_x) / r^2 = (q_k,x - lambda_k r_x) / r`. Any attribute
 //! `a = sum_k lambda_k a_k` then has `da/dx = sum_k a_k d lambda_k / dx`: this is exactly
 //! `du/dx = (q_x r - q r_x) / r^2` for `q = u / w`, evaluated in `f64` here (`UvPlanes` evaluates

@@ -1,7 +1,7 @@
 //! texel-raster: a clipped, watertight, perspective-correct textured-triangle rasterizer on all
 //! cores, with debug views and the supersampled reference renderer every filter is judged against.
 //!
-//! Pipeline (conventions from the project's DESIGN.md): world-space [`Vertex`]es are transformed by
+//! Pipeline (docs/guide/conventions.md): world-space [`Vertex`]es are transformed by
 //! a [`DrawCall`]'s `clip_from_world` ([`camera`]), clipped in homogeneous space against the near and
 //! far planes and a guard band ([`clip`]), set up once per triangle with fixed-point edge functions,
 //! the top-left fill rule and homogeneous plane equations ([`setup`]), binned to 64x64 tiles and

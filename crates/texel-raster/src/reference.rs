@@ -1,5 +1,5 @@
-//! The supersampled reference renderer: the ground truth every filter is judged against (DESIGN.md,
-//! "Reference images and quality").
+//! The supersampled reference renderer: the ground truth every filter is judged against
+//! (docs/guide/conventions.md, "Reference images and quality").
 //!
 //! Each pixel `(i, j)` gets `nx x ny` stratified jittered samples at
 //! `(i + (sx + xi) / nx, j + (sy + eta) / ny)` (`nx = ny = n` for [`render_reference`]; 512 samples
@@ -50,7 +50,7 @@ use texel_texture::rng::SplitMix64;
 /// The largest samples-per-pixel side (`64 x 64 = 4096` samples per pixel).
 pub const MAX_SPP_SIDE: u32 = 64;
 
-/// The default samples-per-pixel side (16 x 16 = 256 samples, DESIGN.md).
+/// The default samples-per-pixel side (16 x 16 = 256 samples, conventions.md).
 pub const DEFAULT_SPP_SIDE: u32 = 16;
 
 /// Progress callback: `(pixels done, pixels in total)`, called from worker threads after each tile.

@@ -18,7 +18,7 @@ pub const MAX_PIXELS: u64 = 1 << 26;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Derivatives {
     /// Exact derivatives of the perspective-correct `uv` at the pixel centre, from the plane
-    /// equations: with `q = u/w` and `r = 1/w`, `du/dx = (q_x r - q r_x) / r^2` (DESIGN.md).
+    /// equations: with `q = u/w` and `r = 1/w`, `du/dx = (q_x r - q r_x) / r^2` (conventions.md).
     #[default]
     Analytic,
     /// GPU-style differences over aligned 2x2 quads ("fine" derivatives, D3D `ddx_fine`): for a pixel

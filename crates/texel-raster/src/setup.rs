@@ -2,8 +2,8 @@
 //! top-left fill rule, and the plane equations every pixel evaluates.
 //!
 //! ## Coverage: fixed-point edge functions
-//! Clipped vertices are projected (DESIGN.md viewport) and snapped to [`SUBPIXEL_BITS`] = 8 fractional
-//! bits in `i64`. For an edge `a -> b` the edge function is
+//! Clipped vertices are projected (the viewport of docs/guide/conventions.md) and snapped to
+//! [`SUBPIXEL_BITS`] = 8 fractional bits in `i64`. For an edge `a -> b` the edge function is
 //! `E(p) = (b.x - a.x)(p.y - a.y) - (b.y - a.y)(p.x - a.x)`, evaluated exactly in integers at pixel
 //! centres `(256 i + 128, 256 j + 128)`. Each sub-triangle is oriented so that its interior has
 //! `E >= 0` on all three edges. Top-left rule (Direct3D rasterization rules, y down): a pixel centre

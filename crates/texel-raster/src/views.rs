@@ -11,7 +11,7 @@
 //! - mip: [`MIP_PALETTE`]`[level]`, `level` = the nearest-level rule `ceil(lod + 1/2) - 1` clamped to
 //!   the pyramid (the level `*_MIPMAP_NEAREST` reads), `lod` from `Sampler::lod`.
 //! - lod: the palette interpolated linearly between `floor(lod)` and `floor(lod) + 1`.
-//! - aniso: `ratio = |Pmax| / |Pmin|` (DESIGN.md), `t = log2(ratio) / 4` (1x .. 16x) on [`ramp`];
+//! - aniso: `ratio = |Pmax| / |Pmin|` (conventions), `t = log2(ratio) / 4` (1x .. 16x) on [`ramp`];
 //!   a zero minor axis counts as infinite ratio.
 //! - fetches: texels read `n`, `t = log2(1 + n) / 10` on [`ramp`] (`n = 1023` is the top).
 //! - barycentric: `(lambda_0, lambda_1, lambda_2)` clamped to `[0, 1]`.

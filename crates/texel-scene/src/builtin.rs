@@ -1,7 +1,7 @@
 //! Built-in scenes, available as `builtin:NAME`.
 //!
 //! `ground`, `zoneplate` and `triangle` are TOML files compiled into the crate (`src/builtin/`;
-//! `ground` is byte for byte `shared/scenes/ground.toml`); `ground-rotated`, `cube`, `sphere`,
+//! `ground` is byte for byte `scenes/ground.toml`); `ground-rotated`, `cube`, `sphere`,
 //! the globes and the lit scenes but `glossy`, `bricks` and `terrain` are built in code.
 
 use std::f32::consts::PI;
@@ -16,7 +16,7 @@ use crate::error::SceneError;
 use crate::model::{Mesh, Output, Scene, SphereUv, TextureSource, TextureSpec};
 use crate::procedural::Procedural;
 
-/// The ground plane TOML (identical to `shared/scenes/ground.toml`).
+/// The ground plane TOML (identical to `scenes/ground.toml`).
 pub const GROUND_TOML: &str = include_str!("builtin/ground.toml");
 /// The zone plate scene's TOML.
 pub const ZONEPLATE_TOML: &str = include_str!("builtin/zoneplate.toml");
@@ -33,7 +33,7 @@ pub const TERRAIN_TOML: &str = include_str!("builtin/terrain.toml");
 pub const GROUND_ROTATION_DEG: f32 = 30.0;
 
 /// The names `builtin:NAME` accepts, in presentation order:
-/// - `ground`: a checkerboard plane receding to the horizon (= `shared/scenes/ground.toml`);
+/// - `ground`: a checkerboard plane receding to the horizon (= `scenes/ground.toml`);
 /// - `ground-rotated`: the same with its uvs rotated by 30 degrees about uv (0, 0), so the checks
 ///   run diagonally to the view (anisotropy off the screen axes);
 /// - `zoneplate`: a zone plate on a square seen at a grazing angle;

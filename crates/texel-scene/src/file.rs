@@ -1,4 +1,4 @@
-//! Scene files: TOML, as `shared/scenes/ground.toml` shows, parsed with serde.
+//! Scene files: TOML, as `scenes/ground.toml` shows, parsed with serde.
 //!
 //! ```toml
 //! [output]                      # width, height (1..=16384); background = [r, g, b, a] sRGB 8-bit

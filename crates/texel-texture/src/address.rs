@@ -1,8 +1,8 @@
 //! Address modes: what happens to texel indices outside `[0, n)`.
 //!
-//! Names follow WebGPU (`GPUAddressMode`) plus Vulkan's `MIRROR_CLAMP_TO_EDGE`. As DESIGN.md fixes,
-//! the mode is applied to the *integer* texel indices after a filter has picked them (Vulkan spec,
-//! "Wrapping Operation"), separately for u and v.
+//! Names follow WebGPU (`GPUAddressMode`) plus Vulkan's `MIRROR_CLAMP_TO_EDGE`. As the conventions
+//! (docs/guide/conventions.md) fix, the mode is applied to the *integer* texel indices after a
+//! filter has picked them (Vulkan spec, "Wrapping Operation"), separately for u and v.
 
 use glam::Vec4;
 

@@ -1,7 +1,8 @@
 //! Hardware-style anisotropic filtering: N trilinear probes along the footprint's major axis.
 //!
 //! Formula (EXT_texture_filter_anisotropic, "Texture Minification"; also the lab's formula and
-//! DESIGN.md): with `Px = (dudx * W, dvdx * H)` and `Py = (dudy * W, dvdy * H)` in texels of level
+//! docs/guide/conventions.md):
+//! with `Px = (dudx * W, dvdx * H)` and `Py = (dudy * W, dvdy * H)` in texels of level
 //! 0, `Pmax`/`Pmin` the longer/shorter of the two,
 //!
 //! ```text

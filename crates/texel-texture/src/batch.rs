@@ -228,7 +228,7 @@ pub(crate) trait Taps: LevelFilter {
     }
     /// The value of a sample near an edge whose taps the pass wrapped: first taps `i[0]`,
     /// `j[0]`, the next ones `i[1]`, `j[1]` (all inside `level`), fractions `ab`. Bit for bit the
-    /// one-sample filter's, which reads the same texels (DESIGN.md: the address mode applies to
+    /// one-sample filter's, which reads the same texels (conventions: the address mode applies to
     /// the integer taps).
     fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], ab: (f32, f32)) -> Vec4;
     /// The blend of two levels' values with weight `t` on `b` ([`lerp`]; the fixed-point

@@ -1,7 +1,7 @@
 //! texel-texture: texture images, address modes, mip pyramids and every classic texture filter,
 //! behind a WebGPU-style sampler.
 //!
-//! Conventions (fixed by the project's DESIGN.md): `uv` is normalised, `xy = (u * W, v * H)` is
+//! Conventions (fixed by docs/guide/conventions.md): `uv` is normalised, `xy = (u * W, v * H)` is
 //! continuous texel space with texel `(i, j)` covering `[i, i+1) x [j, j+1)`, row 0 is the top of the
 //! image file. Colours returned by samplers are linear RGBA `f32`.
 //!

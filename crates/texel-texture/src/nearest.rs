@@ -1,6 +1,7 @@
 //! Nearest-texel (point) filtering.
 //!
-//! `ij = floor(xy)` with `xy = (u * W, v * H)` (DESIGN.md; Vulkan spec "Texel Selection", NEAREST):
+//! `ij = floor(xy)` with `xy = (u * W, v * H)` (docs/guide/conventions.md; Vulkan spec "Texel
+//! Selection", NEAREST):
 //! the texel whose square `[i, i+1) x [j, j+1)` contains the sample point. One texel read. The
 //! batched path (`batch.rs`) stages the same [`origin`] and floor over a chunk of samples.
 

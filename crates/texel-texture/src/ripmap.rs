@@ -1,7 +1,7 @@
 //! Ripmaps: every anisotropic reduction `(W >> a) x (H >> b)` of level 0, for axis-aligned
 //! anisotropic footprints.
 //!
-//! Formula (DESIGN.md; the ripmap of Larson & Shah / the "rip-map" of the lectures): image
+//! Formula (conventions.md; the ripmap of Larson & Shah / the "rip-map" of the lectures): image
 //! `R[a][b]` is level 0 box-reduced `a` times along x and `b` times along y, so it is
 //! `max(1, W >> a) x max(1, H >> b)`, `a` in `0..=floor(log2 W)`, `b` in `0..=floor(log2 H)`. The
 //! footprint's parallelogram (`uv +- Px/2 +- Py/2`, texels of level 0) has the axis-aligned bounding

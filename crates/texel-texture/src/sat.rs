@@ -9,7 +9,7 @@
 //! four entries, one when both are integers). A box `[x0, x1) x [y0, y1)` then sums to
 //! `I(x1, y1) - I(x0, y1) - I(x1, y0) + I(x0, y0)` of the address-mode extension's integral `I`.
 //!
-//! Address modes, exactly (DESIGN.md): per axis, the integral of the extended texture from 0 to
+//! Address modes, exactly (conventions): per axis, the integral of the extended texture from 0 to
 //! `x` is a short combination of `P(p) = integral of the texture from 0 to p`, `p` in `[0, n]`:
 //! - Repeat: `x = q n + r` gives `q P(n) + P(r)` (whole periods counted, the box split at the edge);
 //! - MirrorRepeat: period `2 n`, `x = 2 q n + r`: `2 q P(n) + P(r)` for `r <= n`, else

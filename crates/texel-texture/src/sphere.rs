@@ -1,5 +1,5 @@
 //! Maps between directions (points on the unit sphere) and texture coordinates, with their
-//! analytic derivatives: the three environment-map layouts of DESIGN.md.
+//! analytic derivatives: the three environment-map layouts of conventions.md.
 //!
 //! - **Equirectangular** (latitude-longitude): `u = 0.5 + atan2(d.x, -d.z) / (2 pi)`,
 //!   `v = acos(d.y / |d|) / pi` (`v = 0` straight up, `-z` at the centre column, the seam
@@ -16,7 +16,7 @@
 //!   equal solid angle per texel. Its continuation outside the square is [`octahedral_wrap`].
 //!
 //! Every derivative is the Jacobian of the mapping applied to a change of direction, computed in
-//! closed form ([`equirect_duv`], [`cube_dst`], [`octahedral_duv`]): DESIGN.md forbids
+//! closed form ([`equirect_duv`], [`cube_dst`], [`octahedral_duv`]): conventions.md forbids
 //! differencing `u` across a seam, which jumps by about one texture width.
 
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -403,7 +403,7 @@ impl SurfaceProjection {
     }
 
     /// The change of [`SurfaceProjection::uv`] for a small change `dd` of `d`, in closed form, so
-    /// continuous across the seam (DESIGN.md: `u` is never differenced). `du` is
+    /// continuous across the seam (conventions.md: `u` is never differenced). `du` is
     /// [`equirect_duv`]'s, mirrored; Mercator's `dv = -(dy - y (d.dd) / |d|^2) |d| / (2 Y rho^2)`
     /// with `rho^2 = x^2 + z^2` (the derivative of `atanh(y / |d|)`), and 0 past the cut, where
     /// `v` is clamped. Each component is clamped to `[-1, 1]`; at the poles `du` is the clamp.

@@ -1,4 +1,4 @@
-//! Shared test scenes: the ground plane of `shared/scenes/ground.toml`, built inline.
+//! Shared test scenes: the ground plane of `scenes/ground.toml`, built inline.
 #![allow(dead_code, unused_imports)]
 
 use glam::{DMat4, DVec2, DVec4, Mat4, Vec2, Vec3};

@@ -1,5 +1,5 @@
 #!/bin/bash
-# texel's GPU path on an NVIDIA machine (../shared/gpu/README.md): adapter, bench --gpu at 720p
+# texel's GPU path on an NVIDIA machine (docs/guide/gpu.md): adapter, bench --gpu at 720p
 # and 4K (two rounds), the CPU path on the host, compare --gpu against a 1024-sample reference.
 set -u
 cd "$(dirname "$0")"
