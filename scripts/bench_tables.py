@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
-"""Run a benchmark and print the README table it backs, in the README's format.
+"""Run a benchmark and print the table of docs/guide/measuring.md it backs, in that format.
 
 Usage (from anywhere; runs in the repository root):
-  scripts/bench_tables.py sampler   # README "Sampler throughput": criterion, benches/sampler.rs
-  scripts/bench_tables.py aniso     # README "Anisotropic filters" and the structures' memory/build
+  scripts/bench_tables.py sampler   # "Sampler throughput": criterion, benches/sampler.rs
+  scripts/bench_tables.py aniso     # "Anisotropic filters" and the structures' memory/build
   scripts/bench_tables.py threads [SCENE]
-                                    # README "Frame times by thread count": texel bench, 1 and 2
+                                    # "Frame times by thread count": texel bench, 1 and 2
                                     # threads (default scene scenes/ground.toml)
-  scripts/bench_tables.py demo      # README's first table: texel demo's ground report
+  scripts/bench_tables.py demo      # texel demo's ground report as a table
 
 sampler and aniso take `--exe PATH`: run an already built bench executable (e.g. an older commit's,
 `target/release/deps/sampler-*`) instead of building this tree's, for before/after tables.
@@ -60,7 +60,7 @@ def criterion(bench):
 
 
 def fmt(x):
-    """Three significant figures, as the README's tables write them."""
+    """Three significant figures, as the guide's tables write them."""
     return f"{x:.3g}" if x < 100 else f"{x:.0f}"
 
 

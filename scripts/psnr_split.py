@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """PSNR of two same-sized images over the left third of the columns and over the rest.
 
-Used for the `builtin:bricks` table in README.md, whose left third sees the wall at about 50
-degrees and the rest at grazing angles:
+Used for the `builtin:bricks` table in docs/guide/lighting.md, whose left third sees the wall at
+about 50 degrees and the rest at grazing angles:
 
     python3 scripts/psnr_split.py r/reference.png r/aniso16.png --background 40,46,56
 

@@ -19,7 +19,7 @@
 //! - No automatic downsampling (the later `ssim.m` adds it for large images; the 2004 paper has none).
 //! - `f64` throughout; the two separable passes run in parallel over rows (rayon). A masked
 //!   1280x720 SSIM costs little beside rendering a frame (`cargo bench -p texel-quality --bench
-//!   metrics -- --quick`; figures in docs/perf-log.md).
+//!   metrics -- --quick`; figures in docs/decisions.md).
 
 use rayon::prelude::*;
 

@@ -20,7 +20,7 @@ use texel_texture::Sampler;
 
 /// The four core filters this bench times: the lab's modes 1-4 (nearest, bilinear, mip-nearest,
 /// trilinear). The anisotropic filters (modes 5-8) and EWA have no rows here; their frame times
-/// come from `texel bench` (README.md's Benchmarks section) and their per-sample throughput from
+/// come from `texel bench` (docs/guide/measuring.md) and their per-sample throughput from
 /// `cargo bench -p texel-texture --bench aniso`.
 fn samplers() -> Vec<(&'static str, Sampler)> {
     vec![

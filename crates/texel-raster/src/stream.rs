@@ -10,7 +10,7 @@
 //! non-temporal stores ([`texel_texture::dispatch::stream_copy`]); a tile nothing reaches keeps
 //! the clear the frame already holds. `reset` writes such a frame with non-temporal stores too,
 //! so the draw does not first write back the clear's dirty lines. Images are bit for bit the
-//! same either way (`tests/streaming.rs`); only the memory traffic differs (docs/perf-log.md,
+//! same either way (`tests/streaming.rs`); only the memory traffic differs (docs/decisions.md,
 //! entries 37 and 47).
 
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -21,7 +21,7 @@ use std::sync::OnceLock;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Streaming {
     /// Stream frames larger than the last-level cache ([`last_level_cache_bytes`]): on the Zen 5
-    /// machine of docs/perf-log.md entry 47, frames of 16.6 MB (1920 x 1080) and 29.5 MB
+    /// machine of docs/decisions.md, frames of 16.6 MB (1920 x 1080) and 29.5 MB
     /// (2560 x 1440) drew no faster streamed against a 32 MiB cache, and 66 MB (3840 x 2160)
     /// drew 7-24 % faster.
     #[default]

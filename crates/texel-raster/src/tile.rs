@@ -49,11 +49,11 @@
 //! without mipmaps, `mag_filter == min_filter`), footprints are not captured and no material may
 //! need them, the span skips them and hands the sampler `u` and `v` alone
 //! (`FootprintLanes::points`: zero derivatives). The span's footprints reach the sampler as
-//! lanes, one slice per field, never as structs (perf-log 45). Frames are reusable
+//! lanes, one slice per field, never as structs (docs/decisions.md). Frames are reusable
 //! (`render_into`, `draw_into`).
 //!
-//! Frame times, the mesh's triangle rate and the profiles are in README.md's Benchmarks section;
-//! how each of these decisions moved them is in docs/perf-log.md.
+//! Frame times, the mesh's triangle rate and the profiles are in docs/guide/measuring.md;
+//! how each of these decisions moved them is in docs/decisions.md.
 
 use std::cell::Cell;
 
@@ -693,7 +693,7 @@ impl Span {
     /// Fragment `k`'s footprint (zero derivatives unless `deriv`): what
     /// `Span::footprints(..).get(k)` gives, read from the arrays directly. Through
     /// `FootprintLanes::get` (six bounds-checked slices and a match per fragment) the shaded
-    /// `builtin:knot` retired 1.4-1.7 % more instructions a frame (perf-log 45's review).
+    /// `builtin:knot` retired 1.4-1.7 % more instructions a frame (docs/decisions.md).
     #[inline(always)]
     fn footprint(&self, k: usize) -> Footprint {
         // Indexed lane by lane: `self.d.map(..)` would copy the four lanes (4 KB) per call.
@@ -822,7 +822,7 @@ impl Span {
     /// derivatives only with `deriv` (set where the sampler uses derivatives, footprints are
     /// captured or a material may need them); without it the span's footprints have zero
     /// derivatives and the lanes are not written. The lanes go to the sampler as they are: no
-    /// six-field structs interleaved here and copied back out in the sampler (perf-log 45).
+    /// six-field structs interleaved here and copied back out in the sampler (docs/decisions.md).
     #[inline(always)]
     fn plane_footprints(&mut self, p: &UvPlanes, origin: [u32; 2], deriv: bool) {
         let n = self.n;

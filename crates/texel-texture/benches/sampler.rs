@@ -14,8 +14,8 @@
 //! The `fixed8/*` group compares, on a unorm copy of the texture, the exact `f32` path
 //! (`sample_batch`) with the GPU-style fixed-point one (`sample_batch_fixed8`, unorm8 codes out).
 //! The batched rows (`sample_batch`, `sample_batch_fixed8`) run the best instruction-set copy
-//! the CPU has (`texel_texture::dispatch`, as in the rasterizer; before perf-log 42 they ran the
-//! crate's baseline SSE2 code); the `bound/decode-and-blend-only/bilinear` loop is baseline code.
+//! the CPU has (`texel_texture::dispatch`, as in the rasterizer); the
+//! `bound/decode-and-blend-only/bilinear` loop is baseline code.
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items
 

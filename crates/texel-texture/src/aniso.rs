@@ -31,7 +31,7 @@
 //!   at 0, as the sampler treats non-finite `uv`.
 //!
 //! Cost: `N` trilinear probes, so at most `8 N` texel reads. Throughput and texels read per sample
-//! at anisotropy ratios 1 to 64 are in README.md's Benchmarks section (`benches/aniso.rs`); quality
+//! at anisotropy ratios 1 to 64 are in docs/guide/measuring.md (`benches/aniso.rs`); quality
 //! against a brute-force Gaussian (RMS error 0.0158 for 16x vs 0.0252 for trilinear) is in
 //! [`crate::ewa`].
 //!
@@ -43,7 +43,7 @@
 //! (`plan_chunk`) before reading any probe, as it does the isotropic lods; that needs a `log2`
 //! without a call, so the probe lod uses [`crate::footprint::fast_log2`] (within 1.2 units in the
 //! last place) in both paths, which therefore agree bit for bit. How each of these steps moved
-//! the frame times: docs/perf-log.md.
+//! the frame times: docs/decisions.md.
 
 use glam::{Vec2, Vec4};
 

@@ -27,7 +27,7 @@
 //!
 //! Short calls (at most 16 footprints: a small triangle's fragments) run with 16-sample scratch:
 //! zeroing and filling 64-sample scratch (about 6 KB per call) costs more than sampling a small
-//! triangle's few pixels (figures in docs/perf-log.md).
+//! triangle's few pixels (figures in docs/decisions.md).
 
 use glam::{Vec2, Vec4};
 
@@ -134,7 +134,7 @@ impl<const N: usize> Chunk<N> {
 /// The footprints are first copied into the chunk's lanes (one array per field), and the lod
 /// arithmetic then runs over the lanes rounded up to a multiple of 16 (at most `N`; the entries beyond `n` are ones or stale and unread), so that it
 /// vectorises at the full width with no remainder loop: read from the 24-byte structs, the lod
-/// loop ran four lanes wide plus a scalar remainder (docs/perf-log.md, entry 30).
+/// loop ran four lanes wide plus a scalar remainder (docs/decisions.md).
 #[inline(always)]
 pub(crate) fn queries<S: Source, const N: usize>(
     s: &Sampler,
@@ -281,10 +281,10 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
     let mut plans = [crate::aniso::Plan::default(); CHUNK];
     // The probe scratch (about 13 KB) is reused from the thread's last call: made and zeroed per
     // call it was a quarter of the instructions of aniso16 on a mesh of small triangles, one call
-    // per triangle and tile (docs/perf-log.md, entries 40 and 41).
+    // per triangle and tile (docs/decisions.md).
     // Two batches, each for the probes of one pair of levels: neighbouring samples whose lods
     // straddle a level (a lod near an integer) alternate between two pairs, and one batch would
-    // mix them, which takes the per-probe level path (docs/perf-log.md, entry 46).
+    // mix them, which takes the per-probe level path (docs/decisions.md).
     let mut slots = [ProbeBatch::take(s.address()), ProbeBatch::take(s.address())];
     // Which slot's batch began first: the one flushed when neither holds a sample's pair.
     let mut older = 0usize;
@@ -350,7 +350,7 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
                 continue;
             }
             // The probes' positions and owners in one loop over lanes; the sample's levels,
-            // weight and coarse flag are recorded once, above, not per probe (perf-log 33).
+            // weight and coarse flag are recorded once, above, not per probe (docs/decisions.md).
             let invk = inv[k];
             let (us, vs) = (&mut p.at.u[m..m + n], &mut p.at.v[m..m + n]);
             let lanes = us.iter_mut().zip(vs).zip(&mut p.owner[m..m + n]);
@@ -526,7 +526,7 @@ impl ProbeBatch {
     /// tests. `false`, with nothing added, where a probe lies outside or the views have no run
     /// kernel; the caller then runs [`ProbeBatch::sum_into`] (taking runs of inside probes
     /// through the kernel and the rest through their routes measured slower: 645 -> 682 million
-    /// instructions an aniso16 ground frame, 3 ms a frame more, docs/perf-log.md entry 46).
+    /// instructions an aniso16 ground frame, 3 ms a frame more, docs/decisions.md).
     #[inline(always)]
     fn sum_runs<F: Fetch>(
         &mut self,
@@ -758,7 +758,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
     /// fractions are the one-sample filter's; an origin below -1 was clamped to -1 and leaves a
     /// negative fraction, one at or beyond `w` the index `w`. Decided per sample, from what
     /// [`Pass::coordinates`] stored: computed there for every sample, the wrapped taps cost more
-    /// than the edge route saved (docs/perf-log.md, entry 34).
+    /// than the edge route saved (docs/decisions.md).
     #[inline(always)]
     fn near(&self, (w, h): (u32, u32), k: usize) -> Option<([u32; 2], [u32; 2])> {
         let (i, j, w, h) = (self.i[k], self.j[k], w as i32, h as i32);
@@ -786,7 +786,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
     /// Stage 3's loops take this route alone when every sample of the chunk is inside
     /// ([`Pass::all_inside`]): that loop has no per-sample test and no edge-route code, and
     /// reloads fewer of its invariants from the stack per sample (four of the three-route loop's
-    /// six remain); about 51 instructions a sample against 57 (docs/perf-log.md, entry 38).
+    /// six remain); about 51 instructions a sample against 57 (docs/decisions.md).
     #[inline(always)]
     fn inside_value<F: Fetch>(&self, level: &F, k: usize) -> Vec4 {
         let ab = (self.a[k], self.b[k]);
@@ -831,7 +831,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
     /// for a power-of-two `w`, for negative `i` too). So the value is the one-sample filter's bit
     /// for bit, without its four divisions and border tests. Reached by samples more than a
     /// texel outside the level: anisotropic probes spread half a major axis beyond their sample,
-    /// over several periods of a repeating texture near the ground's horizon (docs/perf-log.md,
+    /// over several periods of a repeating texture near the ground's horizon (docs/decisions.md,
     /// entry 46).
     #[inline(always)]
     fn far_repeat(&self, (w, h): (u32, u32), uv: Vec2) -> Option<WrappedTaps> {
@@ -1023,7 +1023,7 @@ fn run_in<P: Pyramid, S: Source, T: Taps, const N: usize, const V: usize>(
         let l0 = first.level[0];
         // A fold, not `all`: branch-free, it compares the chunk's levels in vector lanes (the
         // early-exit `all` was a byte loop with a branch per sample; that branch alone held 2.5 %
-        // of a one-thread mip-nearest profile's samples, perf-log 36).
+        // of a one-thread mip-nearest profile's samples, docs/decisions.md).
         let one_level = first.level[..n]
             .iter()
             .fold(true, |one, &l| one & (l == l0));
@@ -1062,7 +1062,7 @@ fn run_in<P: Pyramid, S: Source, T: Taps, const N: usize, const V: usize>(
 /// The same values as [`filter_chunk`] with nothing weighed, without its per-sample blend test:
 /// with that test in the loop, LLVM stored each filtered value to the stack and reloaded it after
 /// the test, and 11-13 % of a one-thread mip-nearest profile's samples sat on that reload
-/// (perf-log 35 and 36). A chunk whose samples all lie inside their levels takes a loop of that
+/// (docs/decisions.md). A chunk whose samples all lie inside their levels takes a loop of that
 /// route alone ([`Pass::inside_value`]).
 #[inline(always)]
 fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
@@ -1085,7 +1085,7 @@ fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
 /// [`filter_unblended`] for a chunk whose samples all read the one view `level` (no mipmaps, or one
 /// mip level): where every sample lies inside it and the view has a run kernel
 /// ([`Taps::inside_run`]: linear 8-bit texels, sampled with an AVX2 `Lanes` token), the whole chunk
-/// in one loop that tests the token once; otherwise [`filter_unblended`] (docs/perf-log.md,
+/// in one loop that tests the token once; otherwise [`filter_unblended`] (docs/decisions.md,
 /// entries 40 and 43).
 #[inline(always)]
 fn filter_one_level<T: Taps, F: Fetch, const N: usize>(
@@ -1180,7 +1180,7 @@ fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
 
 /// The anisotropic probes' stage ([`crate::aniso`]): their coordinates, written by the caller, and
 /// two bilinear level passes. Made once per [`crate::Sampler::sample_batch`] call and reused by
-/// every sample (zeroing scratch per sample costs measurable frame time: docs/perf-log.md).
+/// every sample (zeroing scratch per sample costs measurable frame time: docs/decisions.md).
 /// Entries beyond a sample's probe count are stale and never read.
 pub(crate) struct Probes {
     /// The probes' coordinates (`lod` unused), written by the caller for the first `at.n`.

@@ -14,7 +14,7 @@
 //! whole batched sampler, each of its three copies was one function of about 2.2 MB of machine
 //! code (480 000 instructions, nine tenths of them the sampler's), and LLVM's time on a function
 //! grows faster than its size: texel-raster's one `rustc` took most of a 50-minute release build
-//! (docs/perf-log.md, entry 42). A dispatch per sampled span of the rasterizer (up to 256
+//! (docs/decisions.md). A dispatch per sampled span of the rasterizer (up to 256
 //! fragments; per 64-footprint chunk on the stored-codes paths) costs a few nanoseconds against
 //! microseconds of filtering.
 //!

@@ -68,19 +68,19 @@
 //! centres too). On the ground scene a sample has about 34 lines of 2.3 texels, the line-by-line
 //! set-up was half of EWA's instructions, and the block form made its frames 23-24 % faster
 //! (18-20 % in a first version, on the baseline copy as on v3 and v4: the gain is the branches
-//! removed, not vector lanes; docs/perf-log.md, entry 48). Along a line `r^2`
+//! removed, not vector lanes; docs/decisions.md). Along a line `r^2`
 //! ([`LevelEllipse::r2`]) is a quadratic in the offset, carried in `f64` by forward differences
 //! ([`Weights`]), and weights and texels are read in the same loop, so a line has a single loop
 //! exit. An ellipse whose box lies inside the level ([`LevelEllipse::inside`], one test a level)
 //! reads every line directly, with no per-line address decision (frames 3-7 % faster,
-//! docs/perf-log.md, entry 50); otherwise lines inside the level read texels without address
+//! docs/decisions.md); otherwise lines inside the level read texels without address
 //! wrapping, and lines crossing the edge of a power-of-two side under `Repeat` wrap each index by
-//! a mask (docs/perf-log.md, entry 46). Alternatives measured and not adopted (two accumulators,
+//! a mask (docs/decisions.md). Alternatives measured and not adopted (two accumulators,
 //! `r^2` evaluated directly per texel, one bounds check per run, weights in lanes across a block's
 //! lines, their table indices in such lanes, one bounds check per line, short lines' terms summed
 //! in one loop per block, a block's set-up over all 16 lanes, one loop over a block's lines with
 //! the line switch as a select, masks for every line under `Repeat` on power-of-two sides):
-//! docs/perf-log.md.
+//! docs/decisions.md.
 //!
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
@@ -91,8 +91,9 @@
 //! (figures of an earlier noise texture, where pbrt's falloff scored 0.0119).
 //! Keeping it would need a level one finer (4x the reads); pbrt's falloff stays.
 //!
-//! Cost: throughput and texels read per sample at anisotropy ratios 1 to 64 are in README.md's
-//! Benchmarks section (the anisotropic filters' table, from `benches/aniso.rs`); frame times too.
+//! Cost: throughput and texels read per sample at anisotropy ratios 1 to 64 are in
+//! docs/guide/measuring.md (the anisotropic filters' table, from `benches/aniso.rs`); frame
+//! times too.
 
 use std::sync::OnceLock;
 
@@ -279,7 +280,7 @@ impl LevelEllipse {
     /// The scan follows the ellipse's wider side: each line costs a square root, a floor and a ceil
     /// and the set-up of its differences, and a tall, thin ellipse (the ground plane's footprints
     /// near the horizon stretch along v) has many rows of one to four texels but few long
-    /// columns. Timings: docs/perf-log.md.
+    /// columns. Timings: docs/decisions.md.
     #[inline(always)]
     pub fn scan(&self, x: f32, y: f32, mut f: impl FnMut(&Line)) -> u32 {
         let lut = weight_lut();
@@ -449,7 +450,7 @@ impl LineSetup {
     /// `STAGED` without branches or integer conversions, which the compiler may also run in
     /// vector lanes (the line-by-line form spent about 100 instructions a line, about half of
     /// EWA's instructions on the ground scene, with two data-dependent branches in its floors:
-    /// docs/perf-log.md, entry 48). The arithmetic is the line-by-line form's, operation for
+    /// docs/decisions.md). The arithmetic is the line-by-line form's, operation for
     /// operation (Rust fuses no multiply-add), and the floors are exact ([`floor_staged_f64`]
     /// when `STAGED`, which the caller checks the range for), so the values are the same bit for
     /// bit.

@@ -43,7 +43,7 @@ pub(crate) trait Decode: Copy {
     /// level `texels`) into `out` (the run's length), in one call: `true`, or `false` with `out`
     /// untouched where the decoder has no run kernel (the default) and the caller's per-sample
     /// loop runs instead. A `bool`, not a fallback loop here: the caller's loop is the fallback,
-    /// not compiled twice (docs/perf-log.md, entry 40).
+    /// not compiled twice (docs/decisions.md).
     #[inline(always)]
     fn bilinear_run(
         &self,

@@ -27,7 +27,7 @@
 //! (Vulkan spec, "Texel Filtering"), so hardware decodes sRGB texels to more than 8 bits first,
 //! and texel keeps its `f32` path for them. Against the `f32` path a fixed-point sample differs
 //! by the weights' quantisation (at most `255 / 512` of a code per weight), plus the one
-//! rounding per stage; the images' differences are measured in README.md.
+//! rounding per stage; the images' differences are measured in docs/decisions.md.
 
 use glam::{Vec2, Vec4};
 

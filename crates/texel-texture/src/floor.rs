@@ -5,7 +5,7 @@
 //!
 //! Why not `f32::floor`: the x86-64 baseline (SSE2, no SSE4.1 `roundss`) has no rounding
 //! instruction, so `floor`/`ceil` are calls into libm, a measurable share of a frame
-//! (docs/perf-log.md). Each function here is exact on the domain it states, and each has a test
+//! (docs/decisions.md). Each function here is exact on the domain it states, and each has a test
 //! comparing it with `f32::floor`/`f64::floor` there.
 //!
 //! Two forms:
@@ -55,7 +55,7 @@ pub fn floor_nonneg_staged(x: f32, hi: f32) -> (i32, f32) {
 #[inline(always)]
 pub fn ceil_i32(x: f32) -> i32 {
     // Through `i32`: one `cvttss2si`; a conversion to `usize` needs a range fix-up for values
-    // above `i64::MAX`, about 20 instructions (docs/perf-log.md).
+    // above `i64::MAX`, about 20 instructions (docs/decisions.md).
     let t = x as i32;
     t + i32::from((t as f32) < x)
 }

@@ -5,7 +5,7 @@
 //! vectorise), and a rasterizer computes its footprints in lanes too. Handing structs across
 //! meant interleaving six fields into 24-byte structs on one side and copying them back out on
 //! the other: for a bilinear frame about a quarter of the instructions outside the filter itself
-//! (docs/perf-log.md, entry 45). A renderer that has lanes passes them as they are; the structs
+//! (docs/decisions.md). A renderer that has lanes passes them as they are; the structs
 //! remain for everyone else. Both give the same bits.
 //!
 //! Inside the crate each kind is a [`Source`]: the sampler's kernels are compiled once per kind,
@@ -123,7 +123,7 @@ pub(crate) mod sealed {
         /// are at least that long (the lanes panic otherwise; structs stop at the shorter).
         /// A plain copy: `batch::queries` makes them finite in a second loop, which retired
         /// fewer instructions than one loop doing both (the copy is a `memcpy`, the second loop
-        /// runs at full width with no remainder; perf-log 45).
+        /// runs at full width with no remainder; docs/decisions.md).
         fn uv_into(self, u: &mut [f32], v: &mut [f32]);
         /// The derivatives of every footprint into the first `len()` entries of each lane of
         /// `d` (`[dudx, dvdx, dudy, dvdy]`, the order of `batch::queries`' lanes), each at least

@@ -10,7 +10,7 @@
 //! each row to eight `f32` lanes (`vpmovzxbd`, `vcvtdq2ps`), decodes both rows in eight lanes,
 //! and blends the two rows' x-lerps in one eight-lane lerp: about 15 operations. Measured
 //! stand-alone (a trilinear kernel over cache-resident samples): 5.0 -> 3.9 ns a sample
-//! (docs/perf-log.md, entry 35).
+//! (docs/decisions.md).
 //!
 //! Same bits. Each lane computes the scalar kernel's operations in its order: the decode
 //! `b * hi + b * lo` ([`crate::fetch`]'s `unorm8_lanes`: two multiplies and an add, never fused),
@@ -102,7 +102,7 @@ impl Lanes {
     /// length): `true`, or `false` with `out` untouched when this is [`Lanes::scalar`]. The
     /// token is tested once for the run, and the loop runs the eight-lane kernel alone. It is
     /// inlined into the batched sampler's instruction-set copies ([`crate::dispatch`]), where
-    /// the kernel's intrinsics inline on x86-64-v3 and -v4 (perf-log 40 and 43).
+    /// the kernel's intrinsics inline on x86-64-v3 and -v4 (docs/decisions.md).
     #[inline(always)]
     pub(crate) fn bilinear_unorm8_run(
         self,
@@ -161,7 +161,7 @@ fn bilinear_unorm8_v3(
 
 /// A row of two linear 8-bit texels as eight decoded `f32` lanes, `b * hi + b * lo` per byte
 /// ([`crate::fetch`]'s `unorm8_lanes`). A function, not a closure: a closure stays an outlined
-/// function compiled for the baseline, where every intrinsic is a call (docs/perf-log.md, 35).
+/// function compiled for the baseline, where every intrinsic is a call (docs/decisions.md).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn row_v3(simd: pulp::x86::V3, r: [[u8; 4]; 2]) -> std::arch::x86_64::__m256 {

@@ -49,8 +49,8 @@
 //! What bounds the 8-bit path: over half of a trilinear frame is texel loads, the four table loads
 //! that decode each sRGB texel, and the `Vec4` blends. The sampler bench's `bound/*` group times
 //! those alone (every index and fraction precomputed) and on a float copy of the texture (no
-//! decode). The figures are in README.md's Benchmarks section; how each change moved them is in
-//! docs/perf-log.md; why AVX2 builds are not adopted is in ARCHITECTURE.md.
+//! decode). The figures are in docs/guide/measuring.md; the decisions they back, and why AVX2
+//! gathers are not used, are in docs/decisions.md.
 
 use glam::Vec4;
 

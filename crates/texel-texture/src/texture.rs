@@ -5,7 +5,7 @@
 //! buffer. The pyramid is built at creation (see [`crate::pyramid`]): level `k` is
 //! `max(1, W >> k) x max(1, H >> k)`, down to 1x1.
 //!
-//! Decision (recorded in ARCHITECTURE.md): levels below 0 are stored in the texture's own format, as a
+//! Decision (docs/decisions.md): levels below 0 are stored in the texture's own format, as a
 //! GPU stores them, so an 8-bit sRGB texture's pyramid costs 4/3 of level 0 and every level decodes
 //! through the same table. The reduction itself runs in linear `f32` from the previous *unquantised*
 //! level, so rounding does not accumulate down the chain.

@@ -284,7 +284,7 @@ proptest! {
     }
 }
 
-/// The anisotropic batch routes every sample through its probe batches (perf-log 46): a
+/// The anisotropic batch routes every sample through its probe batches (docs/decisions.md): a
 /// magnified sample as one bilinear probe in level 0, an isotropic one as one trilinear probe,
 /// an anisotropic one as its `N` probes, and a batch whose probes all lie inside both levels
 /// through the run kernels. Rows like the ground's (magnified near the viewer, ever more
@@ -348,7 +348,7 @@ fn anisotropic_batch_equals_single_across_its_kinds_of_sample() {
 /// Neighbouring anisotropic samples whose probes read different pairs of levels (lods just
 /// below and above an integer, a third pair, magnified and isotropic samples), in every order the
 /// cycle gives: the batch keeps a probe batch per pair of levels and flushes the older one when
-/// a third pair comes (perf-log 46); `sample_batch` equals `sample` bit for bit.
+/// a third pair comes (docs/decisions.md); `sample_batch` equals `sample` bit for bit.
 #[test]
 fn anisotropic_batch_equals_single_when_neighbours_alternate_levels() {
     let tex = noise_texture(128, 128, Format::Rgba8Unorm);
@@ -496,7 +496,7 @@ fn batch_equals_single_when_a_chunk_shares_a_level() {
 
 /// `sample_batch` and `sample_batch_lanes` (the eight-lane kernel where the CPU has it) equal
 /// `sample` bit for bit on chunks whose samples all lie inside one level (the batch's loop of
-/// the inside route alone, docs/perf-log.md entry 38; the other tests' positions reach the
+/// the inside route alone, docs/decisions.md; the other tests' positions reach the
 /// level's edges, so few of their chunks are wholly inside) for each kind of trilinear chunk:
 /// every blend weight positive (lod 1.5), none (lod 1.0 exactly, and -1: magnified), and some
 /// (lods 1.0 and 1.5 alternating: one level, weights 0 and 0.5), plus one chunk with a sample near

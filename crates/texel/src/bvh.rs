@@ -15,7 +15,7 @@
 //! - **Query**: [`Bvh::occluded`] stops at the first hit in `(0, t_max)`, visiting the nearer child
 //!   first.
 //!
-//! Measured against the `bvh` crate: README ("Baked ambient occlusion") and `ARCHITECTURE.md`
+//! Measured against the `bvh` crate: docs/guide/environment.md and docs/decisions.md
 //! ("Decisions (ambient occlusion bake)").
 
 use glam::Vec3;
