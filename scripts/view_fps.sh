@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Frames per second of `texel view` per mode, in an X server (Xvfb) on this machine: prints the
 # Markdown table of docs/guide/viewer.md. Each mode runs FRAMES frames at SIZE on THREADS threads
-# without the HUD; "render ms" is the median time the render thread took per frame, "fps" the frames shown per
-# second of wall time (rendering, encoding for display and presenting through X).
+# without the HUD; "render ms" is the median time the render thread took per frame, "fps" the
+# frames shown per second of wall time (rendering, encoding for display and presenting through X).
 #
 # Usage: scripts/view_fps.sh [EXE] (default target/release/texel; FRAMES=60 SIZE=1280x720 THREADS=2)
 set -euo pipefail

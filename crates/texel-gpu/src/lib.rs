@@ -685,8 +685,8 @@ impl GpuDraws<'_> {
     /// written at its beginning and end (`None` where the device has no timestamp queries).
     ///
     /// The device idles while the frame is read back, and may lower its clock meanwhile (an
-    /// H200's SM clock moved between 345 and 1980 MHz during such runs: README.md), so this time
-    /// is one frame's as an application that waits for each frame sees it;
+    /// H200's SM clock moved between 345 and 1980 MHz during such runs: docs/guide/gpu.md), so
+    /// this time is one frame's as an application that waits for each frame sees it;
     /// [`GpuDraws::pass_times`] measures passes back to back.
     ///
     /// # Errors
