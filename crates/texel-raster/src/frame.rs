@@ -176,7 +176,7 @@ impl Frame {
         self.cleared.0.filter(|_| self.draw_streams())
     }
 
-    /// Whether a draw into this frame now writes its tiles from per-thread scratch with
+    /// Whether the next draw into this frame writes its tiles from per-thread scratch with
     /// non-temporal stores ([`crate::Streaming`]): the frame holds its clear, has no side
     /// channels (texel counts, footprints), and streaming applies to its size.
     pub fn draw_streams(&self) -> bool {

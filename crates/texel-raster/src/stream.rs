@@ -20,10 +20,8 @@ use std::sync::OnceLock;
 /// its clear use non-temporal stores. Process-wide ([`set_streaming`]); images do not depend on it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Streaming {
-    /// Stream frames larger than the last-level cache ([`last_level_cache_bytes`]): on the Zen 5
-    /// machine of docs/decisions.md, frames of 16.6 MB (1920 x 1080) and 29.5 MB
-    /// (2560 x 1440) drew no faster streamed against a 32 MiB cache, and 66 MB (3840 x 2160)
-    /// drew 7-24 % faster.
+    /// Stream frames larger than the last-level cache ([`last_level_cache_bytes`]): frames that
+    /// fit in the cache draw no faster streamed, larger ones do (figures in docs/decisions.md).
     #[default]
     Auto,
     /// Stream every frame (for measuring: a frame that fits the cache draws slower this way).

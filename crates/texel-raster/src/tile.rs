@@ -7,8 +7,7 @@
 //!   ([`crate::Streaming`]): its tiles are drawn in per-thread scratch and copied into their row
 //!   slices with non-temporal stores (`texel_texture::dispatch::stream_copy`). The split is made
 //!   per band of `TILE` rows by the thread that renders the band's tiles: made serially up front,
-//!   the row lists of a 4K frame (2 040 tiles) held its two-thread nearest frame at 11.2 ms
-//!   against 8.5.
+//!   the row lists of a 4K frame (2 040 tiles) would hold back its frames (docs/decisions.md).
 //! - Each tile processes its triangles in submission order (draw, then triangle, then sub-triangle)
 //!   and every per-pixel computation depends only on the pixel, the triangle and the tile (the
 //!   `UvPlanes` anchor), never on the thread or the order tiles run in, so the image is bit for bit
@@ -321,7 +320,7 @@ impl<'f> Band<'f> {
     /// The band's tiles, left to right, for a `width x height` frame with colour target
     /// `target`: each buffer split into per-tile row lists ([`split_rows`]) by the thread that
     /// renders the band (built serially up front for the whole frame, the lists of a 4K frame's
-    /// 2 040 tiles held its two-thread nearest frame at 11.2 ms against 8.5).
+    /// 2 040 tiles would slow its frames, docs/decisions.md).
     fn tiles(self, (width, height): (u32, u32), target: ColorTarget) -> Vec<TileTarget<'f>> {
         let rows = TILE.min(height - self.y0);
         let mut color = split_rows(self.color, width, rows).into_iter();
@@ -693,7 +692,7 @@ impl Span {
     /// Fragment `k`'s footprint (zero derivatives unless `deriv`): what
     /// `Span::footprints(..).get(k)` gives, read from the arrays directly. Through
     /// `FootprintLanes::get` (six bounds-checked slices and a match per fragment) the shaded
-    /// `builtin:knot` retired 1.4-1.7 % more instructions a frame (docs/decisions.md).
+    /// `builtin:knot` retires more instructions a frame (docs/decisions.md).
     #[inline(always)]
     fn footprint(&self, k: usize) -> Footprint {
         // Indexed lane by lane: `self.d.map(..)` would copy the four lanes (4 KB) per call.
@@ -1061,8 +1060,8 @@ fn decode_unorm8(b: [u8; 4]) -> [f32; 4] {
 }
 
 /// How [`write_rows`] turns a value into what the target stores: a trait with always-inlined
-/// methods rather than a closure, which the compiler kept out of line (in the baseline copy, not
-/// the tile's x86-64-v3 one: 15 % of an sRGB trilinear frame's samples).
+/// methods rather than a closure, which the compiler keeps out of line (in the baseline copy, not
+/// the tile's x86-64-v3 one; docs/decisions.md).
 trait Encode<V, C>: Copy {
     fn encode(self, v: &V) -> C;
     /// `out[k] = encode(values[k])` for a run of one row (same lengths).
@@ -1095,8 +1094,7 @@ impl Encode<[f32; 4], [u8; 4]> for Unorm8 {
         rgba_to_unorm8(*v)
     }
     /// The run's channels in one loop that vectorises across pixels ([`rgba_to_unorm8_slice`],
-    /// the same bytes): colour by colour, the resolve was 17 % of a one-thread raw mip-nearest
-    /// frame.
+    /// the same bytes) rather than colour by colour, four lanes at a time (docs/decisions.md).
     #[inline(always)]
     fn encode_run(self, values: &[[f32; 4]], out: &mut [[u8; 4]]) {
         rgba_to_unorm8_slice(values, out);

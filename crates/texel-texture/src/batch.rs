@@ -150,8 +150,8 @@ pub(crate) fn queries<S: Source, const N: usize>(
     let [dudx, dvdx, dudy, dvdy] = &mut out.d;
     fps.uv_into(&mut out.u[..n], &mut out.v[..n]);
     if deriv {
-        // Lod-free samplers skip this (bilinear frames measured 4-6 % slower copying the
-        // derivatives too).
+        // Lod-free samplers skip this: they read no derivatives, and copying them anyway costs
+        // bilinear frames time (docs/decisions.md).
         fps.derivatives_into([
             &mut dudx[..n],
             &mut dvdx[..n],
@@ -279,9 +279,9 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
     };
     let mut chunk = Chunk::<CHUNK>::new();
     let mut plans = [crate::aniso::Plan::default(); CHUNK];
-    // The probe scratch (about 13 KB) is reused from the thread's last call: made and zeroed per
-    // call it was a quarter of the instructions of aniso16 on a mesh of small triangles, one call
-    // per triangle and tile (docs/decisions.md).
+    // The probe scratch (about 13 KB) is reused from the thread's last call rather than made and
+    // zeroed per call: a mesh of small triangles makes one call per triangle and tile, where that
+    // set-up would be a large share of aniso16's work (docs/decisions.md).
     // Two batches, each for the probes of one pair of levels: neighbouring samples whose lods
     // straddle a level (a lod near an integer) alternate between two pairs, and one batch would
     // mix them, which takes the per-probe level path (docs/decisions.md).
@@ -354,7 +354,8 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
             let invk = inv[k];
             let (us, vs) = (&mut p.at.u[m..m + n], &mut p.at.v[m..m + n]);
             let lanes = us.iter_mut().zip(vs).zip(&mut p.owner[m..m + n]);
-            // `i` counts in `i32` (exact, as `usize` was) so that the conversion vectorises.
+            // `i` counts in `i32` rather than `usize` (exact either way) so that the conversion
+            // vectorises.
             for (i, ((pu, pv), o)) in (0..n as i32).zip(lanes) {
                 let t = (i as f32 + 0.5) * invk - 0.5;
                 *pu = finite(q.fp.u + t * plan.axis.x);
@@ -525,8 +526,7 @@ impl ProbeBatch {
     /// are the inside route's, [`lerp`] the same blend), without its per-probe route and blend
     /// tests. `false`, with nothing added, where a probe lies outside or the views have no run
     /// kernel; the caller then runs [`ProbeBatch::sum_into`] (taking runs of inside probes
-    /// through the kernel and the rest through their routes measured slower: 645 -> 682 million
-    /// instructions an aniso16 ground frame, 3 ms a frame more, docs/decisions.md).
+    /// through the kernel and the rest through their routes is slower, docs/decisions.md).
     #[inline(always)]
     fn sum_runs<F: Fetch>(
         &mut self,
@@ -754,8 +754,8 @@ impl<const N: usize, T: Taps> Pass<N, T> {
     /// The wrapped taps `([i, i + 1], [j, j + 1])` of sample `k` (not inside) of a level
     /// `w` x `h` texels, when its origin lies within one texel of the level, `-1 <= x < w` and
     /// `-1 <= y < h`, and the address modes map such taps to texels (all but `ClampToBorder`);
-    /// else `None`. There [`floor_clamped`]'s clamp was the identity, so `i` is `floor(x)` and the
-    /// fractions are the one-sample filter's; an origin below -1 was clamped to -1 and leaves a
+    /// else `None`. There [`floor_clamped`]'s clamp is the identity, so `i` is `floor(x)` and the
+    /// fractions are the one-sample filter's; an origin below -1 is clamped to -1 and leaves a
     /// negative fraction, one at or beyond `w` the index `w`. Decided per sample, from what
     /// [`Pass::coordinates`] stored: computed there for every sample, the wrapped taps cost more
     /// than the edge route saved (docs/decisions.md).
@@ -786,7 +786,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
     /// Stage 3's loops take this route alone when every sample of the chunk is inside
     /// ([`Pass::all_inside`]): that loop has no per-sample test and no edge-route code, and
     /// reloads fewer of its invariants from the stack per sample (four of the three-route loop's
-    /// six remain); about 51 instructions a sample against 57 (docs/decisions.md).
+    /// six remain), so fewer instructions a sample (docs/decisions.md).
     #[inline(always)]
     fn inside_value<F: Fetch>(&self, level: &F, k: usize) -> Vec4 {
         let ab = (self.a[k], self.b[k]);
@@ -990,8 +990,8 @@ fn run_in<P: Pyramid, S: Source, T: Taps, const N: usize, const V: usize>(
         queries(s, size0, fps, &mut chunk);
         if d.mipmap_filter == MipmapFilterMode::None {
             // Every sample in level 0: stages 2 and 3 with its view and size, no per-sample
-            // level lookups. The one-level chunk below would give the same values, but through
-            // it (stage 1's fill, the level scan) bilinear frames measured 5-7 % slower.
+            // level lookups. The one-level chunk below would give the same values, but its
+            // stage 1 fill and level scan cost bilinear frames time (docs/decisions.md).
             let size = (dims_w[0], dims_h[0]);
             first.coordinates(|_| size, &chunk.u[..n], &chunk.v[..n]);
             filter_one_level(&first, &chunk, base, out);
@@ -1021,9 +1021,8 @@ fn run_in<P: Pyramid, S: Source, T: Taps, const N: usize, const V: usize>(
             (dims_w[l], dims_h[l])
         };
         let l0 = first.level[0];
-        // A fold, not `all`: branch-free, it compares the chunk's levels in vector lanes (the
-        // early-exit `all` was a byte loop with a branch per sample; that branch alone held 2.5 %
-        // of a one-thread mip-nearest profile's samples, docs/decisions.md).
+        // A fold, not `all`: branch-free, it compares the chunk's levels in vector lanes (an
+        // early-exit `all` is a byte loop with a branch per sample, docs/decisions.md).
         let one_level = first.level[..n]
             .iter()
             .fold(true, |one, &l| one & (l == l0));
@@ -1060,9 +1059,9 @@ fn run_in<P: Pyramid, S: Source, T: Taps, const N: usize, const V: usize>(
 /// Stage 3 of [`run_in`] where no sample blends two levels (no mipmaps, nearest mip level, or a
 /// trilinear chunk wholly in the last level): each sample's value filtered in `level(k)`'s view.
 /// The same values as [`filter_chunk`] with nothing weighed, without its per-sample blend test:
-/// with that test in the loop, LLVM stored each filtered value to the stack and reloaded it after
-/// the test, and 11-13 % of a one-thread mip-nearest profile's samples sat on that reload
-/// (docs/decisions.md). A chunk whose samples all lie inside their levels takes a loop of that
+/// with that test in the loop, LLVM stores each filtered value to the stack and reloads it after
+/// the test, and a mip-nearest profile's samples sit on that reload (docs/decisions.md). A chunk
+/// whose samples all lie inside their levels takes a loop of that
 /// route alone ([`Pass::inside_value`]).
 #[inline(always)]
 fn filter_unblended<T: Taps, F: Fetch, const N: usize>(

@@ -10,11 +10,11 @@
 //! texel-raster's tile rasterizer (coverage, interpolation, shading, encoding).
 //!
 //! Each copy is its own function (`#[inline(never)]`): a kernel that runs another kernel calls
-//! that kernel's copy for the level, never inlines it. Why: when the tile rasterizer inlined the
-//! whole batched sampler, each of its three copies was one function of about 2.2 MB of machine
-//! code (480 000 instructions, nine tenths of them the sampler's), and LLVM's time on a function
-//! grows faster than its size: texel-raster's one `rustc` took most of a 50-minute release build
-//! (docs/decisions.md). A dispatch per sampled span of the rasterizer (up to 256
+//! that kernel's copy for the level, never inlines it. Why: the whole batched sampler inlined
+//! into the tile rasterizer makes each of its three copies one very large function, nine tenths
+//! of it the sampler's, and LLVM's time on a function grows faster than its size, so the release
+//! build's time goes to texel-raster's one `rustc` (sizes and build times in docs/decisions.md).
+//! A dispatch per sampled span of the rasterizer (up to 256
 //! fragments; per 64-footprint chunk on the stored-codes paths) costs a few nanoseconds against
 //! microseconds of filtering.
 //!
@@ -23,8 +23,8 @@
 //! approximate instruction (AVX-512's `vrcp14`, `vrsqrt14`, `vgetexp` are not used for `/`,
 //! `sqrt` or `log2`), so the wider instructions compute the same IEEE operations
 //! (texel-raster's `tests/targets.rs` renders every view on every copy the CPU has;
-//! `scripts/same_images.sh` compared 134 images of the v4 copy with the v3 copy, and earlier of a
-//! whole-program x86-64-v3 build with the baseline build, all identical).
+//! `scripts/same_images.sh` compares the 134 images of the v4 copy with the v3 copy's, and of a
+//! whole-program x86-64-v3 build with the baseline build's: all identical).
 //!
 //! The copies differ in one more way: `v3` and `v4` hand the kernel [`Lanes::detect`], the
 //! sampler's eight-lane AVX2 quad kernel (safe intrinsics through `pulp`'s run-time token, bit for
@@ -121,7 +121,7 @@ fn detect() -> SimdLevel {
     SimdLevel::Baseline
 }
 
-/// The level [`run`] picks now: the best the CPU has (detected once), or the limit set by
+/// The level [`run`] picks: the best the CPU has (detected once), or the limit set by
 /// [`limit_level`] when that is lower.
 pub fn level() -> SimdLevel {
     let limit = LIMIT.load(Ordering::Relaxed) as usize;
@@ -148,7 +148,7 @@ pub trait Kernel {
     fn run(self, lanes: Lanes) -> Self::Output;
 }
 
-/// The sampler's quad kernel for the copy [`run`] picks now: [`Lanes::detect`] on x86-64-v3 and
+/// The sampler's quad kernel for the copy [`run`] picks: [`Lanes::detect`] on x86-64-v3 and
 /// above, [`Lanes::scalar`] on the baseline copy.
 pub fn lanes() -> Lanes {
     if level() >= SimdLevel::X86_64V3 {

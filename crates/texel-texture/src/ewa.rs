@@ -65,15 +65,15 @@
 //! (`LineSetup::block`), without branches or integer conversions where the staged floor is exact
 //! for every span end (checked per scan; elsewhere with the conversion floor); the values are the
 //! line-by-line form's bit for bit (tested against it, verbatim, for degenerate ellipses and
-//! centres too). On the ground scene a sample has about 34 lines of 2.3 texels, the line-by-line
-//! set-up was half of EWA's instructions, and the block form made its frames 23-24 % faster
-//! (18-20 % in a first version, on the baseline copy as on v3 and v4: the gain is the branches
-//! removed, not vector lanes; docs/decisions.md). Along a line `r^2`
+//! centres too). On the ground scene a sample has about 34 lines of 2.3 texels, so line set-ups
+//! are a large share of EWA's work; the blocks save their branches and mispredictions (the gain
+//! is the same on the baseline copy as on v3 and v4, so it is not vector lanes;
+//! docs/decisions.md). Along a line `r^2`
 //! ([`LevelEllipse::r2`]) is a quadratic in the offset, carried in `f64` by forward differences
 //! ([`Weights`]), and weights and texels are read in the same loop, so a line has a single loop
 //! exit. An ellipse whose box lies inside the level ([`LevelEllipse::inside`], one test a level)
-//! reads every line directly, with no per-line address decision (frames 3-7 % faster,
-//! docs/decisions.md); otherwise lines inside the level read texels without address
+//! reads every line directly, with no per-line address decision (docs/decisions.md);
+//! otherwise lines inside the level read texels without address
 //! wrapping, and lines crossing the edge of a power-of-two side under `Repeat` wrap each index by
 //! a mask (docs/decisions.md). Alternatives measured and not adopted (two accumulators,
 //! `r^2` evaluated directly per texel, one bounds check per run, weights in lanes across a block's
@@ -85,10 +85,10 @@
 //! Rejected: a narrower Gaussian. Against the box-filtered reference of `texel compare`, pbrt's
 //! falloff (`ALPHA = 2`, standard deviation half a pixel) is wider than the pixel, so EWA scores below
 //! anisotropic 16x there (ground scene, 640x360, 256 spp: EWA 23.5 dB, aniso16 29.8 dB). Matching the
-//! box's variance (`ALPHA = 6`, sigma^2 = 1/12 pixel^2) raised EWA to 27.5 dB but left only about one
-//! texel per standard deviation at the chosen level: rotation invariance fell to 1.5 % RMS (worst 7 %)
-//! and the RMS error against its own brute-force Gaussian rose from 0.0119 to 0.0196, behind aniso16
-//! (figures of an earlier noise texture, where pbrt's falloff scored 0.0119).
+//! box's variance (`ALPHA = 6`, sigma^2 = 1/12 pixel^2) scores EWA 27.5 dB but leaves only about
+//! one texel per standard deviation at the chosen level: rotation invariance drops to 1.5 % RMS
+//! (worst 7 %) and the RMS error against its own brute-force Gaussian is 0.0196 against pbrt's
+//! falloff's 0.0119, behind aniso16 (both on another noise texture than the table's above).
 //! Keeping it would need a level one finer (4x the reads); pbrt's falloff stays.
 //!
 //! Cost: throughput and texels read per sample at anisotropy ratios 1 to 64 are in
@@ -323,7 +323,7 @@ impl LevelEllipse {
             cc,
         };
         // The staged floor is exact below 2^51, and the span ends stay far below that when
-        // (checked here, so any other input takes the conversion floor and the old values):
+        // (checked here, so any other input takes the conversion floor):
         // - the centre is within 2^40 of the origin, so `fa`, `fb` are its fractions in [0, 1)
         //   and the line offsets `db` lie within `sqrt(qbb)` (plus rounding) of 0;
         // - `Q` is consistent and positive definite as `in_level` makes it
@@ -448,8 +448,8 @@ impl LineSetup {
     /// Lines `first .. first + n` (`n <= LINE_BLOCK`): each line's span where `r^2 < 1` (the
     /// quadratic's roots), its first texel's `r^2` and forward difference, in one loop; with
     /// `STAGED` without branches or integer conversions, which the compiler may also run in
-    /// vector lanes (the line-by-line form spent about 100 instructions a line, about half of
-    /// EWA's instructions on the ground scene, with two data-dependent branches in its floors:
+    /// vector lanes (the line-by-line form has two data-dependent branches in its floors, and
+    /// its set-ups are a large share of EWA's instructions on the ground scene:
     /// docs/decisions.md). The arithmetic is the line-by-line form's, operation for
     /// operation (Rust fuses no multiply-add), and the floors are exact ([`floor_staged_f64`]
     /// when `STAGED`, which the caller checks the range for), so the values are the same bit for
@@ -857,9 +857,9 @@ mod tests {
         assert!(weighed > 5_000, "{weighed}");
     }
 
-    /// The line-by-line scan as it was before the set-ups moved into blocks (359a835, verbatim
-    /// but for its name and `self` passed as `q`): the reference [`LevelEllipse::scan`] must
-    /// equal bit for bit.
+    /// The scan with each line set up on its own, one line at a time (the form without
+    /// `LineSetup::block`, verbatim but for its name and `self` passed as `q`): the reference
+    /// [`LevelEllipse::scan`] must equal bit for bit.
     fn line_by_line_scan(q: &LevelEllipse, x: f32, y: f32, mut f: impl FnMut(&Line)) -> u32 {
         let lut = weight_lut();
         let (wide, det) = (q.q00 >= q.q11, q.det);
@@ -936,7 +936,8 @@ mod tests {
     /// [`LevelEllipse::scan`] hands out the same lines (indices, direction, texel count, every
     /// weight's bits) and returns the same visit count as the line-by-line scan, for
     /// `in_level`'s ellipses (shrunk or not) at centres near and far (beyond 2^40, where the
-    /// staged floor is not used, and up to 1e30, where the old floors saturate), for infinite and
+    /// staged floor is not used, and up to 1e30, where the conversion floors saturate), for
+    /// infinite and
     /// NaN centres, and for hand-built ellipses the staged floor must refuse: `det` inconsistent
     /// with the entries, `qbb` tiny, `qaa` beyond 2^80, huge off-diagonals.
     #[test]

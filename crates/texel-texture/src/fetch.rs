@@ -90,8 +90,8 @@ impl Decode for Table8 {
 /// Linear 8-bit (`Rgba8Unorm`) texels, `b / 255` per channel, by arithmetic in lanes (single
 /// texels four channels wide, bilinear quads sixteen: [`unorm8_lanes`]), bit for bit the table
 /// [`unorm8_table`]. A decoder of its own, not a flag on [`Table8`]: a branch in the shared
-/// kernel measured 10 % slower sRGB trilinear frames. Single texels by arithmetic rather than
-/// four table loads: one-thread raw mip-nearest frames 5.87 -> 5.67 ms, trilinear 8.46 -> 8.09.
+/// kernel slows sRGB trilinear frames. Single texels by arithmetic rather than four table
+/// loads, which is faster on mip-nearest and trilinear frames (figures in docs/decisions.md).
 /// Bilinear quads blend in eight lanes where `lanes` has them ([`crate::lanes`]).
 #[derive(Clone, Copy, Default)]
 pub(crate) struct Unorm8 {

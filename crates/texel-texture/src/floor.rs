@@ -14,7 +14,8 @@
 //!   [`floor_index`] (texel indices), [`ceil_i32`] (level and probe counts), [`floor_f64`] /
 //!   [`ceil_f64`] (EWA's spans).
 //! - **staged** (loops over many samples that must vectorise): no float-to-integer conversion,
-//!   whose saturating semantics cost about 20 instructions per value on SSE2; instead the value is
+//!   whose saturating semantics need a range fix-up per value on SSE2 (docs/decisions.md);
+//!   instead the value is
 //!   rounded by adding and subtracting `1.5 * 2^(mantissa bits)`, and one is taken off where that
 //!   rounded up. Exact below `2^22` (`f32`) or `2^51` (`f64`), which callers guarantee by clamping.
 //!   [`floor_clamped`] (the batched sampler's texel indices and levels; the stored codes as
@@ -55,7 +56,7 @@ pub fn floor_nonneg_staged(x: f32, hi: f32) -> (i32, f32) {
 #[inline(always)]
 pub fn ceil_i32(x: f32) -> i32 {
     // Through `i32`: one `cvttss2si`; a conversion to `usize` needs a range fix-up for values
-    // above `i64::MAX`, about 20 instructions (docs/decisions.md).
+    // above `i64::MAX`, many instructions (docs/decisions.md).
     let t = x as i32;
     t + i32::from((t as f32) < x)
 }

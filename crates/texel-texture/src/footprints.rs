@@ -3,8 +3,8 @@
 //!
 //! Why lanes. The batched sampler works on lanes (one array per field, so that its stages
 //! vectorise), and a rasterizer computes its footprints in lanes too. Handing structs across
-//! meant interleaving six fields into 24-byte structs on one side and copying them back out on
-//! the other: for a bilinear frame about a quarter of the instructions outside the filter itself
+//! means interleaving six fields into 24-byte structs on one side and copying them back out on
+//! the other, a large share of a bilinear frame's instructions outside the filter itself
 //! (docs/decisions.md). A renderer that has lanes passes them as they are; the structs
 //! remain for everyone else. Both give the same bits.
 //!
@@ -121,7 +121,7 @@ pub(crate) mod sealed {
         fn range(self, start: usize, end: usize) -> Self;
         /// `u` and `v` of every footprint into the first `len()` entries of `u` and `v`, which
         /// are at least that long (the lanes panic otherwise; structs stop at the shorter).
-        /// A plain copy: `batch::queries` makes them finite in a second loop, which retired
+        /// A plain copy: `batch::queries` makes them finite in a second loop, which retires
         /// fewer instructions than one loop doing both (the copy is a `memcpy`, the second loop
         /// runs at full width with no remainder; docs/decisions.md).
         fn uv_into(self, u: &mut [f32], v: &mut [f32]);

@@ -8,9 +8,8 @@
 //! conversion and the decode's two multiplies and add, then `3 x 3` four-lane operations, about 35
 //! vector operations a quad. The explicit kernel reads the quad as its two rows of 8 bytes, widens
 //! each row to eight `f32` lanes (`vpmovzxbd`, `vcvtdq2ps`), decodes both rows in eight lanes,
-//! and blends the two rows' x-lerps in one eight-lane lerp: about 15 operations. Measured
-//! stand-alone (a trilinear kernel over cache-resident samples): 5.0 -> 3.9 ns a sample
-//! (docs/decisions.md).
+//! and blends the two rows' x-lerps in one eight-lane lerp: about 15 operations, and faster
+//! stand-alone (a trilinear kernel over cache-resident samples; docs/decisions.md).
 //!
 //! Same bits. Each lane computes the scalar kernel's operations in its order: the decode
 //! `b * hi + b * lo` ([`crate::fetch`]'s `unorm8_lanes`: two multiplies and an add, never fused),
