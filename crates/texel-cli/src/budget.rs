@@ -36,19 +36,17 @@ impl std::str::FromStr for ByteSize {
     }
 }
 
-/// The account for `--max-memory` if given, else for half of the machine's memory; errors name
-/// the flag.
+/// The account for `--max-memory` if given, else for the process's default
+/// ([`texel::memory::default_limit`]: the smallest of half the machine's memory, the cgroup's
+/// limit and what `ulimit -v`/`-d` leave); errors name the flag.
 pub fn budget(max_memory: Option<ByteSize>) -> MemoryBudget {
     match max_memory {
         Some(ByteSize(b)) => MemoryBudget::new(b, format!("--max-memory {}", mib(b))),
         None => {
-            let limit = MemoryBudget::half_of_machine().limit();
+            let (limit, why) = texel::memory::default_limit();
             MemoryBudget::new(
                 limit,
-                format!(
-                    "--max-memory's default {} (half of this machine's memory)",
-                    mib(limit)
-                ),
+                format!("--max-memory's default {} ({why})", mib(limit)),
             )
         }
     }
@@ -76,8 +74,6 @@ mod tests {
         b.take("a", 6 << 20).unwrap();
         let e = b.take("the frame", 5 << 20).unwrap_err().to_string();
         assert!(e.contains("over --max-memory 10.0 MiB"), "{e}");
-        assert!(budget(None)
-            .name()
-            .contains("half of this machine's memory"));
+        assert!(budget(None).name().starts_with("--max-memory's default"));
     }
 }

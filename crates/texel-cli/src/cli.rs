@@ -356,7 +356,7 @@ pub struct RenderArgs {
     pub adapter: Option<String>,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
-    #[arg(short, long)]
+    #[arg(short, long, value_parser = crate::output::image_output)]
     pub output: PathBuf,
 }
 
@@ -385,7 +385,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub frames: Option<u32>,
     /// Write the last frame shown (overlays included unless --no-hud) to this PNG at exit.
-    #[arg(long, value_name = "PATH")]
+    #[arg(long, value_name = "PATH", value_parser = crate::output::png_output)]
     pub screenshot: Option<PathBuf>,
     /// Hide the heads-up display and the split-screen divider line, so the window (and a
     /// screenshot) shows exactly the rendered frame; H still shows the key table.
@@ -404,7 +404,7 @@ pub struct ReferenceArgs {
     pub spp: u32,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
-    #[arg(short, long)]
+    #[arg(short, long, value_parser = crate::output::image_output)]
     pub output: PathBuf,
 }
 
@@ -695,7 +695,7 @@ pub struct WarpArgs {
     pub color: ColorArg,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
-    #[arg(short, long)]
+    #[arg(short, long, value_parser = crate::output::image_output)]
     pub output: PathBuf,
 }
 
@@ -739,8 +739,9 @@ pub struct BakeAoArgs {
     /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
-    /// Output PNG: 8-bit grey, linear (1 = unoccluded; read it with color = "linear").
-    #[arg(short, long)]
+    /// Output image: PNG, 8-bit grey, linear (1 = unoccluded; read it with color = "linear"), or
+    /// for a name ending in `.exr`, OpenEXR with the occlusion as 32-bit floats.
+    #[arg(short, long, value_parser = crate::output::image_output)]
     pub output: PathBuf,
 }
 

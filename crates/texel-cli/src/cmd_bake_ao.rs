@@ -1,5 +1,5 @@
 //! `texel bake-ao`: a mesh's ambient occlusion baked into its uv layout ([`texel::ao`]), written
-//! as an 8-bit linear grey PNG.
+//! as an 8-bit linear grey PNG, or as 32-bit floats in OpenEXR for an `.exr` name.
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -10,9 +10,9 @@ use texel::ao::{bake_ao, protected_levels, AoMap, AoMesh, AoSettings};
 use texel::quality::{Encoding, Image8};
 use texel_scene::{load_gltf_with, load_obj_with, Mesh, Scene};
 
-use crate::cli::BakeAoArgs;
+use crate::cli::{BakeAoArgs, ColorArg};
 use crate::input::{scene_limits, Input};
-use crate::output::write_image;
+use crate::output::{is_exr, write_image, write_linear};
 use crate::progress;
 use crate::threads::{thread_count, with_threads};
 
@@ -43,7 +43,12 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
     .with_context(|| format!("cannot bake {}", args.mesh))?;
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
-    write_image(&args.output, &map_image(&map)?)?;
+    if is_exr(&args.output) {
+        let pixels: Vec<[f32; 4]> = map.values.iter().map(|&v| [v, v, v, 1.0]).collect();
+        write_linear(&args.output, map.size, map.size, &pixels, ColorArg::Raw)?;
+    } else {
+        write_image(&args.output, &map_image(&map)?)?;
+    }
     let texels = u64::from(map.size) * u64::from(map.size);
     let margin = match args.margin {
         None => "the whole map (every mip level protected)".to_string(),

@@ -133,6 +133,7 @@ fn time_gpu(
     gpu: &texel_gpu::Gpu,
     scene: &texel::PreparedScene,
     jobs: &[GpuJob],
+    budget: &mut texel::MemoryBudget,
 ) -> Result<Vec<Timing>> {
     let mut out = Vec::new();
     for &(label, filter, gpu_filter) in jobs {
@@ -143,6 +144,13 @@ fn time_gpu(
         if args.target == TargetArg::Float {
             settings.target = texel::ColorTarget::Float;
         }
+        // Held while this job runs, freed with its uploads before the next.
+        let held = texel_gpu::prepare_bytes(&draws)
+            + texel_gpu::frame_bytes(settings.width, settings.height);
+        budget.take(
+            "the GPU's copies of the textures and meshes, and its frame",
+            held,
+        )?;
         let prepared = gpu.prepare(&draws, gpu_filter)?;
         warm_up(args.warmup, MIN_WARMUP, 1, || {
             std::hint::black_box(prepared.render(&settings)?);
@@ -155,7 +163,7 @@ fn time_gpu(
             times.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         // Device time of as many passes, back to back: between read-back frames the device
-        // idles and may clock down (README.md, "On an NVIDIA H200"), so warm-up passes run
+        // idles and may clock down (docs/guide/gpu.md), so warm-up passes run
         // back to back first, as the frames' warm-up does (`--warmup` of them and at least
         // MIN_WARMUP unless 0).
         if gpu.has_timestamps() {
@@ -184,6 +192,8 @@ fn time_gpu(
             },
             streamed: false,
         });
+        drop(prepared);
+        budget.release(held);
     }
     Ok(out)
 }
@@ -206,7 +216,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         None
     };
     let timings = if let Some(gpu) = &gpu {
-        time_gpu(args, gpu, &scene, &jobs)?
+        time_gpu(args, gpu, &scene, &jobs, budget)?
     } else {
         with_threads(args.threads, || -> Result<Vec<Timing>> {
             let mut out = Vec::new();

@@ -165,11 +165,14 @@ fn gpu_rows(
     let mut rows = Vec::new();
     for (label, filter, gpu_filter) in jobs {
         budget.take(
-            "a GPU frame",
-            u64::from(settings.width) * u64::from(settings.height) * 21,
+            "a GPU frame and its read-back",
+            texel_gpu::frame_bytes(settings.width, settings.height),
         )?;
         let samplers = scene.samplers(filter)?;
         let draws = scene.draws(&samplers);
+        // The uploads are held while this row renders; its frame is kept.
+        let uploads = texel_gpu::prepare_bytes(&draws);
+        budget.take("the GPU's copies of the textures and meshes", uploads)?;
         let prepared = gpu.prepare(&draws, gpu_filter)?;
         let settings = RenderSettings {
             environment: scene.environment(&samplers, &scene.scene.camera),
@@ -183,6 +186,8 @@ fn gpu_rows(
             times.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         rows.push((label, frame, median(&mut times)));
+        drop(prepared);
+        budget.release(uploads);
     }
     Ok(rows)
 }
@@ -439,7 +444,10 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
             u64::from(scene.width) * u64::from(scene.height) * (4 * filters.len() as u64 + 5),
         )?;
     }
-    let report = publish_dir(&args.out, |dir| {
+    // What the command reads must not lie inside what it replaces.
+    let mut inputs: Vec<&Path> = vec![Path::new(&args.scene.scene)];
+    inputs.extend(extras.files.iter().map(|(_, p)| p.as_path()));
+    let report = publish_dir(&args.out, &inputs, |dir| {
         compare(
             &scene,
             &args.scene.scene,

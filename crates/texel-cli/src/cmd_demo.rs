@@ -22,7 +22,7 @@ use texel_raster::{render, ColorTarget, UvEvaluation, View};
 /// whole at `--out` when all are done.
 pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let started = std::time::Instant::now();
-    let reports = publish_dir(&args.out, |dir| -> Result<Vec<(String, Report)>> {
+    let reports = publish_dir(&args.out, &[], |dir| -> Result<Vec<(String, Report)>> {
         let mut reports: Vec<(String, Report)> = Vec::new();
         let shaded = texel_scene::shaded_builtin_names();
         for name in texel_scene::builtin_names().iter().chain(shaded) {

@@ -43,7 +43,7 @@ pub fn run(args: &MipsArgs, input: &mut Input) -> Result<()> {
         .budget
         .take("encoding the levels", largest * ENCODE_BYTES_PER_PIXEL)?;
     let enc = encoding(args.color);
-    publish_dir(&args.out, |dir| -> Result<()> {
+    publish_dir(&args.out, &[args.texture.as_path()], |dir| -> Result<()> {
         for (k, l) in levels.iter().enumerate() {
             let image = Image8::from_fn(l.width, l.height, |i, j| {
                 enc.encode(tex.texel(k, i, j).unwrap_or_default())

@@ -71,6 +71,14 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
             );
         };
         settings.derivatives = Derivatives::Quad;
+        input.budget.take(
+            "the GPU's copies of the textures and meshes",
+            texel_gpu::prepare_bytes(&draws),
+        )?;
+        input.budget.take(
+            "the GPU frame and its read-back",
+            texel_gpu::frame_bytes(settings.width, settings.height),
+        )?;
         let gpu = Gpu::new(args.adapter.as_deref())?;
         texel_gpu::render(&gpu, &settings, &draws, gpu_filter)?
     } else {

@@ -2,7 +2,7 @@
 //! `--sanitize` policy and error wording.
 
 use anyhow::Result;
-use texel::memory::{TRIANGLE_BYTES, VERTEX_BYTES};
+use texel::memory::{MESH_BYTES, TRIANGLE_BYTES, VERTEX_BYTES};
 use texel::{MemoryBudget, PreparedScene, Scene, SceneLimits, SceneOptions};
 use texel_texture::{ColorSpace, Limits, LoadOptions, TextureError};
 
@@ -86,6 +86,7 @@ pub fn scene_limits(remaining: u64) -> SceneLimits {
             .max_triangles
             .min(remaining / (TRIANGLE_BYTES + 3 * VERTEX_BYTES + 700)),
         max_vertices: d.max_vertices.min(remaining / VERTEX_BYTES),
+        max_meshes: d.max_meshes.min(remaining / MESH_BYTES),
     }
 }
 
@@ -147,10 +148,22 @@ pub fn load_scene_with(
     input: &mut Input,
 ) -> Result<PreparedScene> {
     let limits = scene_limits(input.budget.remaining());
-    let lowered = limits != SceneLimits::default();
+    let d = SceneLimits::default();
+    // The limits lowered to fit the account, as the errors print them.
+    let lowered: Vec<String> = [
+        (limits.max_scene_bytes, d.max_scene_bytes),
+        (limits.max_mesh_file_bytes, d.max_mesh_file_bytes),
+        (limits.max_triangles, d.max_triangles),
+        (limits.max_vertices, d.max_vertices),
+    ]
+    .iter()
+    .filter(|(l, d)| l < d)
+    .map(|(l, _)| l.to_string())
+    .collect();
     let loaded = Scene::load_with(scene, &limits).map_err(|e| {
-        // A size limit lowered to fit the account says so.
-        let note = if lowered && e.to_string().contains("over the limit") {
+        // A size limit lowered to fit the account says so; a limit at its default does not.
+        let text = e.to_string();
+        let note = if lowered.iter().any(|l| text.contains(l.as_str())) {
             format!(
                 " (its size limits are scaled down to fit {})",
                 input.budget.name()

@@ -29,6 +29,42 @@ pub fn is_exr(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
+/// Parse an image output path for clap: a name ending in `.png`, `.exr` or in no image format's
+/// extension (`-`, `/dev/stdout`, `out.bin`) is accepted; one naming a format texel does not write
+/// (`.jpg`, `.tif`, `.hdr`, ...) is refused before any work, rather than written as PNG bytes
+/// under a name that says otherwise.
+///
+/// # Errors
+/// A message naming the extension and the formats texel writes.
+pub fn image_output(s: &str) -> Result<std::path::PathBuf, String> {
+    let path = std::path::PathBuf::from(s);
+    if let Some(ext) = path.extension().and_then(|e| e.to_str()) {
+        let known = image::ImageFormat::from_extension(ext);
+        if known.is_some_and(|f| f != image::ImageFormat::Png && f != image::ImageFormat::OpenExr) {
+            return Err(format!(
+                "{s:?} names a .{ext} image, which texel does not write: use a .png name (8-bit) \
+                 or an .exr name (32-bit float)"
+            ));
+        }
+    }
+    Ok(path)
+}
+
+/// Parse a PNG-only output path for clap (`view --screenshot`): as [`image_output`], and an
+/// `.exr` name is refused too.
+///
+/// # Errors
+/// As [`image_output`].
+pub fn png_output(s: &str) -> Result<std::path::PathBuf, String> {
+    let path = image_output(s)?;
+    if is_exr(&path) {
+        return Err(format!(
+            "{s:?} names an OpenEXR image; this output is 8-bit PNG only (use a .png name)"
+        ));
+    }
+    Ok(path)
+}
+
 /// Publish `frame` at `path`: OpenEXR of its linear colour ([`is_exr`]; a float frame is
 /// written as it is, an 8-bit one decoded), else PNG encoded as `encoding` ([`write_image`]).
 pub fn write_frame(path: &Path, frame: &Frame, encoding: Encoding) -> Result<()> {
@@ -63,6 +99,12 @@ fn write_exr(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]]) -> Resul
 /// Publish an 8-bit image as PNG at `path` ([`texel_quality::write_atomic`]: atomically over a
 /// regular file or a new path, through to a device or FIFO), or on standard output for `-`.
 pub fn write_image(path: &Path, image: &Image8) -> Result<()> {
+    if is_exr(path) {
+        anyhow::bail!(
+            "cannot write {}: this image is 8-bit, written as PNG only (use a .png name)",
+            path.display()
+        );
+    }
     if path.as_os_str() == "-" {
         let png = image.to_png()?;
         let mut out = std::io::stdout().lock();

@@ -10,6 +10,7 @@ mod help;
 mod hostile;
 mod meshes;
 mod mips;
+mod nothing_lost;
 mod outputs;
 mod reference;
 mod render;

@@ -520,6 +520,32 @@ pub fn render(
     gpu.prepare(draws, filter)?.render(settings)
 }
 
+/// Bytes that [`Gpu::prepare`] of `draws` holds, device and host together, for a memory budget:
+/// per draw its texture's pyramid on the device and in the staging copy the upload goes through,
+/// the host's copy of the level being uploaded, and the vertex, index and uniform buffers (36 bytes
+/// a vertex, 12 a triangle) on the host, in staging and on the device.
+pub fn prepare_bytes(draws: &[DrawCall]) -> u64 {
+    draws
+        .iter()
+        .map(|d| {
+            let t = d.texture;
+            let level0 = u64::from(t.width()) * u64::from(t.height()) * t.format().texel_bytes();
+            let geometry = d.vertices.len() as u64 * 36 + d.triangles.len() as u64 * 12;
+            2 * t.pyramid_bytes() + level0 + 3 * (geometry + 256)
+        })
+        .fold(0u64, u64::saturating_add)
+}
+
+/// Bytes that one frame of `width x height` holds: the render targets on the device (colour 16,
+/// fragment depth 4 and depth 4 bytes a pixel), the read-back buffer (16) and its copy on the
+/// host (16).
+pub fn frame_bytes(width: u32, height: u32) -> u64 {
+    u64::from(width) * u64::from(height) * FRAME_BYTES_PER_PIXEL
+}
+
+/// [`frame_bytes`] per pixel.
+pub const FRAME_BYTES_PER_PIXEL: u64 = 56;
+
 /// Draw calls uploaded to a device with one filter: textures (the whole pyramid), uniforms,
 /// vertices, indices and bind groups, ready to render frames of any size.
 pub struct GpuDraws<'g> {

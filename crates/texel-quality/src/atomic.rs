@@ -9,6 +9,7 @@
 //! | missing, or a regular file | bytes go to a temporary file in the same directory, `sync_all`, then `rename` over it (atomic on POSIX); a replaced file keeps its permissions |
 //! | a symbolic link (chain) | its final target is published as above; the link stays a link |
 //! | a character/block device or a FIFO | opened for writing (no create, no truncate) and written through: `/dev/null` stays `/dev/null`, `/dev/full` reports "No space left on device" |
+//! | an open descriptor's link (`/dev/stdout`, `/dev/stderr`, `/dev/fd/N`, `/proc/PID/fd/N`, or a link chain through one) | written through as a stream: standard output and error through their own handles, so `>> log.txt` appends; another descriptor reopened in its mode (appending, or at its offset); nothing truncated, renamed or created, even when the file behind it is deleted |
 //! | a directory (or a socket) | refused with an error naming the path |
 //!
 //! The temporary name is `.texel-HHHHHHHHHHHHHHHH.PID.N.tmp` (`H`: FNV-1a of the destination's
@@ -22,11 +23,13 @@
 //! hidden staging directory beside the destination, which then replaces the destination as a
 //! whole, so an interrupted run never leaves an `index.html` describing another run's images.
 
+use std::collections::HashSet;
 use std::fs::{self, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
+use std::time::SystemTime;
 
 use image::ImageEncoder;
 
@@ -82,14 +85,112 @@ enum Destination {
     Replaceable(PathBuf),
     /// A device node or FIFO: write through.
     Special(PathBuf),
+    /// An open file descriptor's link (`/proc/PID/fd/N`, reached directly or through `/dev/fd`,
+    /// `/dev/stdout`, `/dev/stderr`): written through as the stream it is.
+    Descriptor(FdLink),
+}
+
+/// A link under `/proc/PID/fd/` (or `/proc/PID/task/TID/fd/`), and what its descriptor is.
+struct FdLink {
+    /// The link itself; opening it reopens the descriptor's file, even a deleted one.
+    link: PathBuf,
+    /// Whether the descriptor is this process's own.
+    own: bool,
+    /// The descriptor's number.
+    fd: u32,
+}
+
+/// If `p` is an entry of a `/proc/*/fd` directory (its parent, links resolved, is `/proc/PID/fd`
+/// or `/proc/PID/task/TID/fd`), that descriptor.
+fn fd_link(p: &Path) -> Option<FdLink> {
+    let fd: u32 = p.file_name()?.to_str()?.parse().ok()?;
+    let parent = match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let dir = fs::canonicalize(parent).ok()?;
+    let parts: Vec<&str> = dir.iter().filter_map(|c| c.to_str()).collect();
+    let pid = match parts.as_slice() {
+        ["/", "proc", pid, "fd"] | ["/", "proc", pid, "task", _, "fd"] => *pid,
+        _ => return None,
+    };
+    let pid: u32 = pid.parse().ok()?;
+    Some(FdLink {
+        link: dir.join(fd.to_string()),
+        own: pid == std::process::id(),
+        fd,
+    })
+}
+
+/// The `flags` and `pos` of a descriptor from `/proc/PID/fdinfo/N` (octal flags, byte offset).
+fn fd_info(link: &Path) -> Option<(u32, u64)> {
+    let fd = link.file_name()?;
+    let info = link.parent()?.parent()?.join("fdinfo").join(fd);
+    let text = fs::read_to_string(info).ok()?;
+    let field = |name: &str| {
+        text.lines()
+            .find_map(|l| l.strip_prefix(name))
+            .map(|v| v.trim().to_string())
+    };
+    let flags = u32::from_str_radix(&field("flags:")?, 8).ok()?;
+    let pos = field("pos:")?.parse().ok()?;
+    Some((flags, pos))
+}
+
+/// Linux's `O_APPEND` (octal 02000 on every architecture texel builds for).
+const O_APPEND: u32 = 0o2000;
+
+/// Write `bytes` through an open descriptor's link: this process's standard output and error
+/// through their own handles (sharing the shell's offset and append mode), any other descriptor
+/// by reopening its link in its own mode: appending if it appends, else at its current offset.
+/// Nothing is truncated, renamed or created.
+fn write_descriptor(d: &FdLink, bytes: &[u8], path: &Path) -> Result<(), QualityError> {
+    if d.own && (d.fd == 1 || d.fd == 2) {
+        let written = if d.fd == 1 {
+            let mut out = std::io::stdout().lock();
+            out.write_all(bytes).and_then(|()| out.flush())
+        } else {
+            let mut err = std::io::stderr().lock();
+            err.write_all(bytes).and_then(|()| err.flush())
+        };
+        return written.map_err(io_err(path));
+    }
+    let meta = fs::metadata(&d.link).map_err(io_err(path))?;
+    if meta.is_dir() {
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::InvalidInput,
+            "is an open directory, not a file",
+        ));
+    }
+    let (flags, pos) = fd_info(&d.link).unwrap_or((O_APPEND, 0));
+    let append = flags & O_APPEND != 0;
+    let mut file = OpenOptions::new()
+        .write(true)
+        .append(append)
+        .open(&d.link)
+        .map_err(io_err(path))?;
+    if !append && meta.is_file() {
+        use std::io::Seek;
+        file.seek(std::io::SeekFrom::Start(pos))
+            .map_err(io_err(path))?;
+    }
+    file.write_all(bytes)
+        .and_then(|()| file.flush())
+        .map_err(io_err(path))
 }
 
 /// Follow `path` through symbolic links (without following the last component of a missing one)
 /// and classify what it names.
 fn resolve(path: &Path) -> Result<Destination, QualityError> {
+    // A path that reaches an open descriptor's link is that descriptor, whatever it holds: a
+    // shell's `>> log.txt` behind /dev/stdout is appended to, never replaced, and a deleted file
+    // behind the link is not recreated under its link text's name.
+    if let Some(d) = descriptor_on_path(path)? {
+        return Ok(Destination::Descriptor(d));
+    }
     // What the path finally names, links followed by the kernel: anything neither a regular file
-    // nor a directory (a device, a FIFO, a pipe behind /dev/stdout or /proc/self/fd/N) is written
-    // through at the path as given.
+    // nor a directory (a device, a FIFO, a pipe) is written through at the path as given.
     if let Ok(meta) = fs::metadata(path) {
         let ft = meta.file_type();
         if !ft.is_file() && !ft.is_dir() && !is_socket(&ft) {
@@ -138,6 +239,27 @@ fn resolve(path: &Path) -> Result<Destination, QualityError> {
         std::io::ErrorKind::InvalidInput,
         "too many levels of symbolic links",
     ))
+}
+
+/// Follow `path`'s chain of symbolic links by hand and return the first `/proc/*/fd` entry on it.
+fn descriptor_on_path(path: &Path) -> Result<Option<FdLink>, QualityError> {
+    let mut p = path.to_path_buf();
+    for _ in 0..=MAX_LINKS {
+        if let Some(d) = fd_link(&p) {
+            return Ok(Some(d));
+        }
+        match fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = fs::read_link(&p).map_err(io_err(path))?;
+                p = match p.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            _ => return Ok(None),
+        }
+    }
+    Ok(None)
 }
 
 #[cfg(unix)]
@@ -236,6 +358,7 @@ fn unregister(guard: &mut MutexGuard<'static, Vec<PathBuf>>, p: &Path) {
 /// left behind.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), QualityError> {
     let target = match resolve(path)? {
+        Destination::Descriptor(d) => return write_descriptor(&d, bytes, path),
         Destination::Special(p) => {
             return OpenOptions::new()
                 .write(true)
@@ -276,9 +399,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), QualityError> {
     result
 }
 
-/// Whether an existing directory may be replaced by [`publish_dir`]: it is empty, or it holds
-/// [`OUTPUT_MARKER`] (every directory `publish_dir` publishes does). Anything else may hold a
-/// user's own files and is never replaced.
+/// Whether an existing directory may be published over by [`publish_dir`]: it is empty, or it
+/// holds [`OUTPUT_MARKER`] (every directory `publish_dir` publishes does). Anything else may hold
+/// a user's own files and is refused.
 fn replaceable_dir(dir: &Path) -> bool {
     match fs::read_dir(dir) {
         Ok(mut entries) => entries.next().is_none() || dir.join(OUTPUT_MARKER).is_file(),
@@ -286,23 +409,180 @@ fn replaceable_dir(dir: &Path) -> bool {
     }
 }
 
+/// The first line of [`OUTPUT_MARKER`]; the files texel wrote follow the line `files:`.
+const MARKER_HEADER: &str = "written by texel; may be replaced by texel";
+
+/// Which entries of a published directory texel wrote, as its marker says.
+enum Owned {
+    /// The files listed in the marker (relative paths); an unmarked directory lists none.
+    Listed(HashSet<PathBuf>),
+    /// A marker without a list: the files no newer than the marker.
+    Before(SystemTime),
+}
+
+impl Owned {
+    /// Read the marker of `dir` (a directory without one owns nothing).
+    fn of(dir: &Path) -> Owned {
+        let marker = dir.join(OUTPUT_MARKER);
+        let Ok(text) = fs::read_to_string(&marker) else {
+            return Owned::Listed(HashSet::new());
+        };
+        let mut lines = text.lines();
+        if lines.any(|l| l == "files:") {
+            return Owned::Listed(lines.map(PathBuf::from).collect());
+        }
+        match fs::metadata(&marker).and_then(|m| m.modified()) {
+            Ok(t) => Owned::Before(t),
+            Err(_) => Owned::Listed(HashSet::new()),
+        }
+    }
+
+    /// Whether texel wrote the file at `rel` (`full` is its path now).
+    fn file(&self, rel: &Path, full: &Path) -> bool {
+        if rel == Path::new(OUTPUT_MARKER) {
+            return true;
+        }
+        match self {
+            Owned::Listed(set) => set.contains(rel),
+            Owned::Before(t) => fs::symlink_metadata(full)
+                .and_then(|m| m.modified())
+                .is_ok_and(|m| m <= *t),
+        }
+    }
+
+    /// Whether the directory at `rel` may hold files texel wrote.
+    fn may_hold(&self, rel: &Path) -> bool {
+        match self {
+            Owned::Listed(set) => set.iter().any(|p| p.starts_with(rel)),
+            Owned::Before(_) => true,
+        }
+    }
+}
+
+/// The relative paths of every file under `dir` (directories themselves not listed), sorted.
+fn list_files(dir: &Path, rel: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
+    for entry in fs::read_dir(dir.join(rel))? {
+        let entry = entry?;
+        let r = rel.join(entry.file_name());
+        if entry.file_type()?.is_dir() {
+            list_files(dir, &r, out)?;
+        } else {
+            out.push(r);
+        }
+    }
+    Ok(())
+}
+
+/// The marker of a staged directory: the header, then every file `fill` wrote.
+fn write_marker(staging: &Path) -> std::io::Result<()> {
+    let mut files = Vec::new();
+    list_files(staging, Path::new(""), &mut files)?;
+    files.sort();
+    let mut text = format!("{MARKER_HEADER}\nfiles:\n");
+    for f in files {
+        // A name that is not UTF-8 (or holds a newline) cannot be listed; texel writes none.
+        if let Some(s) = f.to_str().filter(|s| !s.contains('\n')) {
+            text.push_str(s);
+            text.push('\n');
+        }
+    }
+    fs::write(staging.join(OUTPUT_MARKER), text)
+}
+
+/// Entries of `old` (a directory texel is about to replace) that texel did not write and whose
+/// name is taken in `new`: carrying them over would replace the new output's file.
+fn clashes(old: &Path, new: &Path, owned: &Owned, rel: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = fs::read_dir(old.join(rel)) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let r = rel.join(entry.file_name());
+        let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
+        if is_dir && owned.may_hold(&r) {
+            clashes(old, new, owned, &r, out);
+        } else if (is_dir || !owned.file(&r, &entry.path()))
+            && fs::symlink_metadata(new.join(&r)).is_ok()
+        {
+            out.push(r);
+        }
+    }
+}
+
+/// Move what texel did not write from `old` into `new` (same relative paths) and delete the files
+/// texel wrote; entries whose name `new` already holds stay in `old`.
+fn carry_over(old: &Path, new: &Path, owned: &Owned, rel: &Path) {
+    let Ok(entries) = fs::read_dir(old.join(rel)) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let r = rel.join(entry.file_name());
+        let from = entry.path();
+        let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
+        let to = new.join(&r);
+        if is_dir && owned.may_hold(&r) {
+            if fs::symlink_metadata(&to).is_err() {
+                let _ = fs::create_dir(&to);
+            }
+            carry_over(old, new, owned, &r);
+            let _ = fs::remove_dir(&from);
+        } else if !is_dir && owned.file(&r, &from) {
+            let _ = fs::remove_file(&from);
+        } else if fs::symlink_metadata(&to).is_err() {
+            let _ = fs::rename(&from, &to);
+        }
+    }
+}
+
+/// A name beside `target` that nothing holds: `NAME.texel-WHAT`, or `NAME.texel-WHAT-2`, ...
+fn visible_sibling(target: &Path, what: &str) -> PathBuf {
+    let name = target
+        .file_name()
+        .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
+    let dir = target.parent().unwrap_or(Path::new("."));
+    (1..)
+        .map(|k| match k {
+            1 => dir.join(format!("{name}.texel-{what}")),
+            k => dir.join(format!("{name}.texel-{what}-{k}")),
+        })
+        .find(|p| fs::symlink_metadata(p).is_err())
+        .unwrap_or_else(|| dir.join(format!("{name}.texel-{what}")))
+}
+
 /// Publish a multi-file output at `dest` as a whole: `fill` writes everything into a new staging
 /// directory beside `dest` (it receives its path), then the staging directory replaces `dest`.
 ///
 /// `dest` may be missing (its parents are created), an empty directory, or a directory an earlier
-/// run published (it holds [`OUTPUT_MARKER`], which every published directory gets). A symbolic
-/// link is followed and kept. The old directory is moved aside, the new one renamed into place and
-/// the old one deleted; a process killed between the two renames leaves no `dest` at all, never a
-/// mixture, and its hidden leftovers are deleted by the next publish to `dest`.
+/// run published (it holds [`OUTPUT_MARKER`], which lists the files that run wrote). A symbolic
+/// link is followed and kept. What texel did not write is never lost: at the moment of publishing
+/// the old directory is moved aside, the new one renamed into place, and every entry of the old
+/// one that texel did not write (a file a user saved into `dest` during the run, say) is moved
+/// into the new one; only the files the marker lists are deleted. A process killed between the
+/// two renames leaves no `dest` at all, never a mixture, and its hidden leftovers are deleted by
+/// the next publish to `dest`.
+///
+/// `inputs` are the files the command reads: an input inside `dest` is refused before any work,
+/// since publishing could replace or move it.
 ///
 /// # Errors
 /// [`QualityError::Io`] (converted into `E`) when `dest` is a file or device, a directory that
-/// texel did not write, or cannot be created or renamed; any error of `fill`, after which the
-/// staging directory is deleted and `dest` is unchanged.
+/// texel did not write, an open descriptor's link, holds one of `inputs`, or cannot be created or
+/// renamed; when, at the moment of publishing, `dest` holds a file texel did not write under a
+/// name the new output uses (the new output is then left beside `dest` as `NAME.texel-new`, and
+/// `dest` is unchanged); any error of `fill`, after which the staging directory is deleted and
+/// `dest` is unchanged.
 pub fn publish_dir<T, E: From<QualityError>>(
     dest: &Path,
+    inputs: &[&Path],
     fill: impl FnOnce(&Path) -> Result<T, E>,
 ) -> Result<T, E> {
+    if descriptor_on_path(dest)?.is_some() {
+        return Err(refuse(
+            dest,
+            std::io::ErrorKind::InvalidInput,
+            "names an open file descriptor: give the output directory's own path",
+        )
+        .into());
+    }
     let mut target = dest.to_path_buf();
     let mut links = 0;
     let exists =
@@ -336,6 +616,10 @@ pub fn publish_dir<T, E: From<QualityError>>(
         )
         .into());
     }
+    let marked = exists && target.join(OUTPUT_MARKER).is_file();
+    if exists {
+        check_inputs_outside(dest, &target, inputs)?;
+    }
     let (parent, tag) = split_dest(&target)?;
     fs::create_dir_all(&parent).map_err(io_err(dest))?;
     remove_stale(&parent, &tag);
@@ -346,33 +630,110 @@ pub fn publish_dir<T, E: From<QualityError>>(
         guard.push(staging.clone());
     }
     let filled = fill(&staging).and_then(|v| {
-        fs::write(
-            staging.join(OUTPUT_MARKER),
-            b"written by texel; may be replaced by texel\n",
-        )
-        .map_err(|e| E::from(io_err(dest)(e)))?;
-        Ok(v)
+        write_marker(&staging)
+            .map_err(|e| E::from(io_err(dest)(e)))
+            .map(|()| v)
     });
     let mut guard = pending();
     let result = filled.and_then(|v| {
-        if exists {
-            let old = temporary(&parent, &tag, ".old");
-            fs::rename(&target, &old).map_err(|e| E::from(io_err(dest)(e)))?;
-            if let Err(e) = fs::rename(&staging, &target) {
-                let _ = fs::rename(&old, &target);
-                return Err(io_err(dest)(e).into());
-            }
-            let _ = fs::remove_dir_all(&old);
-        } else {
-            fs::rename(&staging, &target).map_err(|e| E::from(io_err(dest)(e)))?;
-        }
-        Ok(v)
+        swap_in(dest, &target, &staging, marked, (&parent, &tag))
+            .map(|()| v)
+            .map_err(E::from)
     });
-    if result.is_err() {
+    if result.is_err() && fs::symlink_metadata(&staging).is_ok() {
         let _ = fs::remove_dir_all(&staging);
     }
     unregister(&mut guard, &staging);
     result
+}
+
+/// Refuse when one of `inputs` lies inside the existing directory `target`.
+fn check_inputs_outside(dest: &Path, target: &Path, inputs: &[&Path]) -> Result<(), QualityError> {
+    let Ok(dir) = fs::canonicalize(target) else {
+        return Ok(());
+    };
+    for input in inputs {
+        if let Ok(p) = fs::canonicalize(input) {
+            if p.starts_with(&dir) {
+                return Err(refuse(
+                    dest,
+                    std::io::ErrorKind::InvalidInput,
+                    &format!(
+                        "holds the input {}, which publishing the output there could replace \
+                         or move: choose another output directory",
+                        input.display()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Put the filled `staging` in `target`'s place, keeping whatever texel did not write. `marked`:
+/// `target` held a marker when the run started (else it was empty or missing); `(parent, tag)`
+/// name its temporaries.
+fn swap_in(
+    dest: &Path,
+    target: &Path,
+    staging: &Path,
+    marked: bool,
+    (parent, tag): (&Path, &str),
+) -> Result<(), QualityError> {
+    let exists = fs::symlink_metadata(target).is_ok();
+    if !exists {
+        return fs::rename(staging, target).map_err(io_err(dest));
+    }
+    // What the directory holds now, not what it held when the run started.
+    let owned = Owned::of(target);
+    let mut clash = Vec::new();
+    if marked && !target.join(OUTPUT_MARKER).is_file() {
+        clash.push(PathBuf::from(
+            "(the whole directory: its .texel-output marker is gone)",
+        ));
+    } else {
+        clashes(target, staging, &owned, Path::new(""), &mut clash);
+    }
+    if !clash.is_empty() {
+        let kept = visible_sibling(target, "new");
+        let at = match fs::rename(staging, &kept) {
+            Ok(()) => format!("the new output is in {}", kept.display()),
+            Err(_) => "the new output is discarded".to_string(),
+        };
+        let names: Vec<String> = clash.iter().map(|p| p.display().to_string()).collect();
+        return Err(refuse(
+            dest,
+            std::io::ErrorKind::AlreadyExists,
+            &format!(
+                "now holds files texel did not write under names the new output uses ({}): it is \
+                 left as it is, and {at}",
+                names.join(", ")
+            ),
+        ));
+    }
+    let old = temporary(parent, tag, ".old");
+    fs::rename(target, &old).map_err(io_err(dest))?;
+    if let Err(e) = fs::rename(staging, target) {
+        let _ = fs::rename(&old, target);
+        return Err(io_err(dest)(e));
+    }
+    // Files saved into the old directory up to this moment move across; a few passes catch one
+    // that lands while the first is running.
+    for _ in 0..3 {
+        carry_over(&old, target, &owned, Path::new(""));
+        if fs::remove_dir(&old).is_ok() {
+            return Ok(());
+        }
+    }
+    let kept = visible_sibling(target, "kept");
+    let _ = fs::rename(&old, &kept);
+    eprintln!(
+        "texel: warning: files saved into {} while texel published it clash with the new \
+         output's names; they are kept in {}",
+        dest.display(),
+        kept.display()
+    );
+    Ok(())
 }
 
 /// Encode packed `RGBARGBA...` 8-bit bytes as PNG in memory.
@@ -578,19 +939,19 @@ mod tests {
     fn publish_dir_replaces_whole() {
         let d = scratch("atomic-dir");
         let out = d.join("report");
-        publish_dir::<_, QualityError>(&out, |s| {
+        publish_dir::<_, QualityError>(&out, &[], |s| {
             fs::write(s.join("a.png"), b"1").map_err(io_err(s))
         })
         .unwrap();
         assert_eq!(names(&out), vec![OUTPUT_MARKER, "a.png"]);
         // A second run replaces everything: no file of the first run survives.
-        publish_dir::<_, QualityError>(&out, |s| {
+        publish_dir::<_, QualityError>(&out, &[], |s| {
             fs::write(s.join("b.png"), b"2").map_err(io_err(s))
         })
         .unwrap();
         assert_eq!(names(&out), vec![OUTPUT_MARKER, "b.png"]);
         // A failing run leaves the last published output and no staging directory.
-        let e = publish_dir::<(), QualityError>(&out, |s| {
+        let e = publish_dir::<(), QualityError>(&out, &[], |s| {
             fs::write(s.join("c.png"), b"3").unwrap();
             Err(refuse(s, std::io::ErrorKind::Other, "stopped"))
         });
@@ -601,12 +962,209 @@ mod tests {
         let mine = d.join("mine");
         fs::create_dir_all(&mine).unwrap();
         fs::write(mine.join("notes.txt"), b"keep").unwrap();
-        let e = publish_dir::<(), QualityError>(&mine, |_| Ok(())).unwrap_err();
+        let e = publish_dir::<(), QualityError>(&mine, &[], |_| Ok(())).unwrap_err();
         assert!(e.to_string().contains("did not write"), "{e}");
         assert_eq!(names(&mine), vec!["notes.txt"]);
         fs::write(d.join("file"), b"f").unwrap();
-        let e = publish_dir::<(), QualityError>(&d.join("file"), |_| Ok(())).unwrap_err();
+        let e = publish_dir::<(), QualityError>(&d.join("file"), &[], |_| Ok(())).unwrap_err();
         assert!(e.to_string().contains("not a directory"), "{e}");
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    fn fill_with<'a>(
+        files: &'a [&'a str],
+        also: impl FnOnce() + 'a,
+    ) -> impl FnOnce(&Path) -> Result<(), QualityError> + 'a {
+        move |s| {
+            for f in files {
+                fs::write(s.join(f), f.as_bytes()).map_err(io_err(s))?;
+            }
+            also();
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn publish_keeps_files_saved_during_the_run() {
+        let d = scratch("atomic-keep");
+        let out = d.join("out");
+        publish_dir(&out, &[], fill_with(&["a.png", "b.png"], || ())).unwrap();
+        // A user saves a file into the published directory while the next run works, and one
+        // into a sub-directory of their own.
+        let saved = out.join("notes.txt");
+        publish_dir(
+            &out,
+            &[],
+            fill_with(&["a.png"], || {
+                fs::write(&saved, b"mine").unwrap();
+                fs::create_dir(out.join("sub")).unwrap();
+                fs::write(out.join("sub/x"), b"x").unwrap();
+            }),
+        )
+        .unwrap();
+        assert_eq!(
+            names(&out),
+            vec![OUTPUT_MARKER, "a.png", "notes.txt", "sub"]
+        );
+        assert_eq!(fs::read(&saved).unwrap(), b"mine");
+        assert_eq!(fs::read(out.join("sub/x")).unwrap(), b"x");
+        // The marker lists texel's files only: the next run deletes b.png's successor a.png but
+        // keeps the user's files again.
+        let marker = fs::read_to_string(out.join(OUTPUT_MARKER)).unwrap();
+        assert!(marker.ends_with("files:\na.png\n"), "{marker:?}");
+        publish_dir(&out, &[], fill_with(&["c.png"], || ())).unwrap();
+        assert_eq!(
+            names(&out),
+            vec![OUTPUT_MARKER, "c.png", "notes.txt", "sub"]
+        );
+        assert_eq!(names(&d), vec!["out"]);
+        // An empty directory at the start: whatever appears in it during the run is kept.
+        let empty = d.join("empty");
+        fs::create_dir(&empty).unwrap();
+        publish_dir(
+            &empty,
+            &[],
+            fill_with(&["a.png"], || {
+                fs::write(empty.join("late.txt"), b"l").unwrap()
+            }),
+        )
+        .unwrap();
+        assert_eq!(names(&empty), vec![OUTPUT_MARKER, "a.png", "late.txt"]);
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn publish_refuses_a_clash_and_leaves_the_output_beside() {
+        let d = scratch("atomic-clash");
+        let out = d.join("out");
+        publish_dir(&out, &[], fill_with(&["a.png"], || ())).unwrap();
+        // During the run a user saves their own file under a name the new output uses.
+        let e = publish_dir(
+            &out,
+            &[],
+            fill_with(&["a.png", "index.html"], || {
+                fs::write(out.join("index.html"), b"mine").unwrap()
+            }),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("index.html"), "{e}");
+        assert!(e.to_string().contains("out.texel-new"), "{e}");
+        assert_eq!(fs::read(out.join("index.html")).unwrap(), b"mine");
+        assert_eq!(fs::read(out.join("a.png")).unwrap(), b"a.png");
+        assert_eq!(
+            names(&d.join("out.texel-new")),
+            vec![OUTPUT_MARKER, "a.png", "index.html"]
+        );
+        // A marker removed during the run: the directory is no longer texel's to replace.
+        let other = d.join("other");
+        publish_dir(&other, &[], fill_with(&["a.png"], || ())).unwrap();
+        let e = publish_dir(
+            &other,
+            &[],
+            fill_with(&["b.png"], || {
+                fs::remove_file(other.join(OUTPUT_MARKER)).unwrap()
+            }),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("marker is gone"), "{e}");
+        assert_eq!(names(&other), vec!["a.png"]);
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn publish_never_touches_its_input() {
+        let d = scratch("atomic-input");
+        let out = d.join("out");
+        publish_dir(&out, &[], fill_with(&["level-00.png"], || ())).unwrap();
+        let input = out.join("brick.png");
+        fs::write(&input, b"brick").unwrap();
+        let e = publish_dir(&out, &[&input], fill_with(&["level-00.png"], || ())).unwrap_err();
+        assert!(e.to_string().contains("holds the input"), "{e}");
+        assert_eq!(fs::read(&input).unwrap(), b"brick");
+        // Texel's own earlier output read as the input is refused the same way.
+        let own = out.join("level-00.png");
+        assert!(publish_dir(&out, &[&own], fill_with(&["level-00.png"], || ())).is_err());
+        assert_eq!(fs::read(&own).unwrap(), b"level-00.png");
+        // An input elsewhere is fine.
+        let outside = d.join("t.png");
+        fs::write(&outside, b"t").unwrap();
+        publish_dir(&out, &[&outside], fill_with(&["level-00.png"], || ())).unwrap();
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn publish_reads_a_marker_without_a_list() {
+        let d = scratch("atomic-legacy");
+        let out = d.join("out");
+        fs::create_dir(&out).unwrap();
+        fs::write(out.join("old.png"), b"o").unwrap();
+        fs::write(out.join(OUTPUT_MARKER), format!("{MARKER_HEADER}\n")).unwrap();
+        // Files no newer than such a marker are texel's; a later one is the user's.
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        publish_dir(
+            &out,
+            &[],
+            fill_with(&["new.png"], || {
+                fs::write(out.join("later.txt"), b"l").unwrap()
+            }),
+        )
+        .unwrap();
+        assert_eq!(names(&out), vec![OUTPUT_MARKER, "later.txt", "new.png"]);
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn descriptor_links_are_written_through() {
+        use std::io::{Read, Seek};
+        use std::os::fd::AsRawFd;
+        let d = scratch("atomic-fd");
+        // A descriptor opened for appending (a shell's `>>`): texel's bytes follow the old ones.
+        let log = d.join("log.txt");
+        fs::write(&log, b"earlier\n").unwrap();
+        let f = OpenOptions::new().append(true).open(&log).unwrap();
+        let link = PathBuf::from(format!("/proc/self/fd/{}", f.as_raw_fd()));
+        write_atomic(&link, b"png").unwrap();
+        let via_dev_fd = PathBuf::from(format!("/dev/fd/{}", f.as_raw_fd()));
+        write_atomic(&via_dev_fd, b"!").unwrap();
+        assert_eq!(fs::read(&log).unwrap(), b"earlier\npng!");
+        // A symbolic link to such a link is the same descriptor.
+        std::os::unix::fs::symlink(&link, d.join("alias")).unwrap();
+        write_atomic(&d.join("alias"), b"?").unwrap();
+        assert_eq!(fs::read(&log).unwrap(), b"earlier\npng!?");
+        drop(f);
+        // A descriptor that does not append: written at its offset, nothing truncated.
+        let g_path = d.join("g.bin");
+        fs::write(&g_path, b"0123456789").unwrap();
+        let mut g = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&g_path)
+            .unwrap();
+        g.seek(std::io::SeekFrom::Start(4)).unwrap();
+        write_atomic(
+            &PathBuf::from(format!("/proc/self/fd/{}", g.as_raw_fd())),
+            b"ab",
+        )
+        .unwrap();
+        assert_eq!(fs::read(&g_path).unwrap(), b"0123ab6789");
+        // A deleted file behind the link: written to the open file (at the descriptor's offset,
+        // still 4), and no new file appears.
+        fs::remove_file(&g_path).unwrap();
+        write_atomic(
+            &PathBuf::from(format!("/proc/self/fd/{}", g.as_raw_fd())),
+            b"Z",
+        )
+        .unwrap();
+        let mut all = Vec::new();
+        g.seek(std::io::SeekFrom::Start(0)).unwrap();
+        g.read_to_end(&mut all).unwrap();
+        assert_eq!(all, b"0123Zb6789");
+        assert_eq!(names(&d), vec!["alias", "log.txt"]);
+        // A descriptor link is never an output directory.
+        let e = publish_dir::<(), QualityError>(&link, &[], |_| Ok(())).unwrap_err();
+        assert!(e.to_string().contains("descriptor"), "{e}");
+        drop(g);
         fs::remove_dir_all(&d).unwrap();
     }
 }

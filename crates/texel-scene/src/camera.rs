@@ -22,7 +22,22 @@ pub struct Camera {
 impl Camera {
     /// The view matrix: world to camera space (right-handed, the camera looks down -z).
     pub fn view_from_world(&self) -> Mat4 {
-        Mat4::look_at_rh(self.eye, self.target, self.up)
+        let dir = self.target - self.eye;
+        let well_scaled = |v: Vec3| {
+            let l = v.length_squared();
+            l.is_normal() && l.is_finite()
+        };
+        if well_scaled(dir) && well_scaled(self.up) && well_scaled(dir.cross(self.up)) {
+            return Mat4::look_at_rh(self.eye, self.target, self.up);
+        }
+        // A distance or an up vector whose square over- or underflows in f32 (an eye 1e30 away, a
+        // view 1e-25 long): the basis is found in f64, where those squares are exact enough.
+        glam::DMat4::look_at_rh(
+            self.eye.as_dvec3(),
+            self.target.as_dvec3(),
+            self.up.as_dvec3(),
+        )
+        .as_mat4()
     }
 
     /// The OpenGL perspective projection for `aspect = width / height` (NDC z in `[-1, 1]`,

@@ -39,6 +39,32 @@ pub const SUN_RADIANCE: f64 = 30.0;
 /// The largest sky width (its height is half), face side or square side.
 pub const MAX_SKY_WIDTH: u32 = 8192;
 
+/// Most texels (all layers) a procedural sky may have: 2^21, an equirect map of 2048 x 1024. The
+/// environment's prefiltered pyramid and irradiance cost time in proportion.
+pub const MAX_SKY_TEXELS: u64 = 1 << 21;
+
+/// The largest sky `size` in `mapping` within [`MAX_SKY_TEXELS`] (and [`MAX_SKY_WIDTH`]).
+pub fn max_sky_width(mapping: Mapping) -> u32 {
+    let sky = |width| Sky {
+        width,
+        ..Sky::default()
+    };
+    let texels = |w: u32| {
+        let (a, b) = sky(w).layer_size(mapping);
+        u64::from(a) * u64::from(b) * mapping.layers() as u64
+    };
+    let (mut lo, mut hi) = (2u32, MAX_SKY_WIDTH);
+    while lo < hi {
+        let mid = (lo + hi).div_ceil(2);
+        if texels(mid) <= MAX_SKY_TEXELS {
+            lo = mid;
+        } else {
+            hi = mid - 1;
+        }
+    }
+    lo
+}
+
 /// The procedural sky's default size per mapping: a 1024-wide equirect map, 256-texel cube faces
 /// (a 1024 x 768 cross) and a 512-texel octahedral square, within a factor 1.3 of one another in
 /// texel angle (`2 pi / 1024`, `2 / 256`, `sqrt(4 pi) / 512` radians).
@@ -267,6 +293,21 @@ impl EnvironmentSpec {
     /// the mapping's shape (a 2:1 equirect map is not required; a square octahedral map, a 4:3
     /// or 3:4 cross, six square faces of one size are).
     pub fn load(&self, limits: &Limits) -> Result<Vec<Texture>, SceneError> {
+        self.load_with(limits, false).map(|(faces, _)| faces)
+    }
+
+    /// As [`EnvironmentSpec::load`]; with `replace_non_finite`, NaN and infinite texels of the
+    /// map's files are replaced ([`texel_texture::replace_non_finite`]) instead of refused, and
+    /// their count is returned beside the layers.
+    ///
+    /// # Errors
+    /// As [`EnvironmentSpec::load`].
+    pub fn load_with(
+        &self,
+        limits: &Limits,
+        replace_non_finite: bool,
+    ) -> Result<(Vec<Texture>, u64), SceneError> {
+        let replaced = std::cell::Cell::new(0u64);
         let err = |path: Option<PathBuf>| {
             move |source| SceneError::Texture {
                 name: "environment".into(),
@@ -274,8 +315,14 @@ impl EnvironmentSpec {
                 source,
             }
         };
+        let options = texel_texture::LoadOptions {
+            replace_non_finite,
+            ..texel_texture::LoadOptions::new(ColorSpace::Srgb, *limits)
+        };
         let load = |path: &PathBuf| {
-            Texture::load(path, ColorSpace::Srgb, limits).map_err(err(Some(path.clone())))
+            let loaded = Texture::load_with(path, &options).map_err(err(Some(path.clone())))?;
+            replaced.set(replaced.get() + loaded.replaced);
+            Ok::<_, SceneError>(loaded.texture)
         };
         let bad = |s: String| Err(SceneError::Environment(s));
         let faces = match &self.source {
@@ -294,7 +341,8 @@ impl EnvironmentSpec {
                     Mapping::Cube => {
                         let Some((cross, n)) = CubeCross::of(w, h) else {
                             return bad(format!(
-                                "{}: a cube map in one image is a cross of 4x3 or 3x4 square                                  faces; this image is {w}x{h} (or give faces = [six files])",
+                                "{}: a cube map in one image is a cross of 4x3 or 3x4 square \
+                         faces; this image is {w}x{h} (or give faces = [six files])",
                                 path.display()
                             ));
                         };
@@ -306,15 +354,25 @@ impl EnvironmentSpec {
             }
             EnvironmentSource::Faces(paths) => {
                 let faces = paths.iter().map(load).collect::<Result<Vec<_>, _>>()?;
-                let n = faces[0].width();
+                let (n, first) = (faces[0].width(), &paths[0]);
                 if let Some((p, f)) = paths
                     .iter()
                     .zip(&faces)
-                    .find(|(_, f)| f.width() != n || f.height() != n)
+                    .find(|(_, f)| f.width() != f.height())
                 {
                     return bad(format!(
-                        "{}: cube faces are square and of one size ({n}x{n}, as the first);                          this one is {}x{}",
+                        "{}: cube faces are square, but this one is {}x{}",
                         p.display(),
+                        f.width(),
+                        f.height()
+                    ));
+                }
+                if let Some((p, f)) = paths.iter().zip(&faces).find(|(_, f)| f.width() != n) {
+                    return bad(format!(
+                        "{}: cube faces are all of one size, {n}x{n} as the first ({}); this \
+                         one is {}x{}",
+                        p.display(),
+                        first.display(),
                         f.width(),
                         f.height()
                     ));
@@ -332,7 +390,7 @@ impl EnvironmentSpec {
                     .map_err(err(None))?
             }
         };
-        Ok(faces)
+        Ok((faces, replaced.get()))
     }
 
     /// Check the numbers: a finite, non-negative intensity; a sky of a valid width and a non-zero,
@@ -353,6 +411,18 @@ impl EnvironmentSpec {
                 return bad(format!(
                     "size {} is out of range: the sky is 2 to {MAX_SKY_WIDTH} texels wide",
                     sky.width
+                ));
+            }
+            let max = max_sky_width(self.mapping);
+            if sky.width > max {
+                let (w, h) = sky.layer_size(self.mapping);
+                return bad(format!(
+                    "size {} makes a {:?} sky of {} texels ({w}x{h} a layer), over texel's bound \
+                     of {MAX_SKY_TEXELS} (its prefiltering takes about 20 s on 2 cores at the \
+                     bound): use size {max} or less",
+                    sky.width,
+                    self.mapping,
+                    u64::from(w) * u64::from(h) * self.mapping.layers() as u64
                 ));
             }
             if !sky.sun.is_finite() || sky.sun.length() == 0.0 {

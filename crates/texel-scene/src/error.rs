@@ -18,7 +18,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// The TOML is malformed, has an unknown key, a missing key or a value of the wrong type.
-    #[error("{path}:{line}:{column}: {message}")]
+    #[error("{}{}: {message}", path.display(), position(*line, *column))]
     Toml {
         /// The scene file (`builtin:NAME` for built-in scenes).
         path: PathBuf,
@@ -61,8 +61,8 @@ pub enum SceneError {
         /// Far plane distance.
         far: f32,
     },
-    /// `fovy_deg` outside `(0, 180)`.
-    #[error("camera fovy_deg = {0}: must be strictly between 0 and 180 degrees")]
+    /// `fovy_deg` outside `[MIN_FOVY_DEG, 180)`.
+    #[error("camera fovy_deg = {0}: must be at least {min} degrees (f32 view coordinates do not resolve a narrower view) and below 180", min = crate::validate::MIN_FOVY_DEG)]
     CameraFov(f32),
     /// `eye == target`, or `up` parallel to the view direction (or zero).
     #[error("camera eye {eye:?}, target {target:?}, up {up:?} do not define a view: eye must differ from target and up must not be parallel to the view direction")]
@@ -198,4 +198,13 @@ pub enum SceneError {
     /// The scene draws nothing: no meshes, or a mesh without triangles.
     #[error("{0}")]
     Empty(String),
+}
+
+/// `:LINE:COLUMN` for a known position, nothing for an unknown one (line 0).
+fn position(line: usize, column: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}:{column}")
+    }
 }

@@ -654,7 +654,7 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                 Some(v) => Ok(v),
                 None => Ok(default),
             };
-            TextureSource::Procedural(match kind {
+            let procedural = match kind {
                 Kind::Checker => Procedural::Checker {
                     width,
                     height,
@@ -732,7 +732,9 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
                         },
                     },
                 },
-            })
+            };
+            procedural.check_work().map_err(bad)?;
+            TextureSource::Procedural(procedural)
         }
     };
     Ok(TextureSpec::new(source, color))
@@ -788,12 +790,18 @@ fn mesh_texture(
 
 /// The meshes of `[[meshes]]` entry `index`; a glTF file's own textures and materials beside them
 /// where the entry names no material.
+/// glTF files a scene has read, by what the import depended on (path, imported materials, the
+/// entry's texture, the texture the meshes are drawn with): a file named by many entries is read
+/// once.
+type GltfCache = std::collections::HashMap<(PathBuf, bool, Option<String>, String), GltfScene>;
+
 fn meshes(
     index: usize,
     m: RawMesh,
     base: &Path,
     limits: &SceneLimits,
     materials: &BTreeMap<String, MaterialSpec>,
+    cache: &mut GltfCache,
 ) -> Result<GltfScene, SceneError> {
     let src = |reason| SceneError::MeshSource {
         mesh: index,
@@ -854,13 +862,35 @@ fn meshes(
         } else {
             let file = m.gltf.expect("one source");
             let path = base.join(&file);
-            match own_materials {
-                true => {
-                    crate::gltf_import::import_gltf(&path, m.texture.as_deref(), &file, limits)?
+            let key = (
+                path.clone(),
+                own_materials,
+                m.texture.clone(),
+                texture.clone(),
+            );
+            if let Some(done) = cache.get(&key) {
+                let tris: u64 = done.meshes.iter().map(|m| m.triangles.len() as u64).sum();
+                let verts: u64 = done.meshes.iter().map(|m| m.positions.len() as u64).sum();
+                if tris > limits.max_triangles || verts > limits.max_vertices {
+                    return Err(SceneError::TooLarge(format!(
+                        "meshes[{index}] ({file}) adds {tris} triangles and {verts} vertices to \
+                         the meshes before it, over what the limits of the scene leave \
+                         ({} triangles, {} vertices)",
+                        limits.max_triangles, limits.max_vertices
+                    )));
                 }
-                false => {
-                    GltfScene::from(crate::gltf_import::load_gltf_with(&path, &texture, limits)?)
-                }
+                done.clone()
+            } else {
+                let loaded = match own_materials {
+                    true => {
+                        crate::gltf_import::import_gltf(&path, m.texture.as_deref(), &file, limits)?
+                    }
+                    false => GltfScene::from(crate::gltf_import::load_gltf_with(
+                        &path, &texture, limits,
+                    )?),
+                };
+                cache.insert(key, loaded.clone());
+                loaded
             }
         }
     };
@@ -948,17 +978,27 @@ impl Scene {
             .collect();
         let (mut textures, mut materials) = (textures, materials);
         let mut all = Vec::new();
+        let mut cache = GltfCache::new();
+        let (mut tris, mut verts) = (0u64, 0u64);
         for (i, m) in raw.meshes.into_iter().enumerate() {
             // Each mesh file gets what the meshes before it left of the scene's limits.
-            let (tris, verts) = all.iter().fold((0u64, 0u64), |(t, v), m: &Mesh| {
-                (t + m.triangles.len() as u64, v + m.positions.len() as u64)
-            });
+            if all.len() as u64 >= limits.max_meshes {
+                return Err(SceneError::TooLarge(format!(
+                    "meshes[{i}]: the scene already has {} meshes, the limit",
+                    all.len()
+                )));
+            }
             let left = SceneLimits {
                 max_triangles: limits.max_triangles.saturating_sub(tris),
                 max_vertices: limits.max_vertices.saturating_sub(verts),
+                max_meshes: limits.max_meshes - all.len() as u64,
                 ..*limits
             };
-            let imported = meshes(i, m, &base, &left, &materials)?;
+            let imported = meshes(i, m, &base, &left, &materials, &mut cache)?;
+            for m in &imported.meshes {
+                tris += m.triangles.len() as u64;
+                verts += m.positions.len() as u64;
+            }
             all.extend(imported.meshes);
             merge_imported(&mut textures, imported.textures, i, "textures")?;
             merge_imported(&mut materials, imported.materials, i, "materials")?;

@@ -530,6 +530,132 @@ fn check_primitive(prim: &gltf::Primitive, limits: &SceneLimits) -> Result<(), S
     Ok(())
 }
 
+/// Check every accessor's layout against glTF 2.0 (3.6.2, 5.1, 5.11) before the gltf crate's
+/// readers slice buffers with it (they index without checks and panic): its buffer view and the
+/// view's buffer exist, the view lies inside its buffer, a `byteStride` is 4 to 252, a multiple of
+/// the component size and at least the element's size, the accessor's offset is aligned to its
+/// component, its last element ends inside the view, and a sparse accessor's indices (u8, u16 or
+/// u32) and values fit their views, which declare no stride.
+fn check_accessors(json: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::validation::Checked;
+    let view_at = |v: usize, what: &str| -> Result<(u64, Option<u64>), String> {
+        let view = json.buffer_views.get(v).ok_or_else(|| {
+            format!(
+                "{what} refers to buffer view {v}, but the file has {}",
+                json.buffer_views.len()
+            )
+        })?;
+        let b = view.buffer.value();
+        let buffer = json.buffers.get(b).ok_or_else(|| {
+            format!(
+                "buffer view {v} refers to buffer {b}, but the file has {}",
+                json.buffers.len()
+            )
+        })?;
+        let offset = view.byte_offset.map_or(0, |o| o.0);
+        let len = view.byte_length.0;
+        if offset
+            .checked_add(len)
+            .is_none_or(|end| end > buffer.byte_length.0)
+        {
+            return Err(format!(
+                "buffer view {v} (offset {offset}, {len} bytes) reaches past the end of buffer {b} ({} bytes)",
+                buffer.byte_length.0
+            ));
+        }
+        let stride = view.byte_stride.map(|s| s.0 as u64).filter(|&s| s != 0);
+        Ok((len, stride))
+    };
+    // Does `count` elements of `elem` bytes, `stride` apart, from `offset` fit in `len` bytes?
+    let fits = |offset: u64, count: u64, stride: u64, elem: u64, len: u64| {
+        count == 0
+            || (count - 1)
+                .checked_mul(stride)
+                .and_then(|x| x.checked_add(offset))
+                .and_then(|x| x.checked_add(elem))
+                .is_some_and(|end| end <= len)
+    };
+    for (i, a) in json.accessors.iter().enumerate() {
+        let what = format!("accessor {i}");
+        let (Checked::Valid(ct), Checked::Valid(ty)) = (&a.component_type, &a.type_) else {
+            return Err(format!(
+                "{what} has an unknown component type or element type"
+            ));
+        };
+        let comp = ct.0.size() as u64;
+        let elem = comp * ty.multiplicity() as u64;
+        let count = a.count.0;
+        let offset = a.byte_offset.map_or(0, |o| o.0);
+        if let Some(v) = &a.buffer_view {
+            let (len, stride) = view_at(v.value(), &what)?;
+            if offset % comp != 0 {
+                return Err(format!(
+                    "{what}'s byteOffset {offset} is not a multiple of its component size {comp}"
+                ));
+            }
+            if let Some(s) = stride {
+                if !(4..=252).contains(&s) || s % comp != 0 || s < elem {
+                    return Err(format!(
+                        "{what} reads buffer view {} with byteStride {s}, but its elements are {elem} bytes of {comp}-byte components (glTF 2.0 needs a stride of 4 to 252, a multiple of {comp}, at least {elem})",
+                        v.value()
+                    ));
+                }
+            }
+            if !fits(offset, count, stride.unwrap_or(elem), elem, len) {
+                return Err(format!(
+                    "{what}'s {count} elements of {elem} bytes from offset {offset} reach past the end of buffer view {} ({len} bytes)",
+                    v.value()
+                ));
+            }
+        }
+        if let Some(sp) = &a.sparse {
+            let n = sp.count.0;
+            if n > count {
+                return Err(format!(
+                    "{what} has {n} sparse elements but only {count} elements"
+                ));
+            }
+            let Checked::Valid(it) = &sp.indices.component_type else {
+                return Err(format!(
+                    "{what}'s sparse indices have an unknown component type"
+                ));
+            };
+            use gltf::json::accessor::ComponentType as C;
+            if !matches!(it.0, C::U8 | C::U16 | C::U32) {
+                return Err(format!("{what}'s sparse indices are not u8, u16 or u32"));
+            }
+            let parts = [
+                (
+                    "indices",
+                    sp.indices.buffer_view.value(),
+                    sp.indices.byte_offset.0,
+                    it.0.size() as u64,
+                ),
+                (
+                    "values",
+                    sp.values.buffer_view.value(),
+                    sp.values.byte_offset.0,
+                    elem,
+                ),
+            ];
+            for (part, v, off, size) in parts {
+                let (len, stride) = view_at(v, &what)?;
+                if stride.is_some() {
+                    return Err(format!(
+                        "{what}'s sparse {part} use buffer view {v}, which declares a byteStride"
+                    ));
+                }
+                if !fits(off, n, size, size, len) {
+                    return Err(format!(
+                        "{what}'s {n} sparse {part} from offset {off} reach past the end of buffer view {v} ({len} bytes)"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The triangles and vertices of `mesh`'s primitives, from accessor counts (nothing is read).
 fn mesh_counts(mesh: &gltf::Mesh) -> (u64, u64) {
     let (mut tris, mut verts) = (0u64, 0u64);
@@ -759,6 +885,7 @@ fn import_slice(
             }
         }
     }
+    check_accessors(&json).map_err(bad)?;
     let document = gltf::Document::from_json(json).map_err(gerr)?;
     check_hierarchy(&document).map_err(bad)?;
     let roots: Vec<gltf::Node> = match document
@@ -769,12 +896,20 @@ fn import_slice(
         None => Vec::new(),
     };
     // Count what the scene instantiates before reading any buffer.
-    let (mut tris, mut verts) = (0u64, 0u64);
+    let (mut tris, mut verts, mut instances) = (0u64, 0u64, 0u64);
     if roots.is_empty() && document.scenes().len() == 0 {
         for mesh in document.meshes() {
             let (t, v) = mesh_counts(&mesh);
             tris = tris.saturating_add(t);
             verts = verts.saturating_add(v);
+        }
+        instances = document.meshes().map(|m| m.primitives().len() as u64).sum();
+        if instances > limits.max_meshes {
+            return Err(bad(format!(
+                "{instances} primitives (each becomes a mesh of its own), over the limit of {} \
+                 meshes",
+                limits.max_meshes
+            )));
         }
     } else {
         let mut stack = roots.clone();
@@ -783,6 +918,14 @@ fn import_slice(
                 let (t, v) = mesh_counts(&mesh);
                 tris = tris.saturating_add(t);
                 verts = verts.saturating_add(v);
+                instances = instances.saturating_add(mesh.primitives().len() as u64);
+                if instances > limits.max_meshes {
+                    return Err(bad(format!(
+                        "the scene instantiates more than {} primitives (each becomes a mesh of \
+                         its own), over the limit of {} meshes",
+                        limits.max_meshes, limits.max_meshes
+                    )));
+                }
             }
             stack.extend(node.children());
         }

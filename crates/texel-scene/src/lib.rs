@@ -43,6 +43,7 @@ mod procedural;
 mod tangents;
 mod texture;
 mod validate;
+pub use validate::MIN_FOVY_DEG;
 
 pub use builtin::{
     builtin, builtin_names, knot_mesh, shaded_builtin_names, GLOSSY_TOML, GROUND_ROTATION_DEG,
@@ -50,7 +51,8 @@ pub use builtin::{
 };
 pub use camera::Camera;
 pub use environment::{
-    default_sky_size, CubeCross, EnvironmentSource, EnvironmentSpec, Sky, MAX_SKY_WIDTH,
+    default_sky_size, max_sky_width, CubeCross, EnvironmentSource, EnvironmentSpec, Sky,
+    MAX_SKY_TEXELS, MAX_SKY_WIDTH,
 };
 pub use error::SceneError;
 pub use gltf_import::{import_gltf, load_gltf, load_gltf_slice, load_gltf_with, GltfScene};

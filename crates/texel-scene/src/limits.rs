@@ -20,6 +20,9 @@ pub struct SceneLimits {
     /// Most vertices in the whole scene (glTF instances counted once per instance).
     /// Default 2^25.
     pub max_vertices: u64,
+    /// Most meshes in the whole scene: inline entries, and every instance of a glTF primitive
+    /// (each is a mesh of its own, with its own copy of the vertices). Default 2^16 = 65,536.
+    pub max_meshes: u64,
 }
 
 impl Default for SceneLimits {
@@ -29,6 +32,7 @@ impl Default for SceneLimits {
             max_mesh_file_bytes: 512 << 20,
             max_triangles: 1 << 25,
             max_vertices: 1 << 25,
+            max_meshes: 1 << 16,
         }
     }
 }

@@ -392,6 +392,51 @@ impl Procedural {
     }
 }
 
+/// Most sinusoids a [`Procedural::Waves`] texture may sum.
+pub const MAX_WAVES: u32 = 4096;
+
+/// Most wave terms (texels x waves) a [`Procedural::Waves`] texture may evaluate: 2^31, about 30 s
+/// on one core. The default (512 x 512 texels, 64 waves) is 2^24.
+pub const MAX_WAVE_TERMS: u64 = 1 << 31;
+
+impl Procedural {
+    /// Check the work a texture's parameters ask for before any of it is done: the number of
+    /// waves ([`MAX_WAVES`]), the wave terms ([`MAX_WAVE_TERMS`]), and the ring of wave numbers
+    /// (`cells`, at most half the size: finer waves than two texels alias).
+    ///
+    /// # Errors
+    /// A message naming the parameter, the bound and what to change.
+    pub fn check_work(&self) -> Result<(), String> {
+        if let Procedural::Waves {
+            size, waves, cells, ..
+        } = *self
+        {
+            if waves > MAX_WAVES {
+                return Err(format!(
+                    "waves = {waves} is over texel's bound of {MAX_WAVES} sinusoids a texture \
+                     (their slopes are already close to Gaussian at 64)"
+                ));
+            }
+            if cells > (size / 2).max(1) {
+                return Err(format!(
+                    "cells = {cells} is over half the size ({}): waves finer than two texels \
+                     alias",
+                    (size / 2).max(1)
+                ));
+            }
+            let terms = u64::from(size) * u64::from(size) * u64::from(waves);
+            if terms > MAX_WAVE_TERMS {
+                return Err(format!(
+                    "size = {size} with waves = {waves} is {terms} wave terms (texels x waves), \
+                     over texel's bound of {MAX_WAVE_TERMS} (about 30 s of work): use fewer \
+                     waves or a smaller size"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Radius, degrees on the sphere, of [`Procedural::Globe`]'s discs.
 pub const GLOBE_DISC_DEG: f64 = 6.0;
 /// Width, degrees on the sphere, of [`Procedural::Globe`]'s lines.

@@ -35,10 +35,16 @@ fn finite_all<T: Copy>(
     }
 }
 
+/// The narrowest vertical field of view a camera may have, in degrees. At 0.01 degrees a pixel of
+/// a 4096-row image subtends 4.3e-8 radians, about f32's relative precision (6e-8), so view
+/// coordinates still place a point within about a pixel; narrower views quantise the image into
+/// blocks of pixels and, far narrower, overflow the projection and draw nothing. They are refused.
+pub const MIN_FOVY_DEG: f32 = 0.01;
+
 impl Scene {
     /// Check everything a renderer relies on:
     /// output sides in `1..=MAX_OUTPUT_SIDE`; camera values finite, `0 < near < far`,
-    /// `0 < fovy_deg < 180`, `eye != target`, `up` not parallel to the view direction; per mesh
+    /// `MIN_FOVY_DEG <= fovy_deg < 180`, `eye != target`, `up` not parallel to the view direction; per mesh
     /// `uvs`/`normals`/`colors` as long as `positions`, every index in range, every value finite,
     /// its texture defined; at least one mesh, each with at least one triangle.
     ///
@@ -78,13 +84,16 @@ impl Scene {
                 far: c.far,
             });
         }
-        if !(c.fovy_deg > 0.0 && c.fovy_deg < 180.0) {
+        if !(c.fovy_deg >= MIN_FOVY_DEG && c.fovy_deg < 180.0) {
             return Err(SceneError::CameraFov(c.fovy_deg));
         }
-        let dir = c.target - c.eye;
-        let cross = dir.cross(c.up).length();
+        // In f64: a camera 1e30 away or a view 1e-30 long has lengths whose squares leave f32's
+        // range, which would call it degenerate.
+        let dir = c.target.as_dvec3() - c.eye.as_dvec3();
+        let up = c.up.as_dvec3();
+        let cross = dir.cross(up).length();
         // All finite here, so plain comparisons decide.
-        if dir.length() == 0.0 || cross <= 1e-6 * dir.length() * c.up.length() {
+        if dir.length() == 0.0 || cross <= 1e-6 * dir.length() * up.length() {
             return Err(SceneError::CameraDegenerate {
                 eye: c.eye.to_array(),
                 target: c.target.to_array(),
@@ -197,7 +206,7 @@ impl Scene {
                     direction,
                     intensity,
                 } => {
-                    if direction.is_finite() && direction.length() == 0.0 {
+                    if direction.is_finite() && direction.as_dvec3().length() == 0.0 {
                         return Err(SceneError::Light(format!(
                             "lights[{k}].direction is zero; it points towards the light"
                         )));

@@ -104,6 +104,36 @@ pub fn read_regular(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
     if len > max_bytes {
         return Err(too_large(len, max_bytes));
     }
+    if len == 0 {
+        // A size of 0 is not trusted: kernel pseudo-files (`/proc/self/pagemap`, files under
+        // `/sys`) report it and then yield bytes without end. Such a file may yield at most
+        // PSEUDO_FILE_BYTES; a real empty file yields none.
+        let mut out = Vec::new();
+        let cap = max_bytes.min(PSEUDO_FILE_BYTES);
+        // Whole blocks (some pseudo-files refuse reads that are not a multiple of 8 bytes).
+        let mut file = file;
+        let mut block = vec![0u8; 64 << 10];
+        while out.len() as u64 <= cap {
+            let n = match file.read(&mut block) {
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                r => r?,
+            };
+            if n == 0 {
+                break;
+            }
+            out.extend_from_slice(&block[..n]);
+        }
+        if out.len() as u64 > cap {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "reports a size of 0 bytes but yields more than {cap}: a pseudo-file (such \
+                     as /proc/self/pagemap), not an input texel reads"
+                ),
+            ));
+        }
+        return Ok(out);
+    }
     let mut out = Vec::new();
     out.try_reserve_exact(len as usize).map_err(|_| {
         io::Error::new(
@@ -118,6 +148,9 @@ pub fn read_regular(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
     }
     Ok(out)
 }
+
+/// The most bytes [`read_regular`] takes from a file whose reported size is 0.
+pub const PSEUDO_FILE_BYTES: u64 = 1 << 20;
 
 fn too_large(len: u64, max: u64) -> io::Error {
     io::Error::new(
@@ -225,6 +258,20 @@ mod tests {
         );
         let e = read_regular(&dir, 100).unwrap_err();
         assert!(e.to_string().contains("a directory"), "{e}");
+        // An empty file is empty; a pseudo-file that reports 0 bytes and yields more is refused
+        // after at most PSEUDO_FILE_BYTES.
+        let empty = dir.join("empty");
+        std::fs::write(&empty, b"").unwrap();
+        assert!(read_regular(&empty, 100).unwrap().is_empty());
+        #[cfg(target_os = "linux")]
+        {
+            let e = read_regular(Path::new("/proc/self/pagemap"), u64::MAX).unwrap_err();
+            assert!(e.to_string().contains("pseudo-file"), "{e}");
+            // One that yields less is read whole, within the caller's bound.
+            let status = read_regular(Path::new("/proc/self/status"), 1 << 20).unwrap();
+            assert!(status.starts_with(b"Name:"));
+            assert!(read_regular(Path::new("/proc/self/status"), 4).is_err());
+        }
         #[cfg(target_os = "linux")]
         {
             let e = read_regular(Path::new("/dev/zero"), 100).unwrap_err();

@@ -59,8 +59,8 @@ pub struct RenderOptions {
     pub color: ColorHandling,
     /// What each pixel shows (the textured colour, or a debug view).
     pub view: View,
-    /// Most bytes the render may hold at once (meshes, textures, frame); `None`: half of the
-    /// machine's memory ([`MemoryBudget::half_of_machine`]).
+    /// Most bytes the render may hold at once (meshes, textures, frame); `None`: the process's
+    /// default ([`MemoryBudget::process_default`]).
     pub max_memory: Option<u64>,
 }
 
@@ -92,7 +92,7 @@ pub fn frame_image(
 pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Error> {
     let mut budget = match options.max_memory {
         Some(b) => MemoryBudget::new(b, format!("the memory limit of {}", memory::mib(b))),
-        None => MemoryBudget::half_of_machine(),
+        None => MemoryBudget::process_default(),
     };
     let prepared = PreparedScene::new(
         scene.clone(),

@@ -19,6 +19,10 @@ pub const FRAME_BYTES_PER_PIXEL: u64 = 40;
 /// and the rasterizer's [`texel_raster::Vertex`].
 pub const VERTEX_BYTES: u64 = 48 + std::mem::size_of::<texel_raster::Vertex>() as u64;
 
+/// What a scene keeps per mesh beyond its vertices and triangles, as an allowance: the mesh's
+/// record and names, its vectors' allocations, and the renderer's per-draw state.
+pub const MESH_BYTES: u64 = 4096;
+
 /// What a scene keeps per triangle: its indices (12 bytes). The rasterizer's per-frame set-up and
 /// tile bins depend on where the triangle lands on screen: [`raster_bytes`].
 pub const TRIANGLE_BYTES: u64 = 12;
@@ -123,6 +127,82 @@ pub fn machine_memory() -> Option<u64> {
     }
 }
 
+/// A field of a `/proc` text file (`Key: value ...`), its first number.
+fn proc_field(text: &str, key: &str) -> Option<u64> {
+    text.lines()
+        .find_map(|l| l.strip_prefix(key))
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+}
+
+/// The soft limit in bytes of a `/proc/self/limits` row (`None` for "unlimited").
+fn soft_limit(limits: &str, row: &str) -> Option<u64> {
+    limits
+        .lines()
+        .find_map(|l| l.strip_prefix(row))
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+}
+
+/// The share of a process limit's headroom that the default budget grants: the rest covers what
+/// no account charges (the allocator's arenas, thread stacks, decoders' and encoders' scratch).
+const PROCESS_LIMIT_SHARE: u64 = 2;
+
+/// The default memory limit of a piece of work and what set it: the smallest of half of the
+/// machine's memory (`MemTotal`), the cgroup's limit (v2 `memory.max`, v1
+/// `memory.limit_in_bytes`), and half of what the address-space (`ulimit -v`, `RLIMIT_AS`) and
+/// data (`ulimit -d`, `RLIMIT_DATA`) limits leave above what the process already maps. Where none
+/// can be read, [`FALLBACK_BYTES`].
+pub fn default_limit() -> (u64, String) {
+    let read = |p: &str| std::fs::read_to_string(p).ok();
+    let mut best: Option<(u64, String)> = None;
+    let mut offer = |bytes: u64, why: String| {
+        if best.as_ref().is_none_or(|(b, _)| bytes < *b) {
+            best = Some((bytes, why));
+        }
+    };
+    if let Some(kb) = read("/proc/meminfo").and_then(|s| proc_field(&s, "MemTotal:")) {
+        offer(kb * 1024 / 2, "half of this machine's memory".into());
+    }
+    for p in [
+        "/sys/fs/cgroup/memory.max",
+        "/sys/fs/cgroup/memory/memory.limit_in_bytes",
+    ] {
+        if let Some(b) = read(p).and_then(|s| s.trim().parse::<u64>().ok()) {
+            offer(b, format!("the cgroup's memory limit ({p})"));
+        }
+    }
+    if let (Some(limits), Some(status)) = (read("/proc/self/limits"), read("/proc/self/status")) {
+        let rows = [
+            (
+                "Max address space",
+                "VmSize:",
+                "the address-space limit (ulimit -v)",
+            ),
+            (
+                "Max data size",
+                "VmData:",
+                "the data-size limit (ulimit -d)",
+            ),
+        ];
+        for (row, held, name) in rows {
+            if let Some(limit) = soft_limit(&limits, row) {
+                let used = proc_field(&status, held).unwrap_or(0) * 1024;
+                let room = limit.saturating_sub(used) / PROCESS_LIMIT_SHARE;
+                offer(
+                    room,
+                    format!(
+                        "half of what {name} of {} leaves above the {} this process maps",
+                        mib(limit),
+                        mib(used)
+                    ),
+                );
+            }
+        }
+    }
+    best.unwrap_or((FALLBACK_BYTES, "texel's fallback limit".into()))
+}
+
 /// The running account of one piece of work against a limit.
 #[derive(Clone, Debug)]
 pub struct MemoryBudget {
@@ -139,6 +219,12 @@ impl MemoryBudget {
             used: 0,
             name: name.into(),
         }
+    }
+
+    /// The default budget: [`default_limit`], named after the limit that set it.
+    pub fn process_default() -> Self {
+        let (limit, why) = default_limit();
+        Self::new(limit, format!("the memory limit of {} ({why})", mib(limit)))
     }
 
     /// Half of [`machine_memory`] (or [`FALLBACK_BYTES`] where it cannot be read).
@@ -185,6 +271,11 @@ impl MemoryBudget {
         self.used = total;
         Ok(())
     }
+
+    /// Return `bytes` taken earlier whose memory is freed (at most what is in use).
+    pub fn release(&mut self, bytes: u64) {
+        self.used = self.used.saturating_sub(bytes);
+    }
 }
 
 #[cfg(test)]
@@ -196,6 +287,9 @@ mod tests {
         let mut b = MemoryBudget::new(10 << 20, "--max-memory 10.0 MiB");
         b.take("a", 6 << 20).unwrap();
         assert_eq!(b.remaining(), 4 << 20);
+        b.release(1 << 20);
+        assert_eq!(b.remaining(), 5 << 20);
+        b.take("a", 1 << 20).unwrap();
         let e = b.take("the frame", 5 << 20).unwrap_err().to_string();
         assert!(e.contains("the frame needs about 5.0 MiB on top of 6.0 MiB already held, 11.0 MiB in all, over --max-memory 10.0 MiB"), "{e}");
         assert_eq!(b.remaining(), 4 << 20);

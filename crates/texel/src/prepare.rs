@@ -106,7 +106,7 @@ pub fn relay_sky(
         Mapping::Octahedral => 2,
     };
     let width = (sky.width * per_width(spec.mapping) / per_width(mapping))
-        .clamp(2, texel_scene::MAX_SKY_WIDTH);
+        .clamp(2, texel_scene::max_sky_width(mapping));
     Ok(texel_scene::EnvironmentSpec {
         mapping,
         source: EnvironmentSource::Sky(texel_scene::Sky { width, ..*sky }),
@@ -175,16 +175,37 @@ pub struct PreparedScene {
 }
 
 /// Load the environment map of `spec` within what `budget` has left and prefilter it (its
-/// glossy pyramid and irradiance), charging both.
+/// glossy pyramid and irradiance), charging both; with `replace_non_finite`, NaN and infinite
+/// texels of its files are replaced (their count is returned) instead of refused.
 fn environment_maps(
     spec: &texel_scene::EnvironmentSpec,
     budget: &mut MemoryBudget,
-) -> Result<EnvironmentMaps, Error> {
+    replace_non_finite: bool,
+) -> Result<(EnvironmentMaps, u64), Error> {
     let limits = Limits {
         max_bytes: budget.remaining(),
         ..Limits::default()
     };
-    let faces = spec.load(&limits)?;
+    if let texel_scene::EnvironmentSource::Sky(sky) = &spec.source {
+        // A procedural sky is charged before any of it is made: its layers' pyramids, the
+        // texels of the layer being made, and the prefiltered maps.
+        let (w, h) = sky.layer_size(spec.mapping);
+        let f = texel_texture::Format::Rgba32Float.texel_bytes();
+        let layer = texel_texture::pyramid::pyramid_texels(w, h) * f;
+        let made = u64::from(w) * u64::from(h) * f;
+        let need = layer * spec.mapping.layers() as u64
+            + made
+            + EnvironmentMaps::extra_bytes(spec.mapping, w, h);
+        if need > budget.remaining() {
+            return Err(Error::OverBudget {
+                what: format!("the procedural sky ({w}x{h} a layer) and its prefiltered maps"),
+                bytes: need,
+                used: budget.limit() - budget.remaining(),
+                limit: budget.name().to_string(),
+            });
+        }
+    }
+    let (faces, replaced) = spec.load_with(&limits, replace_non_finite)?;
     budget.take(
         "the environment map",
         faces.iter().map(Texture::pyramid_bytes).sum(),
@@ -194,11 +215,8 @@ fn environment_maps(
         "the environment's prefiltered pyramid and irradiance",
         EnvironmentMaps::extra_bytes(spec.mapping, w, h),
     )?;
-    Ok(EnvironmentMaps::new(
-        spec.mapping,
-        faces,
-        &Limits::default(),
-    )?)
+    let maps = EnvironmentMaps::new(spec.mapping, faces, &Limits::default())?;
+    Ok((maps, replaced))
 }
 
 impl PreparedScene {
@@ -256,7 +274,13 @@ impl PreparedScene {
             scene.environment = Some(relay_sky(spec, options.environment_mapping)?);
         }
         let environment = match &scene.environment {
-            Some(spec) => Some(environment_maps(spec, budget)?),
+            Some(spec) => {
+                let (maps, n) = environment_maps(spec, budget, options.replace_non_finite)?;
+                if n > 0 {
+                    replaced.push(("environment".to_string(), n));
+                }
+                Some(maps)
+            }
             None => None,
         };
         let mut own_samplers: Vec<TextureSampler> = Vec::new();
@@ -830,7 +854,7 @@ impl PreparedScene {
                     direction,
                     intensity,
                 } => Light::Directional {
-                    direction,
+                    direction: shading_direction(direction),
                     intensity,
                 },
                 LightSpec::Point {
@@ -1153,4 +1177,39 @@ fn texel_vertices(mesh: &texel_scene::Mesh) -> Vec<Vertex> {
             v
         })
         .collect()
+}
+
+/// A light direction as the shading normalises it: unchanged where its length squared is a normal
+/// f32, else the unit vector of the same direction found in f64 (a direction of `[3e38, 3e38,
+/// 3e38]` overflows f32's length and one of `1e-30` underflows it; both name a direction).
+pub fn shading_direction(direction: glam::Vec3) -> glam::Vec3 {
+    let l = direction.length_squared();
+    if l.is_normal() && l.is_finite() {
+        return direction;
+    }
+    direction
+        .as_dvec3()
+        .try_normalize()
+        .map_or(direction, |d| d.as_vec3())
+}
+
+#[cfg(test)]
+mod direction_tests {
+    use super::shading_direction;
+    use glam::Vec3;
+
+    #[test]
+    fn directions_beyond_f32_squares_keep_their_direction() {
+        let d = Vec3::new(1.0, 2.0, 2.0);
+        assert_eq!(shading_direction(d), d);
+        let huge = shading_direction(Vec3::splat(3e38));
+        let want = Vec3::splat(1.0 / 3f32.sqrt());
+        assert!((huge - want).length() < 1e-6, "{huge}");
+        let tiny = shading_direction(Vec3::new(0.0, 1e-30, -1e-30));
+        assert!(
+            (tiny - Vec3::new(0.0, 1.0, -1.0).normalize()).length() < 1e-6,
+            "{tiny}"
+        );
+        assert!((huge.length() - 1.0).abs() < 1e-6);
+    }
 }
