@@ -1,5 +1,6 @@
 //! glTF/GLB import (embedded buffers only): any bytes either fail with an error or yield meshes
-//! within the limits (index ranges are checked later, by `Scene::validate`).
+//! within the limits: triangles, vertices and meshes (index ranges are checked later, by
+//! `Scene::validate`).
 #![no_main]
 
 use std::path::Path;
@@ -12,6 +13,7 @@ fuzz_target!(|data: &[u8]| {
         max_mesh_file_bytes: 1 << 20,
         max_triangles: 1 << 16,
         max_vertices: 1 << 16,
+        max_meshes: 1 << 10,
         ..SceneLimits::default()
     };
     if let Ok(meshes) = load_gltf_slice(data, None, Path::new("fuzz.gltf"), "t", &limits) {
@@ -19,5 +21,6 @@ fuzz_target!(|data: &[u8]| {
         assert!(tris as u64 <= limits.max_triangles && tris > 0);
         let verts: usize = meshes.iter().map(|m| m.positions.len()).sum();
         assert!(verts as u64 <= limits.max_vertices);
+        assert!(meshes.len() as u64 <= limits.max_meshes);
     }
 });

@@ -64,6 +64,6 @@ pub use model::{
     MAX_SHADING_SAMPLES,
 };
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
-pub use procedural::{NoiseKind, Procedural};
+pub use procedural::{NoiseKind, Procedural, MAX_WAVES, MAX_WAVE_TERMS};
 pub use texel_texture::sphere::Mapping;
 pub use texture::TextureUse;
