@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use clap::builder::TypedValueParser;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::budget::ByteSize;
@@ -356,7 +357,7 @@ pub struct RenderArgs {
     pub adapter: Option<String>,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
-    #[arg(short, long, value_parser = crate::output::image_output)]
+    #[arg(short, long, value_parser = image_output())]
     pub output: PathBuf,
 }
 
@@ -385,7 +386,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub frames: Option<u32>,
     /// Write the last frame shown (overlays included unless --no-hud) to this PNG at exit.
-    #[arg(long, value_name = "PATH", value_parser = crate::output::png_output)]
+    #[arg(long, value_name = "PATH", value_parser = png_output())]
     pub screenshot: Option<PathBuf>,
     /// Hide the heads-up display and the split-screen divider line, so the window (and a
     /// screenshot) shows exactly the rendered frame; H still shows the key table.
@@ -404,7 +405,7 @@ pub struct ReferenceArgs {
     pub spp: u32,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
-    #[arg(short, long, value_parser = crate::output::image_output)]
+    #[arg(short, long, value_parser = image_output())]
     pub output: PathBuf,
 }
 
@@ -695,7 +696,7 @@ pub struct WarpArgs {
     pub color: ColorArg,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
-    #[arg(short, long, value_parser = crate::output::image_output)]
+    #[arg(short, long, value_parser = image_output())]
     pub output: PathBuf,
 }
 
@@ -741,7 +742,7 @@ pub struct BakeAoArgs {
     pub threads: Option<u32>,
     /// Output image: PNG, 8-bit grey, linear (1 = unoccluded; read it with color = "linear"), or
     /// for a name ending in `.exr`, OpenEXR with the occlusion as 32-bit floats.
-    #[arg(short, long, value_parser = crate::output::image_output)]
+    #[arg(short, long, value_parser = image_output())]
     pub output: PathBuf,
 }
 
@@ -751,4 +752,14 @@ fn positive_f32(s: &str) -> Result<f32, String> {
         Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
         _ => Err(format!("{s:?} is not a finite number above 0")),
     }
+}
+
+/// clap's parser for `-o`: any path bytes, checked by [`crate::output::image_output`].
+fn image_output() -> impl TypedValueParser<Value = PathBuf> {
+    clap::builder::OsStringValueParser::new().try_map(crate::output::image_output)
+}
+
+/// clap's parser for `--screenshot`: [`crate::output::png_output`].
+fn png_output() -> impl TypedValueParser<Value = PathBuf> {
+    clap::builder::OsStringValueParser::new().try_map(crate::output::png_output)
 }

@@ -29,15 +29,16 @@ pub fn is_exr(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
-/// Parse an image output path for clap: a name ending in `.png`, `.exr` or in no image format's
+/// Parse an image output path for clap (any bytes, not only UTF-8): a name ending in `.png`, `.exr` or in no image format's
 /// extension (`-`, `/dev/stdout`, `out.bin`) is accepted; one naming a format texel does not write
 /// (`.jpg`, `.tif`, `.hdr`, ...) is refused before any work, rather than written as PNG bytes
 /// under a name that says otherwise.
 ///
 /// # Errors
 /// A message naming the extension and the formats texel writes.
-pub fn image_output(s: &str) -> Result<std::path::PathBuf, String> {
+pub fn image_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
     let path = std::path::PathBuf::from(s);
+    let s = path.display().to_string();
     if let Some(ext) = path.extension().and_then(|e| e.to_str()) {
         let known = image::ImageFormat::from_extension(ext);
         if known.is_some_and(|f| f != image::ImageFormat::Png && f != image::ImageFormat::OpenExr) {
@@ -55,8 +56,9 @@ pub fn image_output(s: &str) -> Result<std::path::PathBuf, String> {
 ///
 /// # Errors
 /// As [`image_output`].
-pub fn png_output(s: &str) -> Result<std::path::PathBuf, String> {
+pub fn png_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
     let path = image_output(s)?;
+    let s = path.display().to_string();
     if is_exr(&path) {
         return Err(format!(
             "{s:?} names an OpenEXR image; this output is 8-bit PNG only (use a .png name)"

@@ -94,6 +94,22 @@ fn gpu_renders_the_lab_modes() {
     let out = texel(&["gpu-info"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(String::from_utf8_lossy(&out.stdout).contains("--gpu uses:"));
+    // Headless (no display, no runtime directory), a command that succeeds prints no error line:
+    // Mesa's device-select layer would try a Wayland connection and print one.
+    let headless = std::process::Command::new(env!("CARGO_BIN_EXE_texel"))
+        .arg("gpu-info")
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("DISPLAY")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    assert!(headless.status.success());
+    assert!(
+        !stderr(&headless).contains("error"),
+        "{}",
+        stderr(&headless)
+    );
 }
 
 #[test]

@@ -161,8 +161,27 @@ impl fmt::Display for AdapterSummary {
     }
 }
 
+/// On a machine without a display, turn off Mesa's Vulkan device-select layer for this process
+/// (its documented switch `NODEVICE_SELECT=1`, unless the user set it): the layer orders devices by
+/// the display's GPU, and without a display it only tries a Wayland connection that prints
+/// `error: XDG_RUNTIME_DIR is invalid or not set` on every instance. texel picks its adapter by
+/// name itself.
+fn quiet_headless_layers() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let unset = |k: &str| std::env::var_os(k).is_none_or(|v| v.is_empty());
+        if unset("WAYLAND_DISPLAY")
+            && unset("DISPLAY")
+            && std::env::var_os("NODEVICE_SELECT").is_none()
+        {
+            std::env::set_var("NODEVICE_SELECT", "1");
+        }
+    });
+}
+
 /// The adapters of one backend.
 fn enumerate(backends: wgpu::Backends) -> Vec<wgpu::Adapter> {
+    quiet_headless_layers();
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
         backends,
         ..wgpu::InstanceDescriptor::new_without_display_handle_from_env()

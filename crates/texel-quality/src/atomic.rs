@@ -137,13 +137,19 @@ fn fd_info(link: &Path) -> Option<(u32, u64)> {
     Some((flags, pos))
 }
 
-/// Linux's `O_APPEND` (octal 02000 on every architecture texel builds for).
+/// Linux's `O_APPEND` (octal 010 on MIPS, SPARC and Alpha, 02000 elsewhere).
+#[cfg(not(any(target_arch = "mips", target_arch = "mips64", target_arch = "sparc64")))]
 const O_APPEND: u32 = 0o2000;
+#[cfg(any(target_arch = "mips", target_arch = "mips64", target_arch = "sparc64"))]
+const O_APPEND: u32 = 0o10;
+/// Linux's access-mode bits of a descriptor's flags (0: read only).
+const O_ACCMODE: u32 = 0o3;
 
 /// Write `bytes` through an open descriptor's link: this process's standard output and error
-/// through their own handles (sharing the shell's offset and append mode), any other descriptor
-/// by reopening its link in its own mode: appending if it appends, else at its current offset.
-/// Nothing is truncated, renamed or created.
+/// through their own handles (sharing the shell's offset and append mode); any other descriptor
+/// by reopening its link: appending where it appends, and a pipe, terminal or device as it is. A
+/// descriptor open for reading only, or a regular file's that does not append (its offset could
+/// not be moved past texel's bytes), is refused. Nothing is truncated, renamed or created.
 fn write_descriptor(d: &FdLink, bytes: &[u8], path: &Path) -> Result<(), QualityError> {
     if d.own && (d.fd == 1 || d.fd == 2) {
         let written = if d.fd == 1 {
@@ -163,18 +169,36 @@ fn write_descriptor(d: &FdLink, bytes: &[u8], path: &Path) -> Result<(), Quality
             "is an open directory, not a file",
         ));
     }
-    let (flags, pos) = fd_info(&d.link).unwrap_or((O_APPEND, 0));
+    let Some((flags, _pos)) = fd_info(&d.link) else {
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::InvalidInput,
+            "names an open descriptor whose mode cannot be read (/proc/PID/fdinfo)",
+        ));
+    };
+    if flags & O_ACCMODE == 0 {
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::PermissionDenied,
+            "names a descriptor open for reading only: texel does not write into it",
+        ));
+    }
     let append = flags & O_APPEND != 0;
+    if meta.is_file() && !append {
+        // Reopened, the file would be written at the descriptor's offset without moving it, and
+        // the descriptor's next write would overwrite texel's bytes.
+        return Err(refuse(
+            path,
+            std::io::ErrorKind::InvalidInput,
+            "names a descriptor on a regular file that is not open for appending: open it with \
+             >> or give the file's own path",
+        ));
+    }
     let mut file = OpenOptions::new()
         .write(true)
         .append(append)
         .open(&d.link)
         .map_err(io_err(path))?;
-    if !append && meta.is_file() {
-        use std::io::Seek;
-        file.seek(std::io::SeekFrom::Start(pos))
-            .map_err(io_err(path))?;
-    }
     file.write_all(bytes)
         .and_then(|()| file.flush())
         .map_err(io_err(path))
@@ -315,7 +339,29 @@ fn owner_gone(pid: u32, entry: &fs::DirEntry) -> bool {
 }
 
 /// Remove temporaries `dir/{tag}PID.N...tmp` whose process is gone (left by a SIGKILL).
-fn remove_stale(dir: &Path, tag: &str) {
+/// A directory that a killed [`publish_dir`] moved aside (`....old.tmp`) may hold files a user
+/// saved into the published directory: unless everything in it is listed by its marker, it is
+/// kept, renamed beside `target` as `NAME.texel-kept`, never deleted.
+fn settle_stale_old(p: &Path, target: Option<&Path>) {
+    let owned = Owned::of(p);
+    let mut foreign = Vec::new();
+    clashes_or_foreign(p, None, &owned, Path::new(""), &mut foreign);
+    if foreign.is_empty() {
+        let _ = fs::remove_dir_all(p);
+    } else if let Some(target) = target {
+        let kept = visible_sibling(target, "kept");
+        if fs::rename(p, &kept).is_ok() {
+            eprintln!(
+                "texel: warning: an interrupted earlier publish of {} left files texel did not \
+                 write; they are kept in {}",
+                target.display(),
+                kept.display()
+            );
+        }
+    }
+}
+
+fn remove_stale(dir: &Path, tag: &str, target: Option<&Path>) {
     let Ok(entries) = fs::read_dir(dir) else {
         return;
     };
@@ -332,8 +378,15 @@ fn remove_stale(dir: &Path, tag: &str) {
         };
         if owner_gone(pid, &entry) {
             let p = entry.path();
-            if fs::remove_file(&p).is_err() {
-                let _ = fs::remove_dir_all(&p);
+            if entry.file_type().is_ok_and(|t| t.is_dir()) {
+                if rest.ends_with(".old.tmp") {
+                    settle_stale_old(&p, target);
+                } else {
+                    // A staging directory: only what texel wrote.
+                    let _ = fs::remove_dir_all(&p);
+                }
+            } else {
+                let _ = fs::remove_file(&p);
             }
         }
     }
@@ -369,7 +422,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), QualityError> {
         Destination::Replaceable(p) => p,
     };
     let (dir, tag) = split_dest(&target)?;
-    remove_stale(&dir, &tag);
+    remove_stale(&dir, &tag, None);
     let tmp = temporary(&dir, &tag, "");
     let mut file = {
         let mut guard = pending();
@@ -416,7 +469,7 @@ const MARKER_HEADER: &str = "written by texel; may be replaced by texel";
 enum Owned {
     /// The files listed in the marker (relative paths); an unmarked directory lists none.
     Listed(HashSet<PathBuf>),
-    /// A marker without a list: the files no newer than the marker.
+    /// A marker without a list: the files older than the marker ([`older`]).
     Before(SystemTime),
 }
 
@@ -444,9 +497,7 @@ impl Owned {
         }
         match self {
             Owned::Listed(set) => set.contains(rel),
-            Owned::Before(t) => fs::symlink_metadata(full)
-                .and_then(|m| m.modified())
-                .is_ok_and(|m| m <= *t),
+            Owned::Before(t) => fs::symlink_metadata(full).is_ok_and(|m| older(&m, *t)),
         }
     }
 
@@ -456,6 +507,27 @@ impl Owned {
             Owned::Listed(set) => set.iter().any(|p| p.starts_with(rel)),
             Owned::Before(_) => true,
         }
+    }
+}
+
+/// Whether a file's modification and (on Unix) status-change times both lie strictly before `t`:
+/// a file moved or copied into a directory after its marker keeps an old modification time, but
+/// gets a new change time.
+fn older(m: &fs::Metadata, t: SystemTime) -> bool {
+    let modified = m.modified().is_ok_and(|x| x < t);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let since = |x: SystemTime| x.duration_since(SystemTime::UNIX_EPOCH).ok();
+        let changed = since(t).is_some_and(|d| {
+            let c = std::time::Duration::new(m.ctime().max(0) as u64, m.ctime_nsec().max(0) as u32);
+            c < d
+        });
+        modified && changed
+    }
+    #[cfg(not(unix))]
+    {
+        modified
     }
 }
 
@@ -492,6 +564,17 @@ fn write_marker(staging: &Path) -> std::io::Result<()> {
 /// Entries of `old` (a directory texel is about to replace) that texel did not write and whose
 /// name is taken in `new`: carrying them over would replace the new output's file.
 fn clashes(old: &Path, new: &Path, owned: &Owned, rel: &Path, out: &mut Vec<PathBuf>) {
+    clashes_or_foreign(old, Some(new), owned, rel, out);
+}
+
+/// With `new`, [`clashes`]; without, every entry of `old` that texel did not write.
+fn clashes_or_foreign(
+    old: &Path,
+    new: Option<&Path>,
+    owned: &Owned,
+    rel: &Path,
+    out: &mut Vec<PathBuf>,
+) {
     let Ok(entries) = fs::read_dir(old.join(rel)) else {
         return;
     };
@@ -499,9 +582,9 @@ fn clashes(old: &Path, new: &Path, owned: &Owned, rel: &Path, out: &mut Vec<Path
         let r = rel.join(entry.file_name());
         let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
         if is_dir && owned.may_hold(&r) {
-            clashes(old, new, owned, &r, out);
+            clashes_or_foreign(old, new, owned, &r, out);
         } else if (is_dir || !owned.file(&r, &entry.path()))
-            && fs::symlink_metadata(new.join(&r)).is_ok()
+            && new.is_none_or(|n| fs::symlink_metadata(n.join(&r)).is_ok())
         {
             out.push(r);
         }
@@ -528,7 +611,15 @@ fn carry_over(old: &Path, new: &Path, owned: &Owned, rel: &Path) {
         } else if !is_dir && owned.file(&r, &from) {
             let _ = fs::remove_file(&from);
         } else if fs::symlink_metadata(&to).is_err() {
-            let _ = fs::rename(&from, &to);
+            if is_dir {
+                let _ = fs::rename(&from, &to);
+            } else if fs::hard_link(&from, &to).is_ok() {
+                // A link fails where the name is taken meanwhile: nothing is replaced.
+                let _ = fs::remove_file(&from);
+            } else if !entry.file_type().is_ok_and(|t| t.is_file()) {
+                // A symbolic link, FIFO or socket: moved as it is.
+                let _ = fs::rename(&from, &to);
+            }
         }
     }
 }
@@ -622,7 +713,7 @@ pub fn publish_dir<T, E: From<QualityError>>(
     }
     let (parent, tag) = split_dest(&target)?;
     fs::create_dir_all(&parent).map_err(io_err(dest))?;
-    remove_stale(&parent, &tag);
+    remove_stale(&parent, &tag, Some(&target));
     let staging = temporary(&parent, &tag, "");
     {
         let mut guard = pending();
@@ -1098,9 +1189,19 @@ mod tests {
         let out = d.join("out");
         fs::create_dir(&out).unwrap();
         fs::write(out.join("old.png"), b"o").unwrap();
+        // Files older than such a marker are texel's; a later one is the user's (the pauses are
+        // longer than the kernel's coarse clock tick).
+        std::thread::sleep(std::time::Duration::from_millis(50));
         fs::write(out.join(OUTPUT_MARKER), format!("{MARKER_HEADER}\n")).unwrap();
-        // Files no newer than such a marker are texel's; a later one is the user's.
-        std::thread::sleep(std::time::Duration::from_millis(20));
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        // A file moved in keeps its old modification time, but not its change time.
+        let moved = d.join("photo.jpg");
+        fs::write(&moved, b"p").unwrap();
+        let f = fs::File::options().write(true).open(&moved).unwrap();
+        f.set_modified(SystemTime::UNIX_EPOCH + std::time::Duration::from_secs(1))
+            .unwrap();
+        drop(f);
+        fs::rename(&moved, out.join("photo.jpg")).unwrap();
         publish_dir(
             &out,
             &[],
@@ -1109,7 +1210,10 @@ mod tests {
             }),
         )
         .unwrap();
-        assert_eq!(names(&out), vec![OUTPUT_MARKER, "later.txt", "new.png"]);
+        assert_eq!(
+            names(&out),
+            vec![OUTPUT_MARKER, "later.txt", "new.png", "photo.jpg"]
+        );
         fs::remove_dir_all(&d).unwrap();
     }
 
@@ -1133,7 +1237,8 @@ mod tests {
         write_atomic(&d.join("alias"), b"?").unwrap();
         assert_eq!(fs::read(&log).unwrap(), b"earlier\npng!?");
         drop(f);
-        // A descriptor that does not append: written at its offset, nothing truncated.
+        // A regular file's descriptor that does not append: its offset could not be moved past
+        // texel's bytes, so it is refused and the file is unchanged; so is a read-only one.
         let g_path = d.join("g.bin");
         fs::write(&g_path, b"0123456789").unwrap();
         let mut g = OpenOptions::new()
@@ -1142,29 +1247,71 @@ mod tests {
             .open(&g_path)
             .unwrap();
         g.seek(std::io::SeekFrom::Start(4)).unwrap();
+        let g_link = PathBuf::from(format!("/proc/self/fd/{}", g.as_raw_fd()));
+        let e = write_atomic(&g_link, b"ab").unwrap_err();
+        assert!(e.to_string().contains("not open for appending"), "{e}");
+        let r = fs::File::open(&g_path).unwrap();
+        let e =
+            write_atomic(&PathBuf::from(format!("/dev/fd/{}", r.as_raw_fd())), b"ab").unwrap_err();
+        assert!(e.to_string().contains("reading only"), "{e}");
+        assert_eq!(fs::read(&g_path).unwrap(), b"0123456789");
+        drop((g, r));
+        // A deleted file behind an appending descriptor: written to the open file, and no new
+        // file appears.
+        let h_path = d.join("h.bin");
+        fs::write(&h_path, b"01").unwrap();
+        let mut h = OpenOptions::new()
+            .read(true)
+            .append(true)
+            .open(&h_path)
+            .unwrap();
+        fs::remove_file(&h_path).unwrap();
         write_atomic(
-            &PathBuf::from(format!("/proc/self/fd/{}", g.as_raw_fd())),
-            b"ab",
-        )
-        .unwrap();
-        assert_eq!(fs::read(&g_path).unwrap(), b"0123ab6789");
-        // A deleted file behind the link: written to the open file (at the descriptor's offset,
-        // still 4), and no new file appears.
-        fs::remove_file(&g_path).unwrap();
-        write_atomic(
-            &PathBuf::from(format!("/proc/self/fd/{}", g.as_raw_fd())),
+            &PathBuf::from(format!("/proc/self/fd/{}", h.as_raw_fd())),
             b"Z",
         )
         .unwrap();
         let mut all = Vec::new();
-        g.seek(std::io::SeekFrom::Start(0)).unwrap();
-        g.read_to_end(&mut all).unwrap();
-        assert_eq!(all, b"0123Zb6789");
-        assert_eq!(names(&d), vec!["alias", "log.txt"]);
+        h.seek(std::io::SeekFrom::Start(0)).unwrap();
+        h.read_to_end(&mut all).unwrap();
+        assert_eq!(all, b"01Z");
+        assert_eq!(names(&d), vec!["alias", "g.bin", "log.txt"]);
         // A descriptor link is never an output directory.
         let e = publish_dir::<(), QualityError>(&link, &[], |_| Ok(())).unwrap_err();
         assert!(e.to_string().contains("descriptor"), "{e}");
-        drop(g);
+        drop(h);
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_killed_publish_never_costs_the_user_files() {
+        let d = scratch("atomic-killed");
+        let out = d.join("out");
+        publish_dir(&out, &[], fill_with(&["a.png"], || ())).unwrap();
+        // What a publish killed between its two renames leaves: the old directory moved aside,
+        // holding texel's listed file and one the user saved; and one holding texel's files only.
+        let tag = name_tag(std::ffi::OsStr::new("out"));
+        let with_user = d.join(format!("{tag}4294967294.0.old.tmp"));
+        let only_texel = d.join(format!("{tag}4294967294.1.old.tmp"));
+        for dir in [&with_user, &only_texel] {
+            fs::create_dir(dir).unwrap();
+            fs::write(dir.join("a.png"), b"a").unwrap();
+            fs::write(
+                dir.join(OUTPUT_MARKER),
+                format!("{MARKER_HEADER}\nfiles:\na.png\n"),
+            )
+            .unwrap();
+        }
+        fs::write(with_user.join("notes.txt"), b"mine").unwrap();
+        publish_dir(&out, &[], fill_with(&["b.png"], || ())).unwrap();
+        if Path::new("/proc/self").exists() {
+            assert!(!with_user.exists() && !only_texel.exists());
+            assert_eq!(
+                fs::read(d.join("out.texel-kept/notes.txt")).unwrap(),
+                b"mine"
+            );
+            assert_eq!(names(&d), vec!["out", "out.texel-kept"]);
+        }
         fs::remove_dir_all(&d).unwrap();
     }
 }

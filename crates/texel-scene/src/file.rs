@@ -871,12 +871,16 @@ fn meshes(
             if let Some(done) = cache.get(&key) {
                 let tris: u64 = done.meshes.iter().map(|m| m.triangles.len() as u64).sum();
                 let verts: u64 = done.meshes.iter().map(|m| m.positions.len() as u64).sum();
-                if tris > limits.max_triangles || verts > limits.max_vertices {
+                let meshes = done.meshes.len() as u64;
+                if tris > limits.max_triangles
+                    || verts > limits.max_vertices
+                    || meshes > limits.max_meshes
+                {
                     return Err(SceneError::TooLarge(format!(
-                        "meshes[{index}] ({file}) adds {tris} triangles and {verts} vertices to \
-                         the meshes before it, over what the limits of the scene leave \
-                         ({} triangles, {} vertices)",
-                        limits.max_triangles, limits.max_vertices
+                        "meshes[{index}] ({file}) adds {meshes} meshes, {tris} triangles and \
+                         {verts} vertices to the meshes before it, over what the limits of the \
+                         scene leave ({} meshes, {} triangles, {} vertices)",
+                        limits.max_meshes, limits.max_triangles, limits.max_vertices
                     )));
                 }
                 done.clone()

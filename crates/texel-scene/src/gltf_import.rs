@@ -585,6 +585,12 @@ fn check_accessors(json: &gltf::json::Root) -> Result<(), String> {
         let comp = ct.0.size() as u64;
         let elem = comp * ty.multiplicity() as u64;
         let count = a.count.0;
+        if count == 0 {
+            // glTF 2.0 requires count >= 1 (the crate's readers compute count - 1).
+            return Err(format!(
+                "{what} has no elements (glTF 2.0 needs a count of at least 1)"
+            ));
+        }
         let offset = a.byte_offset.map_or(0, |o| o.0);
         if let Some(v) = &a.buffer_view {
             let (len, stride) = view_at(v.value(), &what)?;
@@ -610,6 +616,11 @@ fn check_accessors(json: &gltf::json::Root) -> Result<(), String> {
         }
         if let Some(sp) = &a.sparse {
             let n = sp.count.0;
+            if n == 0 {
+                return Err(format!(
+                    "{what} is sparse with no elements (glTF 2.0 needs a count of at least 1)"
+                ));
+            }
             if n > count {
                 return Err(format!(
                     "{what} has {n} sparse elements but only {count} elements"
@@ -921,9 +932,9 @@ fn import_slice(
                 instances = instances.saturating_add(mesh.primitives().len() as u64);
                 if instances > limits.max_meshes {
                     return Err(bad(format!(
-                        "the scene instantiates more than {} primitives (each becomes a mesh of \
-                         its own), over the limit of {} meshes",
-                        limits.max_meshes, limits.max_meshes
+                        "the scene instantiates more primitives than the limit of {} meshes \
+                         (each instance of a primitive becomes a mesh of its own)",
+                        limits.max_meshes
                     )));
                 }
             }

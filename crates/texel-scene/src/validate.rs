@@ -100,6 +100,13 @@ impl Scene {
                 up: c.up.to_array(),
             });
         }
+        if !c.view_from_world().is_finite() {
+            return Err(SceneError::NonFinite {
+                what: "camera (its view matrix: the eye's distance from the origin overflows f32)"
+                    .into(),
+                value: format!("eye {:?}", c.eye.to_array()),
+            });
+        }
         if self.meshes.is_empty() {
             return Err(SceneError::Empty(
                 "the scene has no meshes: there is nothing to render".into(),

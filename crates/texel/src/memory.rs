@@ -144,6 +144,47 @@ fn soft_limit(limits: &str, row: &str) -> Option<u64> {
         .and_then(|v| v.parse().ok())
 }
 
+/// The memory limits of the process's own cgroup and every cgroup above it, as `(file, bytes)`:
+/// cgroup v2 `memory.max` along the `0::PATH` line of `/proc/self/cgroup`, v1
+/// `memory.limit_in_bytes` along the `memory` controller's line ("max" and v1's huge "no limit"
+/// value are larger than any machine's memory, so the smallest of all still decides).
+fn cgroup_limits(self_cgroup: &str) -> Vec<(String, u64)> {
+    let mut out = Vec::new();
+    let mut walk = |root: &str, file: &str, path: &str| {
+        let mut dir = std::path::PathBuf::from(root).join(path.trim_start_matches('/'));
+        loop {
+            let p = dir.join(file);
+            if let Some(b) = std::fs::read_to_string(&p)
+                .ok()
+                .and_then(|s| s.trim().parse::<u64>().ok())
+            {
+                out.push((p.display().to_string(), b));
+            }
+            if dir.as_os_str() == root || !dir.pop() {
+                break;
+            }
+        }
+    };
+    for line in self_cgroup.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (Some(_), Some(controllers), Some(path)) = (parts.next(), parts.next(), parts.next())
+        else {
+            continue;
+        };
+        if controllers.is_empty() {
+            walk("/sys/fs/cgroup", "memory.max", path);
+        } else if controllers.split(',').any(|c| c == "memory") {
+            walk("/sys/fs/cgroup/memory", "memory.limit_in_bytes", path);
+        }
+    }
+    if self_cgroup.trim().is_empty() {
+        // No /proc/self/cgroup: the roots.
+        walk("/sys/fs/cgroup", "memory.max", "/");
+        walk("/sys/fs/cgroup/memory", "memory.limit_in_bytes", "/");
+    }
+    out
+}
+
 /// The share of a process limit's headroom that the default budget grants: the rest covers what
 /// no account charges (the allocator's arenas, thread stacks, decoders' and encoders' scratch).
 const PROCESS_LIMIT_SHARE: u64 = 2;
@@ -164,13 +205,8 @@ pub fn default_limit() -> (u64, String) {
     if let Some(kb) = read("/proc/meminfo").and_then(|s| proc_field(&s, "MemTotal:")) {
         offer(kb * 1024 / 2, "half of this machine's memory".into());
     }
-    for p in [
-        "/sys/fs/cgroup/memory.max",
-        "/sys/fs/cgroup/memory/memory.limit_in_bytes",
-    ] {
-        if let Some(b) = read(p).and_then(|s| s.trim().parse::<u64>().ok()) {
-            offer(b, format!("the cgroup's memory limit ({p})"));
-        }
+    for (p, b) in cgroup_limits(&read("/proc/self/cgroup").unwrap_or_default()) {
+        offer(b, format!("the cgroup's memory limit ({p})"));
     }
     if let (Some(limits), Some(status)) = (read("/proc/self/limits"), read("/proc/self/status")) {
         let rows = [
