@@ -139,6 +139,9 @@ pub struct Extras {
     pub files: Vec<(String, PathBuf)>,
     /// Rendered frames.
     pub frames: Vec<(String, Frame, f64)>,
+    /// A bar that counts the reference and each filter, where a caller shows one bar over several
+    /// comparisons (`texel demo`); `None` draws the comparison's own.
+    pub progress: Option<indicatif::ProgressBar>,
 }
 
 /// Render `filters` (those the GPU path has) with texel's shaders and the device's own sampler:
@@ -217,7 +220,13 @@ pub fn compare(
     budget: &mut MemoryBudget,
 ) -> Result<Report> {
     let enc = encoding(scene.color);
+    if let Some(pb) = &extras.progress {
+        pb.set_message(format!("{label}: reference"));
+    }
     let reference = reference_frame(scene, spp)?;
+    if let Some(pb) = &extras.progress {
+        pb.inc(1);
+    }
     let (w, h) = (reference.width, reference.height);
     let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
     ref_image.write_png(dir.join("reference.png"))?;
@@ -244,9 +253,15 @@ pub fn compare(
 
     let mut rows = Vec::new();
     let mut images = Vec::new();
-    let pb = progress::bar(filters.len() as u64, "filters");
+    let pb = match &extras.progress {
+        Some(pb) => pb.clone(),
+        None => progress::bar(filters.len() as u64, "filters"),
+    };
     for &filter in filters {
-        pb.set_message(filter.name());
+        match &extras.progress {
+            Some(_) => pb.set_message(format!("{label}: {}", filter.name())),
+            None => pb.set_message(filter.name()),
+        }
         let samplers = scene.samplers(filter)?;
         let bytes = scene.build_structures_within(&samplers, budget)?;
         let draws = scene.draws(&samplers);
@@ -268,7 +283,9 @@ pub fn compare(
         }
         pb.inc(1);
     }
-    pb.finish_and_clear();
+    if extras.progress.is_none() {
+        pb.finish_and_clear();
+    }
     let orbit = match orbit {
         Some(spec) => Some(orbit_scores(
             scene,
@@ -422,6 +439,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     let extras = Extras {
         files: extras,
         frames,
+        progress: None,
     };
     let per_pixel = COMPARE_BYTES_PER_PIXEL
         + if extras.files.is_empty() {

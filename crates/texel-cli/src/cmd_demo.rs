@@ -1,12 +1,13 @@
 //! `texel demo`: the comparison on every built-in scene, with an index page linking the reports.
 //!
-//! Defaults: each scene at its own size (1280 x 720 for the ground planes; the lit scenes glossy,
-//! bricks and terrain at half theirs) against a 256-sample (16 x 16) reference (measured in the
-//! README). `--size` and `--spp` change them.
+//! Defaults: each scene at half its own size (640 x 360 for the ground planes) and the lit scenes
+//! glossy, bricks and terrain at a quarter of theirs, against a 256-sample (16 x 16) reference;
+//! `--full` doubles both sides (the README gives both times). `--size` and `--spp` change them.
 
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result};
+use indicatif::ProgressBar;
 use texel_quality::html::escape;
 use texel_quality::{publish_dir, write_atomic, Report};
 
@@ -15,31 +16,36 @@ use crate::cmd_bake_ao::{demo_page, DemoAo};
 use crate::cmd_compare::{compare, Extras, COMPARE_BYTES_PER_PIXEL};
 use crate::filters::Filter;
 use crate::input::{load_scene_with, Input};
+use crate::progress;
 use texel::quality::Encoding;
 use texel_raster::{render, ColorTarget, UvEvaluation, View};
 
 /// Run `texel demo`: every scene's report is written into one staging directory, published as a
-/// whole at `--out` when all are done.
+/// whole at `--out` when all are done. One bar counts every reference and filter image (and the
+/// ambient-occlusion page) with an estimate of the time left.
 pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let started = std::time::Instant::now();
+    let shaded = texel_scene::shaded_builtin_names();
+    let scenes: Vec<&str> = texel_scene::builtin_names()
+        .iter()
+        .chain(shaded)
+        .copied()
+        .collect();
+    let steps =
+        scenes.len() * (Filter::ALL.len() + 1) + GLOBES.len() * (MAPPING_FILTERS.len() + 1) + 1;
+    let pb = progress::bar(steps as u64, "demo");
+    let note = |pb: &ProgressBar, line: String| pb.suspend(|| eprintln!("{line}"));
     let reports = publish_dir(&args.out, &[], |dir| -> Result<Vec<(String, Report)>> {
         let mut reports: Vec<(String, Report)> = Vec::new();
-        let shaded = texel_scene::shaded_builtin_names();
-        for name in texel_scene::builtin_names().iter().chain(shaded) {
+        for name in &scenes {
             let label = format!("builtin:{name}");
-            eprintln!("texel demo: {label} ...");
+            note(&pb, format!("texel demo: {label} ..."));
             // Scenes are rendered one after another: each gets the whole memory account.
             let mut scene_input = Input {
                 budget: input.budget.clone(),
                 sanitize: input.sanitize,
             };
-            // Lit scenes shade every sub-sample of the reference (and bricks draws a finely
-            // tessellated relief): they run at half their size unless --size says otherwise.
-            let size = match args.size {
-                Some(s) => Some(s),
-                None if shaded.contains(name) => Some(half_size(name)?),
-                None => None,
-            };
+            let size = scene_size(args, name)?;
             let scene = load_scene_with(
                 &label,
                 ColorArg::Srgb,
@@ -53,18 +59,20 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
                 &label,
                 &Filter::ALL,
                 args.spp,
+                &pb,
                 &mut scene_input,
             )?;
             reports.push((name.to_string(), report));
         }
-        eprintln!("texel demo: spherical mappings per vertex ...");
-        let mappings = mapping_rows(dir, args, input, &reports)?;
-        eprintln!("texel demo: baked ambient occlusion ...");
+        note(&pb, "texel demo: spherical mappings per vertex ...".into());
+        let mappings = mapping_rows(dir, args, input, &reports, &pb)?;
+        note(&pb, "texel demo: baked ambient occlusion ...".into());
+        pb.set_message("ambient occlusion");
         let sub = dir.join("ao");
         std::fs::create_dir(&sub).with_context(|| format!("cannot create {}", sub.display()))?;
-        let size = match args.size {
+        let size = match scene_size(args, "knot")? {
             Some(s) => s,
-            None => half_size("knot")?,
+            None => own_size("knot", 1)?,
         };
         let mut ao_input = Input {
             budget: input.budget.clone(),
@@ -72,11 +80,13 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
         };
         let ao = demo_page(&sub, (size.width, size.height), &mut ao_input)
             .context("cannot bake the ambient occlusion page")?;
+        pb.inc(1);
         let html = index_html(&reports, &mappings, &ao, started.elapsed().as_secs_f64());
         write_atomic(&dir.join("index.html"), html.as_bytes())?;
         Ok(reports)
     })
     .with_context(|| format!("cannot write the demo to {}", args.out.display()))?;
+    pb.finish_and_clear();
     let index = args.out.join("index.html");
     println!(
         "texel demo: {} scenes in {:.0} s",
@@ -87,6 +97,22 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     Ok(())
 }
 
+/// The size `name` is rendered at: `--size`, or a fraction of the scene's own. Lit scenes shade
+/// every sub-sample of the reference (and bricks draws a finely tessellated relief), so they run
+/// at half the unlit scenes' fraction. `None` is the scene's own size.
+fn scene_size(args: &DemoArgs, name: &str) -> Result<Option<crate::cli::Size>> {
+    if let Some(s) = args.size {
+        return Ok(Some(s));
+    }
+    let lit = texel_scene::shaded_builtin_names().contains(&name);
+    let divisor = match (args.full, lit) {
+        (true, false) => return Ok(None),
+        (true, true) | (false, false) => 2,
+        (false, true) => 4,
+    };
+    own_size(name, divisor).map(Some)
+}
+
 /// Compare `filters` on `scene` against a `spp`-sample reference into the new directory `sub`,
 /// charging the comparison's images to `input`'s account.
 fn report_in(
@@ -95,6 +121,7 @@ fn report_in(
     label: &str,
     filters: &[Filter],
     spp: u32,
+    pb: &ProgressBar,
     input: &mut Input,
 ) -> Result<Report> {
     input.budget.take(
@@ -107,7 +134,10 @@ fn report_in(
         label,
         filters,
         spp,
-        &Extras::default(),
+        &Extras {
+            progress: Some(pb.clone()),
+            ..Extras::default()
+        },
         None,
         sub,
         &mut input.budget,
@@ -139,6 +169,7 @@ fn mapping_rows(
     args: &DemoArgs,
     input: &Input,
     reports: &[(String, Report)],
+    pb: &ProgressBar,
 ) -> Result<Vec<MappingRow>> {
     let views = dir.join("mapping");
     std::fs::create_dir(&views).with_context(|| format!("cannot create {}", views.display()))?;
@@ -155,7 +186,7 @@ fn mapping_rows(
         let mut scene = load_scene_with(
             &label,
             ColorArg::Srgb,
-            args.size,
+            scene_size(args, scene_name)?,
             Default::default(),
             &mut scene_input,
         )?;
@@ -171,6 +202,7 @@ fn mapping_rows(
                         &format!("{label} --surface-uv vertex"),
                         &MAPPING_FILTERS,
                         args.spp,
+                        pb,
                         &mut scene_input,
                     )?;
                     (sub, report)
@@ -253,12 +285,12 @@ fn mapping_html(rows: &[MappingRow]) -> String {
     s
 }
 
-/// Half the output size of built-in scene `name`.
-fn half_size(name: &str) -> Result<crate::cli::Size> {
+/// The output size of built-in scene `name`, each side divided by `divisor`.
+fn own_size(name: &str, divisor: u32) -> Result<crate::cli::Size> {
     let o = texel_scene::builtin(name)?.output;
     Ok(crate::cli::Size {
-        width: (o.width / 2).max(1),
-        height: (o.height / 2).max(1),
+        width: (o.width / divisor).max(1),
+        height: (o.height / divisor).max(1),
     })
 }
 

@@ -4,6 +4,7 @@
 mod bake_ao;
 mod compare;
 mod demo_bench;
+mod docs_commands;
 mod errors;
 mod gpu;
 mod help;

@@ -11,7 +11,7 @@ use texel_quality::{psnr, Image8};
 use crate::util::*;
 
 /// A running Xvfb, killed on drop.
-struct Xvfb {
+pub(crate) struct Xvfb {
     child: Child,
     display: String,
 }
@@ -19,7 +19,7 @@ struct Xvfb {
 impl Xvfb {
     /// Start Xvfb, or `None` (with the reason printed) where it is not installed and CI does not
     /// demand it.
-    fn start() -> Option<Xvfb> {
+    pub(crate) fn start() -> Option<Xvfb> {
         let spawned = Command::new("Xvfb")
             .args([
                 "-displayfd",
@@ -54,6 +54,11 @@ impl Xvfb {
             child,
             display: format!(":{n}"),
         })
+    }
+
+    /// The display's name, for `DISPLAY`.
+    pub(crate) fn display(&self) -> &str {
+        &self.display
     }
 
     /// Run `texel` on this display (and no Wayland one).
@@ -184,6 +189,8 @@ fn the_reference_refines_frame_by_frame() {
             "--size",
             "320x180",
             "--spp",
+            "256",
+            "--max-spp",
             "256",
             "-o",
             &d.arg("ref.png"),
