@@ -27,7 +27,7 @@ for s in "${scenes[@]}"; do
   for f in nearest bilinear bicubic mip-nearest trilinear aniso2 aniso4 aniso8 aniso16 ewa ripmap sat; do
     check "$tag-$f" render "$s" --size 320x180 --filter "$f"
   done
-  check "$tag-reference" reference "$s" --size 160x90 --spp 16
+  check "$tag-reference" reference "$s" --size 160x90 --spp 16 --max-spp 16
   for v in uv mip lod aniso fetches; do
     check "$tag-$v" render "$s" --size 160x90 --view "$v"
   done

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Makes the Python environment that the peer scripts run in: .venv-peers/ at the repository root,
-# with numpy, pillow, moderngl and glcontext from PyPI. With --system it first installs Mesa's EGL
+# with numpy, pillow, moderngl, glcontext and OpenEXR from PyPI. With --system it first installs Mesa's EGL
 # and OpenGL drivers through apt-get (Debian or Ubuntu, as root), which llvmpipe_bench.py needs.
 #   scripts/peers/setup.sh [--system]
 # Then, from the repository root:
@@ -13,5 +13,5 @@ if [ "${1:-}" = "--system" ]; then
 fi
 python3 -m venv .venv-peers
 .venv-peers/bin/pip install --upgrade pip
-.venv-peers/bin/pip install numpy pillow moderngl glcontext
+.venv-peers/bin/pip install numpy pillow moderngl glcontext OpenEXR
 .venv-peers/bin/python -c "import moderngl, numpy, PIL; print('peer environment ready: .venv-peers')"

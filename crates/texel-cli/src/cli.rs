@@ -35,9 +35,10 @@ pub enum Command {
     ///
     /// Example: texel render scenes/ground.toml --lab-mode 8 --view aniso -o aniso.png
     Render(RenderArgs),
-    /// Render the supersampled reference (ground truth) of a scene.
+    /// Render the supersampled reference (ground truth) of a scene with its error bars: at least
+    /// --spp samples a pixel, more where its 95 % interval is wider than --tolerance.
     ///
-    /// Example: texel reference builtin:ground --spp 256 -o reference.png
+    /// Example: texel reference builtin:glossy --size 320x180 --max-spp 4096 --error-map err.png -o reference.png
     Reference(ReferenceArgs),
     /// Render every filter and the reference; write a report (Markdown, JSON, HTML) with images,
     /// error heat maps, horizon crops and a quality/time chart.
@@ -399,14 +400,43 @@ pub struct ViewArgs {
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Samples per pixel, 1 to 4096, stratified n x m with n*m = spp as square as possible and each
-    /// side at most 64 (256 = 16x16, 512 = 16x32).
+    /// Samples every pixel gets, 1 to 4096, in at least 8 independent passes (256 = 8 passes of
+    /// 4x8 stratified samples).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub spp: u32,
+    /// The most samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is wider than
+    /// --tolerance get more passes, doubling, up to this (equal to --spp: no pixel gets more).
+    #[arg(long, default_value_t = 65_536, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub max_spp: u32,
+    /// Half-width of a converged pixel's 95 % interval, in 8-bit steps of the displayed value
+    /// (clipped to 0..255, sRGB-encoded unless --color raw), 0 to 255.
+    #[arg(long, default_value_t = 0.5, value_parser = tolerance())]
+    pub tolerance: f64,
+    /// Seed of the jitter; two seeds give independent estimates.
+    #[arg(long, default_value_t = crate::cmd_reference::SEED)]
+    pub seed: u64,
+    /// Worker threads, 1 to 1024 (default: all cores); the image does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Also write each pixel's error: `.exr` the standard error of the linear mean per channel
+    /// (RGBA floats), `.png` a picture of the 95 % interval's half-width on the display
+    /// (viridis, 0 to 4 8-bit steps; red where a pixel did not converge).
+    #[arg(long, value_name = "PATH", value_parser = image_output())]
+    pub error_map: Option<PathBuf>,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
     #[arg(short, long, value_parser = image_output())]
     pub output: PathBuf,
+}
+
+/// `--tolerance`: a finite number of 8-bit steps in `0..=255`.
+fn tolerance() -> impl clap::builder::TypedValueParser<Value = f64> {
+    clap::builder::StringValueParser::new().try_map(|s: String| match s.trim().parse::<f64>() {
+        Ok(t) if (0.0..=255.0).contains(&t) => Ok(t),
+        _ => Err(format!(
+            "{s:?} is not a tolerance in 8-bit steps from 0 to 255 (e.g. 0.5)"
+        )),
+    })
 }
 
 /// `texel compare`.

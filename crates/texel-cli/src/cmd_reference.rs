@@ -1,12 +1,20 @@
 //! `texel reference`: the supersampled ground truth.
 
-use anyhow::Result;
-use texel_raster::render_reference_strata;
+use std::fmt::Write as _;
+use std::time::Instant;
 
-use crate::cli::ReferenceArgs;
+use anyhow::{Context, Result};
+use texel_quality::{viridis, Image8};
+use texel_raster::{
+    render_reference_adaptive, render_reference_strata, ReferenceEstimate, ReferencePlan,
+    ReferenceStatus,
+};
+
+use crate::cli::{ColorArg, ReferenceArgs};
 use crate::filters::Filter;
 use crate::input::{load_scene, Input};
-use crate::output::{encoding, write_frame};
+use crate::interrupt;
+use crate::output::{encoding, write_frame, write_image};
 use crate::progress;
 use texel::PreparedScene;
 
@@ -52,11 +60,131 @@ pub fn reference_frame_from(
     Ok(frame)
 }
 
-/// Run `texel reference`.
+/// Run `texel reference`: the converging reference (`texel_raster::adaptive`), its summary on
+/// stderr, the image and, with `--error-map`, each pixel's error. Ctrl-C during the passes writes
+/// what is done so far, says so, and exits with status 130.
 pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
+    anyhow::ensure!(
+        args.max_spp >= args.spp,
+        "--max-spp {} is below --spp {}: the maximum must be at least the minimum",
+        args.max_spp,
+        args.spp
+    );
     let scene = load_scene(&args.scene, input)?;
-    let frame = reference_frame(&scene, args.spp)?;
-    write_frame(&args.output, &frame, encoding(args.scene.color))
+    input.budget.take(
+        "the reference's per-pixel statistics",
+        u64::from(scene.width) * u64::from(scene.height) * ADAPTIVE_BYTES_PER_PIXEL,
+    )?;
+    let plan = ReferencePlan {
+        min_spp: args.spp,
+        max_spp: args.max_spp,
+        tolerance: args.tolerance / 255.0,
+        srgb_display: args.scene.color == ColorArg::Srgb,
+        seed: args.seed,
+    };
+    let samplers = scene.samplers(Filter::Bilinear)?;
+    let draws = scene.reference_draws_from(&samplers, &scene.scene.camera)?;
+    let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
+    settings.threads = args.threads.map(|n| n as usize);
+    let started = Instant::now();
+    let pb = progress::bar(1, "reference");
+    let status = |s: &ReferenceStatus| {
+        pb.set_length(s.total.max(1));
+        pb.set_position(s.done);
+        pb.set_message(format!(
+            "round {} ({} spp, {:.1} % converged)",
+            s.round,
+            s.spp,
+            100.0 * s.converged
+        ));
+    };
+    let graceful = interrupt::Graceful::begin();
+    let estimate = render_reference_adaptive(
+        &settings,
+        &draws,
+        &plan,
+        Some(&status),
+        Some(graceful.flag()),
+    )
+    .map_err(|e| match e {
+        texel_raster::RasterError::Interrupted => {
+            anyhow::Error::new(interrupt::Interrupted(e.to_string()))
+        }
+        e => e.into(),
+    })?;
+    drop(graceful);
+    pb.finish_and_clear();
+    let seconds = started.elapsed().as_secs_f64();
+    write_frame(&args.output, &estimate.frame, encoding(args.scene.color))?;
+    if let Some(path) = &args.error_map {
+        write_error_map(path, &estimate)?;
+    }
+    eprintln!("{}", summary(&estimate, args.tolerance, seconds));
+    if estimate.interrupted {
+        return Err(interrupt::Interrupted(format!(
+            "interrupted: {} holds the passes completed so far, not a converged reference (the share converged is above)",
+            args.output.display()
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// Bytes per pixel a converging reference holds: its running statistics, masks and results.
+pub const ADAPTIVE_BYTES_PER_PIXEL: u64 = 160;
+
+/// One line: the share converged, the samples taken and the time.
+pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> String {
+    let max = e.spp.iter().copied().max().unwrap_or(0);
+    let unconverged = e.converged.iter().filter(|&&c| !c).count();
+    let mut line = format!(
+        "reference: {:.2} % of pixels within ±{tolerance_steps}/255 of the display at 95 % confidence; {}-{max} samples per pixel (mean {:.0}); seed {}; {seconds:.1} s",
+        100.0 * e.converged_share(None),
+        e.plan.min_spp,
+        e.mean_spp(),
+        e.plan.seed,
+    );
+    if e.interrupted {
+        line += "; interrupted";
+    } else if unconverged > 0 {
+        let _ = write!(
+            line,
+            "; {unconverged} pixels reached --max-spp {} without converging",
+            e.plan.max_spp
+        );
+    }
+    line
+}
+
+/// Top of the error picture's colour ramp, in 8-bit steps.
+pub const ERROR_MAP_MAX_STEPS: f32 = 4.0;
+
+/// Write `--error-map`: the standard errors as OpenEXR, or their picture as PNG.
+fn write_error_map(path: &std::path::Path, e: &ReferenceEstimate) -> Result<()> {
+    let (w, h) = (e.frame.width, e.frame.height);
+    if crate::output::is_exr(path) {
+        let finite: Vec<[f32; 4]> = e
+            .std_error
+            .iter()
+            .map(|s| s.map(|x| if x.is_finite() { x } else { f32::MAX }))
+            .collect();
+        return texel_quality::write_exr_atomic(path, w, h, &finite)
+            .with_context(|| format!("cannot write {}", path.display()));
+    }
+    let pixels: Vec<[u8; 4]> = e
+        .display_half_width
+        .iter()
+        .zip(&e.converged)
+        .map(|(&hw, &ok)| {
+            if ok {
+                let [r, g, b] = viridis(hw * 255.0 / ERROR_MAP_MAX_STEPS);
+                [r, g, b, 255]
+            } else {
+                [255, 0, 0, 255]
+            }
+        })
+        .collect();
+    write_image(path, &Image8::new(w, h, pixels)?)
 }
 
 #[cfg(test)]

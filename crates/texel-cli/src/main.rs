@@ -16,6 +16,7 @@ mod cmd_render;
 mod cmd_warp;
 mod filters;
 mod input;
+mod interrupt;
 mod output;
 mod progress;
 mod threads;
@@ -26,9 +27,6 @@ use std::process::ExitCode;
 use clap::Parser;
 
 use cli::{Cli, Command};
-
-/// Exit status after SIGINT, SIGTERM or SIGHUP (128 + SIGINT, as shells report an interrupt).
-const INTERRUPTED: i32 = 130;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -41,7 +39,7 @@ fn main() -> ExitCode {
         }
     }));
     // An interrupted run deletes its unpublished temporary files and staging directories.
-    if let Err(e) = ctrlc::set_handler(|| texel_quality::remove_pending_and_exit(INTERRUPTED)) {
+    if let Err(e) = ctrlc::set_handler(interrupt::on_signal) {
         eprintln!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files");
     }
     let mut input = input::Input {
@@ -71,6 +69,9 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             eprintln!("texel: error: {}", chain_line(&err));
+            if err.downcast_ref::<interrupt::Interrupted>().is_some() {
+                return ExitCode::from(interrupt::INTERRUPTED as u8);
+            }
             ExitCode::FAILURE
         }
     }

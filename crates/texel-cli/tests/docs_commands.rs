@@ -3,7 +3,7 @@
 //! blocks) exactly as written; the test only makes the work small (image size, reference samples,
 //! frames, rays), runs each document's commands in order in a scratch directory of its own (a
 //! later command may read what an earlier one wrote), and checks that each exits 0 and writes
-//! what it names (`-o`, `--out`, `--screenshot`).
+//! what it names (`-o`, `--out`, `--screenshot`, `--error-map`).
 //!
 //! - `--gpu` commands need a Vulkan adapter, `view` an X server: without them they are skipped
 //!   with the reason, unless `CI=true`.
@@ -118,7 +118,12 @@ fn shrink(args: &[String]) -> (Vec<String>, Vec<String>) {
     let mut a = args.to_vec();
     let sub = a.first().cloned().unwrap_or_default();
     match sub.as_str() {
-        "render" | "reference" => set(&mut a, "--size", "160x90"),
+        "render" => set(&mut a, "--size", "160x90"),
+        "reference" => {
+            set(&mut a, "--size", "80x45");
+            set(&mut a, "--spp", "8");
+            set(&mut a, "--max-spp", "16");
+        }
         "compare" => {
             set(&mut a, "--size", "160x90");
             set(&mut a, "--spp", "4");
@@ -148,7 +153,7 @@ fn shrink(args: &[String]) -> (Vec<String>, Vec<String>) {
         }
         _ => {}
     }
-    let mut outputs: Vec<String> = ["-o", "--out", "--screenshot"]
+    let mut outputs: Vec<String> = ["-o", "--out", "--screenshot", "--error-map"]
         .iter()
         .filter_map(|f| value(&a, f).map(str::to_string))
         .collect();

@@ -230,7 +230,17 @@ fn error_unwritable_output_path() {
         &["cannot write", &m],
     );
     fails(
-        &["reference", "--size", "32x18", "--spp", "1", "-o", &m],
+        &[
+            "reference",
+            "--size",
+            "32x18",
+            "--spp",
+            "1",
+            "--max-spp",
+            "1",
+            "-o",
+            &m,
+        ],
         1,
         &["cannot write", &m],
     );
@@ -457,25 +467,30 @@ fn error_bad_corners() {
 #[test]
 fn error_reference_spp_unstratifiable() {
     let d = Dir::new("err-spp");
-    // 8 = 2 x 4 and 512 = 16 x 32 stratify; a prime above 64 cannot within 64 per side.
+    // `texel reference` splits any count into passes (67 = 67 passes of one sample); `compare`'s
+    // single pass must stratify within 64 per side, which a prime above 64 cannot.
     ok(&[
         "reference",
         "--size",
         "32x18",
         "--spp",
-        "8",
+        "67",
+        "--max-spp",
+        "67",
         "-o",
-        &d.arg("r8.png"),
+        &d.arg("r67.png"),
     ]);
     fails(
         &[
-            "reference",
+            "compare",
             "--size",
             "32x18",
             "--spp",
             "67",
-            "-o",
-            &d.arg("r.png"),
+            "--filters",
+            "nearest",
+            "--out",
+            &d.arg("c"),
         ],
         1,
         &["--spp 67", "1 x 67", "square root"],
@@ -485,5 +500,5 @@ fn error_reference_spp_unstratifiable() {
         2,
         &["0"],
     );
-    assert!(!d.join("r.png").exists());
+    assert!(!d.join("r.png").exists() && !d.join("c").exists());
 }

@@ -16,7 +16,17 @@ fn failed_writes_leave_no_temporary_files() {
         &["cannot write", &x],
     );
     fails(
-        &["reference", "--size", "32x18", "--spp", "1", "-o", &x],
+        &[
+            "reference",
+            "--size",
+            "32x18",
+            "--spp",
+            "1",
+            "--max-spp",
+            "1",
+            "-o",
+            &x,
+        ],
         1,
         &["cannot write", &x],
     );
@@ -69,15 +79,15 @@ fn exr_outputs_keep_the_linear_colour_unclamped() {
     let d = Dir::new("exr");
     let scene = ["builtin:glossy", "--size", "96x54"];
     for (cmd, extra) in [
-        ("render", ["--filter", "aniso16"]),
-        ("reference", ["--spp", "4"]),
+        ("render", &["--filter", "aniso16"][..]),
+        ("reference", &["--spp", "4", "--max-spp", "4"][..]),
     ] {
         let exr = d.arg(&format!("{cmd}.EXR"));
         let png = d.arg(&format!("{cmd}.png"));
         for out in [&exr, &png] {
             let mut args = vec![cmd];
             args.extend_from_slice(&scene);
-            args.extend_from_slice(&extra);
+            args.extend_from_slice(extra);
             args.extend_from_slice(&["-o", out]);
             ok(&args);
         }

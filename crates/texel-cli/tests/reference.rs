@@ -1,4 +1,4 @@
-//! `texel reference`: size and reproducibility.
+//! `texel reference`: size, reproducibility, error bars and refinement.
 
 use crate::util::*;
 
@@ -6,7 +6,17 @@ use crate::util::*;
 fn reference_is_sized_and_reproducible() {
     let d = Dir::new("reference");
     let (a, b) = (d.arg("a.png"), d.arg("b.png"));
-    ok(&["reference", "--size", "64x36", "--spp", "16", "-o", &a]);
+    ok(&[
+        "reference",
+        "--size",
+        "64x36",
+        "--spp",
+        "16",
+        "--max-spp",
+        "64",
+        "-o",
+        &a,
+    ]);
     ok(&[
         "reference",
         "builtin:ground",
@@ -14,6 +24,8 @@ fn reference_is_sized_and_reproducible() {
         "64x36",
         "--spp",
         "16",
+        "--max-spp",
+        "64",
         "-o",
         &b,
     ]);
@@ -30,10 +42,315 @@ fn reference_is_sized_and_reproducible() {
         "64x36",
         "--spp",
         "16",
+        "--max-spp",
+        "64",
         "--color",
         "raw",
         "-o",
         &raw,
     ]);
     assert_ne!(file_bytes(&raw), file_bytes(&a));
+}
+
+/// Linear RGBA floats of an OpenEXR file.
+fn exr(path: &str) -> Vec<[f32; 4]> {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("cannot read {path}: {e}"))
+        .to_rgba32f()
+        .pixels()
+        .map(|p| p.0)
+        .collect()
+}
+
+/// The glossy plane at 80 x 45 with `spp` samples a pixel and no refinement, seed `seed`:
+/// (mean, standard error), both linear.
+fn glossy(d: &Dir, seed: u32, spp: u32) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let (img, err) = (
+        d.arg(&format!("g{seed}.exr")),
+        d.arg(&format!("e{seed}.exr")),
+    );
+    let spp = spp.to_string();
+    ok(&[
+        "reference",
+        "builtin:glossy",
+        "--size",
+        "80x45",
+        "--spp",
+        &spp,
+        "--max-spp",
+        &spp,
+        "--seed",
+        &seed.to_string(),
+        "--error-map",
+        &err,
+        "-o",
+        &img,
+    ]);
+    (exr(&img), exr(&err))
+}
+
+/// Two seeds give independent estimates whose difference the error bars explain: on the glossy
+/// plane's lit pixels, `|a - b| <= 1.96 sqrt(se_a^2 + se_b^2)` for 80-99.5 % of the red values
+/// (95 % if the error bars were exact; with 8 passes the estimated errors are themselves noisy, so
+/// the share drops towards 90 %; a pixel whose passes all missed its glints reports too small an
+/// error and falls outside).
+#[test]
+fn two_seeds_differ_within_their_error_bars() {
+    let d = Dir::new("reference-seeds");
+    let (a, sa) = glossy(&d, 1, 64);
+    let (b, sb) = glossy(&d, 2, 64);
+    let (mut n, mut inside) = (0, 0);
+    for i in 0..a.len() {
+        let se = (sa[i][0].powi(2) + sb[i][0].powi(2)).sqrt();
+        if se > 0.0 {
+            n += 1;
+            inside += usize::from((a[i][0] - b[i][0]).abs() <= 1.96 * se);
+        }
+    }
+    let share = inside as f64 / n as f64;
+    eprintln!("{inside} of {n} pixels within 1.96 combined standard errors ({share:.3})");
+    assert!(n > a.len() / 2, "too few noisy pixels: {n}");
+    assert!((0.80..=0.995).contains(&share), "{share}");
+    assert_ne!(a, b, "two seeds are two estimates");
+}
+
+/// The estimate is the same on one thread and on two; the error map's picture is the image's
+/// size; `--max-spp` below `--spp` is refused.
+#[test]
+fn the_reference_does_not_depend_on_threads_and_writes_its_error_map() {
+    let d = Dir::new("reference-threads");
+    let run = |threads: &str, out: &str, map: &str| {
+        let out = ok(&[
+            "reference",
+            "builtin:glossy",
+            "--size",
+            "48x27",
+            "--spp",
+            "16",
+            "--max-spp",
+            "64",
+            "--tolerance",
+            "2",
+            "--threads",
+            threads,
+            "--error-map",
+            &d.arg(map),
+            "-o",
+            &d.arg(out),
+        ]);
+        stderr(&out)
+    };
+    let summary = run("1", "one.png", "one-err.png");
+    run("2", "two.png", "two-err.png");
+    assert_eq!(file_bytes(d.join("one.png")), file_bytes(d.join("two.png")));
+    assert_eq!(
+        file_bytes(d.join("one-err.png")),
+        file_bytes(d.join("two-err.png"))
+    );
+    assert_eq!(load(d.join("one-err.png")).size(), (48, 27));
+    assert!(
+        summary.contains("% of pixels within ±2/255") && summary.contains("16-"),
+        "{summary}"
+    );
+    fails(
+        &[
+            "reference",
+            "--spp",
+            "64",
+            "--max-spp",
+            "16",
+            "-o",
+            &d.arg("x.png"),
+        ],
+        1,
+        &["--max-spp 16 is below --spp 64"],
+    );
+    fails(
+        &["reference", "--tolerance", "nan", "-o", &d.arg("x.png")],
+        2,
+        &["not a tolerance"],
+    );
+}
+
+/// Refinement only adds samples where a pixel has not converged: on the unlit ground plane with
+/// a loose tolerance most pixels stop at the minimum, and every pixel the summary calls converged
+/// has an interval within the tolerance (the PNG error map shows red only for the others).
+#[test]
+fn refinement_adds_samples_only_where_needed() {
+    let d = Dir::new("reference-adaptive");
+    let out = ok(&[
+        "reference",
+        "--size",
+        "64x36",
+        "--spp",
+        "16",
+        "--max-spp",
+        "256",
+        "--tolerance",
+        "1",
+        "--error-map",
+        &d.arg("err.png"),
+        "-o",
+        &d.arg("r.png"),
+    ]);
+    let line = stderr(&out);
+    let share: f64 = line
+        .split("reference: ")
+        .nth(1)
+        .and_then(|s| s.split(" %").next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no share in {line}"));
+    let red = load(d.join("err.png"))
+        .pixels()
+        .iter()
+        .filter(|p| **p == [255, 0, 0, 255])
+        .count();
+    let unconverged = 100.0 * red as f64 / (64.0 * 36.0);
+    assert!(
+        (share - (100.0 - unconverged)).abs() < 0.01,
+        "{line}: {red} red pixels"
+    );
+    let mean: f64 = line
+        .split("(mean ")
+        .nth(1)
+        .and_then(|s| s.split(')').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no mean in {line}"));
+    assert!(mean > 16.0 && mean < 256.0, "{line}");
+}
+
+/// The display value (8-bit steps, clipped, sRGB) of a linear value.
+fn display(x: f32) -> f64 {
+    f64::from(texel_texture::color::linear_to_srgb(x.clamp(0.0, 1.0))) * 255.0
+}
+
+/// Glints (`scenes/glints.toml`: a sharp lobe on a bumpy plane under a grazing light) at 48 x 27:
+/// per-pixel estimates have a heavy right tail, and the display clips them, so a reference with too
+/// few samples is biased dark. Against a brute force (192 x 108 at 1024 samples, box-averaged 4 x 4
+/// in linear light: 16 384 samples a pixel) the converging reference's 4 x 4 block means of the
+/// displayed values agree within 3 steps on average and its mean signed error is within 1 step,
+/// while a fixed 64-sample reference is more than 5 steps too dark on average (measured: +0.36
+/// signed and 1.4 on blocks, against -33.7 and 31.2 for the fixed reference).
+#[test]
+fn the_converging_reference_is_not_biased_dark_on_glints() {
+    let d = Dir::new("reference-glints");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/glints.toml");
+    let run = |size: &str, spp: &str, max: &str, out: &str| {
+        ok(&[
+            "reference",
+            scene,
+            "--size",
+            size,
+            "--spp",
+            spp,
+            "--max-spp",
+            max,
+            "-o",
+            &d.arg(out),
+        ]);
+        exr(&d.arg(out))
+    };
+    let brute = run("192x108", "1024", "1024", "brute.exr");
+    let (w, h) = (48usize, 27usize);
+    let truth: Vec<[f64; 3]> = (0..w * h)
+        .map(|p| {
+            let (x, y) = (p % w, p / w);
+            let mut sum = [0f64; 3];
+            for dy in 0..4 {
+                for dx in 0..4 {
+                    let q = brute[(4 * y + dy) * 4 * w + 4 * x + dx];
+                    for c in 0..3 {
+                        sum[c] += f64::from(q[c]) / 16.0;
+                    }
+                }
+            }
+            sum.map(|v| display(v as f32))
+        })
+        .collect();
+    // The plane: pixels the brute force does not show black (the sky is black).
+    let plane: Vec<bool> = truth.iter().map(|t| t.iter().sum::<f64>() > 0.0).collect();
+    let score = |img: &[[f32; 4]]| {
+        let (mut signed, mut n) = (0.0, 0.0);
+        for p in 0..w * h {
+            if plane[p] {
+                for c in 0..3 {
+                    signed += display(img[p][c]) - truth[p][c];
+                    n += 1.0;
+                }
+            }
+        }
+        let (mut block, mut blocks) = (0.0, 0.0);
+        for by in 0..h / 4 {
+            for bx in 0..w / 4 {
+                let px: Vec<usize> = (0..16)
+                    .map(|k| (4 * by + k / 4) * w + 4 * bx + k % 4)
+                    .collect();
+                if px.iter().all(|&p| plane[p]) {
+                    for c in 0..3 {
+                        let mean =
+                            |f: &dyn Fn(usize) -> f64| px.iter().map(|&p| f(p)).sum::<f64>() / 16.0;
+                        block += (mean(&|p| display(img[p][c])) - mean(&|p| truth[p][c])).abs();
+                        blocks += 1.0;
+                    }
+                }
+            }
+        }
+        (signed / n, block / blocks)
+    };
+    let converging = score(&run("48x27", "64", "16384", "adaptive.exr"));
+    let fixed = score(&run("48x27", "64", "64", "fixed.exr"));
+    eprintln!("converging (signed, block): {converging:?}; fixed 64: {fixed:?}");
+    assert!(
+        converging.0.abs() < 1.0 && converging.1 < 3.0,
+        "{converging:?}"
+    );
+    assert!(
+        fixed.0 < -5.0,
+        "the fixed reference is not biased dark: {fixed:?}"
+    );
+}
+
+/// Ctrl-C while a reference converges: it stops after the current pass, writes the passes done
+/// (a whole image, the first passes' estimate), says so and exits with status 130.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_reference_writes_what_it_has() {
+    use std::process::{Command, Stdio};
+    let d = Dir::new("reference-interrupted");
+    let out = d.arg("partial.png");
+    let child = Command::new(env!("CARGO_BIN_EXE_texel"))
+        .args([
+            "reference",
+            "--size",
+            "160x90",
+            "--spp",
+            "64",
+            "--max-spp",
+            "1048576",
+            "--tolerance",
+            "0",
+            "-o",
+            &out,
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Tolerance 0 never converges: without the signal it would run for a long time.
+    std::thread::sleep(std::time::Duration::from_millis(3000));
+    assert!(Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let result = child.wait_with_output().unwrap();
+    let err = stderr(&result);
+    assert_eq!(result.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("stopping after the current pass") && err.contains("interrupted"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(load(&out).size(), (160, 90));
+    assert!(temp_files(d.path()).is_empty());
 }

@@ -20,6 +20,8 @@ fn toksvig_beats_plain_filtered_normals_against_the_reference() {
         size[1],
         "--spp",
         "64",
+        "--max-spp",
+        "64",
         "-o",
         &d.arg("ref.png"),
     ]);

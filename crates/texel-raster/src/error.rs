@@ -92,6 +92,21 @@ pub enum RasterError {
         /// The largest allowed.
         max: u32,
     },
+    /// A converging reference's plan is outside its ranges.
+    #[error(
+        "reference plan is invalid: min_spp {min_spp} must be in 1..=4096, max_spp {max_spp} in min_spp..=1048576, tolerance {tolerance} finite and not negative"
+    )]
+    InvalidReferencePlan {
+        /// The minimum samples per pixel asked for.
+        min_spp: u32,
+        /// The maximum samples per pixel asked for.
+        max_spp: u32,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
+    /// The work was stopped before it had a result.
+    #[error("interrupted before the first pass of the reference completed")]
+    Interrupted,
     /// An environment map's faces do not fit its mapping (six square faces of one size for a
     /// cube, one square image for an octahedral map).
     #[error("environment map: {0}")]

@@ -41,6 +41,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod adaptive;
 pub mod camera;
 pub mod clip;
 mod draw;
@@ -59,6 +60,7 @@ mod stream;
 pub mod tile;
 pub mod views;
 
+pub use adaptive::{render_reference_adaptive, ReferenceEstimate, ReferencePlan, ReferenceStatus};
 pub use draw::{DrawCall, UvEvaluation, UvMapping, Vertex};
 pub use environment::{Environment, EnvironmentMaps};
 pub use error::RasterError;

@@ -87,6 +87,24 @@ pub fn render_reference_strata(
     seed: u64,
     progress: Option<Progress>,
 ) -> Result<Frame, RasterError> {
+    with_passes(settings, draws, strata, |pass| pass(seed, None, progress))
+}
+
+/// One pass of the reference: every pixel (or, with `Some(active)`, those whose entry of the
+/// row-major mask is true; the others keep the background) gets one stratified estimate with the
+/// given seed.
+pub(crate) type Pass<'p> =
+    dyn FnMut(u64, Option<&[bool]>, Option<Progress>) -> Result<Frame, RasterError> + 'p;
+
+/// Validate `settings`, `draws` and `strata`, make the level-0 samplers and materials the
+/// reference reads through, and hand `body` a function that renders one pass with them (on the
+/// settings' thread pool).
+pub(crate) fn with_passes<T: Send>(
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+    strata: [u32; 2],
+    body: impl FnOnce(&mut Pass) -> Result<T, RasterError> + Send,
+) -> Result<T, RasterError> {
     settings.validate()?;
     for spp_side in strata {
         if !(1..=MAX_SPP_SIDE).contains(&spp_side) {
@@ -147,14 +165,18 @@ pub fn render_reference_strata(
         })
         .collect();
     crate::with_threads(settings.threads, || {
-        reference_frame(
-            settings,
-            draws,
-            (&samplers, &materials),
-            strata,
-            seed,
-            progress,
-        )
+        let mut pass = |seed: u64, active: Option<&[bool]>, progress: Option<Progress>| {
+            reference_frame(
+                settings,
+                draws,
+                (&samplers, &materials),
+                strata,
+                seed,
+                active,
+                progress,
+            )
+        };
+        body(&mut pass)
     })
 }
 
@@ -198,6 +220,8 @@ struct Context<'a> {
     background: Option<(Environment<'a>, ViewRays)>,
     strata: [u32; 2],
     seed: u64,
+    /// The pixels to render (row-major), or all.
+    active: Option<&'a [bool]>,
 }
 
 fn reference_frame(
@@ -206,6 +230,7 @@ fn reference_frame(
     (samplers, materials): (&[Sampler], &[Option<Material>]),
     strata: [u32; 2],
     seed: u64,
+    active: Option<&[bool]>,
     progress: Option<Progress>,
 ) -> Result<Frame, RasterError> {
     let (width, height) = (settings.width, settings.height);
@@ -257,6 +282,7 @@ fn reference_frame(
             .and_then(|e| Some((e, e.background_rays(width, height)?))),
         strata,
         seed,
+        active,
     };
     let (tx, _) = tile_counts(width, height);
     let color = split_rows(&mut frame.color, width, height);
@@ -296,13 +322,15 @@ fn reference_frame(
 /// Per-thread buffers for one pixel row of a tile.
 #[derive(Default)]
 struct Scratch {
+    /// The row's pixels being rendered, as offsets into the row.
+    pixels: Vec<u32>,
     pos: Vec<DVec2>,
     fixed: Vec<[i64; 2]>,
     depth: Vec<f32>,
     winner: Vec<u32>,
 }
 
-/// Render the pixels `x0 .. x0 + color.len()` of row `j`.
+/// Render the pixels `x0 .. x0 + color.len()` of row `j` (those the context's mask holds).
 fn reference_row(
     ctx: &Context,
     bin: &[u32],
@@ -315,11 +343,19 @@ fn reference_row(
     let [nx, ny] = ctx.strata.map(|k| k as usize);
     let spp = nx * ny;
     let w = color.len();
-    let count = w * spp;
+    s.pixels.clear();
+    let row = j as usize * ctx.settings.width as usize + x0 as usize;
+    s.pixels
+        .extend((0..w as u32).filter(|&p| ctx.active.is_none_or(|a| a[row + p as usize])));
+    if s.pixels.is_empty() {
+        return;
+    }
+    let count = s.pixels.len() * spp;
     s.pos.clear();
     s.fixed.clear();
     let (inv_nx, inv_ny) = (1.0 / nx as f64, 1.0 / ny as f64);
-    for i in x0..x0 + w as u32 {
+    for &p in &s.pixels {
+        let i = x0 + p;
         let mut rng = SplitMix64::for_pixel(ctx.seed, i, j);
         for sy in 0..ny {
             for sx in 0..nx {
@@ -347,8 +383,9 @@ fn reference_row(
         if i_lo > i_hi {
             continue;
         }
-        let range = (i_lo - x0) as usize * spp..(i_hi - x0 + 1) as usize * spp;
-        for k in range {
+        let q_lo = s.pixels.partition_point(|&p| x0 + p < i_lo);
+        let q_hi = s.pixels.partition_point(|&p| x0 + p <= i_hi);
+        for k in q_lo * spp..q_hi * spp {
             let [xf, yf] = s.fixed[k];
             let e = &t.edges;
             if (e[0].at(xf, yf) | e[1].at(xf, yf) | e[2].at(xf, yf)) >= 0 {
@@ -363,9 +400,10 @@ fn reference_row(
     }
     let background = Vec4::from_array(ctx.settings.background);
     let inv_spp = 1.0 / spp as f32;
-    for (p, (out, nearest)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
+    for (q, &p) in s.pixels.iter().enumerate() {
+        let (out, nearest) = (&mut color[p as usize], &mut depth[p as usize]);
         let mut sum = Vec4::ZERO;
-        for k in p * spp..(p + 1) * spp {
+        for k in q * spp..(q + 1) * spp {
             let id = s.winner[k];
             if id == u32::MAX {
                 sum += match &ctx.background {

@@ -1,0 +1,473 @@
+//! The reference with error bars: independent passes, each pixel's standard error, and more
+//! samples where the error is still larger than the tolerance.
+//!
+//! A *pass* is one stratified jittered estimate per pixel ([`crate::reference`]) with its own
+//! seed, derived from the plan's seed and the pass number. Passes are independent and identically
+//! distributed, so the mean of `K` passes is unbiased and the spread of the pass means estimates
+//! its error: with `s^2` the sample variance of the `K` pass means of a channel (linear light),
+//! the standard error is `s / sqrt(K)` and the 95 % interval is the mean `± t(K - 1) * s / sqrt(K)`
+//! (Student's t quantile, which widens the interval when `K` is small).
+//!
+//! Convergence is judged on what a person sees: a pixel is converged when, for each of R, G and
+//! B, the displayed value (clipped to `[0, 1]`, sRGB-encoded when the display is sRGB) at either
+//! end of the interval lies within the tolerance of the displayed mean. A pixel whose interval
+//! lies wholly above 1 is converged however wide it is, since the display clips it.
+//!
+//! The plan's minimum is spent in [`MIN_PASSES`] passes (fewer when it has fewer samples); then,
+//! in rounds, every unconverged pixel gets as many passes again as it has (its samples double)
+//! until it converges or the next round would exceed the maximum. Every unconverged pixel of a
+//! round gets the same passes, so the result depends on the seed only, not on the thread count or
+//! the order of work. Pixel estimates are unbiased whatever their sample counts (each is a mean of
+//! whole passes).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::draw::DrawCall;
+use crate::error::RasterError;
+use crate::frame::Frame;
+use crate::reference::{with_passes, MAX_SPP_SIDE};
+use crate::settings::RenderSettings;
+use texel_texture::rng::mix64;
+
+/// Passes the minimum sample count is split into (when it has that many samples): enough for a
+/// variance estimate with seven degrees of freedom.
+pub const MIN_PASSES: u32 = 8;
+
+/// The largest maximum samples per pixel ([`ReferencePlan::max_spp`]).
+pub const MAX_ADAPTIVE_SPP: u32 = 1 << 20;
+
+/// How a reference converges.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferencePlan {
+    /// Samples every pixel gets, 1 to 4096.
+    pub min_spp: u32,
+    /// The most samples a pixel gets, `min_spp` to [`MAX_ADAPTIVE_SPP`]; equal to `min_spp`, no
+    /// pixel gets more.
+    pub max_spp: u32,
+    /// Half-width of the 95 % interval of the displayed value, in `[0, 1]` display units, at which
+    /// a pixel is converged (`0.5 / 255` is half an 8-bit step).
+    pub tolerance: f64,
+    /// Whether the display encodes sRGB (otherwise it shows linear values), both clipped to `[0, 1]`.
+    pub srgb_display: bool,
+    /// Seed of the first pass; two seeds give independent estimates.
+    pub seed: u64,
+}
+
+impl Default for ReferencePlan {
+    fn default() -> Self {
+        ReferencePlan {
+            min_spp: 256,
+            max_spp: 65_536,
+            tolerance: 0.5 / 255.0,
+            srgb_display: true,
+            seed: 0x7e_7e1,
+        }
+    }
+}
+
+/// Where a converging reference stands, for progress bars.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceStatus {
+    /// The round: 0 for the minimum's passes, then 1, 2, ...
+    pub round: u32,
+    /// Samples per pixel of the pixels being refined, once this round is done.
+    pub spp: u32,
+    /// Pixels being rendered in this round.
+    pub active: u64,
+    /// Share of all pixels converged before this round.
+    pub converged: f64,
+    /// Pixel-passes of this round done.
+    pub done: u64,
+    /// Pixel-passes of this round in total.
+    pub total: u64,
+}
+
+/// A reference with its error bars.
+#[derive(Clone, Debug)]
+pub struct ReferenceEstimate {
+    /// The mean colour in linear light (float target) and the nearest depth.
+    pub frame: Frame,
+    /// Each pixel's standard error of the mean per channel (linear light, RGBA); infinite for a
+    /// pixel with fewer than two passes.
+    pub std_error: Vec<[f32; 4]>,
+    /// Each pixel's half-width of the 95 % interval of the displayed value, the largest over R, G
+    /// and B (display units, `[0, 1]`); infinite with fewer than two passes.
+    pub display_half_width: Vec<f32>,
+    /// Samples each pixel got.
+    pub spp: Vec<u32>,
+    /// Whether each pixel met the tolerance.
+    pub converged: Vec<bool>,
+    /// Whether the stop flag ended the work early (the passes done are all complete).
+    pub interrupted: bool,
+    /// The plan it was made with.
+    pub plan: ReferencePlan,
+}
+
+impl ReferenceEstimate {
+    /// Share of the pixels that met the tolerance (of those `mask` selects, or all).
+    pub fn converged_share(&self, mask: Option<&[bool]>) -> f64 {
+        share(&self.converged, mask, |&c| c)
+    }
+
+    /// Share of the pixels whose displayed interval is within `t` (display units).
+    pub fn share_within(&self, t: f32, mask: Option<&[bool]>) -> f64 {
+        share(&self.display_half_width, mask, |&h| h <= t)
+    }
+
+    /// Mean samples per pixel.
+    pub fn mean_spp(&self) -> f64 {
+        self.spp.iter().map(|&n| f64::from(n)).sum::<f64>() / self.spp.len().max(1) as f64
+    }
+}
+
+fn share<T>(values: &[T], mask: Option<&[bool]>, pred: impl Fn(&T) -> bool) -> f64 {
+    let (mut n, mut k) = (0u64, 0u64);
+    for (i, v) in values.iter().enumerate() {
+        if mask.is_none_or(|m| m[i]) {
+            n += 1;
+            k += u64::from(pred(v));
+        }
+    }
+    if n == 0 {
+        1.0
+    } else {
+        k as f64 / n as f64
+    }
+}
+
+/// The 0.975 quantile of Student's t with `dof` degrees of freedom (the next smaller tabulated
+/// degree's value: never narrower than the exact interval).
+pub fn t_975(dof: u32) -> f64 {
+    const TABLE: [(u32, f64); 19] = [
+        (1, 12.706),
+        (2, 4.303),
+        (3, 3.182),
+        (4, 2.776),
+        (5, 2.571),
+        (6, 2.447),
+        (7, 2.365),
+        (8, 2.306),
+        (9, 2.262),
+        (10, 2.228),
+        (12, 2.179),
+        (15, 2.131),
+        (20, 2.086),
+        (30, 2.042),
+        (40, 2.021),
+        (60, 2.000),
+        (120, 1.980),
+        (1000, 1.962),
+        (u32::MAX, 1.960),
+    ];
+    TABLE
+        .iter()
+        .rev()
+        .find(|(d, _)| *d <= dof.max(1))
+        .map_or(f64::INFINITY, |&(_, t)| t)
+}
+
+/// The seed of pass `k` of a reference seeded with `seed` (pass 0 uses `seed` itself).
+pub fn pass_seed(seed: u64, k: u32) -> u64 {
+    if k == 0 {
+        seed
+    } else {
+        mix64(seed ^ mix64(u64::from(k).wrapping_mul(0x9E37_79B9_7F4A_7C15)))
+    }
+}
+
+/// How `min_spp` splits into passes: `(passes, [columns, rows] of one pass's strata)`. A pass has
+/// the largest sample count that leaves at least [`MIN_PASSES`] passes, stratified as squarely as
+/// it divides.
+pub fn pass_layout(min_spp: u32) -> (u32, [u32; 2]) {
+    let per_pass = (1..=(min_spp / MIN_PASSES).max(1))
+        .rev()
+        .find(|d| min_spp.is_multiple_of(*d))
+        .unwrap_or(1);
+    let mut n = (f64::from(per_pass).sqrt().floor() as u32).max(1);
+    while !per_pass.is_multiple_of(n) {
+        n -= 1;
+    }
+    (min_spp / per_pass, [n, per_pass / n])
+}
+
+/// Display value of linear `x`: clipped to `[0, 1]`, sRGB-encoded if `srgb`.
+fn display(x: f64, srgb: bool) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    if srgb {
+        f64::from(texel_texture::color::linear_to_srgb(x as f32))
+    } else {
+        x
+    }
+}
+
+/// Per-pixel running statistics of the pass means (Welford's update, in f64).
+#[derive(Clone, Copy, Default)]
+struct Stats {
+    n: u32,
+    mean: [f64; 4],
+    m2: [f64; 4],
+}
+
+impl Stats {
+    fn add(&mut self, x: [f32; 4]) {
+        self.n += 1;
+        let n = f64::from(self.n);
+        for c in 0..4 {
+            let x = f64::from(x[c]);
+            let d = x - self.mean[c];
+            self.mean[c] += d / n;
+            self.m2[c] += d * (x - self.mean[c]);
+        }
+    }
+
+    fn std_error(&self) -> [f64; 4] {
+        if self.n < 2 {
+            return [f64::INFINITY; 4];
+        }
+        let n = f64::from(self.n);
+        self.m2.map(|m2| (m2.max(0.0) / (n - 1.0) / n).sqrt())
+    }
+
+    /// The largest distance over R, G, B between the displayed mean and the displayed ends of the
+    /// 95 % interval.
+    fn display_half_width(&self, srgb: bool) -> f64 {
+        if self.n < 2 {
+            return f64::INFINITY;
+        }
+        let t = t_975(self.n - 1);
+        let se = self.std_error();
+        (0..3)
+            .map(|c| {
+                let (m, h) = (self.mean[c], t * se[c]);
+                let d = display(m, srgb);
+                (display(m + h, srgb) - d).max(d - display(m - h, srgb))
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Render a reference of `draws` that converges as `plan` says (see the module docs).
+///
+/// `progress`, if given, is called from worker threads as pixels finish. `stop`, if given, is
+/// read between passes: once it is set, the estimate so far is returned, marked interrupted.
+///
+/// # Errors
+/// As [`crate::render`]; [`RasterError::InvalidReferencePlan`] for a plan outside its ranges; a
+/// stop before the first pass completes is [`RasterError::Interrupted`].
+pub fn render_reference_adaptive(
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+    plan: &ReferencePlan,
+    progress: Option<&(dyn Fn(&ReferenceStatus) + Sync)>,
+    stop: Option<&AtomicBool>,
+) -> Result<ReferenceEstimate, RasterError> {
+    let max_min = MAX_SPP_SIDE * MAX_SPP_SIDE;
+    let valid = (1..=max_min).contains(&plan.min_spp)
+        && (plan.min_spp..=MAX_ADAPTIVE_SPP).contains(&plan.max_spp)
+        && plan.tolerance >= 0.0
+        && plan.tolerance.is_finite();
+    if !valid {
+        return Err(RasterError::InvalidReferencePlan {
+            min_spp: plan.min_spp,
+            max_spp: plan.max_spp,
+            tolerance: plan.tolerance,
+        });
+    }
+    let (first_passes, strata) = pass_layout(plan.min_spp);
+    let per_pass = strata[0] * strata[1];
+    let max_passes = plan.max_spp / per_pass;
+    let pixels = settings.width as usize * settings.height as usize;
+    let mut stats = vec![Stats::default(); pixels];
+    let mut depth = vec![f32::INFINITY; pixels];
+    let mut converged = vec![false; pixels];
+    let mut interrupted = false;
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    with_passes(settings, draws, strata, |pass| {
+        let mut active: Option<Vec<bool>> = None;
+        let mut done_passes = 0u32;
+        let mut round = 0u32;
+        let mut add = first_passes;
+        loop {
+            let active_count = active
+                .as_ref()
+                .map_or(pixels, |a| a.iter().filter(|&&x| x).count())
+                as u64;
+            let converged_before = share(&converged, None, |&c| c);
+            for k in 0..add {
+                if stopped() {
+                    interrupted = true;
+                    break;
+                }
+                let status = |done: u64, _total: u64| {
+                    if let Some(p) = progress {
+                        p(&ReferenceStatus {
+                            round,
+                            spp: (done_passes + add) * per_pass,
+                            active: active_count,
+                            converged: converged_before,
+                            done: u64::from(k) * active_count
+                                + done * active_count / pixels.max(1) as u64,
+                            total: u64::from(add) * active_count,
+                        });
+                    }
+                };
+                let frame = pass(
+                    pass_seed(plan.seed, done_passes + k),
+                    active.as_deref(),
+                    Some(&status),
+                )?;
+                for (i, st) in stats.iter_mut().enumerate() {
+                    if active.as_ref().is_none_or(|a| a[i]) {
+                        st.add(frame.color[i]);
+                        depth[i] = depth[i].min(frame.depth[i]);
+                    }
+                }
+            }
+            if stats.iter().all(|s| s.n == 0) {
+                return Err(RasterError::Interrupted);
+            }
+            if interrupted {
+                break;
+            }
+            done_passes += add;
+            let mut next = vec![false; pixels];
+            let mut any = false;
+            for i in 0..pixels {
+                if active.as_ref().is_none_or(|a| a[i]) {
+                    converged[i] = stats[i].display_half_width(plan.srgb_display) <= plan.tolerance;
+                    next[i] = !converged[i];
+                    any |= next[i];
+                }
+            }
+            add = done_passes.min(max_passes.saturating_sub(done_passes));
+            if !any || add == 0 {
+                break;
+            }
+            active = Some(next);
+            round += 1;
+        }
+        Ok(())
+    })?;
+    // An interrupted round leaves its pixels with more passes than the others: each is still the
+    // mean of whole passes, and its own statistics say how far it got.
+    for (i, st) in stats.iter().enumerate() {
+        converged[i] = st.display_half_width(plan.srgb_display) <= plan.tolerance;
+    }
+    let frame = Frame {
+        width: settings.width,
+        height: settings.height,
+        target: crate::settings::ColorTarget::Float,
+        color: stats
+            .iter()
+            .map(|s| {
+                if s.n == 0 {
+                    settings.background
+                } else {
+                    s.mean.map(|m| m as f32)
+                }
+            })
+            .collect(),
+        color8: Vec::new(),
+        texels_read: Vec::new(),
+        depth,
+        footprints: Vec::new(),
+        cleared: Default::default(),
+    };
+    Ok(ReferenceEstimate {
+        frame,
+        std_error: stats
+            .iter()
+            .map(|s| s.std_error().map(|e| e as f32))
+            .collect(),
+        display_half_width: stats
+            .iter()
+            .map(|s| s.display_half_width(plan.srgb_display) as f32)
+            .collect(),
+        spp: stats.iter().map(|s| s.n * per_pass).collect(),
+        converged,
+        interrupted,
+        plan: *plan,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pass_layouts() {
+        assert_eq!(pass_layout(256), (8, [4, 8]));
+        assert_eq!(pass_layout(1024), (8, [8, 16]));
+        assert_eq!(pass_layout(4096), (8, [16, 32]));
+        assert_eq!(pass_layout(7), (7, [1, 1]));
+        assert_eq!(pass_layout(1), (1, [1, 1]));
+        assert_eq!(pass_layout(24), (8, [1, 3]));
+        for spp in 1..=4096 {
+            let (k, [n, m]) = pass_layout(spp);
+            assert_eq!(k * n * m, spp, "{spp}");
+            assert!(
+                k >= MIN_PASSES.min(spp) && n <= m && m <= MAX_SPP_SIDE,
+                "{spp}"
+            );
+        }
+    }
+
+    #[test]
+    fn welford_matches_the_two_pass_formulas() {
+        let xs = [0.25f32, 0.5, 1.75, 0.0, 3.0];
+        let mut s = Stats::default();
+        for x in xs {
+            s.add([x; 4]);
+        }
+        let n = xs.len() as f64;
+        let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
+        let var = xs
+            .iter()
+            .map(|&x| (f64::from(x) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        assert!((s.mean[0] - mean).abs() < 1e-12);
+        assert!((s.std_error()[0] - (var / n).sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_display_clips_and_encodes() {
+        // An interval wholly above 1 shows as 1 at both ends: width zero.
+        let mut s = Stats::default();
+        for x in [5.0f32, 9.0, 7.0] {
+            s.add([x, x, x, 1.0]);
+        }
+        assert_eq!(s.display_half_width(true), 0.0);
+        // Linear display: the half-width is t * s / sqrt(n) while the interval stays in [0, 1].
+        let mut s = Stats::default();
+        for x in [0.4f32, 0.5, 0.6] {
+            s.add([x, x, x, 1.0]);
+        }
+        let expected = t_975(2) * 0.1 / 3f64.sqrt();
+        assert!((s.display_half_width(false) - expected).abs() < 1e-6);
+        // sRGB is steeper than linear below mid-grey.
+        assert!(s.display_half_width(true) > 0.0);
+        let mut one = Stats::default();
+        one.add([0.5; 4]);
+        assert!(one.display_half_width(true).is_infinite());
+    }
+
+    #[test]
+    fn t_quantiles() {
+        assert_eq!(t_975(1), 12.706);
+        assert_eq!(t_975(7), 2.365);
+        assert_eq!(t_975(11), 2.228);
+        assert_eq!(t_975(1 << 20), 1.962);
+        assert!(t_975(u32::MAX) == 1.96);
+        for d in 1..2000 {
+            assert!(t_975(d) >= t_975(d + 1));
+        }
+    }
+
+    #[test]
+    fn pass_seeds_differ() {
+        let seeds: std::collections::HashSet<u64> = (0..1000).map(|k| pass_seed(7, k)).collect();
+        assert_eq!(seeds.len(), 1000);
+        assert_eq!(pass_seed(7, 0), 7);
+    }
+}
