@@ -119,6 +119,10 @@ def measure(a):
         rows.append(entry)
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL).stdout.strip()
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
+                           text=True, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL).stdout
+    if commit and dirty.strip():
+        commit += "+changes"
     date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
     record = {
         "date": date,

@@ -400,8 +400,8 @@ pub struct ViewArgs {
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Samples every pixel gets, 1 to 4096, in at least 8 independent passes (256 = 8 passes of
-    /// 4x8 stratified samples).
+    /// Samples every pixel gets, 1 to 4096, in at least 8 independent passes (one per sample below
+    /// 8; 256 = 8 passes of 4x8 stratified samples).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub spp: u32,
     /// The most samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is wider than
@@ -495,8 +495,8 @@ pub struct DemoArgs {
     /// and half for the lit ones).
     #[arg(long)]
     pub size: Option<Size>,
-    /// Every scene at full size (the ground plane at 1280x720): several minutes on two cores,
-    /// where the default takes under two.
+    /// Every unlit scene at its full size (the ground plane at 1280x720) and the lit ones at
+    /// half: several minutes on two cores, where the default takes under two.
     #[arg(long)]
     pub full: bool,
     /// Reference samples per pixel, 1 to 4096, stratified n x m with each side at most 64

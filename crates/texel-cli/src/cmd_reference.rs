@@ -131,16 +131,16 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
 }
 
 /// Bytes per pixel a converging reference holds: its running statistics, masks and results.
-pub const ADAPTIVE_BYTES_PER_PIXEL: u64 = 160;
+pub const ADAPTIVE_BYTES_PER_PIXEL: u64 = 192;
 
 /// One line: the share converged, the samples taken and the time.
 pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> String {
+    let min = e.spp.iter().copied().min().unwrap_or(0);
     let max = e.spp.iter().copied().max().unwrap_or(0);
     let unconverged = e.converged.iter().filter(|&&c| !c).count();
     let mut line = format!(
-        "reference: {:.2} % of pixels within ±{tolerance_steps}/255 of the display at 95 % confidence; {}-{max} samples per pixel (mean {:.0}); seed {}; {seconds:.1} s",
+        "reference: {:.2} % of pixels within ±{tolerance_steps}/255 of the display at 95 % confidence; {min}-{max} samples per pixel (mean {:.0}); seed {}; {seconds:.1} s",
         100.0 * e.converged_share(None),
-        e.plan.min_spp,
         e.mean_spp(),
         e.plan.seed,
     );
@@ -149,7 +149,7 @@ pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> Str
     } else if unconverged > 0 {
         let _ = write!(
             line,
-            "; {unconverged} pixels reached --max-spp {} without converging",
+            "; {unconverged} pixels stopped unconverged at the maximum, {max} samples (--max-spp {} in whole passes)",
             e.plan.max_spp
         );
     }

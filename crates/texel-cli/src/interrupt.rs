@@ -17,7 +17,7 @@ static STOP: AtomicBool = AtomicBool::new(false);
 /// The signal handler.
 pub fn on_signal() {
     if GRACEFUL.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
-        eprintln!("\ntexel: stopping after the current pass (press Ctrl-C again to abort)");
+        eprintln!("\ntexel: stopping after the current pass (a second signal aborts)");
         return;
     }
     texel_quality::remove_pending_and_exit(INTERRUPTED)

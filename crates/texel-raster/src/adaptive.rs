@@ -13,12 +13,14 @@
 //! end of the interval lies within the tolerance of the displayed mean. A pixel whose interval
 //! lies wholly above 1 is converged however wide it is, since the display clips it.
 //!
-//! The plan's minimum is spent in [`MIN_PASSES`] passes (fewer when it has fewer samples); then,
-//! in rounds, every unconverged pixel gets as many passes again as it has (its samples double)
-//! until it converges or the next round would exceed the maximum. Every unconverged pixel of a
-//! round gets the same passes, so the result depends on the seed only, not on the thread count or
-//! the order of work. Pixel estimates are unbiased whatever their sample counts (each is a mean of
-//! whole passes).
+//! The plan's minimum is spent in at least [`MIN_PASSES`] passes (one per sample when it has fewer
+//! samples); then, in rounds, every unconverged pixel gets as many passes again as it has (its
+//! samples double; the last round adds only what the maximum leaves) until it converges or
+//! reaches the maximum, rounded down to whole passes. Every unconverged pixel of a round gets the
+//! same passes, so the result depends on the seed only, not on the thread count or the order of
+//! work. Each pass is an unbiased estimate; whether a pixel gets more passes depends on the ones it
+//! has, so a pixel whose passes all missed a rare bright feature (a glint) shows a small spread,
+//! stops early and stays too dark. The error bars cannot see what no pass sampled.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -135,8 +137,8 @@ fn share<T>(values: &[T], mask: Option<&[bool]>, pred: impl Fn(&T) -> bool) -> f
     }
 }
 
-/// The 0.975 quantile of Student's t with `dof` degrees of freedom (the next smaller tabulated
-/// degree's value: never narrower than the exact interval).
+/// The 0.975 quantile of Student's t with `dof` degrees of freedom: the value of the next smaller
+/// tabulated degree, rounded to three decimals.
 pub fn t_975(dof: u32) -> f64 {
     const TABLE: [(u32, f64); 19] = [
         (1, 12.706),
@@ -176,18 +178,22 @@ pub fn pass_seed(seed: u64, k: u32) -> u64 {
 }
 
 /// How `min_spp` splits into passes: `(passes, [columns, rows] of one pass's strata)`. A pass has
-/// the largest sample count that leaves at least [`MIN_PASSES`] passes, stratified as squarely as
-/// it divides.
+/// the largest sample count that leaves at least [`MIN_PASSES`] passes (every sample its own pass
+/// below that) and stratifies within [`MAX_SPP_SIDE`] per side, as squarely as it divides.
 pub fn pass_layout(min_spp: u32) -> (u32, [u32; 2]) {
-    let per_pass = (1..=(min_spp / MIN_PASSES).max(1))
+    let split = |d: u32| {
+        let mut n = (f64::from(d).sqrt().floor() as u32).max(1);
+        while !d.is_multiple_of(n) {
+            n -= 1;
+        }
+        [n, d / n]
+    };
+    (1..=(min_spp / MIN_PASSES).max(1))
         .rev()
-        .find(|d| min_spp.is_multiple_of(*d))
-        .unwrap_or(1);
-    let mut n = (f64::from(per_pass).sqrt().floor() as u32).max(1);
-    while !per_pass.is_multiple_of(n) {
-        n -= 1;
-    }
-    (min_spp / per_pass, [n, per_pass / n])
+        .filter(|d| min_spp.is_multiple_of(*d))
+        .map(|d| (min_spp / d, split(d)))
+        .find(|(_, [_, m])| *m <= MAX_SPP_SIDE)
+        .unwrap_or((min_spp, [1, 1]))
 }
 
 /// Display value of linear `x`: clipped to `[0, 1]`, sRGB-encoded if `srgb`.
@@ -402,6 +408,8 @@ mod tests {
         assert_eq!(pass_layout(7), (7, [1, 1]));
         assert_eq!(pass_layout(1), (1, [1, 1]));
         assert_eq!(pass_layout(24), (8, [1, 3]));
+        // 536 = 8 x 67: a pass of 67 samples cannot stratify within 64 per side.
+        assert_eq!(pass_layout(536), (67, [2, 4]));
         for spp in 1..=4096 {
             let (k, [n, m]) = pass_layout(spp);
             assert_eq!(k * n * m, spp, "{spp}");
