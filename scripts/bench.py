@@ -15,9 +15,23 @@ It writes one JSON record: the machine (CPU model, family, SIMD level, cores, th
 date, the commit, the commands, and the figures. Default file: docs/benchmarks/<cpu>-<date>.json.
 
 `render` turns every record in docs/benchmarks/ (or the ones named) into docs/benchmarks.md, and
-the newest record into the README's table between the `bench:begin` and `bench:end` markers.
-`--check` writes nothing and exits 1 where a file differs from what the records give (the test
-suite runs it). Only the Python standard library is needed.
+the newest ground-plane record into the README's table between the `bench:begin` and `bench:end`
+markers. `--check` writes nothing and exits 1 where a file differs from what the records give (the
+test suite runs it). Only the Python standard library is needed.
+
+Two kinds of record live in docs/benchmarks/:
+  - ground-plane records, as `measure` writes them (no `kind` key), shown newest first;
+  - table records, `"kind": "table"`, for the output of the other measuring commands
+    (scripts/vs_llvmpipe.py, scripts/bench_tables.py sampler|aniso|threads, texel bench):
+      {"kind": "table", "order": N, "title": "...", "setup": "...",
+       "machine": {"name": "...", "description": "..."}, "other_machines": [{...}],
+       "command": "..." or ["...", ...], "caption": "...",
+       "tables": [{"columns": [...], "align": ["l" | "r", ...], "rows": [[cell, ...], ...]}],
+       "notes": "..."}
+    Every cell is a string, copied as the command prints it. `order` (ascending, then the file
+    name) places the record among the others; `setup`, `other_machines` and `notes` are optional,
+    and `align` defaults to the first column left and the others right. docs/benchmarks.md shows
+    them after the ground-plane records, one section each, with a list of their machines.
 """
 import argparse
 import datetime
@@ -158,8 +172,8 @@ def slug(s):
 def machine_line(r):
     m = r["machine"]
     fam = f", family {m['family']} model {m['model']}" if m.get("family") else ""
-    return (f"{m['cpu']}{fam}, {m['cores']} cores, {m['simd']}, {m['threads']} threads; "
-            f"measured {r['date']}")
+    date = f"; measured {r['date']}" if r.get("date") else ""
+    return f"{m['cpu']}{fam}, {m['cores']} cores, {m['simd']}, {m['threads']} threads{date}"
 
 
 def num(v, fmt):
@@ -212,32 +226,100 @@ def caption(r):
             f" by up to {spread(r):.0f} %).{peer} Machine: {machine_line(r)}.")
 
 
+def is_table(r):
+    return r.get("kind") == "table"
+
+
 def load_records(paths):
+    """Ground-plane records (newest first) and table records (by `order`, then path), each a list
+    of (path, record)."""
     records = []
     for p in paths:
-        with open(p) as f:
+        with open(p, encoding="utf-8") as f:
             records.append((os.path.relpath(p, ROOT), json.load(f)))
-    records.sort(key=lambda pr: (pr[1]["date"], pr[0]), reverse=True)
-    return records
+    ground = [pr for pr in records if not is_table(pr[1])]
+    tables = [pr for pr in records if is_table(pr[1])]
+    ground.sort(key=lambda pr: (pr[1].get("date") or "", pr[0]), reverse=True)
+    tables.sort(key=lambda pr: (pr[1].get("order", float("inf")), pr[0]))
+    return ground, tables
+
+
+def cell(v):
+    return str(v).replace("|", "\\|")
+
+
+def markdown_table(t):
+    cols = t["columns"]
+    align = t.get("align") or ["l"] + ["r"] * (len(cols) - 1)
+    if len(align) != len(cols):
+        sys.exit(f"table {cols}: {len(align)} alignments for {len(cols)} columns")
+    out = ["| " + " | ".join(cell(c) for c in cols) + " |",
+           "|" + "|".join("--:" if a == "r" else "---" for a in align) + "|"]
+    for row in t["rows"]:
+        if len(row) != len(cols):
+            sys.exit(f"table {cols}: row {row} has {len(row)} cells")
+        out.append("| " + " | ".join(cell(c) for c in row) + " |")
+    return "\n".join(out)
+
+
+def machines(tables):
+    """Every machine the table records name, in their order; one description per name."""
+    seen = {}
+    named = [(p, r["machine"]) for p, r in tables]
+    named += [(p, m) for p, r in tables for m in r.get("other_machines", [])]
+    for path, m in named:
+        if m["name"] in seen and seen[m["name"]] != m["description"]:
+            sys.exit(f"{path}: machine {m['name']!r} has a description that differs from "
+                     "another record's")
+        seen.setdefault(m["name"], m["description"])
+    return seen
+
+
+def table_section(tables):
+    ms = machines(tables)
+    listed = [f"the **{name}** ({desc})" for name, desc in ms.items()]
+    if len(listed) > 1:
+        listed = [", ".join(listed[:-1]) + " and " + listed[-1]]
+    doc = ["## Tables from other machines", "",
+           f"The machines: {listed[0]}. They are shared with other work: figures move by up to"
+           " 15 % between runs, more for 1 ms frames, so compare within one table only.", ""]
+    for path, r in tables:
+        setup = f", {r['setup']}" if r.get("setup") else ""
+        commands = r["command"] if isinstance(r["command"], list) else [r["command"]]
+        doc += [f"### {r['title']} ({r['machine']['name']}{setup})", "",
+                ("Commands: " if len(commands) > 1 else "Command: ")
+                + ", ".join(f"`{c}`" for c in commands) + ".", ""]
+        if r.get("caption"):
+            doc += [r["caption"], ""]
+        for t in r["tables"]:
+            doc += [markdown_table(t), ""]
+        if r.get("notes"):
+            doc += [r["notes"], ""]
+        doc += [f"Record: `{path}`.", ""]
+    return doc
 
 
 def render(a):
     paths = a.records or sorted(glob.glob(os.path.join(RECORDS, "*.json")))
-    records = load_records(paths)
+    records, tables = load_records(paths)
     if not records:
-        sys.exit("no records: run scripts/bench.py measure first")
+        sys.exit("no ground-plane records: run scripts/bench.py measure first")
     doc = ["# Benchmarks", "",
-           "Generated by `scripts/bench.py render` from the records in `docs/benchmarks/`"
-           " (one JSON file per machine and run, written by `scripts/bench.py measure`). Newest"
-           " first. Timings on shared virtual machines move by 10-15 % between runs; ratios"
-           " against llvmpipe come from the same rounds.", ""]
+           "Generated by `scripts/bench.py render` from the records in `docs/benchmarks/`. The"
+           " ground-plane tables come first, newest first (one JSON file per machine and run,"
+           " written by `scripts/bench.py measure`); timings on shared virtual machines move by"
+           " 10-15 % between runs, and ratios against llvmpipe come from the same rounds."
+           + (" Then the [tables from other machines](#tables-from-other-machines), one for each"
+              " record of `\"kind\": \"table\"`." if tables else ""), ""]
     for path, r in records:
         doc += [f"## {machine_line(r)}", "", caption(r), "", table(r), "",
                 f"Texture memory: {memory(r)}. Record: `{path}`.", ""]
+    if tables:
+        doc += table_section(tables)
     files = {os.path.join(ROOT, "docs", "benchmarks.md"): "\n".join(doc)}
     newest = records[0][1]
     readme_path = os.path.join(ROOT, "README.md")
-    with open(readme_path) as f:
+    with open(readme_path, encoding="utf-8") as f:
         readme = f.read()
     begin, end = readme.find(README_BEGIN), readme.find(README_END)
     if begin < 0 or end < begin:
@@ -246,12 +328,12 @@ def render(a):
     files[readme_path] = readme[:begin] + block + readme[end:]
     stale = []
     for path, text in files.items():
-        with open(path) if os.path.exists(path) else open(os.devnull) as f:
+        with open(path if os.path.exists(path) else os.devnull, encoding="utf-8") as f:
             old = f.read()
         if old != text:
             stale.append(os.path.relpath(path, ROOT))
             if not a.check:
-                with open(path, "w") as f:
+                with open(path, "w", encoding="utf-8") as f:
                     f.write(text)
     if a.check and stale:
         sys.exit("out of date with docs/benchmarks/: " + ", ".join(stale)

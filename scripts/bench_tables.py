@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Run a benchmark and print the table of docs/guide/measuring.md it backs, in that format.
+"""Run a benchmark and print the table of docs/benchmarks.md it backs, in that format.
 
 Usage (from anywhere; runs in the repository root):
   scripts/bench_tables.py sampler   # "Sampler throughput": criterion, benches/sampler.rs
@@ -13,7 +13,8 @@ sampler and aniso take `--exe PATH`: run an already built bench executable (e.g.
 `target/release/deps/sampler-*`) instead of building this tree's, for before/after tables.
 
 Each prints markdown on stdout and the command it ran on stderr. Numbers move by up to 15 % between
-runs on a shared machine: paste a table with the date and machine next to it.
+runs on a shared machine: keep a table as a `"kind": "table"` record in docs/benchmarks/ with the
+machine next to it (the format is in scripts/bench.py), then run scripts/bench.py render.
 """
 import json
 import os

@@ -1,4 +1,4 @@
-//! Print the frame-time table of docs/guide/measuring.md: the ground scene at 1280 x 720 per
+//! Print the frame-time table of docs/benchmarks.md: the ground scene at 1280 x 720 per
 //! filter and thread count, the 100k-triangle mesh, and the 16 x 16 reference; min and median of N runs (the min is the
 //! least-disturbed estimate on a shared machine; criterion's `benches/frame.rs` measures the same
 //! renders).

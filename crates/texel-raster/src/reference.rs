@@ -21,7 +21,7 @@
 //! visibility for all `64 nx ny` samples of the row (integer edge tests against the row's triangles
 //! only, with a per-sample depth and winner buffer), then shading each sample once, so hidden
 //! samples are never shaded. Tiles run in parallel; the result is independent of the thread count.
-//! Its time for 16 x 16 spp of the ground scene at 1280 x 720 is in docs/guide/measuring.md
+//! Its time for 16 x 16 spp of the ground scene at 1280 x 720 is in docs/benchmarks.md
 //! (`examples/frame_table.rs`; `examples/ground.rs` prints it too).
 //! The settings' `view`, `derivatives` and `perspective` are ignored (always colour, level 0,
 //! perspective-correct); `count_texels` and `capture_footprints` leave their buffers empty; the

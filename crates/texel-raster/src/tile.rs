@@ -51,8 +51,8 @@
 //! lanes, one slice per field, never as structs (docs/decisions.md). Frames are reusable
 //! (`render_into`, `draw_into`).
 //!
-//! Frame times, the mesh's triangle rate and the profiles are in docs/guide/measuring.md;
-//! how each of these decisions moved them is in docs/decisions.md.
+//! Frame times and the mesh's triangle rate are in docs/benchmarks.md; the profiles, and how each
+//! of these decisions moved them, are in docs/decisions.md.
 
 use std::cell::Cell;
 

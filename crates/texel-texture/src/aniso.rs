@@ -31,7 +31,7 @@
 //!   at 0, as the sampler treats non-finite `uv`.
 //!
 //! Cost: `N` trilinear probes, so at most `8 N` texel reads. Throughput and texels read per sample
-//! at anisotropy ratios 1 to 64 are in docs/guide/measuring.md (`benches/aniso.rs`); quality
+//! at anisotropy ratios 1 to 64 are in docs/benchmarks.md (`benches/aniso.rs`); quality
 //! against a brute-force Gaussian (RMS error 0.0158 for 16x vs 0.0252 for trilinear) is in
 //! [`crate::ewa`].
 //!

@@ -92,7 +92,7 @@
 //! Keeping it would need a level one finer (4x the reads); pbrt's falloff stays.
 //!
 //! Cost: throughput and texels read per sample at anisotropy ratios 1 to 64 are in
-//! docs/guide/measuring.md (the anisotropic filters' table, from `benches/aniso.rs`); frame
+//! docs/benchmarks.md (the anisotropic filters' table, from `benches/aniso.rs`); frame
 //! times too.
 
 use std::sync::OnceLock;

@@ -32,7 +32,7 @@
 //!
 //! The build of a 2048x2048 sRGB ripmap is dominated by sRGB-encoding its 12.6 M texels (three
 //! `powf` each), ten times the pyramid's. Memory, build time, throughput and texels read per sample
-//! (2048x2048, `benches/aniso.rs`) are in docs/guide/measuring.md.
+//! (2048x2048, `benches/aniso.rs`) are in docs/benchmarks.md.
 
 use glam::Vec4;
 use rayon::prelude::*;

@@ -49,7 +49,7 @@
 //! What bounds the 8-bit path: over half of a trilinear frame is texel loads, the four table loads
 //! that decode each sRGB texel, and the `Vec4` blends. The sampler bench's `bound/*` group times
 //! those alone (every index and fraction precomputed) and on a float copy of the texture (no
-//! decode). The figures are in docs/guide/measuring.md; the decisions they back, and why AVX2
+//! decode). The figures are in docs/benchmarks.md; the decisions they back, and why AVX2
 //! gathers are not used, are in docs/decisions.md.
 
 use glam::Vec4;

@@ -41,7 +41,7 @@
 //! texture's edge is split, so it reads more.
 //!
 //! Memory, build time, throughput and entries read per sample (2048x2048, `benches/aniso.rs`) are
-//! in docs/guide/measuring.md.
+//! in docs/benchmarks.md.
 
 use glam::Vec4;
 use rayon::prelude::*;
