@@ -17,7 +17,7 @@ use texel_raster::{render, Frame, RenderSettings};
 
 use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
-use crate::cmd_reference::{reference_frame, reference_frame_from};
+use crate::cmd_reference::reference_frame_from;
 use crate::filters::{parse_list, Filter};
 use crate::input::{load_scene, Input};
 use crate::output::encoding;
@@ -223,7 +223,8 @@ pub fn compare(
     if let Some(pb) = &extras.progress {
         pb.set_message(format!("{label}: reference"));
     }
-    let reference = reference_frame(scene, spp)?;
+    let reference =
+        reference_frame_from(scene, spp, &scene.scene.camera, extras.progress.is_none())?;
     if let Some(pb) = &extras.progress {
         pb.inc(1);
     }
@@ -374,7 +375,7 @@ fn orbit_scores(
     for k in 1..spec.frames {
         eprintln!("orbit frame {k} of {}", spec.frames - 1);
         let camera = scene.scene.camera.orbited(spec.step_deg * k as f32);
-        let reference = reference_frame_from(scene, spp, &camera)?;
+        let reference = reference_frame_from(scene, spp, &camera, true)?;
         let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
         let coverage = Mask::new(w, h, reference.coverage())?;
         ref_change += mean_abs_change(&prev_ref, &ref_image, &prev_cov, &coverage)?;

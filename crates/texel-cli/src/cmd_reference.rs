@@ -31,16 +31,14 @@ pub fn strata(spp: u32) -> (u32, u32) {
     (n, spp / n)
 }
 
-/// Render the reference of a prepared scene, with a progress bar on a terminal.
-pub fn reference_frame(scene: &PreparedScene, spp: u32) -> Result<texel_raster::Frame> {
-    reference_frame_from(scene, spp, &scene.scene.camera)
-}
-
-/// [`reference_frame`] seen by `camera` instead of the scene's.
+/// Render the single-pass reference (`spp` samples, stratified) of a prepared scene seen by
+/// `camera`, as `compare` scores against it; `bar` says whether it draws its own progress bar on a
+/// terminal (a caller that shows one bar over several steps passes false).
 pub fn reference_frame_from(
     scene: &PreparedScene,
     spp: u32,
     camera: &texel_scene::Camera,
+    bar: bool,
 ) -> Result<texel_raster::Frame> {
     // The reference samples level 0 bilinearly with each mesh's address modes; the filter only
     // supplies those.
@@ -48,7 +46,11 @@ pub fn reference_frame_from(
     let draws = scene.reference_draws_from(&samplers, camera)?;
     let settings = scene.settings_for(&samplers, camera);
     let (n, m) = strata(spp);
-    let pb = progress::bar(1000, "reference");
+    let pb = if bar {
+        progress::bar(1000, "reference")
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
     let report = |done: u64, total: u64| pb.set_position(done * 1000 / total.max(1));
     let max = texel_raster::reference::MAX_SPP_SIDE;
     anyhow::ensure!(

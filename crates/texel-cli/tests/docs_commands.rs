@@ -163,14 +163,18 @@ fn shrink(args: &[String]) -> (Vec<String>, Vec<String>) {
     (a, outputs)
 }
 
-/// `args` with every word that names a file of the repository made absolute, so the command runs
-/// in a scratch directory and still finds `scenes/` and `docs/images/`.
+/// `args` with every input word that names a file of the repository made absolute, so the command
+/// runs in a scratch directory and still finds `scenes/` and `docs/images/`. The values of output
+/// flags stay relative: a command never writes into the repository.
 fn rooted(args: &[String]) -> Vec<String> {
     let root = repo();
+    let outputs = ["-o", "--out", "--screenshot", "--error-map"];
     args.iter()
-        .map(|a| {
+        .enumerate()
+        .map(|(i, a)| {
             let p = root.join(a);
-            if !a.starts_with('-') && a.contains('/') && p.exists() {
+            let output = i > 0 && outputs.contains(&args[i - 1].as_str());
+            if !output && !a.starts_with('-') && a.contains('/') && p.exists() {
                 p.to_string_lossy().into_owned()
             } else {
                 a.clone()

@@ -172,51 +172,55 @@ fn the_reference_does_not_depend_on_threads_and_writes_its_error_map() {
     );
 }
 
-/// Refinement only adds samples where a pixel has not converged: on the unlit ground plane with
-/// a loose tolerance most pixels stop at the minimum, and every pixel the summary calls converged
-/// has an interval within the tolerance (the PNG error map shows red only for the others).
+/// Refinement adds samples only where a pixel has not converged: on the unlit ground plane with a
+/// loose tolerance, refining up to 256 samples raises the share converged over the fixed 16-sample
+/// estimate while the mean count stays well below 256 (most pixels stop at the minimum), and the
+/// PNG error map marks exactly the unconverged share in red.
 #[test]
 fn refinement_adds_samples_only_where_needed() {
     let d = Dir::new("reference-adaptive");
-    let out = ok(&[
-        "reference",
-        "--size",
-        "64x36",
-        "--spp",
-        "16",
-        "--max-spp",
-        "256",
-        "--tolerance",
-        "1",
-        "--error-map",
-        &d.arg("err.png"),
-        "-o",
-        &d.arg("r.png"),
-    ]);
-    let line = stderr(&out);
-    let share: f64 = line
-        .split("reference: ")
-        .nth(1)
-        .and_then(|s| s.split(" %").next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("no share in {line}"));
-    let red = load(d.join("err.png"))
-        .pixels()
-        .iter()
-        .filter(|p| **p == [255, 0, 0, 255])
-        .count();
-    let unconverged = 100.0 * red as f64 / (64.0 * 36.0);
-    assert!(
-        (share - (100.0 - unconverged)).abs() < 0.01,
-        "{line}: {red} red pixels"
-    );
-    let mean: f64 = line
-        .split("(mean ")
-        .nth(1)
-        .and_then(|s| s.split(')').next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("no mean in {line}"));
-    assert!(mean > 16.0 && mean < 256.0, "{line}");
+    let run = |max: &str| {
+        let out = ok(&[
+            "reference",
+            "--size",
+            "64x36",
+            "--spp",
+            "16",
+            "--max-spp",
+            max,
+            "--tolerance",
+            "1",
+            "--error-map",
+            &d.arg(&format!("err{max}.png")),
+            "-o",
+            &d.arg(&format!("r{max}.png")),
+        ]);
+        let line = stderr(&out);
+        let field = |before: &str, after: char| -> f64 {
+            line.split(before)
+                .nth(1)
+                .and_then(|s| s.split(after).next())
+                .and_then(|s| s.trim().parse().ok())
+                .unwrap_or_else(|| panic!("no {before:?} in {line}"))
+        };
+        let (share, mean) = (field("reference: ", '%'), field("(mean ", ')'));
+        let red = load(d.join(&format!("err{max}.png")))
+            .pixels()
+            .iter()
+            .filter(|p| **p == [255, 0, 0, 255])
+            .count();
+        let unconverged = 100.0 * red as f64 / (64.0 * 36.0);
+        assert!(
+            (share - (100.0 - unconverged)).abs() < 0.01,
+            "{line}: {red} red"
+        );
+        (share, mean, line)
+    };
+    let (fixed, fixed_mean, _) = run("16");
+    let (refined, refined_mean, line) = run("256");
+    assert_eq!(fixed_mean, 16.0);
+    assert!(refined > fixed, "{fixed} -> {refined}: {line}");
+    assert!(refined_mean > 16.0 && refined_mean < 128.0, "{line}");
 }
 
 /// The display value (8-bit steps, clipped, sRGB) of a linear value.
