@@ -72,6 +72,14 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
         args.max_spp,
         args.spp
     );
+    if let Some(map) = &args.error_map {
+        anyhow::ensure!(
+            !same_destination(map, &args.output),
+            "--error-map {} and -o {} name the same file: give the error map a path of its own",
+            map.display(),
+            args.output.display()
+        );
+    }
     let scene = load_scene(&args.scene, input)?;
     input.budget.take(
         "the reference's per-pixel statistics",
@@ -130,6 +138,28 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
         .into());
     }
     Ok(())
+}
+
+/// Whether two output paths name one destination: both standard output, or one file, resolved
+/// through links (a file that does not exist yet through its directory).
+fn same_destination(a: &std::path::Path, b: &std::path::Path) -> bool {
+    use std::path::Path;
+    if a.as_os_str() == "-" || b.as_os_str() == "-" {
+        return a == b;
+    }
+    let resolve = |p: &Path| {
+        std::fs::canonicalize(p).ok().or_else(|| {
+            let parent = p
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            Some(std::fs::canonicalize(parent).ok()?.join(p.file_name()?))
+        })
+    };
+    match (resolve(a), resolve(b)) {
+        (Some(x), Some(y)) => x == y,
+        _ => std::path::absolute(a).ok() == std::path::absolute(b).ok(),
+    }
 }
 
 /// Bytes per pixel a converging reference holds: its running statistics, masks and results.

@@ -170,6 +170,23 @@ fn the_reference_does_not_depend_on_threads_and_writes_its_error_map() {
         2,
         &["not a tolerance"],
     );
+    // The error map may not replace the image: refused before any work, nothing written.
+    let same = d.join("sub/../same.png");
+    std::fs::create_dir(d.join("sub")).unwrap();
+    fails(
+        &[
+            "reference",
+            "--size",
+            "16x9",
+            "-o",
+            &d.arg("same.png"),
+            "--error-map",
+            &same.to_string_lossy(),
+        ],
+        1,
+        &["name the same file"],
+    );
+    assert!(!d.join("same.png").exists());
 }
 
 /// Refinement adds samples only where a pixel has not converged: on the unlit ground plane with a
