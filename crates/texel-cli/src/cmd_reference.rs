@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use texel_quality::{viridis, Image8};
+use texel_raster::reference::square_strata;
 use texel_raster::{
     render_reference_adaptive, render_reference_strata, ReferenceEstimate, ReferencePlan,
     ReferenceStatus,
@@ -21,16 +22,6 @@ use texel::PreparedScene;
 /// Seed of the reference's jitter: fixed, so references are reproducible.
 pub const SEED: u64 = 0x7e_7e1;
 
-/// Split `spp` samples into an `n x m` stratification with `n <= m` as square as possible
-/// (256 -> 16 x 16, 512 -> 16 x 32, 7 -> 1 x 7).
-pub fn strata(spp: u32) -> (u32, u32) {
-    let mut n = (f64::from(spp).sqrt().floor() as u32).max(1);
-    while !spp.is_multiple_of(n) {
-        n -= 1;
-    }
-    (n, spp / n)
-}
-
 /// Render the single-pass reference (`spp` samples, stratified) of a prepared scene seen by
 /// `camera`, as `compare` scores against it; `bar` says whether it draws its own progress bar on a
 /// terminal (a caller that shows one bar over several steps passes false).
@@ -45,7 +36,7 @@ pub fn reference_frame_from(
     let samplers = scene.samplers(Filter::Bilinear)?;
     let draws = scene.reference_draws_from(&samplers, camera)?;
     let settings = scene.settings_for(&samplers, camera);
-    let (n, m) = strata(spp);
+    let [n, m] = square_strata(spp);
     let pb = if bar {
         progress::bar(1000, "reference")
     } else {
@@ -217,19 +208,4 @@ fn write_error_map(path: &std::path::Path, e: &ReferenceEstimate) -> Result<()> 
         })
         .collect();
     write_image(path, &Image8::new(w, h, pixels)?)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::strata;
-
-    #[test]
-    fn stratifications() {
-        assert_eq!(strata(256), (16, 16));
-        assert_eq!(strata(512), (16, 32));
-        assert_eq!(strata(1024), (32, 32));
-        assert_eq!(strata(1), (1, 1));
-        assert_eq!(strata(7), (1, 7));
-        assert_eq!(strata(12), (3, 4));
-    }
 }

@@ -113,6 +113,9 @@ fn value<'a>(args: &'a [String], flag: &str) -> Option<&'a str> {
     args.get(i + 1).map(String::as_str)
 }
 
+/// The flags whose value is a path the command writes.
+const OUTPUT_FLAGS: [&str; 4] = ["-o", "--out", "--screenshot", "--error-map"];
+
 /// `args` (a `texel` command line without the program) made small; also the outputs it names.
 fn shrink(args: &[String]) -> (Vec<String>, Vec<String>) {
     let mut a = args.to_vec();
@@ -153,7 +156,7 @@ fn shrink(args: &[String]) -> (Vec<String>, Vec<String>) {
         }
         _ => {}
     }
-    let mut outputs: Vec<String> = ["-o", "--out", "--screenshot", "--error-map"]
+    let mut outputs: Vec<String> = OUTPUT_FLAGS
         .iter()
         .filter_map(|f| value(&a, f).map(str::to_string))
         .collect();
@@ -168,12 +171,11 @@ fn shrink(args: &[String]) -> (Vec<String>, Vec<String>) {
 /// flags stay relative: a command never writes into the repository.
 fn rooted(args: &[String]) -> Vec<String> {
     let root = repo();
-    let outputs = ["-o", "--out", "--screenshot", "--error-map"];
     args.iter()
         .enumerate()
         .map(|(i, a)| {
             let p = root.join(a);
-            let output = i > 0 && outputs.contains(&args[i - 1].as_str());
+            let output = i > 0 && OUTPUT_FLAGS.contains(&args[i - 1].as_str());
             if !output && !a.starts_with('-') && a.contains('/') && p.exists() {
                 p.to_string_lossy().into_owned()
             } else {

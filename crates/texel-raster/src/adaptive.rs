@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crate::draw::DrawCall;
 use crate::error::RasterError;
 use crate::frame::Frame;
-use crate::reference::{with_passes, MAX_SPP_SIDE};
+use crate::reference::{square_strata, with_passes, MAX_SPP_SIDE};
 use crate::settings::RenderSettings;
 use texel_texture::rng::mix64;
 
@@ -181,17 +181,10 @@ pub fn pass_seed(seed: u64, k: u32) -> u64 {
 /// the largest sample count that leaves at least [`MIN_PASSES`] passes (every sample its own pass
 /// below that) and stratifies within [`MAX_SPP_SIDE`] per side, as squarely as it divides.
 pub fn pass_layout(min_spp: u32) -> (u32, [u32; 2]) {
-    let split = |d: u32| {
-        let mut n = (f64::from(d).sqrt().floor() as u32).max(1);
-        while !d.is_multiple_of(n) {
-            n -= 1;
-        }
-        [n, d / n]
-    };
     (1..=(min_spp / MIN_PASSES).max(1))
         .rev()
         .filter(|d| min_spp.is_multiple_of(*d))
-        .map(|d| (min_spp / d, split(d)))
+        .map(|d| (min_spp / d, square_strata(d)))
         .find(|(_, [_, m])| *m <= MAX_SPP_SIDE)
         .unwrap_or((min_spp, [1, 1]))
 }
@@ -356,9 +349,11 @@ pub fn render_reference_adaptive(
     })?;
     // An interrupted round leaves its pixels with more passes than the others: each is still the
     // mean of whole passes, and its own statistics say how far it got.
-    for (i, st) in stats.iter().enumerate() {
-        converged[i] = st.display_half_width(plan.srgb_display) <= plan.tolerance;
-    }
+    let half: Vec<f64> = stats
+        .iter()
+        .map(|s| s.display_half_width(plan.srgb_display))
+        .collect();
+    let converged = half.iter().map(|&h| h <= plan.tolerance).collect();
     let frame = Frame {
         width: settings.width,
         height: settings.height,
@@ -385,10 +380,7 @@ pub fn render_reference_adaptive(
             .iter()
             .map(|s| s.std_error().map(|e| e as f32))
             .collect(),
-        display_half_width: stats
-            .iter()
-            .map(|s| s.display_half_width(plan.srgb_display) as f32)
-            .collect(),
+        display_half_width: half.iter().map(|&h| h as f32).collect(),
         spp: stats.iter().map(|s| s.n * per_pass).collect(),
         converged,
         interrupted,

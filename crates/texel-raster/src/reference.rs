@@ -53,6 +53,16 @@ pub const MAX_SPP_SIDE: u32 = 64;
 /// The default samples-per-pixel side (16 x 16 = 256 samples, conventions.md).
 pub const DEFAULT_SPP_SIDE: u32 = 16;
 
+/// `spp` samples as `[n, m]` strata with `n <= m`, as square as `spp` divides (256 -> 16 x 16,
+/// 512 -> 16 x 32, 7 -> 1 x 7).
+pub fn square_strata(spp: u32) -> [u32; 2] {
+    let mut n = (f64::from(spp).sqrt().floor() as u32).max(1);
+    while !spp.is_multiple_of(n) {
+        n -= 1;
+    }
+    [n, spp / n]
+}
+
 /// Progress callback: `(pixels done, pixels in total)`, called from worker threads after each tile.
 pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
 
@@ -165,16 +175,55 @@ pub(crate) fn with_passes<T: Send>(
         })
         .collect();
     crate::with_threads(settings.threads, || {
+        // Triangle setup, binning and the draws' contexts serve every pass.
+        let (width, height) = (settings.width, settings.height);
+        let setups = setup_draws(settings, draws)?;
+        // Sub-samples reach the whole pixel: bin by the sample box, so a triangle that ends just
+        // short of a tile's first pixel centre, or covers no centre at all, still reaches its
+        // samples.
+        let bins = bin(
+            &setups,
+            width,
+            height,
+            |t| Some(t.sample_bbox),
+            |s, _| s as u32,
+        );
+        let ref_draws: Vec<DrawCall> = draws
+            .iter()
+            .zip(&samplers)
+            .zip(&materials)
+            .map(|((d, s), m)| DrawCall {
+                sampler: s,
+                material: *m,
+                // The reference evaluates a sphere mapping at every sample, whichever way the
+                // rasterizer does: the ground truth both evaluations approximate.
+                uv_mapping: d.uv_mapping.map(|m| UvMapping {
+                    evaluation: UvEvaluation::PerPixel,
+                    ..m
+                }),
+                ..*d
+            })
+            .collect();
+        let contexts: Vec<DrawContext> = ref_draws.iter().map(DrawContext::new).collect();
+        let shared = Context {
+            settings,
+            setups: &setups,
+            draws: &contexts,
+            lighting: Lighting::of(settings, true),
+            background: settings
+                .environment
+                .and_then(|e| Some((e, e.background_rays(width, height)?))),
+            strata,
+            seed: 0,
+            active: None,
+        };
         let mut pass = |seed: u64, active: Option<&[bool]>, progress: Option<Progress>| {
-            reference_frame(
-                settings,
-                draws,
-                (&samplers, &materials),
-                strata,
+            let ctx = Context {
                 seed,
                 active,
-                progress,
-            )
+                ..shared.clone()
+            };
+            Ok(reference_pass(&ctx, &bins, progress))
         };
         body(&mut pass)
     })
@@ -211,10 +260,12 @@ fn level0(sampler: &Sampler) -> Result<Sampler, RasterError> {
     Ok(Sampler::new(level0_descriptor(sampler.descriptor()))?)
 }
 
+/// What a pass reads: the frame's setup, shared by every pass, and the pass's seed and pixels.
+#[derive(Clone)]
 struct Context<'a> {
     settings: &'a RenderSettings<'a>,
     setups: &'a [TriangleSetup],
-    draws: Vec<DrawContext<'a>>,
+    draws: &'a [DrawContext<'a>],
     lighting: Option<Lighting<'a>>,
     /// The environment and its camera rays, when it is the background.
     background: Option<(Environment<'a>, ViewRays)>,
@@ -224,26 +275,11 @@ struct Context<'a> {
     active: Option<&'a [bool]>,
 }
 
-fn reference_frame(
-    settings: &RenderSettings,
-    draws: &[DrawCall],
-    (samplers, materials): (&[Sampler], &[Option<Material>]),
-    strata: [u32; 2],
-    seed: u64,
-    active: Option<&[bool]>,
-    progress: Option<Progress>,
-) -> Result<Frame, RasterError> {
+/// One pass of the reference with `ctx`'s seed over its active pixels (the others keep the
+/// background).
+fn reference_pass(ctx: &Context, bins: &[Vec<u32>], progress: Option<Progress>) -> Frame {
+    let settings = ctx.settings;
     let (width, height) = (settings.width, settings.height);
-    let setups = setup_draws(settings, draws)?;
-    // Sub-samples reach the whole pixel: bin by the sample box, so a triangle that ends just short
-    // of a tile's first pixel centre, or covers no centre at all, still reaches its samples.
-    let bins = bin(
-        &setups,
-        width,
-        height,
-        |t| Some(t.sample_bbox),
-        |s, _| s as u32,
-    );
     let pixels = width as usize * height as usize;
     let mut frame = Frame {
         width,
@@ -255,34 +291,6 @@ fn reference_frame(
         depth: vec![f32::INFINITY; pixels],
         footprints: Vec::new(),
         cleared: Default::default(),
-    };
-    let ref_draws: Vec<DrawCall> = draws
-        .iter()
-        .zip(samplers)
-        .zip(materials)
-        .map(|((d, s), m)| DrawCall {
-            sampler: s,
-            material: *m,
-            // The reference evaluates a sphere mapping at every sample, whichever way the
-            // rasterizer does: the ground truth both evaluations approximate.
-            uv_mapping: d.uv_mapping.map(|m| UvMapping {
-                evaluation: UvEvaluation::PerPixel,
-                ..m
-            }),
-            ..*d
-        })
-        .collect();
-    let ctx = Context {
-        settings,
-        setups: &setups,
-        draws: ref_draws.iter().map(DrawContext::new).collect(),
-        lighting: Lighting::of(settings, true),
-        background: settings
-            .environment
-            .and_then(|e| Some((e, e.background_rays(width, height)?))),
-        strata,
-        seed,
-        active,
     };
     let (tx, _) = tile_counts(width, height);
     let color = split_rows(&mut frame.color, width, height);
@@ -307,7 +315,7 @@ fn reference_frame(
                 if c0 < c1 && (sy0..sy1).contains(&j) {
                     let (c0, c1) = (c0 as usize, c1 as usize);
                     let (crow, drow) = (&mut crow[c0..c1], &mut drow[c0..c1]);
-                    reference_row(&ctx, bin, x0 + c0 as u32, j, crow, drow, &mut scratch);
+                    reference_row(ctx, bin, x0 + c0 as u32, j, crow, drow, &mut scratch);
                 }
             }
             let tile_pixels = color.iter().map(|r| r.len() as u64).sum::<u64>();
@@ -316,7 +324,7 @@ fn reference_frame(
                 p(now, total);
             }
         });
-    Ok(frame)
+    frame
 }
 
 /// Per-thread buffers for one pixel row of a tile.
@@ -445,5 +453,20 @@ fn reference_row(
             sum += Vec4::from_array(c);
         }
         *out = (sum * inv_spp).to_array();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::square_strata;
+
+    #[test]
+    fn stratifications() {
+        assert_eq!(square_strata(256), [16, 16]);
+        assert_eq!(square_strata(512), [16, 32]);
+        assert_eq!(square_strata(1024), [32, 32]);
+        assert_eq!(square_strata(1), [1, 1]);
+        assert_eq!(square_strata(7), [1, 7]);
+        assert_eq!(square_strata(12), [3, 4]);
     }
 }
