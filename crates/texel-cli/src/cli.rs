@@ -447,10 +447,19 @@ pub struct CompareArgs {
     /// Filters to compare: comma-separated names, or all.
     #[arg(long, default_value = "all")]
     pub filters: String,
-    /// Reference samples per pixel, 1 to 4096, stratified n x m with each side at most 64
-    /// (256 = 16x16, 512 = 16x32).
+    /// Reference samples every pixel gets, 1 to 4096, in at least 8 independent passes whose
+    /// spread gives each pixel's standard error (256 = 8 passes of 4x8 stratified samples).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub spp: u32,
+    /// The most reference samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is
+    /// wider than --tolerance get more passes, doubling, up to this (default: --spp, a fixed
+    /// budget; the report says how much of the reference converged and what it can rank).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub max_spp: Option<u32>,
+    /// With --max-spp: half-width of a converged reference pixel's 95 % interval, in 8-bit steps
+    /// of the displayed value, 0 to 255 (also the converged share the report gives).
+    #[arg(long, default_value_t = 0.5, value_parser = tolerance())]
+    pub tolerance: f64,
     /// An image rendered elsewhere to score against the same reference: LABEL=PATH (repeatable;
     /// labels must differ from each other and from the filters compared).
     #[arg(long, value_name = "LABEL=IMAGE")]
@@ -499,8 +508,8 @@ pub struct DemoArgs {
     /// half: several minutes on two cores, where the default takes under two.
     #[arg(long)]
     pub full: bool,
-    /// Reference samples per pixel, 1 to 4096, stratified n x m with each side at most 64
-    /// (256 = 16x16, 512 = 16x32).
+    /// Reference samples per pixel, 1 to 4096, in at least 8 independent passes (256 = 8 passes
+    /// of 4x8 stratified samples); each report gives the reference's noise floor.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP))]
     pub spp: u32,
 }

@@ -10,14 +10,15 @@ use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 use texel_quality::{
-    crop_enlarge, default_band_rows, excess_change, heat_map, horizon_crop_rect, mean_abs_change,
-    psnr, publish_dir, FilterRow, Image8, Mask, Orbit, Report, Scores,
+    block_psnr, crop_enlarge, default_band_rows, excess_change, heat_map, horizon_crop_rect,
+    mean_abs_change, psnr, publish_dir, Encoding, FilterRow, Image8, Mask, Orbit, ReferenceError,
+    ReferenceSummary, Report, Scores, DEFAULT_BLOCK,
 };
-use texel_raster::{render, Frame, RenderSettings};
+use texel_raster::{render, Frame, ReferencePlan, RenderSettings};
 
 use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
-use crate::cmd_reference::reference_frame_from;
+use crate::cmd_reference::{reference_estimate, ADAPTIVE_BYTES_PER_PIXEL};
 use crate::filters::{parse_list, Filter};
 use crate::input::{load_scene, Input};
 use crate::output::encoding;
@@ -62,6 +63,7 @@ fn slug(label: &str) -> String {
 /// What every scored image shares: the reference, the coverage and the output directory.
 struct Scoring<'a> {
     reference: Image8,
+    encoding: Encoding,
     coverage: Mask,
     band_rows: u32,
     crop: Option<texel_quality::Rect>,
@@ -78,6 +80,13 @@ impl Scoring<'_> {
             image.write_png(self.dir.join(&file))?;
         }
         let mut row = FilterRow::new(name, scores, file);
+        row.psnr_block = Some(block_psnr(
+            &self.reference,
+            image,
+            Some(&self.coverage),
+            DEFAULT_BLOCK,
+            self.encoding,
+        )?);
         let heat = heat_map(&self.reference, image, Some(&self.coverage), HEAT_MAP_MAX)?;
         let heat_file = format!("{stem}-error.png");
         heat.write_png(self.dir.join(&heat_file))?;
@@ -92,11 +101,16 @@ impl Scoring<'_> {
 }
 
 /// What a comparison holds per pixel besides the prepared scene's one frame: the reference frame
-/// ([`FRAME_BYTES_PER_PIXEL`]), the coverage mask (1), the reference and current 8-bit images
-/// (8), the heat map (4) and the encoder's copies (8), rounded up. An `--extra` image, checked
+/// ([`FRAME_BYTES_PER_PIXEL`]) and its statistics ([`ADAPTIVE_BYTES_PER_PIXEL`]), the coverage
+/// mask (1), the reference and current 8-bit images (8), the heat map (4) and the encoder's
+/// copies (8), rounded up; each row's 8-bit image is kept besides ([`ROW_BYTES_PER_PIXEL`]) to rank
+/// the rows against each other. An `--extra` image, checked
 /// against the comparison's size from its header first, adds [`EXTRA_BYTES_PER_PIXEL`] while it
 /// is decoded and scored.
-pub const COMPARE_BYTES_PER_PIXEL: u64 = FRAME_BYTES_PER_PIXEL + 32;
+pub const COMPARE_BYTES_PER_PIXEL: u64 = FRAME_BYTES_PER_PIXEL + ADAPTIVE_BYTES_PER_PIXEL + 32;
+
+/// Each row's 8-bit image, kept until the rows are ranked.
+pub const ROW_BYTES_PER_PIXEL: u64 = 4;
 
 /// An `--extra` image while it is decoded (the decoder's buffer, up to 16-bit RGBA: 8) and held as
 /// 8-bit RGBA (4), rounded up; one at a time.
@@ -204,16 +218,59 @@ pub struct OrbitSpec {
     pub step_deg: f32,
 }
 
-/// Compare `filters` on a prepared scene against a `spp` reference, write everything into `dir`
-/// (which must exist: the caller publishes it, see [`texel_quality::publish_dir`]) and return the
-/// report. `label` names the scene in the report. With an `orbit`, the filters' rows also get
-/// their flicker and orbit PSNR ([`orbit_scores`]).
+/// The reference plan a comparison scores against: `plan`'s sample counts and tolerance with the
+/// scene's display (sRGB unless raw) and the fixed seed.
+pub fn reference_plan(
+    scene: &PreparedScene,
+    min_spp: u32,
+    max_spp: u32,
+    tolerance_steps: f64,
+) -> ReferencePlan {
+    ReferencePlan {
+        min_spp,
+        max_spp,
+        tolerance: tolerance_steps / 255.0,
+        srgb_display: scene.color == texel::ColorHandling::Srgb,
+        seed: crate::cmd_reference::SEED,
+    }
+}
+
+/// The reference's figures for the report, over the covered pixels.
+fn reference_summary(
+    estimate: &texel_raster::ReferenceEstimate,
+    error: &ReferenceError,
+    coverage: &Mask,
+) -> Result<ReferenceSummary> {
+    let covered = coverage.bits();
+    let (sum, n) = estimate
+        .spp
+        .iter()
+        .zip(covered)
+        .filter(|(_, &c)| c)
+        .fold((0.0, 0usize), |(s, n), (&k, _)| (s + f64::from(k), n + 1));
+    Ok(ReferenceSummary {
+        min_spp: estimate.plan.min_spp,
+        max_spp: estimate.plan.max_spp,
+        mean_spp: sum / n.max(1) as f64,
+        tolerance: estimate.plan.tolerance * 255.0,
+        converged: estimate.converged_share(Some(covered)),
+        noise_floor: error.noise_floor(Some(coverage))?,
+        noise_floor_block: error.block_noise_floor(Some(coverage), DEFAULT_BLOCK)?,
+        block: DEFAULT_BLOCK,
+    })
+}
+
+/// Compare `filters` on a prepared scene against a reference made as `plan` says, write
+/// everything into `dir` (which must exist: the caller publishes it, see
+/// [`texel_quality::publish_dir`]) and return the report. `label` names the scene in the report.
+/// With an `orbit`, the filters' rows also get their flicker and orbit PSNR ([`orbit_scores`]).
+/// Every row gets its block-mean PSNR and the rows the reference cannot rank it against.
 #[allow(clippy::too_many_arguments)]
 pub fn compare(
     scene: &PreparedScene,
     label: &str,
     filters: &[Filter],
-    spp: u32,
+    plan: &ReferencePlan,
     extras: &Extras,
     orbit: Option<OrbitSpec>,
     dir: &Path,
@@ -223,11 +280,16 @@ pub fn compare(
     if let Some(pb) = &extras.progress {
         pb.set_message(format!("{label}: reference"));
     }
-    let reference =
-        reference_frame_from(scene, spp, &scene.scene.camera, extras.progress.is_none())?;
+    let bar = match &extras.progress {
+        Some(_) => indicatif::ProgressBar::hidden(),
+        None => progress::bar(1, "reference"),
+    };
+    let estimate = reference_estimate(scene, plan, &scene.scene.camera, None, &bar, None)?;
+    bar.finish_and_clear();
     if let Some(pb) = &extras.progress {
         pb.inc(1);
     }
+    let reference = &estimate.frame;
     let (w, h) = (reference.width, reference.height);
     let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
     ref_image.write_png(dir.join("reference.png"))?;
@@ -235,9 +297,21 @@ pub fn compare(
     if coverage.count() == 0 {
         bail!("the scene covers no pixel: nothing to compare");
     }
+    let error = ReferenceError {
+        width: w,
+        height: h,
+        mean: &reference.color,
+        std_error: &estimate.std_error,
+        encoding: enc,
+    };
+    let reference_error = reference_summary(&estimate, &error, &coverage)?;
+    let rows_count = filters.len() + extras.frames.len() + extras.files.len();
+    let kept = u64::from(w) * u64::from(h) * ROW_BYTES_PER_PIXEL * rows_count as u64;
+    budget.take("the rows' images, kept to rank them", kept)?;
     let crop = horizon_crop_rect(&coverage, (w / 5).max(16), (h / 8).max(8));
     let scoring = Scoring {
         reference: ref_image,
+        encoding: enc,
         coverage,
         band_rows: default_band_rows(h),
         crop,
@@ -279,9 +353,7 @@ pub fn compare(
         row.ms_per_frame = Some(median(&mut times.draw_ms));
         row.texture_bytes = Some(bytes);
         rows.push(row);
-        if orbit.is_some() {
-            images.push(image);
-        }
+        images.push(image);
         pb.inc(1);
     }
     if extras.progress.is_none() {
@@ -291,9 +363,9 @@ pub fn compare(
         Some(spec) => Some(orbit_scores(
             scene,
             filters,
-            spp,
+            plan,
             spec,
-            (&scoring, images),
+            (&scoring, &images),
             &mut rows,
         )?),
         None => None,
@@ -305,6 +377,7 @@ pub fn compare(
         row.extra = true;
         row.ms_per_frame = Some(*ms);
         rows.push(row);
+        images.push(image);
     }
     for (label, path) in &extras.files {
         let cannot = || format!("cannot load --extra image {label}={}", path.display());
@@ -321,13 +394,22 @@ pub fn compare(
         let mut row = scoring.row(label, &stem, &image, true)?;
         row.extra = true;
         rows.push(row);
+        images.push(image);
     }
+    let refs: Vec<&Image8> = images.iter().collect();
+    let ties = error.within_noise(&scoring.reference, &refs, Some(&scoring.coverage))?;
+    let names: Vec<String> = rows.iter().map(|r| r.name.clone()).collect();
+    for (row, tied) in rows.iter_mut().zip(ties) {
+        row.within_noise_of = tied.into_iter().map(|j| names[j].clone()).collect();
+    }
+    drop(images);
+    budget.release(kept);
 
     let report = Report {
         scene: label.to_string(),
         width: w,
         height: h,
-        spp,
+        spp: plan.min_spp,
         // The colour handling, and the filtering arithmetic where it is not the exact default.
         color: format!(
             "{}{}",
@@ -346,6 +428,7 @@ pub fn compare(
         heat_map_max: HEAT_MAP_MAX,
         rows,
         orbit,
+        reference_error: Some(reference_error),
     };
     report.write(dir)?;
     Ok(report)
@@ -359,23 +442,26 @@ pub fn compare(
 fn orbit_scores(
     scene: &PreparedScene,
     filters: &[Filter],
-    spp: u32,
+    plan: &ReferencePlan,
     spec: OrbitSpec,
-    (scoring, images): (&Scoring, Vec<Image8>),
+    (scoring, images): (&Scoring, &[Image8]),
     rows: &mut [FilterRow],
 ) -> Result<Orbit> {
     let enc = encoding(scene.color);
     let (w, h) = (scene.width, scene.height);
     let mut prev_ref = scoring.reference.clone();
     let mut prev_cov = scoring.coverage.clone();
-    let mut prev = images;
+    let mut prev = images[..filters.len()].to_vec();
     let mut ref_change = 0.0;
     let mut change = vec![0.0; filters.len()];
     let mut psnr_sum: Vec<f64> = rows.iter().map(|r| r.psnr_all).collect();
     for k in 1..spec.frames {
         eprintln!("orbit frame {k} of {}", spec.frames - 1);
         let camera = scene.scene.camera.orbited(spec.step_deg * k as f32);
-        let reference = reference_frame_from(scene, spp, &camera, true)?;
+        let bar = progress::bar(1, "reference");
+        let estimate = reference_estimate(scene, plan, &camera, None, &bar, None)?;
+        bar.finish_and_clear();
+        let reference = estimate.frame;
         let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
         let coverage = Mask::new(w, h, reference.coverage())?;
         ref_change += mean_abs_change(&prev_ref, &ref_image, &prev_cov, &coverage)?;
@@ -466,12 +552,19 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     // What the command reads must not lie inside what it replaces.
     let mut inputs: Vec<&Path> = vec![Path::new(&args.scene.scene)];
     inputs.extend(extras.files.iter().map(|(_, p)| p.as_path()));
+    let max_spp = args.max_spp.unwrap_or(args.spp);
+    anyhow::ensure!(
+        max_spp >= args.spp,
+        "--max-spp {max_spp} is below --spp {}: the maximum must be at least the minimum",
+        args.spp
+    );
+    let plan = reference_plan(&scene, args.spp, max_spp, args.tolerance);
     let report = publish_dir(&args.out, &inputs, |dir| {
         compare(
             &scene,
             &args.scene.scene,
             &filters,
-            args.spp,
+            &plan,
             &extras,
             orbit,
             dir,

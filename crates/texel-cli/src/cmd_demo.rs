@@ -133,7 +133,7 @@ fn report_in(
         scene,
         label,
         filters,
-        spp,
+        &crate::cmd_compare::reference_plan(scene, spp, spp, 0.5),
         &Extras {
             progress: Some(pb.clone()),
             ..Extras::default()

@@ -5,11 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use texel_quality::{viridis, Image8};
-use texel_raster::reference::square_strata;
-use texel_raster::{
-    render_reference_adaptive, render_reference_strata, ReferenceEstimate, ReferencePlan,
-    ReferenceStatus,
-};
+use texel_raster::{render_reference_adaptive, ReferenceEstimate, ReferencePlan, ReferenceStatus};
 
 use crate::cli::{ColorArg, ReferenceArgs};
 use crate::filters::Filter;
@@ -22,35 +18,39 @@ use texel::PreparedScene;
 /// Seed of the reference's jitter: fixed, so references are reproducible.
 pub const SEED: u64 = 0x7e_7e1;
 
-/// Render the single-pass reference (`spp` samples, stratified) of a prepared scene seen by
-/// `camera`, as `compare` scores against it; `bar` says whether it draws its own progress bar on a
-/// terminal (a caller that shows one bar over several steps passes false).
-pub fn reference_frame_from(
+/// Render a prepared scene's converging reference seen by `camera`, as `plan` says
+/// (`texel_raster::adaptive`), on `threads` workers (`None`: all cores), showing its rounds on
+/// `pb`. `stop`, once set, ends it after the current pass (see `render_reference_adaptive`).
+pub fn reference_estimate(
     scene: &PreparedScene,
-    spp: u32,
+    plan: &ReferencePlan,
     camera: &texel_scene::Camera,
-    bar: bool,
-) -> Result<texel_raster::Frame> {
+    threads: Option<usize>,
+    pb: &indicatif::ProgressBar,
+    stop: Option<&std::sync::atomic::AtomicBool>,
+) -> Result<ReferenceEstimate> {
     // The reference samples level 0 bilinearly with each mesh's address modes; the filter only
     // supplies those.
     let samplers = scene.samplers(Filter::Bilinear)?;
     let draws = scene.reference_draws_from(&samplers, camera)?;
-    let settings = scene.settings_for(&samplers, camera);
-    let [n, m] = square_strata(spp);
-    let pb = if bar {
-        progress::bar(1000, "reference")
-    } else {
-        indicatif::ProgressBar::hidden()
+    let mut settings = scene.settings_for(&samplers, camera);
+    settings.threads = threads;
+    let status = |s: &ReferenceStatus| {
+        pb.set_length(s.total.max(1));
+        pb.set_position(s.done);
+        pb.set_message(format!(
+            "round {} ({} spp, {:.1} % converged)",
+            s.round,
+            s.spp,
+            100.0 * s.converged
+        ));
     };
-    let report = |done: u64, total: u64| pb.set_position(done * 1000 / total.max(1));
-    let max = texel_raster::reference::MAX_SPP_SIDE;
-    anyhow::ensure!(
-        m <= max,
-        "--spp {spp} stratifies as {n} x {m}, over {max} per side: choose a number with a divisor near its square root (e.g. 256, 512, 1024)"
-    );
-    let frame = render_reference_strata(&settings, &draws, [n, m], SEED, Some(&report))?;
-    pb.finish_and_clear();
-    Ok(frame)
+    render_reference_adaptive(&settings, &draws, plan, Some(&status), stop).map_err(|e| match e {
+        texel_raster::RasterError::Interrupted => {
+            anyhow::Error::new(interrupt::Interrupted(e.to_string()))
+        }
+        e => e.into(),
+    })
 }
 
 /// Run `texel reference`: the converging reference (`texel_raster::adaptive`), its summary on
@@ -83,36 +83,17 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
         srgb_display: args.scene.color == ColorArg::Srgb,
         seed: args.seed,
     };
-    let samplers = scene.samplers(Filter::Bilinear)?;
-    let draws = scene.reference_draws_from(&samplers, &scene.scene.camera)?;
-    let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
-    settings.threads = args.threads.map(|n| n as usize);
     let started = Instant::now();
     let pb = progress::bar(1, "reference");
-    let status = |s: &ReferenceStatus| {
-        pb.set_length(s.total.max(1));
-        pb.set_position(s.done);
-        pb.set_message(format!(
-            "round {} ({} spp, {:.1} % converged)",
-            s.round,
-            s.spp,
-            100.0 * s.converged
-        ));
-    };
     let graceful = interrupt::Graceful::begin();
-    let estimate = render_reference_adaptive(
-        &settings,
-        &draws,
+    let estimate = reference_estimate(
+        &scene,
         &plan,
-        Some(&status),
+        &scene.scene.camera,
+        args.threads.map(|n| n as usize),
+        &pb,
         Some(graceful.flag()),
-    )
-    .map_err(|e| match e {
-        texel_raster::RasterError::Interrupted => {
-            anyhow::Error::new(interrupt::Interrupted(e.to_string()))
-        }
-        e => e.into(),
-    })?;
+    )?;
     drop(graceful);
     pb.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();

@@ -1,6 +1,8 @@
 //! `texel compare`: the report agrees with the images it wrote; the filter ranking on the ground plane.
 
-use texel_quality::{psnr, psnr_band, ssim, Image8, Mask, Report, OUTSIDE};
+use texel_quality::{
+    block_psnr, psnr, psnr_band, ssim, Encoding, Image8, Mask, Report, DEFAULT_BLOCK, OUTSIDE,
+};
 
 use crate::util::*;
 
@@ -85,6 +87,37 @@ fn compare_report_is_consistent_with_its_images() {
             row.name,
             row.psnr_band
         );
+        let k = block_psnr(
+            &reference,
+            &image,
+            Some(&mask),
+            DEFAULT_BLOCK,
+            Encoding::Srgb,
+        )
+        .unwrap();
+        assert!(
+            row.psnr_block.is_some_and(|v| close(v, k)),
+            "{}: psnr_block {:?} but the images give {k}",
+            row.name,
+            row.psnr_block
+        );
+        // Block means hide per-pixel noise and aliasing: never a lower score than per pixel
+        // by more than the re-encoding's rounding.
+        assert!(
+            k >= row.psnr_all - 0.5,
+            "{}: blocks {k} < pixels {}",
+            row.name,
+            row.psnr_all
+        );
+        // The reference cannot rank two rows one way and not the other.
+        for other in &row.within_noise_of {
+            let o = report.rows.iter().find(|r| &r.name == other).unwrap();
+            assert!(
+                o.within_noise_of.contains(&row.name),
+                "{} / {other}",
+                row.name
+            );
+        }
         let s = ssim(&reference, &image, Some(&mask)).unwrap();
         assert!(
             close(row.ssim, s),
@@ -139,6 +172,49 @@ fn compare_report_is_consistent_with_its_images() {
         )
     );
 
+    // Two identical images are within the reference's noise of each other, whatever its noise.
+    assert!(gpu.within_noise_of.contains(&"bilinear".to_string()));
+    assert!(report.rows[1].within_noise_of.contains(&"gpu".to_string()));
+    // The reference is `texel reference` with the same minimum and no refinement, bit for bit,
+    // and the report says what it measured of its own error.
+    let alone = d.arg("alone.png");
+    ok(&[
+        "reference",
+        "builtin:ground",
+        "--size",
+        "96x54",
+        "--spp",
+        "16",
+        "--max-spp",
+        "16",
+        "-o",
+        &alone,
+    ]);
+    assert_eq!(load(&alone), reference);
+    let e = report
+        .reference_error
+        .as_ref()
+        .expect("the reference's error");
+    assert_eq!(
+        (e.min_spp, e.max_spp, e.mean_spp, e.block),
+        (16, 16, 16.0, 8)
+    );
+    assert!((0.0..=1.0).contains(&e.converged), "{}", e.converged);
+    // A 16-sample reference of a checkerboard is noisy: its floor is finite, and no filter
+    // scores above it.
+    assert!(
+        e.noise_floor.is_finite() && e.noise_floor_block > e.noise_floor,
+        "{e:?}"
+    );
+    for row in &report.rows {
+        assert!(
+            row.psnr_all < e.noise_floor + 3.0,
+            "{}: {}",
+            row.name,
+            row.psnr_all
+        );
+    }
+
     // report.md has the same table; index.html shows every image.
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
@@ -151,12 +227,13 @@ fn compare_report_is_consistent_with_its_images() {
         assert!(html.contains(&row.image), "index.html lacks {}", row.image);
     }
     assert!(md.contains("gpu (extra)"));
+    assert!(md.contains("Noise floor"), "{md}");
     assert!(html.contains("<svg"), "no chart in index.html");
     assert!(temp_files(&out).is_empty());
 }
 
 #[test]
-fn ground_plane_filter_ranking_against_a_16x16_reference() {
+fn ground_plane_filter_ranking_against_a_256_sample_reference() {
     let d = Dir::new("ranking");
     let out = d.arg("report");
     ok(&[
@@ -182,6 +259,21 @@ fn ground_plane_filter_ranking_against_a_16x16_reference() {
     assert!(e > t && a > t, "ewa {e} aniso16 {a} trilinear {t}");
     assert!(t > b, "trilinear {t} bilinear {b}");
     assert!(b > n, "bilinear {b} nearest {n}");
+    // The reference's error bars support each of those rankings.
+    let report =
+        Report::from_json(&std::fs::read_to_string(d.join("report/report.json")).unwrap()).unwrap();
+    let tied = |x: &str, y: &str| {
+        let row = report.rows.iter().find(|r| r.name == x).unwrap();
+        row.within_noise_of.iter().any(|o| o == y)
+    };
+    for (x, y) in [
+        ("ewa", "trilinear"),
+        ("aniso16", "trilinear"),
+        ("trilinear", "bilinear"),
+        ("bilinear", "nearest"),
+    ] {
+        assert!(!tied(x, y), "{x} and {y} are within the reference's noise");
+    }
 }
 
 #[test]

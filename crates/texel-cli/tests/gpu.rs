@@ -141,10 +141,15 @@ fn compare_gpu_scores_shader_and_hardware_rows() {
             .unwrap_or_else(|| panic!("no row {row}: {md}"));
         line.split('|').nth(2).unwrap().trim().parse().unwrap()
     };
-    // texel's shaders filter as the CPU does: their scores agree to within a tenth of a dB.
+    // texel's shaders filter as the CPU does: the images are close to each other (41.6 and
+    // 37.7 dB apart on lavapipe), and their scores against the 16-sample reference agree to a
+    // quarter of a dB.
     for f in ["trilinear", "aniso16"] {
         let (cpu, gpu) = (psnr(f), psnr(&format!("gpu-{f} (extra)")));
-        assert!((cpu - gpu).abs() < 0.1, "{f}: cpu {cpu} gpu {gpu}");
+        assert!((cpu - gpu).abs() < 0.25, "{f}: cpu {cpu} gpu {gpu}");
+        let image = |name: &str| load(d.join("report").join(format!("{name}.png")));
+        let apart = texel_quality::psnr(&image(f), &image(&format!("gpu-{f}")), None).unwrap();
+        assert!(apart > 35.0, "{f}: cpu and gpu images {apart} dB apart");
     }
     assert!(psnr("hw-trilinear (extra)") > 0.0 && psnr("hw-aniso16 (extra)") > 0.0);
 }

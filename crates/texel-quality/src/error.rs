@@ -57,6 +57,9 @@ pub enum QualityError {
         /// Which measurement found nothing to average.
         what: &'static str,
     },
+    /// A block-mean score with blocks of 0 pixels.
+    #[error("the block side of a block-mean score must be at least 1 pixel")]
+    InvalidBlock,
     /// A heat-map scale that is not a finite positive number.
     #[error("invalid heat-map scale {0}: the error mapped to the top of the ramp must be finite and > 0")]
     InvalidScale(f32),

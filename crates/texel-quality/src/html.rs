@@ -256,6 +256,9 @@ impl Report {
             escape(&self.color),
             self.band_rows
         );
+        if let Some(e) = &self.reference_error {
+            s += &format!("<p>{}</p>\n", escape(&e.sentence()));
+        }
         s += "<table>\n<tr>";
         let orbit = self.orbit.is_some();
         for h in table_header(orbit) {

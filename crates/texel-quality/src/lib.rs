@@ -4,6 +4,8 @@
 //!   band, per RGB channel on 8-bit encoded values, peak 255.
 //! - [`ssim()`] / [`ssim_map`]: SSIM exactly per Wang et al. 2004 (11x11 Gaussian, sigma 1.5,
 //!   K1 = 0.01, K2 = 0.03, L = 255), per RGB channel, averaged.
+//! - [`ReferenceError`] / [`block_psnr`]: how sure a score is: the reference's noise floor, PSNR
+//!   on block means in linear light, and whether the reference can rank two images.
 //! - [`horizon_band`]: the strip just below the horizon, where minification is extreme.
 //! - [`heat_map`], [`legend_svg`], [`crop_enlarge`], [`horizon_crop_rect`]: pictures of the error.
 //! - [`Report`] / [`FilterRow`]: JSON, Markdown and a self-contained `index.html` with a chart.
@@ -48,6 +50,7 @@ mod psnr;
 mod report;
 mod scores;
 pub mod ssim;
+mod uncertainty;
 
 /// The largest image side, in pixels, any function here accepts (16384, the common GPU limit).
 pub const MAX_SIDE: u32 = 16384;
@@ -64,6 +67,7 @@ pub use heatmap::{error_map, heat_map, legend_image, legend_svg, viridis, OUTSID
 pub use image8::{Encoding, Image8};
 pub use mask::Mask;
 pub use psnr::{mse, psnr, psnr_band, psnr_from_mse, psnr_linear, PEAK};
-pub use report::{FilterRow, Orbit, Report};
+pub use report::{FilterRow, Orbit, ReferenceSummary, Report};
 pub use scores::Scores;
 pub use ssim::{ssim, ssim_map, SsimMap};
+pub use uncertainty::{block_psnr, MseDifference, ReferenceError, DEFAULT_BLOCK, Z_975};

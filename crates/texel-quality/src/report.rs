@@ -41,6 +41,34 @@ pub struct Report {
     /// The camera orbit the rows' flicker and orbit PSNR were measured over (`--orbit`).
     #[serde(default)]
     pub orbit: Option<Orbit>,
+    /// How sure the reference is, where it measured its own error.
+    #[serde(default)]
+    pub reference_error: Option<ReferenceSummary>,
+}
+
+/// The reference's own uncertainty ([`crate::ReferenceError`]), over the covered pixels.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSummary {
+    /// Samples every pixel got.
+    pub min_spp: u32,
+    /// The most samples a pixel could get.
+    pub max_spp: u32,
+    /// Mean samples per covered pixel.
+    pub mean_spp: f64,
+    /// Half-width of a converged pixel's 95 % interval, in 8-bit steps of the display.
+    pub tolerance: f64,
+    /// Share of the covered pixels that met the tolerance.
+    pub converged: f64,
+    /// PSNR (dB) a perfect filter would score against this reference per pixel: no score above
+    /// it means anything.
+    #[serde(with = "inf_f64")]
+    pub noise_floor: f64,
+    /// The same for the block-mean PSNR.
+    #[serde(with = "inf_f64")]
+    pub noise_floor_block: f64,
+    /// Side of the blocks of the block-mean PSNR, in pixels.
+    pub block: u32,
 }
 
 /// A slow camera orbit (`texel compare --orbit N`): the scene's camera turned about its up axis
@@ -100,6 +128,15 @@ pub struct FilterRow {
     /// With an orbit: PSNR over the covered pixels averaged over the orbit's frames.
     #[serde(default)]
     pub psnr_orbit: Option<f64>,
+    /// PSNR in dB on block means in linear light ([`crate::block_psnr`], blocks of
+    /// [`ReferenceSummary::block`]); `"inf"` in JSON when equal.
+    #[serde(default, with = "opt_inf_f64")]
+    pub psnr_block: Option<f64>,
+    /// The other rows whose per-pixel PSNR difference from this one lies within the reference's
+    /// 95 % uncertainty ([`crate::MseDifference::distinguishable`]): the reference does not rank
+    /// them against this one.
+    #[serde(default)]
+    pub within_noise_of: Vec<String>,
 }
 
 impl FilterRow {
@@ -121,6 +158,8 @@ impl FilterRow {
             horizon_crop: None,
             flicker: None,
             psnr_orbit: None,
+            psnr_block: None,
+            within_noise_of: Vec::new(),
         }
     }
 }
@@ -158,6 +197,25 @@ mod inf_f64 {
     }
 }
 
+/// `Option<f64>` with infinities as in [`inf_f64`] and `None` as `null`.
+mod opt_inf_f64 {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize)]
+    struct Ser(#[serde(with = "super::inf_f64")] f64);
+
+    #[derive(Deserialize)]
+    struct De(#[serde(with = "super::inf_f64")] f64);
+
+    pub fn serialize<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+        v.map(Ser).serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+        Ok(Option::<De>::deserialize(d)?.map(|De(v)| v))
+    }
+}
+
 /// A PSNR for a table: two decimals, `inf` for identical.
 pub(crate) fn fmt_psnr(v: f64) -> String {
     if v.is_infinite() {
@@ -183,11 +241,17 @@ pub(crate) fn row_cells(r: &FilterRow, orbit: bool) -> Vec<String> {
         },
         fmt_psnr(r.psnr_all),
         fmt_psnr(r.psnr_band),
+        fmt_opt(r.psnr_block, fmt_psnr),
         format!("{:.4}", r.ssim),
         fmt_opt(r.texels_per_pixel_mean, |v| format!("{v:.1}")),
         fmt_opt(r.texels_per_pixel_max, |v| v.to_string()),
         fmt_opt(r.ms_per_frame, |v| format!("{v:.2}")),
         fmt_opt(r.texture_bytes, |v| v.to_string()),
+        if r.within_noise_of.is_empty() {
+            "-".to_string()
+        } else {
+            r.within_noise_of.join(", ")
+        },
     ];
     if orbit {
         cells.push(fmt_opt(r.psnr_orbit, fmt_psnr));
@@ -206,15 +270,17 @@ pub(crate) fn table_header(orbit: bool) -> Vec<&'static str> {
 }
 
 /// Column headers of the report table without an orbit.
-const TABLE_HEADER: [&str; 8] = [
+const TABLE_HEADER: [&str; 10] = [
     "filter",
     "PSNR all (dB)",
     "PSNR band (dB)",
+    "PSNR blocks (dB)",
     "SSIM",
     "texels/px mean",
     "texels/px max",
     "ms/frame",
     "texture bytes",
+    "within noise of",
 ];
 
 /// Escape a Markdown table cell (`|`, `\`, newlines).
@@ -222,6 +288,29 @@ fn md_cell(s: &str) -> String {
     s.replace('\\', "\\\\")
         .replace('|', "\\|")
         .replace(['\n', '\r'], " ")
+}
+
+impl ReferenceSummary {
+    /// One paragraph: the samples, the share converged, the noise floors and what the "within
+    /// noise of" column means.
+    pub fn sentence(&self) -> String {
+        format!(
+            "Reference: {}-{} samples per pixel (mean {:.0}); {:.1} % of the covered pixels within \
+             ±{}/255 of the display at 95 % confidence. Noise floor (the PSNR a perfect filter \
+             would score against this reference): {} dB per pixel, {} dB on {b}x{b} block means \
+             in linear light (PSNR blocks). \"Within noise of\" lists the rows whose PSNR \
+             difference from the row lies within the reference's 95 % uncertainty: the reference \
+             does not rank them.",
+            self.min_spp,
+            self.max_spp,
+            self.mean_spp,
+            100.0 * self.converged,
+            self.tolerance,
+            fmt_psnr(self.noise_floor),
+            fmt_psnr(self.noise_floor_block),
+            b = self.block,
+        )
+    }
 }
 
 impl Report {
@@ -253,6 +342,10 @@ impl Report {
             md_cell(&self.color),
             self.band_rows
         );
+        if let Some(e) = &self.reference_error {
+            s += &e.sentence();
+            s += "\n\n";
+        }
         let orbit = self.orbit.is_some();
         if let Some(o) = &self.orbit {
             s += &format!(
@@ -335,6 +428,7 @@ pub(crate) mod tests {
             heat_map_max: 32.0,
             rows: vec![near, tri, same, extra],
             orbit: None,
+            reference_error: None,
         }
     }
 
@@ -398,16 +492,63 @@ pub(crate) mod tests {
         assert_eq!(lines.len(), 2 + 4);
         assert_eq!(
             lines[3],
-            "| trilinear | 27.50 | 19.25 | 0.9100 | 8.0 | 8 | 12.50 | 5592404 |"
+            "| trilinear | 27.50 | 19.25 | - | 0.9100 | 8.0 | 8 | 12.50 | 5592404 | - |"
         );
         assert!(lines[4].starts_with("| self | inf | inf |"));
         assert_eq!(
             lines[5],
-            "| gpu <a\\|b> (extra) | 21.30 | 15.00 | 0.8000 | - | - | - | - |"
+            "| gpu <a\\|b> (extra) | 21.30 | 15.00 | - | 0.8000 | - | - | - | - | - |"
         );
         // Every row has the header's number of cells (escaped pipes do not split).
         for l in &lines {
-            assert_eq!(l.replace("\\|", "").matches('|').count(), 9, "{l}");
+            assert_eq!(l.replace("\\|", "").matches('|').count(), 11, "{l}");
         }
+    }
+
+    #[test]
+    fn the_reference_error_and_block_scores_round_trip() {
+        let mut r = sample();
+        r.reference_error = Some(ReferenceSummary {
+            min_spp: 256,
+            max_spp: 4096,
+            mean_spp: 700.4,
+            tolerance: 0.5,
+            converged: 0.9625,
+            noise_floor: 41.234,
+            noise_floor_block: f64::INFINITY,
+            block: 8,
+        });
+        r.rows[1].psnr_block = Some(33.125);
+        r.rows[2].psnr_block = Some(f64::INFINITY);
+        r.rows[1].within_noise_of = vec!["self".into(), "nearest".into()];
+        let md = r.to_markdown();
+        assert!(md.contains("256-4096 samples per pixel (mean 700)"), "{md}");
+        assert!(
+            md.contains("96.2 % of the covered pixels within ±0.5/255"),
+            "{md}"
+        );
+        assert!(
+            md.contains("41.23 dB per pixel, inf dB on 8x8 block means"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| trilinear | 27.50 | 19.25 | 33.12 | 0.9100 | 8.0 | 8 | 12.50 | 5592404 | self, nearest |"),
+            "{md}"
+        );
+        assert!(r.to_html().contains("<td>self, nearest</td>"));
+        let j = r.to_json();
+        assert!(j.contains("\"psnr_block\": \"inf\""), "{j}");
+        assert!(j.contains("\"psnr_block\": null"), "{j}");
+        assert_eq!(Report::from_json(&j).unwrap(), r);
+        // Reports without the new fields still read.
+        let v: serde_json::Value = serde_json::from_str(&sample().to_json()).unwrap();
+        let mut old = v.clone();
+        for row in old["rows"].as_array_mut().unwrap() {
+            let row = row.as_object_mut().unwrap();
+            row.remove("psnr_block");
+            row.remove("within_noise_of");
+        }
+        old.as_object_mut().unwrap().remove("reference_error");
+        assert_eq!(Report::from_json(&old.to_string()).unwrap(), sample());
     }
 }
