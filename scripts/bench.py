@@ -122,6 +122,8 @@ def measure(a):
             "texels_mean": row["texels_per_pixel_mean"],
             "texels_max": row["texels_per_pixel_max"],
             "texture_bytes": row["texture_bytes"],
+            "psnr_block": row.get("psnr_block"),
+            "within_noise_of": row.get("within_noise_of", []),
             "ms": statistics.median(times),
             "ms_rounds": times,
         }
@@ -147,6 +149,7 @@ def measure(a):
         "height": report["height"],
         "spp": report["spp"],
         "band_rows": report["band_rows"],
+        "reference_error": report.get("reference_error"),
         "frames": a.frames,
         "rounds": a.rounds,
         "commands": {
@@ -221,9 +224,24 @@ def caption(r):
             " gives the per-round ratios." if r["commands"].get("llvmpipe") else "")
     return (f"{r['width']} x {r['height']}, `{r['scene']}`. Quality: `{r['commands']['compare']}`"
             f" (PSNR over the plane and over the {r['band_rows']} rows below the horizon, against a"
-            f" {r['spp']}-sample reference; these do not depend on the machine). Time:"
+            f" {r['spp']}-sample reference; these do not depend on the machine).{noise(r)} Time:"
             f" `{r['commands']['bench']}`, median of {r['rounds']} rounds' medians (rounds differ"
             f" by up to {spread(r):.0f} %).{peer} Machine: {machine_line(r)}.")
+
+
+def noise(r):
+    """What the record says of its reference's own error, as a sentence (empty without it)."""
+    e = r.get("reference_error")
+    if not e:
+        return ""
+    floor = "inf" if e["noise_floor"] == "inf" else f"{e['noise_floor']:.2f}"
+    pairs = sorted({tuple(sorted((x["filter"], o))) for x in r["filters"]
+                    for o in x.get("within_noise_of", [])})
+    ties = ("; it cannot rank " + ", ".join(f"{a} and {b}" for a, b in pairs) if pairs
+            else "; it ranks every pair of rows")
+    return (f" The reference's noise floor (what a perfect filter would score) is {floor} dB;"
+            f" {100 * e['converged']:.1f} % of the plane's pixels lie within"
+            f" ±{e['tolerance']:g}/255 at 95 % confidence{ties}.")
 
 
 def is_table(r):

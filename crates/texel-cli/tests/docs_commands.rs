@@ -130,6 +130,9 @@ fn shrink(args: &[String]) -> (Vec<String>, Vec<String>) {
         "compare" => {
             set(&mut a, "--size", "160x90");
             set(&mut a, "--spp", "4");
+            if value(&a, "--max-spp").is_some() {
+                set(&mut a, "--max-spp", "16");
+            }
             if value(&a, "--orbit").is_some() {
                 set(&mut a, "--orbit", "2");
             }
