@@ -406,11 +406,11 @@ pub struct ReferenceArgs {
     pub spp: u32,
     /// The most samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is wider than
     /// --tolerance get more passes, doubling, up to this (equal to --spp: no pixel gets more).
-    #[arg(long, default_value_t = 65_536, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    #[arg(long, default_value_t = 65_536, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel_raster::adaptive::MAX_ADAPTIVE_SPP)))]
     pub max_spp: u32,
     /// Half-width of a converged pixel's 95 % interval, in 8-bit steps of the displayed value
     /// (clipped to 0..255, sRGB-encoded unless --color raw), 0 to 255.
-    #[arg(long, default_value_t = 0.5, value_parser = tolerance())]
+    #[arg(long, default_value_t = crate::cmd_reference::DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
     pub tolerance: f64,
     /// Seed of the jitter; two seeds give independent estimates.
     #[arg(long, default_value_t = crate::cmd_reference::SEED)]
@@ -454,11 +454,11 @@ pub struct CompareArgs {
     /// The most reference samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is
     /// wider than --tolerance get more passes, doubling, up to this (default: --spp, a fixed
     /// budget; the report says how much of the reference converged and what it can rank).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel_raster::adaptive::MAX_ADAPTIVE_SPP)))]
     pub max_spp: Option<u32>,
     /// With --max-spp: half-width of a converged reference pixel's 95 % interval, in 8-bit steps
     /// of the displayed value, 0 to 255 (also the converged share the report gives).
-    #[arg(long, default_value_t = 0.5, value_parser = tolerance())]
+    #[arg(long, default_value_t = crate::cmd_reference::DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
     pub tolerance: f64,
     /// An image rendered elsewhere to score against the same reference: LABEL=PATH (repeatable;
     /// labels must differ from each other and from the filters compared).

@@ -16,9 +16,9 @@ use texel_quality::{
 };
 use texel_raster::{render, Frame, ReferencePlan, RenderSettings};
 
-use crate::cli::CompareArgs;
+use crate::cli::{ColorArg, CompareArgs};
 use crate::cmd_bench::{median, time_frames};
-use crate::cmd_reference::{reference_estimate, ADAPTIVE_BYTES_PER_PIXEL};
+use crate::cmd_reference::{self as reference, reference_estimate, ADAPTIVE_BYTES_PER_PIXEL};
 use crate::filters::{parse_list, Filter};
 use crate::input::{load_scene, Input};
 use crate::output::encoding;
@@ -218,23 +218,6 @@ pub struct OrbitSpec {
     pub step_deg: f32,
 }
 
-/// The reference plan a comparison scores against: `plan`'s sample counts and tolerance with the
-/// scene's display (sRGB unless raw) and the fixed seed.
-pub fn reference_plan(
-    scene: &PreparedScene,
-    min_spp: u32,
-    max_spp: u32,
-    tolerance_steps: f64,
-) -> ReferencePlan {
-    ReferencePlan {
-        min_spp,
-        max_spp,
-        tolerance: tolerance_steps / 255.0,
-        srgb_display: scene.color == texel::ColorHandling::Srgb,
-        seed: crate::cmd_reference::SEED,
-    }
-}
-
 /// The reference's figures for the report, over the covered pixels.
 fn reference_summary(
     estimate: &texel_raster::ReferenceEstimate,
@@ -242,16 +225,10 @@ fn reference_summary(
     coverage: &Mask,
 ) -> Result<ReferenceSummary> {
     let covered = coverage.bits();
-    let (sum, n) = estimate
-        .spp
-        .iter()
-        .zip(covered)
-        .filter(|(_, &c)| c)
-        .fold((0.0, 0usize), |(s, n), (&k, _)| (s + f64::from(k), n + 1));
     Ok(ReferenceSummary {
         min_spp: estimate.plan.min_spp,
         max_spp: estimate.plan.max_spp,
-        mean_spp: sum / n.max(1) as f64,
+        mean_spp: estimate.mean_spp(Some(covered)),
         tolerance: estimate.plan.tolerance * 255.0,
         converged: estimate.converged_share(Some(covered)),
         noise_floor: error.noise_floor(Some(coverage))?,
@@ -517,6 +494,13 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         .map(|e| parse_extra(e))
         .collect::<Result<Vec<_>>>()?;
     check_extras(&extras, &filters)?;
+    let plan = reference::plan(
+        args.spp,
+        args.max_spp.unwrap_or(args.spp),
+        args.tolerance,
+        args.scene.color == ColorArg::Srgb,
+        reference::SEED,
+    )?;
     let scene = load_scene(&args.scene, input)?;
     let frames = if args.gpu {
         gpu_rows(&scene, &filters, args.adapter.as_deref(), &mut input.budget)?
@@ -552,13 +536,6 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     // What the command reads must not lie inside what it replaces.
     let mut inputs: Vec<&Path> = vec![Path::new(&args.scene.scene)];
     inputs.extend(extras.files.iter().map(|(_, p)| p.as_path()));
-    let max_spp = args.max_spp.unwrap_or(args.spp);
-    anyhow::ensure!(
-        max_spp >= args.spp,
-        "--max-spp {max_spp} is below --spp {}: the maximum must be at least the minimum",
-        args.spp
-    );
-    let plan = reference_plan(&scene, args.spp, max_spp, args.tolerance);
     let report = publish_dir(&args.out, &inputs, |dir| {
         compare(
             &scene,

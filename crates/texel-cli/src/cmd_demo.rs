@@ -1,8 +1,9 @@
 //! `texel demo`: the comparison on every built-in scene, with an index page linking the reports.
 //!
 //! Defaults: each scene at half its own size (640 x 360 for the ground planes) and the lit scenes
-//! glossy, bricks and terrain at a quarter of theirs, against a 256-sample (16 x 16) reference;
-//! `--full` doubles both sides (the README gives both times). `--size` and `--spp` change them.
+//! glossy, bricks and terrain at a quarter of theirs, against a 256-sample reference (8 passes of
+//! 4 x 8); `--full` doubles both sides (the README gives both times). `--size` and `--spp` change
+//! them.
 
 use std::fmt::Write as _;
 
@@ -14,6 +15,7 @@ use texel_quality::{publish_dir, write_atomic, Report};
 use crate::cli::{ColorArg, DemoArgs};
 use crate::cmd_bake_ao::{demo_page, DemoAo};
 use crate::cmd_compare::{compare, Extras, COMPARE_BYTES_PER_PIXEL};
+use crate::cmd_reference::{plan, DEFAULT_TOLERANCE_STEPS, SEED};
 use crate::filters::Filter;
 use crate::input::{load_scene_with, Input};
 use crate::progress;
@@ -133,7 +135,7 @@ fn report_in(
         scene,
         label,
         filters,
-        &crate::cmd_compare::reference_plan(scene, spp, spp, 0.5),
+        &plan(spp, spp, DEFAULT_TOLERANCE_STEPS, true, SEED)?,
         &Extras {
             progress: Some(pb.clone()),
             ..Extras::default()

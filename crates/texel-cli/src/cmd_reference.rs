@@ -16,7 +16,36 @@ use crate::progress;
 use texel::PreparedScene;
 
 /// Seed of the reference's jitter: fixed, so references are reproducible.
-pub const SEED: u64 = 0x7e_7e1;
+pub const SEED: u64 = texel_raster::adaptive::DEFAULT_SEED;
+
+/// `--tolerance`'s default: half an 8-bit step of the displayed value.
+pub const DEFAULT_TOLERANCE_STEPS: f64 = 0.5;
+
+/// A reference plan from the command line's numbers: `min_spp` to `max_spp` samples a pixel,
+/// converged within `tolerance_steps` 8-bit steps of the display (sRGB-encoded when `srgb`), jitter
+/// from `seed`.
+///
+/// # Errors
+/// A maximum below the minimum.
+pub fn plan(
+    min_spp: u32,
+    max_spp: u32,
+    tolerance_steps: f64,
+    srgb: bool,
+    seed: u64,
+) -> Result<ReferencePlan> {
+    anyhow::ensure!(
+        max_spp >= min_spp,
+        "--max-spp {max_spp} is below --spp {min_spp}: the maximum must be at least the minimum"
+    );
+    Ok(ReferencePlan {
+        min_spp,
+        max_spp,
+        tolerance: tolerance_steps / 255.0,
+        srgb_display: srgb,
+        seed,
+    })
+}
 
 /// Render a prepared scene's converging reference seen by `camera`, as `plan` says
 /// (`texel_raster::adaptive`), on `threads` workers (`None`: all cores), showing its rounds on
@@ -39,8 +68,9 @@ pub fn reference_estimate(
         pb.set_length(s.total.max(1));
         pb.set_position(s.done);
         pb.set_message(format!(
-            "round {} ({} spp, {:.1} % converged)",
+            "round {} ({} pixels to {} spp, {:.1} % converged)",
             s.round,
+            s.active,
             s.spp,
             100.0 * s.converged
         ));
@@ -57,12 +87,13 @@ pub fn reference_estimate(
 /// stderr, the image and, with `--error-map`, each pixel's error. Ctrl-C during the passes writes
 /// what is done so far, says so, and exits with status 130.
 pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
-    anyhow::ensure!(
-        args.max_spp >= args.spp,
-        "--max-spp {} is below --spp {}: the maximum must be at least the minimum",
+    let plan = plan(
+        args.spp,
         args.max_spp,
-        args.spp
-    );
+        args.tolerance,
+        args.scene.color == ColorArg::Srgb,
+        args.seed,
+    )?;
     if let Some(map) = &args.error_map {
         anyhow::ensure!(
             !same_destination(map, &args.output),
@@ -76,13 +107,6 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
         "the reference's per-pixel statistics",
         u64::from(scene.width) * u64::from(scene.height) * ADAPTIVE_BYTES_PER_PIXEL,
     )?;
-    let plan = ReferencePlan {
-        min_spp: args.spp,
-        max_spp: args.max_spp,
-        tolerance: args.tolerance / 255.0,
-        srgb_display: args.scene.color == ColorArg::Srgb,
-        seed: args.seed,
-    };
     let started = Instant::now();
     let pb = progress::bar(1, "reference");
     let graceful = interrupt::Graceful::begin();
@@ -145,7 +169,7 @@ pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> Str
     let mut line = format!(
         "reference: {:.2} % of pixels within ±{tolerance_steps}/255 of the display at 95 % confidence; {min}-{max} samples per pixel (mean {:.0}); seed {}; {seconds:.1} s",
         100.0 * e.converged_share(None),
-        e.mean_spp(),
+        e.mean_spp(None),
         e.plan.seed,
     );
     if e.interrupted {

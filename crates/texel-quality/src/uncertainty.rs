@@ -21,7 +21,7 @@
 //!   Two rows whose MSE difference is within 1.96 of those are within the reference's 95 %
 //!   uncertainty: the reference does not rank them.
 
-use texel_texture::color::{linear_to_srgb, srgb_to_linear};
+use texel_texture::color::{displayed, srgb_to_linear};
 
 use crate::error::QualityError;
 use crate::image8::{check_same, Encoding, Image8};
@@ -37,11 +37,7 @@ pub const Z_975: f64 = 1.959_964;
 
 /// Displayed value in `[0, 1]` of a linear value: clipped, then encoded.
 fn display(x: f64, encoding: Encoding) -> f64 {
-    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
-    match encoding {
-        Encoding::Srgb => f64::from(linear_to_srgb(x as f32)),
-        Encoding::Linear => x,
-    }
+    displayed(x, encoding == Encoding::Srgb)
 }
 
 /// Linear value of an 8-bit displayed code.
@@ -169,7 +165,11 @@ impl ReferenceError<'_> {
         mask: Option<&Mask>,
     ) -> Result<MseDifference, QualityError> {
         self.check()?;
-        difference_with(&self.display_sd(), reference, a, b, mask)
+        check_same(reference.size(), (self.width, self.height))?;
+        Ok(MseDifference {
+            difference: mse(reference, a, mask)? - mse(reference, b, mask)?,
+            sd: noise_sd(&self.display_sd(), a, b, mask)?,
+        })
     }
 
     /// For each of `images`, the indices of the others the reference cannot rank it against
@@ -184,11 +184,20 @@ impl ReferenceError<'_> {
         mask: Option<&Mask>,
     ) -> Result<Vec<Vec<usize>>, QualityError> {
         self.check()?;
+        check_same(reference.size(), (self.width, self.height))?;
         let sd = self.display_sd();
+        let mses = images
+            .iter()
+            .map(|image| mse(reference, image, mask))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut out = vec![Vec::new(); images.len()];
         for i in 0..images.len() {
             for j in i + 1..images.len() {
-                if !difference_with(&sd, reference, images[i], images[j], mask)?.distinguishable() {
+                let d = MseDifference {
+                    difference: mses[i] - mses[j],
+                    sd: noise_sd(&sd, images[i], images[j], mask)?,
+                };
+                if !d.distinguishable() {
                     out[i].push(j);
                     out[j].push(i);
                 }
@@ -201,26 +210,17 @@ impl ReferenceError<'_> {
     }
 }
 
-/// [`ReferenceError::mse_difference`] with the displayed standard deviations `sd` given.
-fn difference_with(
+/// The standard deviation the reference's noise (displayed standard deviations `sd`, one per
+/// pixel and RGB channel) gives the MSE difference of `a` and `b`: `2 sqrt(sum (a - b)^2 d^2) /
+/// (3 n)` over the pixels `mask` selects.
+fn noise_sd(
     sd: &[[f64; 3]],
-    reference: &Image8,
     a: &Image8,
     b: &Image8,
     mask: Option<&Mask>,
-) -> Result<MseDifference, QualityError> {
-    check_same(a.size(), reference.size())?;
-    check_same(b.size(), reference.size())?;
-    let (w, h) = reference.size();
-    if sd.len() != w as usize * h as usize {
-        return Err(QualityError::DataLength {
-            width: w,
-            height: h,
-            expected: w as usize * h as usize,
-            got: sd.len(),
-        });
-    }
-    let difference = mse(reference, a, mask)? - mse(reference, b, mask)?;
+) -> Result<f64, QualityError> {
+    check_same(a.size(), b.size())?;
+    check_mask(mask, a.size())?;
     let (mut var, mut n) = (0.0, 0usize);
     for (i, (pa, pb)) in a.pixels().iter().zip(b.pixels()).enumerate() {
         if mask.is_none_or(|m| m.bits()[i]) {
@@ -231,10 +231,7 @@ fn difference_with(
             }
         }
     }
-    Ok(MseDifference {
-        difference,
-        sd: 2.0 * var.sqrt() / (3.0 * n.max(1) as f64),
-    })
+    Ok(2.0 * var.sqrt() / (3.0 * n.max(1) as f64))
 }
 
 /// Two images' MSE difference against a reference and the part of it the reference's noise could

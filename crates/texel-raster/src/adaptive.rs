@@ -29,11 +29,15 @@ use crate::error::RasterError;
 use crate::frame::Frame;
 use crate::reference::{square_strata, with_passes, MAX_SPP_SIDE};
 use crate::settings::RenderSettings;
+use texel_texture::color::displayed as display;
 use texel_texture::rng::mix64;
 
 /// Passes the minimum sample count is split into (when it has that many samples): enough for a
 /// variance estimate with seven degrees of freedom.
 pub const MIN_PASSES: u32 = 8;
+
+/// The seed of [`ReferencePlan::default`], the one the command line's references use unless told.
+pub const DEFAULT_SEED: u64 = 0x7e_7e1;
 
 /// The largest maximum samples per pixel ([`ReferencePlan::max_spp`]).
 pub const MAX_ADAPTIVE_SPP: u32 = 1 << 20;
@@ -62,7 +66,7 @@ impl Default for ReferencePlan {
             max_spp: 65_536,
             tolerance: 0.5 / 255.0,
             srgb_display: true,
-            seed: 0x7e_7e1,
+            seed: DEFAULT_SEED,
         }
     }
 }
@@ -111,30 +115,27 @@ impl ReferenceEstimate {
         share(&self.converged, mask, |&c| c)
     }
 
-    /// Share of the pixels whose displayed interval is within `t` (display units).
-    pub fn share_within(&self, t: f32, mask: Option<&[bool]>) -> f64 {
-        share(&self.display_half_width, mask, |&h| h <= t)
-    }
-
-    /// Mean samples per pixel.
-    pub fn mean_spp(&self) -> f64 {
-        self.spp.iter().map(|&n| f64::from(n)).sum::<f64>() / self.spp.len().max(1) as f64
+    /// Mean samples per pixel (of those `mask` selects, or all).
+    pub fn mean_spp(&self, mask: Option<&[bool]>) -> f64 {
+        masked_mean(&self.spp, mask, |&n| f64::from(n)).unwrap_or(0.0)
     }
 }
 
+/// Share of the values `mask` selects (or all) for which `pred` holds; 1 when it selects none.
 fn share<T>(values: &[T], mask: Option<&[bool]>, pred: impl Fn(&T) -> bool) -> f64 {
-    let (mut n, mut k) = (0u64, 0u64);
+    masked_mean(values, mask, |v| f64::from(u8::from(pred(v)))).unwrap_or(1.0)
+}
+
+/// Mean of `f` over the values `mask` selects (or all); `None` when it selects none.
+fn masked_mean<T>(values: &[T], mask: Option<&[bool]>, f: impl Fn(&T) -> f64) -> Option<f64> {
+    let (mut n, mut sum) = (0u64, 0.0);
     for (i, v) in values.iter().enumerate() {
         if mask.is_none_or(|m| m[i]) {
             n += 1;
-            k += u64::from(pred(v));
+            sum += f(v);
         }
     }
-    if n == 0 {
-        1.0
-    } else {
-        k as f64 / n as f64
-    }
+    (n > 0).then(|| sum / n as f64)
 }
 
 /// The 0.975 quantile of Student's t with `dof` degrees of freedom: the value of the next smaller
@@ -187,16 +188,6 @@ pub fn pass_layout(min_spp: u32) -> (u32, [u32; 2]) {
         .map(|d| (min_spp / d, square_strata(d)))
         .find(|(_, [_, m])| *m <= MAX_SPP_SIDE)
         .unwrap_or((min_spp, [1, 1]))
-}
-
-/// Display value of linear `x`: clipped to `[0, 1]`, sRGB-encoded if `srgb`.
-fn display(x: f64, srgb: bool) -> f64 {
-    let x = x.clamp(0.0, 1.0);
-    if srgb {
-        f64::from(texel_texture::color::linear_to_srgb(x as f32))
-    } else {
-        x
-    }
 }
 
 /// Per-pixel running statistics of the pass means (Welford's update, in f64).
@@ -278,20 +269,19 @@ pub fn render_reference_adaptive(
     let pixels = settings.width as usize * settings.height as usize;
     let mut stats = vec![Stats::default(); pixels];
     let mut depth = vec![f32::INFINITY; pixels];
-    let mut converged = vec![false; pixels];
     let mut interrupted = false;
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
     with_passes(settings, draws, strata, |pass| {
+        // The pixels this round refines, as indices and (after round 0) as the passes' mask;
+        // every other pixel has converged.
+        let mut indices: Vec<usize> = (0..pixels).collect();
         let mut active: Option<Vec<bool>> = None;
         let mut done_passes = 0u32;
         let mut round = 0u32;
         let mut add = first_passes;
         loop {
-            let active_count = active
-                .as_ref()
-                .map_or(pixels, |a| a.iter().filter(|&&x| x).count())
-                as u64;
-            let converged_before = share(&converged, None, |&c| c);
+            let active_count = indices.len() as u64;
+            let converged_before = 1.0 - active_count as f64 / pixels as f64;
             for k in 0..add {
                 if stopped() {
                     interrupted = true;
@@ -315,34 +305,30 @@ pub fn render_reference_adaptive(
                     active.as_deref(),
                     Some(&status),
                 )?;
-                for (i, st) in stats.iter_mut().enumerate() {
-                    if active.as_ref().is_none_or(|a| a[i]) {
-                        st.add(frame.color[i]);
-                        depth[i] = depth[i].min(frame.depth[i]);
-                    }
+                for &i in &indices {
+                    stats[i].add(frame.color[i]);
+                    depth[i] = depth[i].min(frame.depth[i]);
                 }
             }
-            if stats.iter().all(|s| s.n == 0) {
+            // Round 0 gives every pixel the same passes: none has one only if it was stopped
+            // before the first.
+            if stats[0].n == 0 {
                 return Err(RasterError::Interrupted);
             }
             if interrupted {
                 break;
             }
             done_passes += add;
-            let mut next = vec![false; pixels];
-            let mut any = false;
-            for i in 0..pixels {
-                if active.as_ref().is_none_or(|a| a[i]) {
-                    converged[i] = stats[i].display_half_width(plan.srgb_display) <= plan.tolerance;
-                    next[i] = !converged[i];
-                    any |= next[i];
-                }
-            }
+            indices.retain(|&i| stats[i].display_half_width(plan.srgb_display) > plan.tolerance);
             add = done_passes.min(max_passes.saturating_sub(done_passes));
-            if !any || add == 0 {
+            if indices.is_empty() || add == 0 {
                 break;
             }
-            active = Some(next);
+            let mut mask = vec![false; pixels];
+            for &i in &indices {
+                mask[i] = true;
+            }
+            active = Some(mask);
             round += 1;
         }
         Ok(())
@@ -358,16 +344,8 @@ pub fn render_reference_adaptive(
         width: settings.width,
         height: settings.height,
         target: crate::settings::ColorTarget::Float,
-        color: stats
-            .iter()
-            .map(|s| {
-                if s.n == 0 {
-                    settings.background
-                } else {
-                    s.mean.map(|m| m as f32)
-                }
-            })
-            .collect(),
+        // Every pixel has at least one pass (an earlier stop is an error above).
+        color: stats.iter().map(|s| s.mean.map(|m| m as f32)).collect(),
         color8: Vec::new(),
         texels_read: Vec::new(),
         depth,

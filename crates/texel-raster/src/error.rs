@@ -94,7 +94,9 @@ pub enum RasterError {
     },
     /// A converging reference's plan is outside its ranges.
     #[error(
-        "reference plan is invalid: min_spp {min_spp} must be in 1..=4096, max_spp {max_spp} in min_spp..=1048576, tolerance {tolerance} finite and not negative"
+        "reference plan is invalid: min_spp {min_spp} must be in 1..={min_max}, max_spp {max_spp} in min_spp..={max_max}, tolerance {tolerance} finite and not negative",
+        min_max = crate::reference::MAX_SPP_SIDE * crate::reference::MAX_SPP_SIDE,
+        max_max = crate::adaptive::MAX_ADAPTIVE_SPP
     )]
     InvalidReferencePlan {
         /// The minimum samples per pixel asked for.

@@ -41,6 +41,19 @@ pub fn linear_to_srgb(l: f32) -> f32 {
     c.copysign(l)
 }
 
+/// The value a display shows for linear light `l`, in `[0, 1]` before quantisation: clipped to
+/// `[0, 1]` (NaN gives 0), then sRGB-encoded when `srgb`. What a reference's convergence and its
+/// noise are judged on.
+#[inline]
+pub fn displayed(l: f64, srgb: bool) -> f64 {
+    let x = if l.is_nan() { 0.0 } else { l.clamp(0.0, 1.0) };
+    if srgb {
+        f64::from(linear_to_srgb(x as f32))
+    } else {
+        x
+    }
+}
+
 /// Quantise a `[0, 1]` float to 8 bits, rounding to nearest; out-of-range values clamp, NaN gives 0.
 #[inline]
 pub fn unorm8(x: f32) -> u8 {
