@@ -48,13 +48,6 @@ impl Drop for Graceful {
 
 /// The error of work that a signal stopped after writing its partial result: `main` prints it
 /// and exits with [`INTERRUPTED`].
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
 pub struct Interrupted(pub String);
-
-impl std::fmt::Display for Interrupted {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for Interrupted {}
