@@ -84,7 +84,7 @@ fuzz_target!(|input: Input| {
             material: None,
             uv_mapping: None,
         };
-        render(&settings, &[call]).expect("valid draw").coverage
+        render(&settings, &[call]).expect("valid draw").coverage()
     };
     let first = [[0u32, 1, 2]];
     let second = [[1u32, 0, 3]];

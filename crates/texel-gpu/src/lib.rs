@@ -292,12 +292,12 @@ impl Gpu {
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
         });
 
-        let table: Vec<u8> = texel_texture::color::srgb_table()
+        let table: Vec<u8> = texel_texture::base::color::srgb_table()
             .iter()
             .flat_map(|x| x.to_le_bytes())
             .collect();
         let srgb = buffer(&device, &queue, &table, wgpu::BufferUsages::STORAGE);
-        let lut: Vec<u8> = texel_texture::ewa::weight_lut()
+        let lut: Vec<u8> = texel_texture::technique::ewa::weight_lut()
             .iter()
             .flat_map(|x| x.to_le_bytes())
             .collect();

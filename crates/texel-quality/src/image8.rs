@@ -2,13 +2,13 @@
 //!
 //! Decision: quality is measured on what a person sees and what the CLI writes to disk — the 8-bit
 //! encoded values — not on linear floats. A linear `f32` frame is first quantised exactly as the
-//! CLI quantises its output ([`Encoding::Srgb`]: `texel_texture::color::linear_to_srgb8`, or
+//! CLI quantises its output ([`Encoding::Srgb`]: `texel_texture::base::color::linear_to_srgb8`, or
 //! [`Encoding::Linear`] for `--color raw`: `unorm8`), so that scores recomputed from the PNG files
 //! equal the reported ones bit for bit.
 
 use std::path::Path;
 
-use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8};
+use texel_texture::base::color::{rgba_to_srgb8, rgba_to_unorm8};
 
 use crate::error::QualityError;
 use crate::MAX_SIDE;

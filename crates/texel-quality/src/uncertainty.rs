@@ -21,7 +21,7 @@
 //!   Two rows whose MSE difference is within 1.96 of those are within the reference's 95 %
 //!   uncertainty: the reference does not rank them.
 
-use texel_texture::color::{displayed, srgb_to_linear};
+use texel_texture::base::color::{displayed, srgb_to_linear};
 
 use crate::error::QualityError;
 use crate::image8::{check_same, Encoding, Image8};

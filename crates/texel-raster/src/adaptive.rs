@@ -29,8 +29,8 @@ use crate::error::RasterError;
 use crate::frame::Frame;
 use crate::reference::{square_strata, with_passes, MAX_SPP_SIDE};
 use crate::settings::RenderSettings;
-use texel_texture::color::displayed as display;
-use texel_texture::rng::mix64;
+use texel_texture::base::color::displayed as display;
+use texel_texture::base::rng::mix64;
 
 /// Passes the minimum sample count is split into (when it has that many samples): enough for a
 /// variance estimate with seven degrees of freedom.

@@ -1,7 +1,7 @@
 //! What is drawn: vertices, indexed triangles and the texture/sampler pair of one draw call.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use texel_texture::sphere::SurfaceProjection;
+use texel_texture::mapping::sphere::SurfaceProjection;
 use texel_texture::{Sampler, Texture};
 
 use crate::material::Material;

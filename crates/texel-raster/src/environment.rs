@@ -1,15 +1,15 @@
 //! Environment maps: light from every direction, stored equirectangular (latitude-longitude), as
 //! a cube or octahedral, seen as the background and reflected by surfaces.
 //!
-//! Directions become texture coordinates through [`texel_texture::sphere`] (the conventions'
+//! Directions become texture coordinates through [`texel_texture::mapping::sphere`] (the conventions'
 //! conventions: equirect `u = 0.5 + atan2(d.x, -d.z) / (2 pi)`, `v = acos(d.y / |d|) / pi`;
 //! Vulkan's cube faces; pbrt-v4's equal-area octahedral square).
 //!
 //! **Footprints come from analytic gradients** ([`MapLayout::footprint`]): the screen
 //! derivatives of the direction (the camera ray's for the background; the reflected
 //! direction's, differentiated as pbrt-v4 does with `dn/dx` and `dp/dx`, for reflections) are
-//! mapped through the exact Jacobian of the mapping ([`texel_texture::sphere::equirect_duv`],
-//! [`texel_texture::sphere::cube_dst`], [`texel_texture::sphere::octahedral_duv`]). Differencing
+//! mapped through the exact Jacobian of the mapping ([`texel_texture::mapping::sphere::equirect_duv`],
+//! [`texel_texture::mapping::sphere::cube_dst`], [`texel_texture::mapping::sphere::octahedral_duv`]). Differencing
 //! `u` itself would jump by about 1 across a seam and pick the coarsest level there (a visible
 //! line). Near an equirect map's poles `du` grows as `1 / sin(theta)`: the footprint becomes long
 //! in `u`, which is exactly the stretch the anisotropic and EWA filters are for.
@@ -18,7 +18,7 @@
 //! with a border of [`border`]`(N) = N / 8` texels (at least 1) on every side, filled from the
 //! neighbouring faces (the face's plane extended: a border texel holds the map's radiance along
 //! the direction through its centre, read bilinearly from the face that direction selects) or, for
-//! the octahedral square, from the square's own continuation ([`texel_texture::sphere::octahedral_wrap`],
+//! the octahedral square, from the square's own continuation ([`texel_texture::mapping::sphere::octahedral_wrap`],
 //! which maps border texel centres exactly onto texel centres). The box pyramid is built over the
 //! bordered image, so every level's border continues its face. Any filter then reads across an
 //! edge as if the neighbouring face were there: where Vulkan's seamless cube filtering fetches the
@@ -64,7 +64,7 @@ use std::sync::OnceLock;
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Mat4, Vec3};
 use rayon::prelude::*;
-pub use texel_texture::sphere::{equirect_direction, equirect_duv, equirect_uv, Mapping};
+pub use texel_texture::mapping::sphere::{equirect_direction, equirect_duv, equirect_uv, Mapping};
 use texel_texture::{AddressMode, Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
 use crate::error::RasterError;
@@ -389,9 +389,10 @@ impl EnvironmentMaps {
         let f = Format::Rgba32Float.texel_bytes();
         let layout = MapLayout::new(mapping, width, height);
         let (w, h) = layout.stored_size();
-        let layer = texel_texture::pyramid::pyramid_texels(w, h);
+        let layer = texel_texture::storage::pyramid::pyramid_texels(w, h);
         let copies = if mapping == Mapping::Equirect { 1 } else { 2 };
-        let irr = texel_texture::pyramid::pyramid_texels(IRRADIANCE_WIDTH, IRRADIANCE_WIDTH / 2);
+        let irr =
+            texel_texture::storage::pyramid::pyramid_texels(IRRADIANCE_WIDTH, IRRADIANCE_WIDTH / 2);
         (layer * copies * layout.layers() as u64 + irr) * f
     }
 }
@@ -451,9 +452,9 @@ impl MapFaces<'_> {
         let theta0 = layout.texel_angle();
         let texel_solid_angle = theta0 * theta0;
         let mut all: Vec<[f32; 4]> = Vec::new();
-        let levels = texel_texture::pyramid::level_count(w, h);
+        let levels = texel_texture::storage::pyramid::level_count(w, h);
         for k in 0..levels {
-            let (lw, lh) = texel_texture::pyramid::level_size(w, h, k);
+            let (lw, lh) = texel_texture::storage::pyramid::level_size(w, h, k);
             if k == 0 {
                 all.extend((0..lh).flat_map(|j| {
                     (0..lw).map(move |i| radiance.texel(0, i, j).unwrap_or([0.0; 4]))
@@ -809,7 +810,7 @@ mod tests {
             let rho = dd
                 .iter()
                 .map(|&v| {
-                    let duv = texel_texture::sphere::equirect_duv(d, v);
+                    let duv = texel_texture::mapping::sphere::equirect_duv(d, v);
                     DVec2::new(duv.x * w, duv.y * h).length()
                 })
                 .fold(0.0, f64::max);

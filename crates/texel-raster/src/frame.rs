@@ -3,7 +3,7 @@
 use std::borrow::Cow;
 
 use rayon::prelude::*;
-use texel_texture::dispatch::{self, StreamElement};
+use texel_texture::engine::dispatch::{self, StreamElement};
 use texel_texture::Footprint;
 
 use crate::settings::{ColorTarget, RenderSettings};

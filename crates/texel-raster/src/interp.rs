@@ -303,8 +303,8 @@ impl UvPlanes {
     pub fn reduce(&self, c: usize, x: f32) -> f32 {
         let (p, inv_p) = (self.period[c], self.inv_period[c]);
         let t = x * inv_p;
-        let q = texel_texture::floor::floor_staged(t);
-        if p > 0.0 && t.abs() < texel_texture::floor::STAGED_F32_LIMIT {
+        let q = texel_texture::base::floor::floor_staged(t);
+        if p > 0.0 && t.abs() < texel_texture::base::floor::STAGED_F32_LIMIT {
             x - p * q
         } else {
             x

@@ -75,7 +75,7 @@ pub use settings::{
     MAX_PIXELS,
 };
 pub use stream::{last_level_cache_bytes, set_streaming, streaming, Streaming};
-pub use texel_texture::dispatch::{level as simd_level, limit_level, SimdLevel};
+pub use texel_texture::engine::dispatch::{level as simd_level, limit_level, SimdLevel};
 
 /// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].
 ///

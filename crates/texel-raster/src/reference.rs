@@ -45,7 +45,7 @@ use crate::settings::{ColorTarget, Perspective, RenderSettings};
 use crate::setup::{setup_draws, validate_draws, TriangleSetup, SUBPIXEL};
 use crate::shade::{shade, DrawContext, Lighting};
 use crate::tile::{bin, split_rows, tile_counts, TILE};
-use texel_texture::rng::SplitMix64;
+use texel_texture::base::rng::SplitMix64;
 
 /// The largest samples-per-pixel side (`64 x 64 = 4096` samples per pixel).
 pub const MAX_SPP_SIDE: u32 = 64;

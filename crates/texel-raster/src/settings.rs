@@ -1,7 +1,7 @@
 //! How a frame is rendered: size, background, derivative and interpolation modes, debug view, light,
 //! threads.
 
-use texel_texture::color::{rgba_to_srgb8, rgba_to_unorm8, srgb_table, unorm8_table};
+use texel_texture::base::color::{rgba_to_srgb8, rgba_to_unorm8, srgb_table, unorm8_table};
 
 use crate::environment::Environment;
 use crate::error::RasterError;

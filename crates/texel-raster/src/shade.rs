@@ -15,8 +15,8 @@
 //! reduce it here ([`DrawContext::footprint`]) before the conversion to `f32`.
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3, Vec4};
-use texel_texture::floor::{floor_staged_f64, STAGED_F64_LIMIT};
-use texel_texture::sphere::SurfaceProjection;
+use texel_texture::base::floor::{floor_staged_f64, STAGED_F64_LIMIT};
+use texel_texture::mapping::sphere::SurfaceProjection;
 use texel_texture::{AddressMode, Footprint, Sampler, Texture};
 
 use crate::draw::{DrawCall, UvEvaluation, Vertex};

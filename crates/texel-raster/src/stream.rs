@@ -7,7 +7,7 @@
 //! texel does the same for a frame that holds its clear ([`crate::Frame::reset`]) and is larger
 //! than the last-level cache: each tile some triangle (or the environment background)
 //! reaches is drawn in per-thread scratch filled with the clear, then copied out with
-//! non-temporal stores ([`texel_texture::dispatch::stream_copy`]); a tile nothing reaches keeps
+//! non-temporal stores ([`texel_texture::engine::dispatch::stream_copy`]); a tile nothing reaches keeps
 //! the clear the frame already holds. `reset` writes such a frame with non-temporal stores too,
 //! so the draw does not first write back the clear's dirty lines. Images are bit for bit the
 //! same either way (`tests/streaming.rs`); only the memory traffic differs (docs/decisions.md,

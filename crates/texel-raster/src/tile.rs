@@ -5,7 +5,7 @@
 //!   are written in place by whichever thread renders them; no locks, no `unsafe` here, no final
 //!   copy. Except for a frame that holds its clear and is larger than the last-level cache
 //!   ([`crate::Streaming`]): its tiles are drawn in per-thread scratch and copied into their row
-//!   slices with non-temporal stores (`texel_texture::dispatch::stream_copy`). The split is made
+//!   slices with non-temporal stores (`texel_texture::engine::dispatch::stream_copy`). The split is made
 //!   per band of `TILE` rows by the thread that renders the band's tiles: made serially up front,
 //!   the row lists of a 4K frame (2 040 tiles) would hold back its frames (docs/decisions.md).
 //! - Each tile processes its triangles in submission order (draw, then triangle, then sub-triangle)
@@ -58,10 +58,10 @@ use std::cell::Cell;
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-use texel_texture::color::{
+use texel_texture::base::color::{
     rgba_to_unorm8, rgba_to_unorm8_slice, srgb8_encoder, unorm8_table, Srgb8Encoder,
 };
-use texel_texture::dispatch::{self, Kernel, StreamElement};
+use texel_texture::engine::dispatch::{self, Kernel, StreamElement};
 use texel_texture::{Footprint, FootprintLanes, Lanes};
 
 use crate::draw::DrawCall;

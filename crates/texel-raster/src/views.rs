@@ -17,8 +17,8 @@
 //! - barycentric: `(lambda_0, lambda_1, lambda_2)` clamped to `[0, 1]`.
 
 use glam::DVec3;
-use texel_texture::color::srgb_to_linear;
-use texel_texture::mip::nearest_level;
+use texel_texture::base::color::srgb_to_linear;
+use texel_texture::technique::mip::nearest_level;
 use texel_texture::{Footprint, Sampler, Texture};
 
 /// One displayed (sRGB 8-bit) colour per mip level, cycling after 16 levels.
@@ -136,7 +136,7 @@ pub fn barycentric_color(lambda: DVec3) -> [f32; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use texel_texture::color::linear_to_srgb8;
+    use texel_texture::base::color::linear_to_srgb8;
 
     fn shown(c: [f32; 4]) -> [u8; 3] {
         [

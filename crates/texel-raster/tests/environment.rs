@@ -400,7 +400,7 @@ fn the_octahedral_border_is_the_square_continued_at_every_level() {
                     continue;
                 }
                 let centre = glam::DVec2::new(fi as f64 + 0.5, fj as f64 + 0.5) / f64::from(nk);
-                let w = texel_texture::sphere::octahedral_wrap(centre) * f64::from(nk);
+                let w = texel_texture::mapping::sphere::octahedral_wrap(centre) * f64::from(nk);
                 let (wi, wj) = (w.x.floor() as u32 + bk, w.y.floor() as u32 + bk);
                 let (a, c) = (tex.texel(k, i, j).unwrap(), tex.texel(k, wi, wj).unwrap());
                 for (x, y) in a.iter().zip(c) {

@@ -7,7 +7,7 @@ use texel_raster::{
     camera, render, render_reference, Derivatives, DrawCall, Frame, RenderSettings, UvEvaluation,
     UvMapping, Vertex,
 };
-use texel_texture::sphere::SurfaceProjection;
+use texel_texture::mapping::sphere::SurfaceProjection;
 use texel_texture::{AddressMode, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
 const PROJECTIONS: [SurfaceProjection; 2] =

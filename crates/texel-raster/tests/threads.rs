@@ -8,7 +8,7 @@ use texel_raster::{
     render, render_reference, Derivatives, DrawCall, Light, Material, RenderSettings, TextureInput,
     UvEvaluation, UvMapping, View, MAX_LIGHTS,
 };
-use texel_texture::sphere::SurfaceProjection;
+use texel_texture::mapping::sphere::SurfaceProjection;
 
 #[test]
 fn one_and_two_threads_give_identical_frames() {

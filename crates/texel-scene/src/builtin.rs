@@ -8,7 +8,7 @@ use std::f32::consts::PI;
 use std::path::Path;
 
 use glam::{Vec2, Vec3, Vec4};
-use texel_texture::sphere::SurfaceProjection;
+use texel_texture::mapping::sphere::SurfaceProjection;
 use texel_texture::{AddressMode, ColorSpace};
 
 use crate::camera::Camera;
@@ -156,7 +156,7 @@ fn metal(rgb: Vec3, roughness: f32) -> crate::model::MaterialSpec {
 fn sky_environment(width: u32) -> Option<crate::environment::EnvironmentSpec> {
     use crate::environment::{EnvironmentSource, EnvironmentSpec, Sky};
     Some(EnvironmentSpec {
-        mapping: texel_texture::sphere::Mapping::Equirect,
+        mapping: texel_texture::mapping::sphere::Mapping::Equirect,
         source: EnvironmentSource::Sky(Sky {
             width,
             ..Sky::default()

@@ -3,7 +3,7 @@
 //! sky, with an intensity and whether it is seen as the background.
 //!
 //! A cube map comes as six files (`faces`, in Vulkan's layer order `+x, -x, +y, -y, +z, -z`, each
-//! oriented as Vulkan's face table says, [`texel_texture::sphere`]) or as one cross image
+//! oriented as Vulkan's face table says, [`texel_texture::mapping::sphere`]) or as one cross image
 //! ([`CubeCross`]): a horizontal cross 4 faces wide and 3 high (`+y` above `+z`; `-x, +z, +x, -z`
 //! left to right; `-y` below `+z`), or a vertical cross 3 wide and 4 high (the same, with `-z`
 //! below `-y`, turned 180 degrees so that its edge meets `-y`'s). Both layouts unfold the cube
@@ -24,7 +24,7 @@
 use std::path::PathBuf;
 
 use glam::{DVec2, DVec3, Vec3};
-use texel_texture::sphere::Mapping;
+use texel_texture::mapping::sphere::Mapping;
 use texel_texture::{ColorSpace, Format, Limits, Texture};
 
 use crate::error::SceneError;
@@ -507,7 +507,7 @@ mod tests {
 #[cfg(test)]
 mod cross_tests {
     use super::*;
-    use texel_texture::sphere::cube_direction;
+    use texel_texture::mapping::sphere::cube_direction;
 
     #[test]
     fn crosses_are_recognised_by_shape_and_split_into_faces() {

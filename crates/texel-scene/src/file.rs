@@ -80,7 +80,7 @@ use crate::model::{
     Output, ScalarInput, Scene, SpecularAaSpec, SphereUv, TextureSource, TextureSpec,
 };
 use crate::procedural::{NoiseKind, Procedural};
-use texel_texture::sphere::Mapping;
+use texel_texture::mapping::sphere::Mapping;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -518,7 +518,7 @@ enum SphereUvName {
 /// The sphere mapping of `[[meshes]]` entry `m`, checked: a finite centre, a cut latitude in
 /// `(0, 89.9]` degrees and only for Mercator, neither without `sphere_uv`.
 fn sphere_uv(m: &RawMesh) -> Result<Option<SphereUv>, String> {
-    use texel_texture::sphere::SurfaceProjection;
+    use texel_texture::mapping::sphere::SurfaceProjection;
     let Some(name) = m.sphere_uv else {
         if m.sphere_centre.is_some() || m.mercator_cut_deg.is_some() {
             return Err("sphere_centre and mercator_cut_deg need sphere_uv".into());

@@ -65,5 +65,5 @@ pub use model::{
 };
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::{NoiseKind, Procedural, MAX_WAVES, MAX_WAVE_TERMS};
-pub use texel_texture::sphere::Mapping;
+pub use texel_texture::mapping::sphere::Mapping;
 pub use texture::TextureUse;

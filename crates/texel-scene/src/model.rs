@@ -451,12 +451,12 @@ pub struct Mesh {
 }
 
 /// A mesh's texture coordinates as a projection of its points' directions from `centre`: the
-/// lecture's spherical mappings (`texel_texture::sphere::SurfaceProjection`). The mesh's own
+/// lecture's spherical mappings (`texel_texture::mapping::sphere::SurfaceProjection`). The mesh's own
 /// `uvs` should hold the projection at each vertex (what per-vertex evaluation interpolates).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SphereUv {
     /// Equirect or Mercator (with its cut latitude).
-    pub projection: texel_texture::sphere::SurfaceProjection,
+    pub projection: texel_texture::mapping::sphere::SurfaceProjection,
     /// The sphere's centre, world units.
     pub centre: Vec3,
 }

@@ -142,7 +142,7 @@ pub enum Procedural {
         /// What is made of the noise.
         kind: NoiseKind,
     },
-    /// A globe's map for the spherical mappings ([`texel_texture::sphere::SurfaceProjection`]):
+    /// A globe's map for the spherical mappings ([`texel_texture::mapping::sphere::SurfaceProjection`]):
     /// texel `(i, j)` is coloured by the point of the sphere it shows, `d = direction(u, v)` at its
     /// centre, latitude `phi`, longitude `lambda` (east from `+z`). Ocean `[28, 64, 128]`;
     /// Tissot's indicatrix, discs of `GLOBE_DISC_DEG` radius on the sphere centred every 30
@@ -273,7 +273,7 @@ impl Procedural {
                 } else {
                     // Per-brick shade; the column wraps so the texture tiles.
                     let c = (col as i64).rem_euclid(i64::from(columns.max(1))) as u64;
-                    let h = texel_texture::rng::mix64((row as u64) << 32 | c);
+                    let h = texel_texture::base::rng::mix64((row as u64) << 32 | c);
                     let f = 0.8 + 0.3 * (h >> 11) as f64 / (1u64 << 53) as f64;
                     let s = |v: f64| (v * f).round().clamp(0.0, 255.0) as u8;
                     [s(150.0), s(62.0), s(46.0), 255]
@@ -445,7 +445,7 @@ pub const GLOBE_LINE_DEG: f64 = 0.5;
 impl Procedural {
     /// The projection a [`Procedural::Globe`] map is drawn in (`None` for other kinds): equirect,
     /// or Mercator cut where `ln tan(pi/4 + cut/2) = pi height / width`.
-    pub fn globe_projection(&self) -> Option<texel_texture::sphere::SurfaceProjection> {
+    pub fn globe_projection(&self) -> Option<texel_texture::mapping::sphere::SurfaceProjection> {
         match *self {
             Procedural::Globe {
                 width,
@@ -462,8 +462,8 @@ fn globe_projection(
     width: u32,
     height: u32,
     mercator: bool,
-) -> texel_texture::sphere::SurfaceProjection {
-    use texel_texture::sphere::SurfaceProjection;
+) -> texel_texture::mapping::sphere::SurfaceProjection {
+    use texel_texture::mapping::sphere::SurfaceProjection;
     if mercator && width == height {
         SurfaceProjection::MERCATOR
     } else if mercator {
@@ -478,7 +478,7 @@ fn globe_projection(
 
 /// [`Procedural::Globe`]'s texel `(i, j)` of a `width x height` map in `projection`.
 fn globe(
-    projection: texel_texture::sphere::SurfaceProjection,
+    projection: texel_texture::mapping::sphere::SurfaceProjection,
     width: u32,
     height: u32,
     i: u32,
@@ -486,7 +486,7 @@ fn globe(
 ) -> [u8; 4] {
     use glam::{DVec2, DVec3};
     use std::f64::consts::PI;
-    use texel_texture::sphere::SurfaceProjection;
+    use texel_texture::mapping::sphere::SurfaceProjection;
     let (w, h) = (f64::from(width.max(1)), f64::from(height.max(1)));
     let uv = DVec2::new((f64::from(i) + 0.5) / w, (f64::from(j) + 0.5) / h);
     let d = projection.direction(uv);
@@ -564,7 +564,7 @@ fn noise(size: u32, cells: u32, seed: u32, i: u32, j: u32) -> f64 {
         let n = u64::from(cells.max(1)) << o;
         let lattice = |a: u64, b: u64| {
             let key = (u64::from(seed) << 40) ^ (u64::from(o) << 56) ^ ((a % n) << 20) ^ (b % n);
-            (texel_texture::rng::mix64(key) >> 11) as f64 / (1u64 << 53) as f64
+            (texel_texture::base::rng::mix64(key) >> 11) as f64 / (1u64 << 53) as f64
         };
         let (fx, fy) = (x * n as f64, y * n as f64);
         let (a, b) = (fx.floor(), fy.floor());
@@ -598,7 +598,7 @@ struct WaveSet {
 
 fn wave_set(size: u32, count: u32, cells: u32, slope: f32, seed: u32) -> WaveSet {
     use std::f64::consts::TAU;
-    let mut rng = texel_texture::rng::SplitMix64::new(u64::from(seed));
+    let mut rng = texel_texture::base::rng::SplitMix64::new(u64::from(seed));
     let (lo, hi) = (f64::from(cells) / 2.0, f64::from(cells).max(1.0));
     let span = hi.ceil() as i64;
     let mut waves = Vec::with_capacity(count as usize);
@@ -639,7 +639,7 @@ fn wave_set(size: u32, count: u32, cells: u32, slope: f32, seed: u32) -> WaveSet
 #[cfg(test)]
 mod tests {
     use super::*;
-    use texel_texture::color::srgb_table;
+    use texel_texture::base::color::srgb_table;
 
     #[test]
     fn checker_layout() {

@@ -751,7 +751,7 @@ fn cube_and_octahedral_maps_load_from_crosses_faces_and_the_sky() {
     assert_eq!(faces.len(), 6);
     for (face, t) in faces.iter().enumerate() {
         assert_eq!((t.width(), t.height()), (4, 4));
-        let want = texel_texture::color::srgb_to_linear(f32::from(grey(face)) / 255.0);
+        let want = texel_texture::base::color::srgb_to_linear(f32::from(grey(face)) / 255.0);
         assert!(
             (t.texel(0, 1, 2).unwrap()[0] - want).abs() < 1e-4,
             "face {face}"
@@ -834,7 +834,7 @@ fn bad_environment_tables_are_refused() {
 
 #[test]
 fn sphere_uv_keys_parse_and_bad_ones_are_refused() {
-    use texel_texture::sphere::SurfaceProjection;
+    use texel_texture::mapping::sphere::SurfaceProjection;
     let with = |keys: &str| parse(&format!("{HEAD}{TRI}{keys}\n"));
     let m = with("sphere_uv = \"mercator\"\nsphere_centre = [1.0, 2.0, 3.0]").unwrap();
     let u = m.meshes[0].uv_mapping.unwrap();
@@ -885,7 +885,7 @@ fn sphere_uv_keys_parse_and_bad_ones_are_refused() {
 
 #[test]
 fn the_globes_carry_their_projection_at_every_vertex() {
-    use texel_texture::sphere::SurfaceProjection;
+    use texel_texture::mapping::sphere::SurfaceProjection;
     for (name, want) in [
         ("sphere", SurfaceProjection::Equirect),
         ("globe-equirect", SurfaceProjection::Equirect),

@@ -21,7 +21,7 @@ use texel_texture::{
 const SIZE: u32 = 2048;
 const BATCH: usize = 4096;
 
-use texel_texture::rng::SplitMix64 as Rng;
+use texel_texture::base::rng::SplitMix64 as Rng;
 
 fn texels() -> Vec<[u8; 4]> {
     let mut rng = Rng::new(42);

@@ -21,7 +21,7 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec4;
-use texel_texture::color::{srgb_table, unorm8_table};
+use texel_texture::base::color::{srgb_table, unorm8_table};
 use texel_texture::{
     AddressMode, Cubic, FilterMode, Footprint, Format, Limits, MipmapFilterMode, Sampler,
     SamplerDescriptor, Texture,
@@ -148,11 +148,11 @@ fn bound(c: &mut Criterion) {
             let t = pattern((k % w) as u32, (k / w) as u32);
             [0, 1, 2, 3].map(|c| {
                 let x = if c < 3 {
-                    texel_texture::color::linear_to_srgb(t[c])
+                    texel_texture::base::color::linear_to_srgb(t[c])
                 } else {
                     t[c]
                 };
-                texel_texture::color::unorm8(x)
+                texel_texture::base::color::unorm8(x)
             })
         })
         .collect();

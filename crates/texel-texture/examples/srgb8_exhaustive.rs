@@ -7,7 +7,7 @@
 //! cargo run --release -p texel-texture --example srgb8_exhaustive
 //! ```
 
-use texel_texture::color::{linear_to_srgb8, linear_to_srgb8_exact};
+use texel_texture::base::color::{linear_to_srgb8, linear_to_srgb8_exact};
 
 fn main() {
     const END: u32 = 0x3F80_0000; // 1.0

@@ -30,45 +30,27 @@
 //! # Ok::<(), texel_texture::TextureError>(())
 //! ```
 
-pub mod address;
-pub mod aniso;
-mod batch;
-pub mod bicubic;
-mod bilinear;
-pub mod color;
-pub mod dispatch;
-mod error;
-pub mod ewa;
-mod fetch;
-pub mod fixed8;
-pub mod floor;
-pub mod footprint;
-mod footprints;
+pub mod base;
+pub mod engine;
 pub mod input;
-mod lanes;
-pub mod mip;
-mod nearest;
-pub mod pyramid;
-pub mod ripmap;
-pub mod rng;
-pub mod sampler;
-pub mod sat;
-pub mod sphere;
-pub mod texture;
+pub mod kernel;
+pub mod mapping;
+pub mod storage;
+pub mod technique;
 pub mod warp;
 
-pub use address::{Address, AddressMode, BorderColor};
-pub use bicubic::Cubic;
-pub use error::TextureError;
-pub use footprint::{Axes, Footprint};
-pub use footprints::{FootprintBatch, FootprintLanes};
-pub use lanes::Lanes;
-pub use ripmap::Ripmap;
-pub use sampler::{
+pub use base::address::{Address, AddressMode, BorderColor};
+pub use base::error::TextureError;
+pub use base::footprint::{Axes, Footprint};
+pub use base::footprint_batch::{FootprintBatch, FootprintLanes};
+pub use engine::sampler::{
     FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,
 };
-pub use sat::SummedAreaTable;
-pub use texture::{
+pub use kernel::bicubic::Cubic;
+pub use storage::lanes::Lanes;
+pub use storage::texture::{
     replace_non_finite, ColorSpace, Format, LevelInfo, LevelTexels, Limits, LoadOptions, Loaded,
     Texture, NON_FINITE_CLAMP,
 };
+pub use technique::ripmap::Ripmap;
+pub use technique::sat::SummedAreaTable;

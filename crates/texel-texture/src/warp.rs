@@ -23,9 +23,9 @@
 
 use glam::DVec2;
 
-use crate::footprint::Footprint;
-use crate::sampler::Sampler;
-use crate::texture::Texture;
+use crate::base::footprint::Footprint;
+use crate::engine::sampler::Sampler;
+use crate::storage::texture::Texture;
 
 /// A projective map from the unit square `(s, t)` onto a quadrilateral (Heckbert 1989).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -5,14 +5,14 @@
 
 use glam::{DVec2, Vec2};
 use proptest::prelude::*;
-use texel_texture::ewa::Ellipse;
+use texel_texture::technique::ewa::Ellipse;
 use texel_texture::{
     Address, AddressMode, BorderColor, FilterMode, Footprint, Format, Limits, Sampler,
     SamplerDescriptor, Texture, TextureError,
 };
 
 /// Deterministic uniform noise in [0, 1): the project's one generator.
-use texel_texture::rng::SplitMix64 as Rng;
+use texel_texture::base::rng::SplitMix64 as Rng;
 
 fn noise_texture(w: u32, h: u32, format: Format, seed: u64) -> Texture {
     let mut rng = Rng::new(seed);
@@ -186,7 +186,7 @@ proptest! {
         px in prop::array::uniform2(-50.0f32..50.0), py in prop::array::uniform2(-50.0f32..50.0),
         x in -100.0f32..100.0, y in -100.0f32..100.0, scale in 0.01f64..1.0,
     ) {
-        let lut = texel_texture::ewa::weight_lut();
+        let lut = texel_texture::technique::ewa::weight_lut();
         let e = Ellipse::from_axes(Vec2::from(px), Vec2::from(py), 16.0).unwrap();
         let q = e.in_level(DVec2::splat(scale), true);
         let mut weights = Vec::new();
@@ -206,7 +206,7 @@ proptest! {
 /// At a texel centre the centre texel gets `LUT[0]`, the largest weight, for any ellipse.
 #[test]
 fn ewa_centre_texel_gets_the_peak_weight() {
-    let lut = texel_texture::ewa::weight_lut();
+    let lut = texel_texture::technique::ewa::weight_lut();
     for (px, py) in [
         ((3.0, 0.0), (0.0, 1.0)),
         ((5.0, 5.0), (-0.5, 0.5)),
@@ -618,7 +618,7 @@ fn degenerate_footprints_never_panic_and_stay_bounded() {
                     let (c, reads) = s.sample_counted(tex, fp);
                     // Bounded work: 16 trilinear probes, two EWA levels, 4 bilinear, 36 corners.
                     assert!(
-                        reads <= 2 * texel_texture::ewa::MAX_VISITS,
+                        reads <= 2 * texel_texture::technique::ewa::MAX_VISITS,
                         "{name} {fp:?}: {reads}"
                     );
                     let sane = fp.u.abs() < 1e8 && fp.v.abs() < 1e8;

@@ -1099,7 +1099,7 @@ fn png_round_trip() {
     );
     let srgb = Texture::decode(&png, ColorSpace::Srgb, &Limits::default()).unwrap();
     let t = srgb.texel(0, 1, 0).unwrap();
-    assert!((t[0] - texel_texture::color::srgb_to_linear(40.0 / 255.0)).abs() < 1e-6);
+    assert!((t[0] - texel_texture::base::color::srgb_to_linear(40.0 / 255.0)).abs() < 1e-6);
     assert_eq!(t[3], 70.0 / 255.0, "alpha stays linear");
 }
 
@@ -1217,7 +1217,7 @@ fn cubic_overshoot_is_bounded_at_the_parameter_limits() {
         [v, v, v, 1.0]
     })
     .unwrap();
-    let m = texel_texture::bicubic::MAX_CUBIC_PARAMETER;
+    let m = texel_texture::kernel::bicubic::MAX_CUBIC_PARAMETER;
     for (b, c) in [(m, m), (-m, m), (m, -m), (-m, -m), (0.0, 0.5)] {
         let s = Sampler::new(SamplerDescriptor {
             mag_filter: FilterMode::Cubic(Cubic { b, c }),
@@ -1344,8 +1344,8 @@ proptest! {
         for format in [Format::Rgba8Srgb, Format::Rgba8Unorm, Format::Rgba32Float] {
             let tex = noise_texture(w, h, format);
             let table = match format {
-                Format::Rgba8Srgb => texel_texture::color::srgb_table(),
-                _ => texel_texture::color::unorm8_table(),
+                Format::Rgba8Srgb => texel_texture::base::color::srgb_table(),
+                _ => texel_texture::base::color::unorm8_table(),
             };
             for border in borders {
                 for s in every_sampler(border) {
@@ -1364,8 +1364,8 @@ proptest! {
                     for (f, &o) in fps.iter().zip(&out) {
                         let c = s.sample(&tex, f);
                         let encoded = match format {
-                            Format::Rgba8Srgb => texel_texture::color::rgba_to_srgb8(c),
-                            _ => texel_texture::color::rgba_to_unorm8(c),
+                            Format::Rgba8Srgb => texel_texture::base::color::rgba_to_srgb8(c),
+                            _ => texel_texture::base::color::rgba_to_unorm8(c),
                         };
                         prop_assert_eq!(o, encoded, "{:?} {:?} {:?}", d, f, format);
                         let decoded = [
@@ -1420,7 +1420,7 @@ proptest! {
                         _ => 2,
                     };
                     for (f, o) in fps.iter().zip(&out) {
-                        let exact = texel_texture::color::rgba_to_unorm8(s.sample(&tex, f));
+                        let exact = texel_texture::base::color::rgba_to_unorm8(s.sample(&tex, f));
                         for c in 0..4 {
                             let diff = (i32::from(o[c]) - i32::from(exact[c])).abs();
                             prop_assert!(diff <= bound, "{:?} {:?}: {:?} vs {:?}", d, f, o, exact);

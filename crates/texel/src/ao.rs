@@ -35,7 +35,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use glam::{DVec2, Vec2, Vec3};
 use rayon::prelude::*;
 use texel_scene::Mesh;
-use texel_texture::rng::SplitMix64;
+use texel_texture::base::rng::SplitMix64;
 
 use crate::bvh::Bvh;
 use crate::{Error, MemoryBudget};

@@ -132,7 +132,7 @@ mod tests {
     use glam::Vec4;
     use texel_raster::layers::{Layer, LayerBlend, MAX_LAYERS};
     use texel_raster::{ChannelInput, TextureInput};
-    use texel_texture::rng::SplitMix64;
+    use texel_texture::base::rng::SplitMix64;
 
     /// A 2-layer mask whose weights sum to 1 texel by texel, and a height map.
     fn maps() -> (Texture, Texture) {

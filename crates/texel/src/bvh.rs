@@ -379,7 +379,7 @@ pub fn hits_triangle(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use texel_texture::rng::SplitMix64;
+    use texel_texture::base::rng::SplitMix64;
 
     fn random_soup(n: usize, seed: u64) -> (Vec<Vec3>, Vec<[u32; 3]>) {
         let mut r = SplitMix64::new(seed);

@@ -16,7 +16,7 @@ use texel_scene::{
     ColorInput, LayerBlendSpec, LayerOrder, LightSpec, MaterialSpec, ScalarInput, Scene,
     SpecularAaSpec, TextureSampler,
 };
-use texel_texture::color::srgb_to_linear;
+use texel_texture::base::color::srgb_to_linear;
 use texel_texture::{AddressMode, ColorSpace, Limits, Sampler, Texture};
 
 use crate::bake::{self, Composite};
@@ -191,7 +191,7 @@ fn environment_maps(
         // texels of the layer being made, and the prefiltered maps.
         let (w, h) = sky.layer_size(spec.mapping);
         let f = texel_texture::Format::Rgba32Float.texel_bytes();
-        let layer = texel_texture::pyramid::pyramid_texels(w, h) * f;
+        let layer = texel_texture::storage::pyramid::pyramid_texels(w, h) * f;
         let made = u64::from(w) * u64::from(h) * f;
         let need = layer * spec.mapping.layers() as u64
             + made

@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 use glam::{Vec2, Vec3};
 use texel::ao::{bake_ao, AoMap, AoMesh, AoSettings};
 use texel::bvh::hits_triangle;
-use texel::texture::rng::SplitMix64;
+use texel::texture::base::rng::SplitMix64;
 use texel::{Error, MemoryBudget, Scene};
 
 /// A 4 x 4 plane at `y = 0` (uv = `((x + 2) / 4, (z + 2) / 4)`) with a unit box standing on it at

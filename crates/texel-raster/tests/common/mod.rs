@@ -112,7 +112,7 @@ impl Ground {
 }
 
 /// The project's deterministic generator (SplitMix64), for test geometry.
-pub use texel_texture::rng::SplitMix64 as Rng;
+pub use texel_texture::base::rng::SplitMix64 as Rng;
 
 /// A vertex given in pixel coordinates of a `width x height` frame, for `clip_from_world = I`.
 pub fn screen_vertex(x: f64, y: f64, width: u32, height: u32) -> Vertex {

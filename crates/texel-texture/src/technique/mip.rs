@@ -1,5 +1,5 @@
 //! Mipmapped filtering: nearest level (`mip_nearest`) and trilinear, and the two level rules they
-//! share with the batched path (`batch.rs`) and the anisotropic probes ([`crate::aniso`]).
+//! share with the batched path (`batch.rs`) and the anisotropic probes ([`crate::technique::aniso`]).
 //!
 //! Level selection follows the Vulkan spec ("Level-of-Detail Operation" and "Image Level(s)
 //! Selection") with `level_base = 0` and `q` the last level: `d' = clamp(lod, 0, q)`;
@@ -13,14 +13,14 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::address::Address;
-use crate::bicubic::bicubic;
-use crate::bilinear::{bilinear, lerp};
-use crate::fetch::{Fetch, Pyramid};
-use crate::floor::{ceil_clamped, ceil_i32, floor_nonneg, floor_nonneg_staged};
-use crate::footprint::Query;
-use crate::nearest::nearest;
-use crate::sampler::FilterMode;
+use crate::base::address::Address;
+use crate::base::floor::{ceil_clamped, ceil_i32, floor_nonneg, floor_nonneg_staged};
+use crate::base::footprint::Query;
+use crate::engine::sampler::FilterMode;
+use crate::kernel::bicubic::bicubic;
+use crate::kernel::bilinear::{bilinear, lerp};
+use crate::kernel::nearest::nearest;
+use crate::storage::fetch::{Fetch, Pyramid};
 
 /// Filter one level with a within-level filter (Nearest, Linear or Cubic) at normalised `uv`.
 ///

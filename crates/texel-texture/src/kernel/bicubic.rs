@@ -16,10 +16,10 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::address::Address;
-use crate::bilinear::{origin, texel_or_border};
-use crate::fetch::Fetch;
-use crate::floor::floor_index;
+use crate::base::address::Address;
+use crate::base::floor::floor_index;
+use crate::kernel::bilinear::{origin, texel_or_border};
+use crate::storage::fetch::Fetch;
 
 /// Largest `|B|` and `|C|` a sampler accepts. Mitchell and Netravali's family is drawn for B and C
 /// in `[0, 1]` and Keys' cubics need C up to 1; unbounded values overflow `f32` (found by fuzzing:

@@ -133,7 +133,7 @@ impl Address {
 mod tests {
     use super::AddressMode::*;
     use super::*;
-    use crate::floor::floor_index;
+    use crate::base::floor::floor_index;
 
     /// (mode, index, n, expected) straight from the documented examples.
     const TABLE: &[(AddressMode, i64, u32, Option<u32>)] = &[

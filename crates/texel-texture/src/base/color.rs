@@ -11,7 +11,7 @@ use std::sync::OnceLock;
 
 use glam::Vec4;
 
-use crate::floor::{floor_clamped4, integer_byte, integer_bytes4, round_staged};
+use crate::base::floor::{floor_clamped4, integer_byte, integer_bytes4, round_staged};
 
 /// sRGB-encoded value in `[0, 1]` to linear light in `[0, 1]` (IEC 61966-2-1).
 ///

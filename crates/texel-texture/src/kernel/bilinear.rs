@@ -19,11 +19,11 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::address::Address;
-use crate::batch::Taps;
-use crate::fetch::Fetch;
-use crate::floor::floor_index;
-use crate::mip::LevelFilter;
+use crate::base::address::Address;
+use crate::base::floor::floor_index;
+use crate::engine::batch::Taps;
+use crate::storage::fetch::Fetch;
+use crate::technique::mip::LevelFilter;
 
 /// `a + (b - a) * t`: the one interpolation every filter blends with (bilinear's three, the
 /// lerp between mip levels, the ripmap's and EWA's level blends).
@@ -72,7 +72,7 @@ pub(crate) fn bilinear<F: Fetch>(level: &F, addr: &Address, uv: Vec2) -> Vec4 {
 
 /// The four texels (or border colours) a bilinear sample of `level` at normalised `uv` (finite)
 /// reads, in [`Fetch::quad`]'s order, and its fractions `(a, b)`: [`bilinear`] before the blend
-/// (also [`crate::fixed8`]'s).
+/// (also [`crate::kernel::fixed8`]'s).
 #[inline(always)]
 pub(crate) fn taps<F: Fetch>(level: &F, addr: &Address, uv: Vec2) -> ([Vec4; 4], f32, f32) {
     let (w, h) = level.size();
@@ -117,7 +117,11 @@ impl Taps for Bilinear {
         level.bilinear_quad(i, j, a, b)
     }
     #[inline(always)]
-    fn inside_run<F: Fetch>(level: &F, run: crate::fetch::Run<'_>, out: &mut [[f32; 4]]) -> bool {
+    fn inside_run<F: Fetch>(
+        level: &F,
+        run: crate::storage::fetch::Run<'_>,
+        out: &mut [[f32; 4]],
+    ) -> bool {
         level.bilinear_run(run, out)
     }
     #[inline(always)]

@@ -11,10 +11,10 @@ use std::cell::Cell;
 
 use glam::Vec4;
 
-use crate::bilinear::{blend, wrapped_quad};
-use crate::color::{srgb_table, unorm8_table};
-use crate::lanes::Lanes;
-use crate::texture::{Format, LevelInfo, Storage, Texture};
+use crate::base::color::{srgb_table, unorm8_table};
+use crate::kernel::bilinear::{blend, wrapped_quad};
+use crate::storage::lanes::Lanes;
+use crate::storage::texture::{Format, LevelInfo, Storage, Texture};
 
 /// How a stored texel becomes linear RGBA, per storage format: [`Table8`] for 8-bit texels,
 /// [`Float`] for `f32` ones. The level and pyramid views below are generic over it, so the two
@@ -34,7 +34,7 @@ pub(crate) trait Decode: Copy {
     }
     /// The bilinear blend ([`blend`]) of the quad whose rows are `r0 = [T00, T10]` and
     /// `r1 = [T01, T11]`, with fractions `a` (x) and `b` (y): [`Decode::decode4`] then [`blend`],
-    /// which a decoder may compute in wider lanes (the same bits: [`crate::lanes`]).
+    /// which a decoder may compute in wider lanes (the same bits: [`crate::storage::lanes`]).
     #[inline(always)]
     fn bilinear_rows(&self, r0: [Self::Texel; 2], r1: [Self::Texel; 2], a: f32, b: f32) -> Vec4 {
         blend(self.decode4([r0[0], r0[1], r1[0], r1[1]]), a, b)
@@ -92,7 +92,7 @@ impl Decode for Table8 {
 /// [`unorm8_table`]. A decoder of its own, not a flag on [`Table8`]: a branch in the shared
 /// kernel slows sRGB trilinear frames. Single texels by arithmetic rather than four table
 /// loads, which is faster on mip-nearest and trilinear frames (figures in docs/decisions.md).
-/// Bilinear quads blend in eight lanes where `lanes` has them ([`crate::lanes`]).
+/// Bilinear quads blend in eight lanes where `lanes` has them ([`crate::storage::lanes`]).
 #[derive(Clone, Copy, Default)]
 pub(crate) struct Unorm8 {
     pub lanes: Lanes,
@@ -459,16 +459,18 @@ impl<P: Pyramid> Pyramid for Counted<P> {
 
 /// Call `$body` with `$p` bound to the texture's pyramid view (8-bit or float), monomorphising once
 /// per storage format; with `$lanes`, the linear 8-bit view blends bilinear quads with that
-/// kernel ([`crate::lanes`]), else with the scalar one.
+/// kernel ([`crate::storage::lanes`]), else with the scalar one.
 macro_rules! with_pyramid {
     ($tex:expr, |$p:ident| $body:expr) => {
-        $crate::fetch::with_pyramid!($tex, $crate::lanes::Lanes::scalar(), |$p| $body)
+        $crate::storage::fetch::with_pyramid!($tex, $crate::storage::lanes::Lanes::scalar(), |$p| {
+            $body
+        })
     };
     ($tex:expr, $lanes:expr, |$p:ident| $body:expr) => {
-        match $crate::fetch::pyramid_with($tex, $lanes) {
-            $crate::fetch::AnyPyramid::U8($p) => $body,
-            $crate::fetch::AnyPyramid::Unorm8($p) => $body,
-            $crate::fetch::AnyPyramid::F32($p) => $body,
+        match $crate::storage::fetch::pyramid_with($tex, $lanes) {
+            $crate::storage::fetch::AnyPyramid::U8($p) => $body,
+            $crate::storage::fetch::AnyPyramid::Unorm8($p) => $body,
+            $crate::storage::fetch::AnyPyramid::F32($p) => $body,
         }
     };
 }

@@ -15,7 +15,7 @@
 //! - **mip blend**: `D = round(256 delta)`, `round((a (256 - D) + b D) / 256)` ([`mix8`]).
 //!
 //! Every rounding is to the nearest integer with halves to even (IEEE's default, so it costs an
-//! addition and a subtraction: [`crate::floor::round_staged`]; hardware documents only its
+//! addition and a subtraction: [`crate::base::floor::round_staged`]; hardware documents only its
 //! precision, not its tie rule).
 //!
 //! Level selection (the lod) is the `f32` path's, so both read the same texels. Every value is an
@@ -31,13 +31,13 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::address::Address;
-use crate::batch::Taps;
-use crate::bilinear;
-use crate::fetch::Fetch;
-use crate::floor::{round_staged, round_staged4};
-use crate::mip::LevelFilter;
-use crate::nearest;
+use crate::base::address::Address;
+use crate::base::floor::{round_staged, round_staged4};
+use crate::engine::batch::Taps;
+use crate::kernel::bilinear;
+use crate::kernel::nearest;
+use crate::storage::fetch::Fetch;
+use crate::technique::mip::LevelFilter;
 
 /// The 8-bit weight of a fraction `a` in `[0, 1]`: `round(256 a)` (halves to even), in
 /// `0..=256`. A fraction outside `[0, 1]` is clamped first; NaN gives 0.
@@ -99,7 +99,7 @@ impl Taps for Point8 {
     }
 }
 
-/// Bilinear on codes: [`bilinear8`] of the taps [`crate::bilinear`] reads, [`mix8`] between
+/// Bilinear on codes: [`bilinear8`] of the taps [`crate::kernel::bilinear`] reads, [`mix8`] between
 /// levels.
 #[derive(Clone, Copy)]
 pub(crate) struct Bilinear8;

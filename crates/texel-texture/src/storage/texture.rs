@@ -2,7 +2,7 @@
 //!
 //! A [`Texture`] owns every mip level in one contiguous allocation of its own texel format
 //! (`[u8; 4]` or `[f32; 4]`), level 0 first, so that a filter reading two adjacent levels touches one
-//! buffer. The pyramid is built at creation (see [`crate::pyramid`]): level `k` is
+//! buffer. The pyramid is built at creation (see [`crate::storage::pyramid`]): level `k` is
 //! `max(1, W >> k) x max(1, H >> k)`, down to 1x1.
 //!
 //! Decision (docs/decisions.md): levels below 0 are stored in the texture's own format, as a
@@ -15,13 +15,13 @@ use std::sync::OnceLock;
 
 use glam::Vec4;
 
-use crate::color::{linear_to_srgb8, srgb_table, srgb_to_linear, unorm8, unorm8_table};
-use crate::error::TextureError;
-use crate::fetch::{table8, Fetch, Float, Level};
-use crate::pyramid;
-use crate::ripmap::Ripmap;
-use crate::sampler::{FilterMode, Sampler, SamplerDescriptor};
-use crate::sat::SummedAreaTable;
+use crate::base::color::{linear_to_srgb8, srgb_table, srgb_to_linear, unorm8, unorm8_table};
+use crate::base::error::TextureError;
+use crate::engine::sampler::{FilterMode, Sampler, SamplerDescriptor};
+use crate::storage::fetch::{table8, Fetch, Float, Level};
+use crate::storage::pyramid;
+use crate::technique::ripmap::Ripmap;
+use crate::technique::sat::SummedAreaTable;
 
 /// How 8-bit colour channels are to be interpreted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -338,8 +338,8 @@ impl Texture {
     }
 
     /// A float texture whose mip levels are given rather than built: `texels` holds every level of
-    /// a full `width x height` chain ([`crate::pyramid::level_size`], down to 1x1), level 0 first,
-    /// each row-major and the levels back to back ([`crate::pyramid::pyramid_texels`] in all).
+    /// a full `width x height` chain ([`crate::storage::pyramid::level_size`], down to 1x1), level 0 first,
+    /// each row-major and the levels back to back ([`crate::storage::pyramid::pyramid_texels`] in all).
     /// For pyramids whose levels are not box reductions of level 0, such as an environment map's
     /// GGX-prefiltered levels (each convolved with a wider specular lobe). Ripmaps and
     /// summed-area tables, built from level 0, know nothing of the other levels.
@@ -563,7 +563,7 @@ impl Texture {
     pub fn ripmap(&self) -> Result<&Ripmap, TextureError> {
         let r = self.ripmap.get_or_init(|| Ripmap::build_within(self));
         r.as_ref()
-            .map_err(|&bytes| crate::ripmap::over_limit(self, bytes))
+            .map_err(|&bytes| crate::technique::ripmap::over_limit(self, bytes))
     }
 
     /// The texture's summed-area table, built from level 0 on first call (thread-safe, once).
@@ -573,7 +573,7 @@ impl Texture {
     pub fn summed_area_table(&self) -> Result<&SummedAreaTable, TextureError> {
         let r = self.sat.get_or_init(|| SummedAreaTable::build_within(self));
         r.as_ref()
-            .map_err(|&bytes| crate::sat::over_limit(self, bytes))
+            .map_err(|&bytes| crate::technique::sat::over_limit(self, bytes))
     }
 
     /// Build ahead of time whatever acceleration structure `sampler` needs (the ripmap for

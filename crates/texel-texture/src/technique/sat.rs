@@ -46,12 +46,12 @@
 use glam::Vec4;
 use rayon::prelude::*;
 
-use crate::address::{Address, AddressMode};
-use crate::error::TextureError;
-use crate::fetch::{with_pyramid, Fetch, Pyramid};
-use crate::footprint::{lod_from_rho, Query};
-use crate::sampler::Sampler;
-use crate::texture::Texture;
+use crate::base::address::{Address, AddressMode};
+use crate::base::error::TextureError;
+use crate::base::footprint::{lod_from_rho, Query};
+use crate::engine::sampler::Sampler;
+use crate::storage::fetch::{with_pyramid, Fetch, Pyramid};
+use crate::storage::texture::Texture;
 
 /// Boxes narrower than this (texels) are widened to it, centred: the mean of a vanishing box is
 /// the texel under it, and `f64` cancellation makes narrower boxes meaningless.
@@ -393,8 +393,8 @@ pub(crate) fn summed_area<P: Pyramid>(p: &P, t: &SummedAreaTable, s: &Sampler, q
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::address::BorderColor;
-    use crate::texture::{Format, Limits};
+    use crate::base::address::BorderColor;
+    use crate::storage::texture::{Format, Limits};
 
     fn ramp4() -> Texture {
         Texture::from_fn(4, 1, Format::Rgba32Float, &Limits::default(), |i, _| {

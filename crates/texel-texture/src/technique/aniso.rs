@@ -33,27 +33,27 @@
 //! Cost: `N` trilinear probes, so at most `8 N` texel reads. Throughput and texels read per sample
 //! at anisotropy ratios 1 to 64 are in docs/benchmarks.md (`benches/aniso.rs`); quality
 //! against a brute-force Gaussian (RMS error 0.0158 for 16x vs 0.0252 for trilinear) is in
-//! [`crate::ewa`].
+//! [`crate::technique::ewa`].
 //!
 //! The code path: `anisotropic` is `plan` (axes, `N`, the probes' lod) then `filter_planned`
-//! (the sum above). The probes share their lod, so `crate::mip::linear_levels` picks their two
+//! (the sum above). The probes share their lod, so `crate::technique::mip::linear_levels` picks their two
 //! levels once, and their trilinear samples run through the batched path's stages
 //! (`batch::Probes::trilinear_sum`: the same bilinear kernels, staged over the probes).
 //! [`crate::Sampler::sample_batch`] makes the plans of a chunk of 64 footprints in one loop
 //! (`plan_chunk`) before reading any probe, as it does the isotropic lods; that needs a `log2`
-//! without a call, so the probe lod uses [`crate::footprint::fast_log2`] (within 1.2 units in the
+//! without a call, so the probe lod uses [`crate::base::footprint::fast_log2`] (within 1.2 units in the
 //! last place) in both paths, which therefore agree bit for bit. How each of these steps moved
 //! the frame times: docs/decisions.md.
 
 use glam::{Vec2, Vec4};
 
-use crate::batch::{self, Probes};
-use crate::bilinear::Bilinear;
-use crate::fetch::{Fetch, Pyramid};
-use crate::floor::ceil_i32;
-use crate::footprint::{fast_log2, log2_normal, Footprint, Query};
-use crate::mip::{linear_levels, trilinear};
-use crate::sampler::Sampler;
+use crate::base::floor::ceil_i32;
+use crate::base::footprint::{fast_log2, log2_normal, Footprint, Query};
+use crate::engine::batch::{self, Probes};
+use crate::engine::sampler::Sampler;
+use crate::kernel::bilinear::Bilinear;
+use crate::storage::fetch::{Fetch, Pyramid};
+use crate::technique::mip::{linear_levels, trilinear};
 
 /// Relative tolerance applied to `|Pmax| / |Pmin|` before rounding up (see the module docs).
 pub const RATIO_TOLERANCE: f32 = 1e-5;
@@ -99,7 +99,7 @@ pub(crate) struct Plan {
 /// `anisotropy_clamp` as the most probes), with `log2` either [`fast_log2`] or its branch-free
 /// normal-input path [`log2_normal`]; also whether `rho = |Pmax| / N` is zero or subnormal, where
 /// the latter is wrong and the plan must be made again with [`fast_log2`]. [`Footprint::axes`],
-/// [`probe_count`] and [`crate::footprint::lod_from_rho`]'s arithmetic (clamping by `max`/`min`,
+/// [`probe_count`] and [`crate::base::footprint::lod_from_rho`]'s arithmetic (clamping by `max`/`min`,
 /// which equals `clamp` for the non-NaN values reaching it), inlined so that [`plan_chunk`]'s loop
 /// over a chunk pipelines.
 #[inline(always)]
@@ -192,11 +192,11 @@ pub(crate) fn filter_planned<P: Pyramid>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bilinear::bilinear;
-    use crate::fetch::pyramid_with;
-    use crate::lanes::Lanes;
-    use crate::sampler::SamplerDescriptor;
-    use crate::texture::{Format, Limits, Texture};
+    use crate::engine::sampler::SamplerDescriptor;
+    use crate::kernel::bilinear::bilinear;
+    use crate::storage::fetch::pyramid_with;
+    use crate::storage::lanes::Lanes;
+    use crate::storage::texture::{Format, Limits, Texture};
 
     /// The staged probes (`Probes::trilinear_sum`) equal the formula's plain loop bit for bit:
     /// each probe a bilinear-in-two-levels trilinear sample in the shared levels, summed in order.
@@ -205,13 +205,13 @@ mod tests {
     /// `Pass::far_repeat`), with positions up to a texture away from it.
     #[test]
     fn staged_probes_equal_the_probe_loop() {
-        use crate::address::AddressMode::{MirrorRepeat, Repeat};
+        use crate::base::address::AddressMode::{MirrorRepeat, Repeat};
         for (w, h, v_mode) in [(61, 34, MirrorRepeat), (64, 32, Repeat)] {
             check_staged_probes(w, h, v_mode);
         }
     }
 
-    fn check_staged_probes(w: u32, h: u32, v_mode: crate::address::AddressMode) {
+    fn check_staged_probes(w: u32, h: u32, v_mode: crate::base::address::AddressMode) {
         let tex = Texture::from_fn(w, h, Format::Rgba8Srgb, &Limits::default(), |i, j| {
             let x = (i * 7 + j * 13) % 256;
             [
@@ -222,11 +222,11 @@ mod tests {
             ]
         })
         .unwrap();
-        let crate::fetch::AnyPyramid::U8(p) = pyramid_with(&tex, Lanes::scalar()) else {
+        let crate::storage::fetch::AnyPyramid::U8(p) = pyramid_with(&tex, Lanes::scalar()) else {
             unreachable!()
         };
         let d = SamplerDescriptor {
-            address_mode_u: crate::address::AddressMode::Repeat,
+            address_mode_u: crate::base::address::AddressMode::Repeat,
             address_mode_v: v_mode,
             ..SamplerDescriptor::anisotropic(16)
         };
@@ -249,7 +249,7 @@ mod tests {
             if n == 1 {
                 continue;
             }
-            let lod = crate::footprint::lod_from_rho(major / n as f32, 0.0, 0.0, 32.0);
+            let lod = crate::base::footprint::lod_from_rho(major / n as f32, 0.0, 0.0, 32.0);
             let last = p.level_count() - 1;
             let dl = lod.clamp(0.0, last as f32);
             let k = dl as usize;

@@ -81,7 +81,7 @@ pub enum TextureError {
     )]
     AnisotropyNeedsLinear(u16),
     /// A cubic filter's (B, C) parameters are not finite or outside
-    /// `[-MAX_CUBIC_PARAMETER, MAX_CUBIC_PARAMETER]` ([`crate::bicubic::MAX_CUBIC_PARAMETER`]).
+    /// `[-MAX_CUBIC_PARAMETER, MAX_CUBIC_PARAMETER]` ([`crate::kernel::bicubic::MAX_CUBIC_PARAMETER`]).
     #[error("invalid Mitchell-Netravali parameters B = {b}, C = {c}: each must be within [-2, 2]")]
     InvalidCubic {
         /// The B parameter.

@@ -12,14 +12,14 @@
 //! stand-alone (a trilinear kernel over cache-resident samples; docs/decisions.md).
 //!
 //! Same bits. Each lane computes the scalar kernel's operations in its order: the decode
-//! `b * hi + b * lo` ([`crate::fetch`]'s `unorm8_lanes`: two multiplies and an add, never fused),
-//! then [`crate::bilinear::blend`]'s `lerp(lerp(t00, t10, a), lerp(t01, t11, a), b)` with
+//! `b * hi + b * lo` ([`crate::storage::fetch`]'s `unorm8_lanes`: two multiplies and an add, never fused),
+//! then [`crate::kernel::bilinear::blend`]'s `lerp(lerp(t00, t10, a), lerp(t01, t11, a), b)` with
 //! `lerp(x, y, t) = x + (y - x) * t`. Only the grouping into registers differs, so the result is
 //! bit for bit the scalar kernel's (unit test below; `tests/core.rs` compares whole batches).
 //!
-//! Where it runs. The batched sampler's kernels run on [`crate::dispatch`]'s instruction-set
+//! Where it runs. The batched sampler's kernels run on [`crate::engine::dispatch`]'s instruction-set
 //! copies; [`crate::Sampler::sample_batch`] takes the token of the copy it runs on
-//! ([`crate::dispatch::lanes`]: [`Lanes::detect`] on x86-64-v3 and -v4), and
+//! ([`crate::engine::dispatch::lanes`]: [`Lanes::detect`] on x86-64-v3 and -v4), and
 //! [`crate::Sampler::sample_batch_lanes`] the caller's (the rasterizer's tiles pass their copy's).
 //! The one-sample path keeps the scalar kernel: pulp's intrinsics carry `#[target_feature]`, so in
 //! code compiled for the x86-64 baseline each would stay a call.
@@ -27,8 +27,8 @@
 use glam::Vec4;
 
 #[cfg(target_arch = "x86_64")]
-use crate::fetch::quad_rows;
-use crate::fetch::Run;
+use crate::storage::fetch::quad_rows;
+use crate::storage::fetch::Run;
 
 /// Which quad kernel the batched sampler ([`crate::Sampler::sample_batch_lanes`]) uses for the
 /// bilinear blend of a 2x2 quad of linear 8-bit texels (`Rgba8Unorm`, its staged path: minifying
@@ -42,7 +42,7 @@ use crate::fetch::Run;
 /// eight lanes (`b * hi + b * lo` with `1/255 = hi + lo`, two multiplies and an add per lane,
 /// never fused), lerps both rows along x in one eight-lane step and the two halves along y:
 /// per lane the four-lane kernel's operations in its order. Its intrinsics carry
-/// `#[target_feature]`, so it is fast only in code compiled with AVX2 ([`crate::dispatch`]'s
+/// `#[target_feature]`, so it is fast only in code compiled with AVX2 ([`crate::engine::dispatch`]'s
 /// x86-64-v3 and -v4 copies); called from baseline code each intrinsic stays a call (correct,
 /// slower).
 #[derive(Clone, Copy, Debug, Default)]
@@ -78,7 +78,7 @@ impl Lanes {
 
     /// The bilinear blend of the linear 8-bit quad whose rows are `r0 = [T00, T10]` and
     /// `r1 = [T01, T11]`, with fractions `a` (along x) and `b` (along y), in eight lanes: each
-    /// byte decoded to `b / 255` (exactly [`crate::fetch`]'s `Unorm8`), then
+    /// byte decoded to `b / 255` (exactly [`crate::storage::fetch`]'s `Unorm8`), then
     /// `lerp(lerp(T00, T10, a), lerp(T01, T11, a), b)`, bit for bit the four-lane kernel.
     /// `None` when this is [`Lanes::scalar`]: the caller then runs the four-lane kernel (an
     /// `Option`, not a fallback closure: closures can stay outlined, compiled for the baseline).
@@ -97,10 +97,10 @@ impl Lanes {
     }
 
     /// [`Lanes::bilinear_unorm8`] of each sample of `run` (every quad inside the `width`-wide
-    /// linear 8-bit level `texels`, read by [`crate::fetch::quad_rows`]) into `out` (the run's
+    /// linear 8-bit level `texels`, read by [`crate::storage::fetch::quad_rows`]) into `out` (the run's
     /// length): `true`, or `false` with `out` untouched when this is [`Lanes::scalar`]. The
     /// token is tested once for the run, and the loop runs the eight-lane kernel alone. It is
-    /// inlined into the batched sampler's instruction-set copies ([`crate::dispatch`]), where
+    /// inlined into the batched sampler's instruction-set copies ([`crate::engine::dispatch`]), where
     /// the kernel's intrinsics inline on x86-64-v3 and -v4 (docs/decisions.md).
     #[inline(always)]
     pub(crate) fn bilinear_unorm8_run(
@@ -159,12 +159,12 @@ fn bilinear_unorm8_v3(
 }
 
 /// A row of two linear 8-bit texels as eight decoded `f32` lanes, `b * hi + b * lo` per byte
-/// ([`crate::fetch`]'s `unorm8_lanes`). A function, not a closure: a closure stays an outlined
+/// ([`crate::storage::fetch`]'s `unorm8_lanes`). A function, not a closure: a closure stays an outlined
 /// function compiled for the baseline, where every intrinsic is a call (docs/decisions.md).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn row_v3(simd: pulp::x86::V3, r: [[u8; 4]; 2]) -> std::arch::x86_64::__m256 {
-    use crate::fetch::{UNORM8_HI, UNORM8_LO};
+    use crate::storage::fetch::{UNORM8_HI, UNORM8_LO};
     let (avx, avx2, sse2) = (simd.avx, simd.avx2, simd.sse2);
     let bytes = u64::from(u32::from_le_bytes(r[0])) | u64::from(u32::from_le_bytes(r[1])) << 32;
     let x = sse2._mm_set_epi64x(0, bytes as i64);
@@ -178,9 +178,9 @@ fn row_v3(simd: pulp::x86::V3, r: [[u8; 4]; 2]) -> std::arch::x86_64::__m256 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bilinear::blend;
-    use crate::fetch::{Decode, Unorm8};
-    use crate::rng::SplitMix64;
+    use crate::base::rng::SplitMix64;
+    use crate::kernel::bilinear::blend;
+    use crate::storage::fetch::{Decode, Unorm8};
 
     /// The eight-lane kernel equals the four-lane one bit for bit: random quads (every byte value
     /// reached), fractions at the ends of `[0, 1)`, at halves, near 1, and random; both kernels

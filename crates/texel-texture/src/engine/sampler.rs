@@ -6,16 +6,16 @@
 //!
 //! Mag/min selection (Vulkan spec, "Texel Filtering"): `lod <= 0` uses `mag_filter` at level 0,
 //! `lod > 0` uses `min_filter` with `mipmap_filter` choosing the level(s). `lod` is
-//! `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]` (see [`crate::footprint`]).
+//! `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]` (see [`crate::base::footprint`]).
 //!
 //! Beyond the core filters, four anisotropic techniques are selected through the same descriptor:
 //!
 //! | technique | descriptor | module |
 //! |---|---|---|
-//! | hardware-style N x anisotropic | mag, min and mipmap filters `Linear`, `anisotropy_clamp` 2..=16 (up to 64 accepted); [`SamplerDescriptor::lab_mode`] 5-8 | [`crate::aniso`] |
-//! | EWA | `min_filter: FilterMode::Ewa` | [`crate::ewa`] |
-//! | ripmap | `min_filter: FilterMode::Ripmap` | [`crate::ripmap`] |
-//! | summed-area table | `min_filter: FilterMode::SummedArea` | [`crate::sat`] |
+//! | hardware-style N x anisotropic | mag, min and mipmap filters `Linear`, `anisotropy_clamp` 2..=16 (up to 64 accepted); [`SamplerDescriptor::lab_mode`] 5-8 | [`crate::technique::aniso`] |
+//! | EWA | `min_filter: FilterMode::Ewa` | [`crate::technique::ewa`] |
+//! | ripmap | `min_filter: FilterMode::Ripmap` | [`crate::technique::ripmap`] |
+//! | summed-area table | `min_filter: FilterMode::SummedArea` | [`crate::technique::sat`] |
 //!
 //! Decisions for the three minification-only filters (`Ewa`, `Ripmap`, `SummedArea`):
 //! - magnification works as on a GPU: when the isotropic `lod` (from `rho`, the longer axis) is
@@ -32,18 +32,18 @@
 //! ## The code path
 //!
 //! [`Sampler::sample`] is two stages: `Sampler::query` makes the sample's query once (`uv` made
-//! finite, the isotropic lod `0.5 * log2(rho^2)` with [`crate::footprint::fast_log2`]; skipped when
+//! finite, the isotropic lod `0.5 * log2(rho^2)` with [`crate::base::footprint::fast_log2`]; skipped when
 //! it cannot matter: no mipmapping and `mag_filter == min_filter`), then `Sampler::filter`
 //! dispatches on the resolved technique to one filter, each a function of the pyramid, the sampler
-//! and the query ([`crate::mip`], [`crate::aniso`], [`crate::ewa`], [`crate::ripmap`],
-//! [`crate::sat`]).
+//! and the query ([`crate::technique::mip`], [`crate::technique::aniso`], [`crate::technique::ewa`], [`crate::technique::ripmap`],
+//! [`crate::technique::sat`]).
 //!
 //! [`Sampler::sample_batch`] runs the same stages over chunks of 64 footprints: all queries first
 //! (the one-sample path is latency-bound, one long dependency chain per sample, so letting the
 //! independent lod computations overlap is what moves the wall time), then the filters. The core
 //! filters (nearest or bilinear inside the levels, any mipmap mode) go through `batch.rs`, which
-//! stages the very kernels of `crate::bilinear` and [`crate::mip`] over the chunk; anisotropic
-//! probes are planned per chunk ([`crate::aniso`]). Results are bit-identical to
+//! stages the very kernels of `crate::kernel::bilinear` and [`crate::technique::mip`] over the chunk; anisotropic
+//! probes are planned per chunk ([`crate::technique::aniso`]). Results are bit-identical to
 //! [`Sampler::sample`] (tested).
 //!
 //! What bounds the 8-bit path: over half of a trilinear frame is texel loads, the four table loads
@@ -54,24 +54,24 @@
 
 use glam::Vec4;
 
-use crate::address::{Address, AddressMode, BorderColor};
-use crate::aniso::{anisotropic, filter_planned, plan_chunk, Plan};
-use crate::batch::{self, Chunk, Probes};
-use crate::bicubic::Cubic;
-use crate::bilinear::Bilinear;
-use crate::color::{rgba_to_srgb8, rgba_to_unorm8};
-use crate::error::TextureError;
-use crate::ewa::ewa;
-use crate::fetch::{codes_of, with_pyramid, Counted, Fetch, Pyramid};
-use crate::floor::integer_bytes4;
-pub use crate::footprint::UV_LIMIT;
-use crate::footprint::{finite_uv, lod_from_rho_squared, rho_squared, Footprint, Query};
-use crate::footprints::{chunks, FootprintBatch, Source};
-use crate::lanes::Lanes;
-use crate::mip::{filter_level, mip_nearest, trilinear};
-use crate::ripmap::ripmap;
-use crate::sat::summed_area;
-use crate::texture::{Format, Texture};
+use crate::base::address::{Address, AddressMode, BorderColor};
+use crate::base::color::{rgba_to_srgb8, rgba_to_unorm8};
+use crate::base::error::TextureError;
+use crate::base::floor::integer_bytes4;
+pub use crate::base::footprint::UV_LIMIT;
+use crate::base::footprint::{finite_uv, lod_from_rho_squared, rho_squared, Footprint, Query};
+use crate::base::footprint_batch::{chunks, FootprintBatch, Source};
+use crate::engine::batch::{self, Chunk, Probes};
+use crate::kernel::bicubic::Cubic;
+use crate::kernel::bilinear::Bilinear;
+use crate::storage::fetch::{codes_of, with_pyramid, Counted, Fetch, Pyramid};
+use crate::storage::lanes::Lanes;
+use crate::storage::texture::{Format, Texture};
+use crate::technique::aniso::{anisotropic, filter_planned, plan_chunk, Plan};
+use crate::technique::ewa::ewa;
+use crate::technique::mip::{filter_level, mip_nearest, trilinear};
+use crate::technique::ripmap::ripmap;
+use crate::technique::sat::summed_area;
 
 /// Filter used within one mip level (WebGPU `GPUFilterMode`, plus cubic).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -84,13 +84,13 @@ pub enum FilterMode {
     /// Bicubic Mitchell-Netravali with the given `(B, C)` over 4x4 texels (16 reads).
     Cubic(Cubic),
     /// Elliptically weighted average (Heckbert 1989, pbrt-v4 structure) over the footprint's
-    /// ellipse in two pyramid levels; `min_filter` only. See [`crate::ewa`].
+    /// ellipse in two pyramid levels; `min_filter` only. See [`crate::technique::ewa`].
     Ewa,
     /// Anisotropically reduced images `(W >> a) x (H >> b)` chosen from the footprint's
-    /// axis-aligned bounding box, four blended; `min_filter` only. See [`crate::ripmap`].
+    /// axis-aligned bounding box, four blended; `min_filter` only. See [`crate::technique::ripmap`].
     Ripmap,
     /// Box mean over the footprint's axis-aligned bounding rectangle from a summed-area table
-    /// (Crow 1984); `min_filter` only. See [`crate::sat`].
+    /// (Crow 1984); `min_filter` only. See [`crate::technique::sat`].
     SummedArea,
 }
 
@@ -140,7 +140,7 @@ pub struct SamplerDescriptor {
     pub lod_bias: f32,
     /// Largest anisotropy ratio honoured, 1 to 64. Default 1 (isotropic). Values above 1 with the
     /// core filters need mag, min and mipmap filters `Linear` (WebGPU rule) and select the
-    /// hardware-style anisotropic filter ([`crate::aniso`]); with [`FilterMode::Ewa`] it is the
+    /// hardware-style anisotropic filter ([`crate::technique::aniso`]); with [`FilterMode::Ewa`] it is the
     /// eccentricity clamp (1 means [`EWA_DEFAULT_ANISOTROPY`]).
     pub anisotropy_clamp: u16,
     /// Colour read outside the texture under [`AddressMode::ClampToBorder`].
@@ -279,7 +279,7 @@ impl Sampler {
         }
         for f in [desc.mag_filter, desc.min_filter] {
             if let FilterMode::Cubic(c) = f {
-                let ok = |x: f32| x.abs() <= crate::bicubic::MAX_CUBIC_PARAMETER;
+                let ok = |x: f32| x.abs() <= crate::kernel::bicubic::MAX_CUBIC_PARAMETER;
                 if !ok(c.b) || !ok(c.c) {
                     return Err(TextureError::InvalidCubic { b: c.b, c: c.c });
                 }
@@ -344,8 +344,8 @@ impl Sampler {
 
     /// The lod this sampler uses for `footprint` on `texture` (before clamping to the last level):
     /// `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]`, computed as
-    /// `0.5 * log2(rho^2)` with [`crate::footprint::fast_log2`] (within about one
-    /// unit in the last place of [`crate::footprint::lod_from_rho`]; exact on integer lods), the same value the sampling path uses.
+    /// `0.5 * log2(rho^2)` with [`crate::base::footprint::fast_log2`] (within about one
+    /// unit in the last place of [`crate::base::footprint::lod_from_rho`]; exact on integer lods), the same value the sampling path uses.
     pub fn lod(&self, texture: &Texture, footprint: &Footprint) -> f32 {
         let d = &self.desc;
         let rho2 = rho_squared(footprint, texture.width(), texture.height());
@@ -387,7 +387,7 @@ impl Sampler {
     /// whose decoding `sample(texture, f)` of footprint `k`, `f`, returns (the same query, level and texel,
     /// bit for bit), or, where `ClampToBorder` reads outside the texture, the border colour
     /// encoded in the texture's format (sRGB RGB and linear alpha for `Rgba8Srgb`, all linear
-    /// for `Rgba8Unorm`; [`crate::color::rgba_to_srgb8`], [`crate::color::rgba_to_unorm8`]).
+    /// for `Rgba8Unorm`; [`crate::base::color::rgba_to_srgb8`], [`crate::base::color::rgba_to_unorm8`]).
     ///
     /// Encoding a sample in the texture's own format gives these bytes (the decode tables
     /// round-trip every code), so a renderer writing an 8-bit target of that format may copy
@@ -398,7 +398,7 @@ impl Sampler {
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
     // Not inlined into the tile rasterizer's copies: its kernels (`batch::point_bytes`,
-    // `batch::run`) run on their own instruction-set copies (`crate::dispatch`).
+    // `batch::run`) run on their own instruction-set copies (`crate::engine::dispatch`).
     pub fn sample_batch_stored(
         &self,
         texture: &Texture,
@@ -418,7 +418,7 @@ impl Sampler {
             && batch::staged((texture.width(), texture.height()))
     }
 
-    /// GPU-style fixed-point filtering ([`crate::fixed8`]): for each footprint the unorm8 code
+    /// GPU-style fixed-point filtering ([`crate::kernel::fixed8`]): for each footprint the unorm8 code
     /// that 8-bit sub-texel and mip weights give, with one rounding per blend; the same query,
     /// lod, levels and texels as [`Sampler::sample`], whose result it approximates. Where
     /// `ClampToBorder` reads outside the texture the border colour enters as its unorm8 codes.
@@ -438,8 +438,8 @@ impl Sampler {
         self.run_codes(applies, texture, footprints.source(), out, true)
     }
 
-    /// Where the path `applies`, run the staged kernels (`fixed`: [`crate::fixed8`]'s) over
-    /// `texture`'s stored codes ([`crate::fetch::Codes8`]) and narrow the results to bytes; the
+    /// Where the path `applies`, run the staged kernels (`fixed`: [`crate::kernel::fixed8`]'s) over
+    /// `texture`'s stored codes ([`crate::storage::fetch::Codes8`]) and narrow the results to bytes; the
     /// border colour enters as codes of the texture's format. `false` where it does not apply,
     /// for float storage or a level 0 beyond the staged kernels. Panics if the lengths differ.
     fn run_codes<S: Source>(
@@ -500,7 +500,7 @@ impl Sampler {
     /// footprints are computed in one loop before any is filtered (independent iterations that
     /// pipeline, instead of one long dependency chain per sample). A rasterizer should hand it a
     /// row span at a time. The kernels run on the best instruction-set copy the CPU has
-    /// ([`crate::dispatch`]); on x86-64-v3 and above linear 8-bit quads blend in eight lanes
+    /// ([`crate::engine::dispatch`]); on x86-64-v3 and above linear 8-bit quads blend in eight lanes
     /// ([`Lanes::detect`]), else in four. Same bits on every copy.
     ///
     /// `footprints` is any [`FootprintBatch`]: structs (`&[Footprint]`, `&Vec<Footprint>`,
@@ -516,14 +516,14 @@ impl Sampler {
         footprints: impl FootprintBatch,
         out: &mut [[f32; 4]],
     ) {
-        self.sample_batch_lanes(crate::dispatch::lanes(), texture, footprints, out)
+        self.sample_batch_lanes(crate::engine::dispatch::lanes(), texture, footprints, out)
     }
 
     /// [`Sampler::sample_batch`] with the bilinear quads of linear 8-bit textures
     /// (`Rgba8Unorm`) blended by `lanes`' kernel: the same bits with every [`Lanes`]. The
-    /// kernels run on the CPU's best instruction-set copy ([`crate::dispatch`]), where
+    /// kernels run on the CPU's best instruction-set copy ([`crate::engine::dispatch`]), where
     /// [`Lanes::detect`]'s intrinsics inline on the x86-64-v3 and -v4 copies; under
-    /// [`crate::dispatch::limit_level`]`(Baseline)` they stay calls (correct, slower).
+    /// [`crate::engine::dispatch::limit_level`]`(Baseline)` they stay calls (correct, slower).
     ///
     /// # Panics
     /// If `footprints.len() != out.len()` (a programming error, not bad input).
@@ -555,7 +555,7 @@ impl Sampler {
                 // `batch::run` dispatches per within-level filter.
                 return batch::run(&p, self, self.addr, footprints, out);
             }
-            crate::dispatch::run(BatchJob {
+            crate::engine::dispatch::run(BatchJob {
                 s: self,
                 p: &p,
                 footprints,
@@ -685,7 +685,7 @@ struct BatchJob<'j, P, S> {
     out: &'j mut [[f32; 4]],
 }
 
-impl<P: Pyramid, S: Source> crate::dispatch::Kernel for BatchJob<'_, P, S> {
+impl<P: Pyramid, S: Source> crate::engine::dispatch::Kernel for BatchJob<'_, P, S> {
     type Output = ();
     /// Ignores `lanes`: a linear 8-bit pyramid carries its quad kernel (`fetch::Unorm8`).
     #[inline(always)]

@@ -1,5 +1,5 @@
 //! The batched path behind [`crate::Sampler::sample_batch`]: the same kernels as the one-sample
-//! path ([`crate::bilinear`], [`crate::nearest`], [`crate::mip`]), staged over a chunk of samples.
+//! path ([`crate::kernel::bilinear`], [`crate::kernel::nearest`], [`crate::technique::mip`]), staged over a chunk of samples.
 //!
 //! The one-sample path ([`crate::Sampler::sample`]) walks one sample through its query (uv made
 //! finite, the lod), level choice, texel set-up, loads and blends: one long dependency chain per
@@ -31,20 +31,20 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::address::{Address, AddressMode};
-use crate::bilinear::{lerp, Bilinear};
-use crate::dispatch::{self, Kernel};
-use crate::fetch::{Fetch, Pyramid, Run};
-use crate::fixed8::{Bilinear8, Point8};
-use crate::floor::{floor_clamped, floor_index, STAGED_F32_LIMIT};
-use crate::footprint::{
+use crate::base::address::{Address, AddressMode};
+use crate::base::floor::{floor_clamped, floor_index, STAGED_F32_LIMIT};
+use crate::base::footprint::{
     finite_uv, lod_from_rho_squared, log2_normal, rho_squared, Footprint, Query,
 };
-use crate::footprints::{chunks, Source};
-use crate::lanes::Lanes;
-use crate::mip::{self, LevelFilter};
-use crate::nearest::Point;
-use crate::sampler::{FilterMode, MipmapFilterMode, Sampler};
+use crate::base::footprint_batch::{chunks, Source};
+use crate::engine::dispatch::{self, Kernel};
+use crate::engine::sampler::{FilterMode, MipmapFilterMode, Sampler};
+use crate::kernel::bilinear::{lerp, Bilinear};
+use crate::kernel::fixed8::{Bilinear8, Point8};
+use crate::kernel::nearest::Point;
+use crate::storage::fetch::{Fetch, Pyramid, Run};
+use crate::storage::lanes::Lanes;
+use crate::technique::mip::{self, LevelFilter};
 
 /// Samples per stage (the sampler's chunk).
 pub(crate) const CHUNK: usize = 64;
@@ -127,7 +127,7 @@ impl<const N: usize> Chunk<N> {
 
 /// Stage 0: the queries of `fps` (at most `N`) on a `size` level 0, as `Sampler::query` makes one:
 /// [`finite_uv`], and `rho^2` ([`rho_squared`]) into [`lod_from_rho_squared`] with
-/// [`crate::footprint::fast_log2`]'s normal-input path written branch-free, so the loop
+/// [`crate::base::footprint::fast_log2`]'s normal-input path written branch-free, so the loop
 /// vectorises. The inputs that path does not cover (`rho^2` zero or subnormal) are rare; a second
 /// loop recomputes those lanes with the scalar functions.
 ///
@@ -232,7 +232,7 @@ pub(crate) trait Taps: LevelFilter {
     /// the integer taps).
     fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], ab: (f32, f32)) -> Vec4;
     /// The blend of two levels' values with weight `t` on `b` ([`lerp`]; the fixed-point
-    /// filters of [`crate::fixed8`] round it).
+    /// filters of [`crate::kernel::fixed8`] round it).
     #[inline(always)]
     fn mix(a: Vec4, b: Vec4, t: f32) -> Vec4 {
         lerp(a, b, t)
@@ -245,13 +245,13 @@ const PROBES: usize = 256;
 /// Anisotropic filtering of `footprints` into `out` for a sampler whose technique is
 /// anisotropic (its mag, min and mipmap filters all `Linear`: `Sampler::new`), on a pyramid whose
 /// level 0 is at most [`MAX_SIDE`] per side: per chunk the queries ([`queries`]) and probe plans
-/// ([`crate::aniso::plan_chunk`]); every sample then lays its probes out in shared scratch, up to
+/// ([`crate::technique::aniso::plan_chunk`]); every sample then lays its probes out in shared scratch, up to
 /// [`PROBES`] from several samples, which are filtered together, stage by stage, as [`run`]
 /// filters trilinear samples (so the lods, floors and texel loads of many probes pipeline, where
 /// one sample's few probes did not). Two such batches are kept, each for the probes of one pair
 /// of levels, so that samples alternating between two pairs (lods near an integer) do not make
 /// one batch of mixed levels. A sample with more than one probe (and a positive lod) has
-/// [`crate::aniso::filter_planned`]'s probes; one with a single probe (an isotropic footprint) is
+/// [`crate::technique::aniso::filter_planned`]'s probes; one with a single probe (an isotropic footprint) is
 /// one probe at its `uv` and isotropic lod (`mip::trilinear`); a magnified one (`lod <= 0`) is
 /// one probe in level 0 alone (the `Linear` mag filter, bilinear). Bit for bit
 /// [`crate::Sampler::filter`]: the same probe positions, levels and blends, each sample's probes
@@ -278,7 +278,7 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
         (dims_w[l], dims_h[l])
     };
     let mut chunk = Chunk::<CHUNK>::new();
-    let mut plans = [crate::aniso::Plan::default(); CHUNK];
+    let mut plans = [crate::technique::aniso::Plan::default(); CHUNK];
     // The probe scratch (about 13 KB) is reused from the thread's last call rather than made and
     // zeroed per call: a mesh of small triangles makes one call per triangle and tile, where that
     // set-up would be a large share of aniso16's work (docs/decisions.md).
@@ -294,7 +294,7 @@ pub(crate) fn anisotropic<P: Pyramid, S: Source>(
     let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
     for (fps, out) in chunks(footprints, CHUNK).zip(out.chunks_mut(CHUNK)) {
         queries(s, size0, fps, &mut chunk);
-        crate::aniso::plan_chunk(s, size0, &chunk, &mut plans);
+        crate::technique::aniso::plan_chunk(s, size0, &chunk, &mut plans);
         for k in 0..fps.len() {
             let (q, plan) = (chunk.query(k), &plans[k]);
             // A sample with one probe at its `uv` (finite: `queries`): magnified, the `Linear`
@@ -592,9 +592,9 @@ impl ProbeBatch {
 /// bytes are copied, elsewhere [`Point`]'s one-sample filter (address wrapping, border codes
 /// in `addr`) gives the codes. The indices of a chunk are computed in one loop that vectorises,
 /// then the texels are copied.
-/// On the instruction set's copy for the CPU ([`crate::dispatch`]).
+/// On the instruction set's copy for the CPU ([`crate::engine::dispatch`]).
 pub(crate) fn point_bytes<S: Source>(
-    level: &crate::fetch::Level<'_, crate::fetch::Codes8>,
+    level: &crate::storage::fetch::Level<'_, crate::storage::fetch::Codes8>,
     addr: &Address,
     footprints: S,
     out: &mut [[u8; 4]],
@@ -609,7 +609,7 @@ pub(crate) fn point_bytes<S: Source>(
 
 /// [`point_bytes`]' arguments, as the dispatcher's unit of work.
 struct PointBytesJob<'j, 'l, S> {
-    level: &'j crate::fetch::Level<'l, crate::fetch::Codes8>,
+    level: &'j crate::storage::fetch::Level<'l, crate::storage::fetch::Codes8>,
     addr: &'j Address,
     footprints: S,
     out: &'j mut [[u8; 4]],
@@ -626,7 +626,7 @@ impl<S: Source> Kernel for PointBytesJob<'_, '_, S> {
 /// [`point_bytes`]' body.
 #[inline(always)]
 fn point_bytes_in<S: Source>(
-    level: &crate::fetch::Level<'_, crate::fetch::Codes8>,
+    level: &crate::storage::fetch::Level<'_, crate::storage::fetch::Codes8>,
     addr: &Address,
     footprints: S,
     out: &mut [[u8; 4]],
@@ -654,7 +654,7 @@ fn point_bytes_in<S: Source>(
             } else {
                 let uv = Vec2::new(finite_uv(us[k]), finite_uv(vs[k]));
                 let c = Point.filter(level, addr, uv).to_array();
-                crate::floor::integer_bytes4(c)
+                crate::base::floor::integer_bytes4(c)
             };
         }
     }
@@ -684,7 +684,7 @@ struct Pass<const N: usize, T> {
 /// The first tap `i` of a sample near an edge (`-1 <= i < n`, `n` the level's side) and the
 /// next one `i + 1`, wrapped into `[0, n)`: by `Repeat` (`-1 -> n - 1`, `n -> 0`) where
 /// `repeat`, else as `ClampToEdge`, `MirrorRepeat` and `MirrorClampToEdge` all map these two
-/// indices (`-1 -> 0`, `n -> n - 1`; [`crate::address::AddressMode::wrap`]): two selects, no
+/// indices (`-1 -> 0`, `n -> n - 1`; [`crate::base::address::AddressMode::wrap`]): two selects, no
 /// division.
 #[inline(always)]
 fn wrap_pair(i: i32, n: i32, repeat: bool) -> (i32, i32) {
@@ -869,7 +869,7 @@ pub(crate) fn run<P: Pyramid, S: Source>(
     run_taps(p, (Point, Bilinear), s, addr, (footprints, out));
 }
 
-/// [`run`] with [`crate::fixed8`]'s fixed-point filters, on a pyramid of stored codes. A function
+/// [`run`] with [`crate::kernel::fixed8`]'s fixed-point filters, on a pyramid of stored codes. A function
 /// of its own, not a flag of [`run`]: each pairing of a pyramid with a filter is compiled as a
 /// kernel per instruction set, and the float pyramids never take these filters.
 #[inline(always)]
@@ -899,7 +899,7 @@ fn run_taps<P: Pyramid, S: Source, N: Taps, L: Taps>(
 }
 
 /// [`run`] with the within-level filter `T`, on the instruction set's copy for the CPU
-/// ([`crate::dispatch`]: one function per pyramid, filter and copy).
+/// ([`crate::engine::dispatch`]: one function per pyramid, filter and copy).
 #[inline(always)]
 fn run_with<P: Pyramid, S: Source, T: Taps>(
     p: &P,
@@ -1177,7 +1177,7 @@ fn filter_chunk<T: Taps, F: Fetch, const N: usize>(
     }
 }
 
-/// The anisotropic probes' stage ([`crate::aniso`]): their coordinates, written by the caller, and
+/// The anisotropic probes' stage ([`crate::technique::aniso`]): their coordinates, written by the caller, and
 /// two bilinear level passes. Made once per [`crate::Sampler::sample_batch`] call and reused by
 /// every sample (zeroing scratch per sample costs measurable frame time: docs/decisions.md).
 /// Entries beyond a sample's probe count are stale and never read.
@@ -1242,9 +1242,9 @@ impl Probes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::address::BorderColor;
-    use crate::fetch::{Codes8, Level, Unorm8};
-    use crate::lanes::Lanes;
+    use crate::base::address::BorderColor;
+    use crate::storage::fetch::{Codes8, Level, Unorm8};
+    use crate::storage::lanes::Lanes;
 
     const MODES: [AddressMode; 5] = [
         AddressMode::ClampToEdge,

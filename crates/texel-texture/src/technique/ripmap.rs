@@ -37,15 +37,15 @@
 use glam::Vec4;
 use rayon::prelude::*;
 
-use crate::bilinear::{bilinear, lerp};
-use crate::color::{linear_to_srgb8, unorm8};
-use crate::error::TextureError;
-use crate::fetch::{with_pyramid, Fetch, Pyramid};
-use crate::footprint::{lod_from_rho, Query};
-use crate::mip::linear_levels;
-use crate::pyramid::{axis_taps, level_count};
-use crate::sampler::Sampler;
-use crate::texture::{Format, LevelInfo, Storage, Texture};
+use crate::base::color::{linear_to_srgb8, unorm8};
+use crate::base::error::TextureError;
+use crate::base::footprint::{lod_from_rho, Query};
+use crate::engine::sampler::Sampler;
+use crate::kernel::bilinear::{bilinear, lerp};
+use crate::storage::fetch::{with_pyramid, Fetch, Pyramid};
+use crate::storage::pyramid::{axis_taps, level_count};
+use crate::storage::texture::{Format, LevelInfo, Storage, Texture};
+use crate::technique::mip::linear_levels;
 
 /// All anisotropic reductions of a texture's level 0 (see the module docs).
 #[derive(Debug)]
@@ -134,7 +134,7 @@ impl Ripmap {
         let idx = info.offset + j as usize * w as usize + i as usize;
         Some(match &self.storage {
             // Decode as the pyramid does.
-            Storage::U8(v) => crate::texture::decode_rgba8(v[idx], self.srgb),
+            Storage::U8(v) => crate::storage::texture::decode_rgba8(v[idx], self.srgb),
             Storage::F32(v) => v[idx],
         })
     }
@@ -311,7 +311,7 @@ pub(crate) fn ripmap<P: Pyramid>(p: &P, rip: &Ripmap, s: &Sampler, q: &Query) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::texture::Limits;
+    use crate::storage::texture::Limits;
 
     #[test]
     fn sizes_and_memory() {

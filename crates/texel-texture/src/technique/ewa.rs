@@ -57,7 +57,7 @@
 //! reads.
 //!
 //! The code path: `ewa` builds the [`Ellipse`] in `f64` (eigen-axes in closed form: no `atan2`,
-//! `sin`, `cos` or `hypot`), picks its levels with `crate::mip::linear_levels`, and in each level
+//! `sin`, `cos` or `hypot`), picks its levels with `crate::technique::mip::linear_levels`, and in each level
 //! runs one scan ([`LevelEllipse::scan`]) and one weighted-sum loop over the scan's lines. The scan
 //! follows the ellipse's wider side (columns for a tall ellipse, rows otherwise): footprints near
 //! the ground's horizon are long in v, and rows would give many lines one to four texels long, each
@@ -99,13 +99,13 @@ use std::sync::OnceLock;
 
 use glam::{DVec2, Vec2, Vec4};
 
-use crate::address::{Address, AddressMode};
-use crate::bilinear::{bilinear, lerp, texel_or_border, Bilinear};
-use crate::fetch::{Fetch, Pyramid};
-use crate::floor::{ceil_f64, floor_f64, floor_staged_f64};
-use crate::footprint::{lod_from_rho, Query};
-use crate::mip::{linear_levels, trilinear};
-use crate::sampler::Sampler;
+use crate::base::address::{Address, AddressMode};
+use crate::base::floor::{ceil_f64, floor_f64, floor_staged_f64};
+use crate::base::footprint::{lod_from_rho, Query};
+use crate::engine::sampler::Sampler;
+use crate::kernel::bilinear::{bilinear, lerp, texel_or_border, Bilinear};
+use crate::storage::fetch::{Fetch, Pyramid};
+use crate::technique::mip::{linear_levels, trilinear};
 
 /// Entries of the Gaussian weight table, indexed by `floor(r^2 * LUT_SIZE)` for `r^2` in `[0, 1)`.
 pub const LUT_SIZE: usize = 128;
@@ -718,8 +718,8 @@ pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Sampler, q: &Query, max: f32) -> Vec4 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::footprint::Footprint;
-    use crate::sampler::{FilterMode, SamplerDescriptor};
+    use crate::base::footprint::Footprint;
+    use crate::engine::sampler::{FilterMode, SamplerDescriptor};
 
     /// An ellipse far larger than the texture ends at the 1x1 level, which is read once (it used
     /// to be revisited up to the 4096-texel area cap), and equals that level's texel.
@@ -811,7 +811,7 @@ mod tests {
     /// evaluated directly at that texel's centre.
     #[test]
     fn scan_matches_bounding_box_and_direct_weights() {
-        let mut rng = crate::rng::SplitMix64::new(0x2545_f491_4f6c_dd1d);
+        let mut rng = crate::base::rng::SplitMix64::new(0x2545_f491_4f6c_dd1d);
         let mut rnd = || rng.next_f64() as f32;
         let lut = weight_lut();
         let mut weighed = 0;
@@ -952,10 +952,11 @@ mod tests {
             });
             (visits, seen)
         };
-        let mut rng = crate::rng::SplitMix64::new(0x5851_f42d_4c95_7f2d);
+        let mut rng = crate::base::rng::SplitMix64::new(0x5851_f42d_4c95_7f2d);
         let mut ellipses = Vec::new();
         for case in 0..300 {
-            let r = |rng: &mut crate::rng::SplitMix64, s: f64| (rng.next_f64() * 2.0 - 1.0) * s;
+            let r =
+                |rng: &mut crate::base::rng::SplitMix64, s: f64| (rng.next_f64() * 2.0 - 1.0) * s;
             let size = [0.5, 4.0, 40.0, 3000.0][case % 4];
             let px = Vec2::new(r(&mut rng, size) as f32, r(&mut rng, size) as f32);
             let py = Vec2::new(r(&mut rng, 3.0) as f32, r(&mut rng, 3.0) as f32);
@@ -1005,10 +1006,11 @@ mod tests {
     /// span ends from the roots, `r^2` at the first texel and its difference.
     #[test]
     fn line_blocks_equal_the_line_by_line_setup() {
-        let mut rng = crate::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
+        let mut rng = crate::base::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
         let mut checked = 0;
         for case in 0..2000 {
-            let r = |rng: &mut crate::rng::SplitMix64, s: f64| (rng.next_f64() * 2.0 - 1.0) * s;
+            let r =
+                |rng: &mut crate::base::rng::SplitMix64, s: f64| (rng.next_f64() * 2.0 - 1.0) * s;
             // Thin and round, small and large (up to a few hundred lines: several blocks).
             let size = [0.5, 4.0, 40.0, 300.0][case % 4];
             let px = Vec2::new(r(&mut rng, size) as f32, r(&mut rng, size) as f32);
@@ -1079,7 +1081,7 @@ mod tests {
     /// spans reach beyond `sqrt(q00)`.
     #[test]
     fn inside_ellipses_scan_only_texels_of_the_level() {
-        let mut rng = crate::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
+        let mut rng = crate::base::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
         let mut rnd = || rng.next_f64();
         let (w, h) = (64u32, 16u32);
         let in_level =
