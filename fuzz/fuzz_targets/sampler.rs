@@ -2,7 +2,7 @@
 //! infinities included) either make `Sampler::new` refuse the descriptor or give a finite result;
 //! every filter but the cubic ones stays within the range of the texels and the border colour, and
 //! the cubic ones (whose negative lobes overshoot) within 5.5 times their largest magnitude
-//! (`texel_texture::kernel::bicubic::MAX_CUBIC_PARAMETER`'s bound).
+//! (`texel_texture::base::filter::MAX_CUBIC_PARAMETER`'s bound).
 #![no_main]
 
 use arbitrary::Arbitrary;

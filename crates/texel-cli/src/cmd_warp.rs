@@ -6,7 +6,7 @@
 
 use anyhow::{bail, Context, Result};
 use glam::DVec2;
-use texel_texture::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
+use texel_raster::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
 use texel_texture::{AddressMode, Sampler, Texture};
 
 use crate::cli::WarpArgs;
@@ -27,8 +27,8 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
         }
     }
     let cannot = || format!("cannot load image {}", args.input.display());
-    let bytes = texel_texture::input::read_regular(&args.input, input.budget.remaining())
-        .with_context(cannot)?;
+    let bytes =
+        texel_io::read_regular(&args.input, input.budget.remaining()).with_context(cannot)?;
     let (sw, sh, _) = Texture::header(&bytes).with_context(cannot)?;
     let (w, h) = match args.size {
         Some(s) => (s.width, s.height),

@@ -30,11 +30,11 @@ use cli::{Cli, Command};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    // A decoder panic that texel_texture::input::guarded turns into an error is not reported as a
+    // A decoder panic that texel_io::guarded turns into an error is not reported as a
     // panic; every other panic is.
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        if !texel_texture::input::in_guarded_decode() {
+        if !texel_io::in_guarded_decode() {
             default_hook(info);
         }
     }));

@@ -175,8 +175,7 @@ impl Image8 {
             source,
         };
         // At most a 16384 x 16384 image of 16-bit RGBA: no larger file is a valid input.
-        let bytes = texel_texture::input::read_regular(path, 8 * u64::from(MAX_SIDE).pow(2))
-            .map_err(io_err)?;
+        let bytes = texel_io::read_regular(path, 8 * u64::from(MAX_SIDE).pow(2)).map_err(io_err)?;
         let decode_err = |msg: String| {
             img_err(image::ImageError::Decoding(
                 image::error::DecodingError::new(image::error::ImageFormatHint::Unknown, msg),
@@ -190,7 +189,7 @@ impl Image8 {
         limits.max_image_height = Some(MAX_SIDE);
         reader.limits(limits);
         if reader.format() == Some(image::ImageFormat::Jpeg) {
-            let (w, h) = texel_texture::input::guarded(|| {
+            let (w, h) = texel_io::guarded(|| {
                 image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
                     .with_guessed_format()
                     .map_err(io_err)?
@@ -198,9 +197,9 @@ impl Image8 {
                     .map_err(img_err)
             })
             .map_err(decode_err)??;
-            texel_texture::input::check_jpeg_complete(&bytes, w, h).map_err(decode_err)?;
+            texel_io::check_jpeg_complete(&bytes, w, h).map_err(decode_err)?;
         }
-        let img = texel_texture::input::guarded(|| reader.decode())
+        let img = texel_io::guarded(|| reader.decode())
             .map_err(|msg| decode_err(format!("the decoder failed on this file: {msg}")))?
             .map_err(img_err)?
             .into_rgba8();
@@ -218,7 +217,7 @@ impl Image8 {
             path: path.to_path_buf(),
             source,
         };
-        let file = texel_texture::input::open_regular(path).map_err(io_err)?;
+        let file = texel_io::open_regular(path).map_err(io_err)?;
         let reader = image::ImageReader::new(std::io::BufReader::new(file))
             .with_guessed_format()
             .map_err(io_err)?;
@@ -226,7 +225,7 @@ impl Image8 {
             path: path.to_path_buf(),
             source,
         };
-        texel_texture::input::guarded(|| reader.into_dimensions())
+        texel_io::guarded(|| reader.into_dimensions())
             .map_err(|msg| {
                 img_err(image::ImageError::Decoding(
                     image::error::DecodingError::new(

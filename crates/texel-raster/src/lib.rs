@@ -59,6 +59,7 @@ mod shade;
 mod stream;
 pub mod tile;
 pub mod views;
+pub mod warp;
 
 pub use adaptive::{render_reference_adaptive, ReferenceEstimate, ReferencePlan, ReferenceStatus};
 pub use draw::{DrawCall, UvEvaluation, UvMapping, Vertex};

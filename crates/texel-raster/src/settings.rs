@@ -69,7 +69,7 @@ pub enum Precision {
     #[default]
     Exact,
     /// As GPUs filter unorm8 texels: 8-bit sub-texel and mip weights and a rounding to 8 bits
-    /// per blend ([`texel_texture::fixed8`]; the CLI's `--precision gpu`). Other textures, other
+    /// per blend ([`texel_texture::kernel::fixed8`]; the CLI's `--precision gpu`). Other textures, other
     /// filters and the reference keep [`Precision::Exact`].
     Gpu,
 }

@@ -426,7 +426,7 @@ fn streamed_tile(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup], c
 }
 
 /// Rasterise one tile into `tile`'s buffers, on the best instruction set the CPU has
-/// ([`texel_texture::dispatch`]), then show the environment where nothing was drawn.
+/// ([`texel_texture::engine::dispatch`]), then show the environment where nothing was drawn.
 fn tile_in_place(ctx: &Context, tile: &mut TileTarget, bin: &[&TriangleSetup]) {
     dispatch::run(TileJob { ctx, tile, bin });
     if let Some((env, rays)) = &ctx.background {

@@ -1065,7 +1065,7 @@ impl Scene {
             path: path.to_path_buf(),
             source,
         };
-        let bytes = texel_texture::input::read_regular(path, limits.max_scene_bytes).map_err(io)?;
+        let bytes = texel_io::read_regular(path, limits.max_scene_bytes).map_err(io)?;
         let text = String::from_utf8(bytes).map_err(|e| {
             io(std::io::Error::new(
                 std::io::ErrorKind::InvalidData,

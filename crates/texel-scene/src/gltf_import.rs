@@ -709,7 +709,7 @@ fn read_buffer(
                     .map_err(|e| format!("buffer {i}: {e}"))?
             } else {
                 let path = buffer_path(uri, base).map_err(|e| format!("buffer {i}: {e}"))?;
-                let file = texel_texture::input::open_regular(&path)
+                let file = texel_io::open_regular(&path)
                     .map_err(|e| format!("buffer {i}: {}: {e}", path.display()))?;
                 let mut data = Vec::new();
                 file.take(len as u64)

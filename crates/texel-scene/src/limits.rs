@@ -39,13 +39,11 @@ impl Default for SceneLimits {
 
 impl SceneLimits {
     /// Read a mesh file (OBJ, glTF, GLB): a regular file of at most
-    /// [`SceneLimits::max_mesh_file_bytes`] ([`texel_texture::input::read_regular`]).
+    /// [`SceneLimits::max_mesh_file_bytes`] ([`texel_io::read_regular`]).
     pub(crate) fn read_mesh_file(&self, path: &Path) -> Result<Vec<u8>, SceneError> {
-        texel_texture::input::read_regular(path, self.max_mesh_file_bytes).map_err(|source| {
-            SceneError::Io {
-                path: path.to_path_buf(),
-                source,
-            }
+        texel_io::read_regular(path, self.max_mesh_file_bytes).map_err(|source| SceneError::Io {
+            path: path.to_path_buf(),
+            source,
         })
     }
 }

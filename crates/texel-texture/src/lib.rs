@@ -32,25 +32,21 @@
 
 pub mod base;
 pub mod engine;
-pub mod input;
 pub mod kernel;
 pub mod mapping;
 pub mod storage;
 pub mod technique;
-pub mod warp;
 
 pub use base::address::{Address, AddressMode, BorderColor};
+pub use base::descriptor::SamplerDescriptor;
 pub use base::error::TextureError;
+pub use base::filter::{Cubic, FilterMode, MipmapFilterMode, EWA_DEFAULT_ANISOTROPY};
 pub use base::footprint::{Axes, Footprint};
 pub use base::footprint_batch::{FootprintBatch, FootprintLanes};
-pub use engine::sampler::{
-    FilterMode, MipmapFilterMode, Sampler, SamplerDescriptor, EWA_DEFAULT_ANISOTROPY,
-};
-pub use kernel::bicubic::Cubic;
+pub use engine::sampler::Sampler;
 pub use storage::lanes::Lanes;
+pub use storage::tables::{Ripmap, SummedAreaTable};
 pub use storage::texture::{
     replace_non_finite, ColorSpace, Format, LevelInfo, LevelTexels, Limits, LoadOptions, Loaded,
     Texture, NON_FINITE_CLAMP,
 };
-pub use technique::ripmap::Ripmap;
-pub use technique::sat::SummedAreaTable;

@@ -1208,7 +1208,7 @@ fn bytemuck_f32(v: &[f32]) -> Vec<u8> {
 }
 
 /// Within the accepted range (`|B|, |C| <= 2`) a cubic sample stays within (7/3)^2 times the
-/// largest texel magnitude, the bound `bicubic::MAX_CUBIC_PARAMETER` documents; checked at the
+/// largest texel magnitude, the bound `filter::MAX_CUBIC_PARAMETER` documents; checked at the
 /// range's corners on a checkerboard, the worst case for negative lobes.
 #[test]
 fn cubic_overshoot_is_bounded_at_the_parameter_limits() {
@@ -1217,7 +1217,7 @@ fn cubic_overshoot_is_bounded_at_the_parameter_limits() {
         [v, v, v, 1.0]
     })
     .unwrap();
-    let m = texel_texture::kernel::bicubic::MAX_CUBIC_PARAMETER;
+    let m = texel_texture::base::filter::MAX_CUBIC_PARAMETER;
     for (b, c) in [(m, m), (-m, m), (m, -m), (-m, -m), (0.0, 0.5)] {
         let s = Sampler::new(SamplerDescriptor {
             mag_filter: FilterMode::Cubic(Cubic { b, c }),

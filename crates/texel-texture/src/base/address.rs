@@ -122,11 +122,6 @@ impl Address {
             border: Vec4::from_array(border.rgba()),
         }
     }
-
-    /// The address modes and border colour of `desc`.
-    pub fn of(desc: &crate::SamplerDescriptor) -> Address {
-        Address::new(desc.address_mode_u, desc.address_mode_v, desc.border_color)
-    }
 }
 
 #[cfg(test)]

@@ -224,6 +224,11 @@ pub fn unorm8_table() -> &'static [f32; 256] {
     TABLE.get_or_init(|| std::array::from_fn(|b| b as f32 / 255.0))
 }
 
+/// `1 / 255` split into a high part of 12 significant bits, so that `b * UNORM8_HI` is exact for
+/// every byte `b`, and the `f32` nearest to the rest.
+pub(crate) const UNORM8_HI: f32 = f32::from_bits((1.0f32 / 255.0).to_bits() & !((1 << 12) - 1));
+pub(crate) const UNORM8_LO: f32 = (1.0f64 / 255.0 - UNORM8_HI as f64) as f32;
+
 #[cfg(test)]
 mod tests {
     use super::*;

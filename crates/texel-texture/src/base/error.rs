@@ -81,7 +81,7 @@ pub enum TextureError {
     )]
     AnisotropyNeedsLinear(u16),
     /// A cubic filter's (B, C) parameters are not finite or outside
-    /// `[-MAX_CUBIC_PARAMETER, MAX_CUBIC_PARAMETER]` ([`crate::kernel::bicubic::MAX_CUBIC_PARAMETER`]).
+    /// `[-MAX_CUBIC_PARAMETER, MAX_CUBIC_PARAMETER]` ([`crate::base::filter::MAX_CUBIC_PARAMETER`]).
     #[error("invalid Mitchell-Netravali parameters B = {b}, C = {c}: each must be within [-2, 2]")]
     InvalidCubic {
         /// The B parameter.
@@ -94,7 +94,7 @@ pub enum TextureError {
     /// `min_filter`; magnification (`lod <= 0`) uses `mag_filter`, which must be Nearest, Linear or
     /// Cubic.
     #[error("mag_filter {0:?} is a minification-only filter: use it as min_filter, with mag_filter Nearest, Linear or Cubic")]
-    MinificationOnlyFilter(crate::FilterMode),
+    MinificationOnlyFilter(crate::base::filter::FilterMode),
     /// An acceleration structure (ripmap, summed-area table) would exceed
     /// [`crate::Limits::max_bytes`] together with the texture's pyramid and the other structures
     /// already built.
@@ -123,7 +123,7 @@ pub enum TextureError {
         /// The value found.
         value: f32,
     },
-    /// The image decoder crashed on the file (a panic caught by [`crate::input::guarded`]): the
+    /// The image decoder crashed on the file (a panic caught by [`texel_io::guarded`]): the
     /// file is corrupt, or uses a feature the decoder mishandles.
     #[error("cannot decode image: the decoder failed on this file (corrupt, or a feature it mishandles): {0}")]
     DecoderFailed(String),

@@ -11,7 +11,7 @@
 //! Inside the crate each kind is a [`Source`]: the sampler's kernels are compiled once per kind,
 //! not once per caller's type (`&Vec<Footprint>` and `&[Footprint; N]` are slices here).
 
-use crate::Footprint;
+use crate::base::footprint::Footprint;
 
 /// Footprints as lanes: `u[k]`, `v[k]` and, where given, the derivatives `dudx[k]`, `dudy[k]`,
 /// `dvdx[k]`, `dvdy[k]` of footprint `k` (the fields of [`Footprint`], same units). Without
@@ -101,7 +101,7 @@ pub(crate) use sealed::Source;
 
 pub(crate) mod sealed {
     use super::FootprintLanes;
-    use crate::Footprint;
+    use crate::base::footprint::Footprint;
 
     /// What a [`super::FootprintBatch`] becomes inside the crate: one of the two [`Source`]s.
     pub trait Batch: Copy {

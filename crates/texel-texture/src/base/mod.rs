@@ -5,8 +5,11 @@
 
 pub mod address;
 pub mod color;
+pub mod descriptor;
 pub(crate) mod error;
+pub mod filter;
 pub mod floor;
 pub mod footprint;
 pub(crate) mod footprint_batch;
+pub mod lerp;
 pub mod rng;

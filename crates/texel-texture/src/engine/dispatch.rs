@@ -43,7 +43,7 @@
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::OnceLock;
 
-use crate::Lanes;
+use crate::storage::lanes::Lanes;
 
 /// The instruction set the dispatched kernels (the sampler's batch kernels, the rasterizer's
 /// tiles) run on, ordered from the least to the most.

@@ -1,7 +1,8 @@
 //! The engine: the validated [`sampler::Sampler`] that resolves a descriptor to one technique, the
-//! batched path that stages kernels over chunks of footprints ([`batch`]) and the instruction-set
+//! batched path that stages kernels over chunks of footprints (`batch`) and the instruction-set
 //! copies it runs on ([`dispatch`]). The top floor: it may use everything below.
 
 pub(crate) mod batch;
 pub mod dispatch;
+pub mod sample;
 pub mod sampler;

@@ -17,71 +17,10 @@
 use glam::{Vec2, Vec4};
 
 use crate::base::address::Address;
+use crate::base::filter::Cubic;
 use crate::base::floor::floor_index;
 use crate::kernel::bilinear::{origin, texel_or_border};
 use crate::storage::fetch::Fetch;
-
-/// Largest `|B|` and `|C|` a sampler accepts. Mitchell and Netravali's family is drawn for B and C
-/// in `[0, 1]` and Keys' cubics need C up to 1; unbounded values overflow `f32` (found by fuzzing:
-/// B = 6e17 gave infinite samples). Within the bound the 4 weights of an axis sum in absolute value
-/// to at most 7/3 (at B = -2, C = ±2; 1.19 for Catmull-Rom), so a 4x4 sample lies within
-/// (7/3)^2 < 5.5 times the largest texel magnitude.
-pub const MAX_CUBIC_PARAMETER: f32 = 2.0;
-
-/// Mitchell-Netravali cubic parameters `(B, C)`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Cubic {
-    /// B (blur): 0 for Catmull-Rom, 1 for the B-spline.
-    pub b: f32,
-    /// C (ringing): 1/2 for Catmull-Rom, 0 for the B-spline.
-    pub c: f32,
-}
-
-impl Default for Cubic {
-    /// Catmull-Rom.
-    fn default() -> Self {
-        Cubic::CATMULL_ROM
-    }
-}
-
-impl Cubic {
-    /// Catmull-Rom `(0, 1/2)`: interpolating, sharp, slight overshoot.
-    pub const CATMULL_ROM: Cubic = Cubic { b: 0.0, c: 0.5 };
-    /// Mitchell `(1/3, 1/3)`: the filter Mitchell and Netravali recommend.
-    pub const MITCHELL: Cubic = Cubic {
-        b: 1.0 / 3.0,
-        c: 1.0 / 3.0,
-    };
-    /// Cubic B-spline `(1, 0)`: smooth, non-negative, approximating (does not interpolate).
-    pub const B_SPLINE: Cubic = Cubic { b: 1.0, c: 0.0 };
-
-    /// The kernel `k(x)`.
-    pub fn kernel(&self, x: f32) -> f32 {
-        let (b, c) = (self.b, self.c);
-        let x = x.abs();
-        let v = if x < 1.0 {
-            ((12.0 - 9.0 * b - 6.0 * c) * x + (-18.0 + 12.0 * b + 6.0 * c)) * x * x
-                + (6.0 - 2.0 * b)
-        } else if x < 2.0 {
-            (((-b - 6.0 * c) * x + (6.0 * b + 30.0 * c)) * x + (-12.0 * b - 48.0 * c)) * x
-                + (8.0 * b + 24.0 * c)
-        } else {
-            0.0
-        };
-        v / 6.0
-    }
-
-    /// The four tap weights for fractional offset `t` in `[0, 1)`.
-    #[inline]
-    pub fn weights(&self, t: f32) -> [f32; 4] {
-        [
-            self.kernel(1.0 + t),
-            self.kernel(t),
-            self.kernel(1.0 - t),
-            self.kernel(2.0 - t),
-        ]
-    }
-}
 
 /// Bicubic sample of `level` at normalised `(u, v)` (finite).
 #[inline]

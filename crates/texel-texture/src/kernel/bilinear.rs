@@ -21,23 +21,10 @@ use glam::{Vec2, Vec4};
 
 use crate::base::address::Address;
 use crate::base::floor::floor_index;
-use crate::engine::batch::Taps;
+use crate::base::lerp::blend;
+use crate::kernel::staged::Taps;
+use crate::kernel::LevelFilter;
 use crate::storage::fetch::Fetch;
-use crate::technique::mip::LevelFilter;
-
-/// `a + (b - a) * t`: the one interpolation every filter blends with (bilinear's three, the
-/// lerp between mip levels, the ripmap's and EWA's level blends).
-#[inline(always)]
-pub(crate) fn lerp(a: Vec4, b: Vec4, t: f32) -> Vec4 {
-    a + (b - a) * t
-}
-
-/// The bilinear blend of the quad `[T00, T10, T01, T11]` (as [`Fetch::quad`] orders it) with
-/// fractions `a` (along x) and `b` (along y).
-#[inline(always)]
-pub(crate) fn blend([t00, t10, t01, t11]: [Vec4; 4], a: f32, b: f32) -> Vec4 {
-    lerp(lerp(t00, t10, a), lerp(t01, t11, a), b)
-}
 
 /// The offset of the first tap in texels: bilinear's taps start half a texel before the sample point (texel centres sit at half-integers).
 pub(crate) const HALF: f32 = 0.5;
@@ -119,7 +106,7 @@ impl Taps for Bilinear {
     #[inline(always)]
     fn inside_run<F: Fetch>(
         level: &F,
-        run: crate::storage::fetch::Run<'_>,
+        run: crate::storage::lanes::Run<'_>,
         out: &mut [[f32; 4]],
     ) -> bool {
         level.bilinear_run(run, out)
@@ -128,16 +115,4 @@ impl Taps for Bilinear {
     fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], (a, b): (f32, f32)) -> Vec4 {
         level.bilinear_wrapped(i, j, a, b)
     }
-}
-
-/// The 2x2 texels of taps `i`, `j` already wrapped into `level`, in [`Fetch::quad`]'s order: the
-/// texels [`taps`] reads near an edge where no tap takes the border colour.
-#[inline(always)]
-pub(crate) fn wrapped_quad<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2]) -> [Vec4; 4] {
-    [
-        level.texel(i[0], j[0]),
-        level.texel(i[1], j[0]),
-        level.texel(i[0], j[1]),
-        level.texel(i[1], j[1]),
-    ]
 }

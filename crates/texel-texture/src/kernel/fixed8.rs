@@ -33,11 +33,11 @@ use glam::{Vec2, Vec4};
 
 use crate::base::address::Address;
 use crate::base::floor::{round_staged, round_staged4};
-use crate::engine::batch::Taps;
 use crate::kernel::bilinear;
 use crate::kernel::nearest;
+use crate::kernel::staged::Taps;
+use crate::kernel::LevelFilter;
 use crate::storage::fetch::Fetch;
-use crate::technique::mip::LevelFilter;
 
 /// The 8-bit weight of a fraction `a` in `[0, 1]`: `round(256 a)` (halves to even), in
 /// `0..=256`. A fraction outside `[0, 1]` is clamped first; NaN gives 0.
@@ -121,7 +121,7 @@ impl Taps for Bilinear8 {
     }
     #[inline(always)]
     fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], (a, b): (f32, f32)) -> Vec4 {
-        bilinear8(bilinear::wrapped_quad(level, i, j), a, b)
+        bilinear8(crate::storage::fetch::wrapped_quad(level, i, j), a, b)
     }
     #[inline(always)]
     fn mix(a: Vec4, b: Vec4, t: f32) -> Vec4 {

@@ -9,10 +9,10 @@ use glam::{Vec2, Vec4};
 
 use crate::base::address::Address;
 use crate::base::floor::floor_index;
-use crate::engine::batch::Taps;
 use crate::kernel::bilinear::texel_or_border;
+use crate::kernel::staged::Taps;
+use crate::kernel::LevelFilter;
 use crate::storage::fetch::Fetch;
-use crate::technique::mip::LevelFilter;
 
 /// The offset of the first tap in texels: nearest reads the texel containing the sample point: no offset.
 pub(crate) const HALF: f32 = 0.0;

@@ -7,14 +7,12 @@
 //! statistics mode: counting is a wrapper type, not a flag, and costs nothing when it is not used
 //! (the plain views monomorphise to a bare load).
 
-use std::cell::Cell;
-
 use glam::Vec4;
 
-use crate::base::color::{srgb_table, unorm8_table};
-use crate::kernel::bilinear::{blend, wrapped_quad};
-use crate::storage::lanes::Lanes;
-use crate::storage::texture::{Format, LevelInfo, Storage, Texture};
+use crate::base::color::{srgb_table, unorm8_table, UNORM8_HI, UNORM8_LO};
+use crate::base::lerp::blend;
+use crate::storage::format::{Format, Storage};
+use crate::storage::lanes::{quad_rows, Lanes, Run};
 
 /// How a stored texel becomes linear RGBA, per storage format: [`Table8`] for 8-bit texels,
 /// [`Float`] for `f32` ones. The level and pyramid views below are generic over it, so the two
@@ -97,11 +95,6 @@ impl Decode for Table8 {
 pub(crate) struct Unorm8 {
     pub lanes: Lanes,
 }
-
-/// `1 / 255` split into a high part of 12 significant bits, so that `b * UNORM8_HI` is exact for
-/// every byte `b`, and the `f32` nearest to the rest.
-pub(crate) const UNORM8_HI: f32 = f32::from_bits((1.0f32 / 255.0).to_bits() & !((1 << 12) - 1));
-pub(crate) const UNORM8_LO: f32 = (1.0f64 / 255.0 - UNORM8_HI as f64) as f32;
 
 /// `b / 255` for the sixteen bytes of a quad, as `b * hi + b * lo` with `1 / 255 = hi + lo`
 /// (`hi` with 12 significant bits, so `b * hi` is exact and only the `b * lo` product and the sum
@@ -267,29 +260,6 @@ pub(crate) trait Fetch: Copy {
     }
 }
 
-/// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level
-/// (`i + 1 < width`, `j + 1` below the height; out of bounds panics), by one range check: the
-/// rows lie in the `width + 2` texels from `(i, j)`, whose elements then need none.
-#[inline(always)]
-pub(crate) fn quad_rows<T: Copy>(texels: &[T], width: u32, i: u32, j: u32) -> ([T; 2], [T; 2]) {
-    let w = width as usize;
-    let k = j as usize * w + i as usize;
-    let q = &texels[k..k + w + 2];
-    ([q[0], q[1]], [q[w], q[w + 1]])
-}
-
-/// Stage 2's results for a run of samples whose taps all lie inside one level (the batched
-/// sampler's inside route, `batch.rs`): per sample its first tap `(i[k], j[k])` (non-negative)
-/// and fractions `a[k]`, `b[k]`. The four slices have the run's length.
-#[derive(Clone, Copy)]
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 run kernel
-pub(crate) struct Run<'r> {
-    pub i: &'r [i32],
-    pub j: &'r [i32],
-    pub a: &'r [f32],
-    pub b: &'r [f32],
-}
-
 impl<D: Decode> Fetch for Level<'_, D> {
     #[inline(always)]
     fn size(&self) -> (u32, u32) {
@@ -325,165 +295,6 @@ impl<D: Decode> Fetch for Level<'_, D> {
     }
 }
 
-/// All mip levels of a texture.
-pub(crate) trait Pyramid {
-    /// One level's view.
-    type Level<'a>: Fetch
-    where
-        Self: 'a;
-    /// Number of levels (at least 1).
-    fn level_count(&self) -> usize;
-    /// Level `k < level_count()`.
-    fn level(&self, k: usize) -> Self::Level<'_>;
-    /// The texture these levels belong to (for its lazily built ripmap and summed-area table).
-    fn texture(&self) -> &Texture;
-    /// A view of another image stored in the same format as these levels (a ripmap image), decoded
-    /// and counted exactly as the levels are. `info` locates the image inside `storage`.
-    ///
-    /// A storage of the other format (impossible for structures built from this texture) gives a
-    /// 1x1 transparent-black view instead of a panic.
-    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> Self::Level<'s>;
-    /// Record `n` reads of a structure that is not made of texels (summed-area table entries).
-    /// Free for the plain views; [`Counted`] adds `n` to its counter.
-    #[inline(always)]
-    fn note_reads(&self, _n: u32) {}
-}
-
-/// The pyramid of a texture whose storage `D` decodes.
-pub(crate) struct Stored<'a, D: Decode> {
-    pub tex: &'a Texture,
-    pub levels: &'a [LevelInfo],
-    pub texels: &'a [D::Texel],
-    pub decode: D,
-}
-
-fn level_slice<'t, T>(info: &LevelInfo, all: &'t [T]) -> &'t [T] {
-    &all[info.offset..info.offset + info.width as usize * info.height as usize]
-}
-
-impl<D: Decode> Pyramid for Stored<'_, D> {
-    type Level<'b>
-        = Level<'b, D>
-    where
-        Self: 'b;
-    #[inline(always)]
-    fn level_count(&self) -> usize {
-        self.levels.len()
-    }
-    #[inline(always)]
-    fn level(&self, k: usize) -> Level<'_, D> {
-        let info = &self.levels[k];
-        Level {
-            width: info.width,
-            height: info.height,
-            texels: level_slice(info, self.texels),
-            decode: self.decode,
-        }
-    }
-    #[inline(always)]
-    fn texture(&self) -> &Texture {
-        self.tex
-    }
-    #[inline]
-    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> Level<'s, D> {
-        let (width, height, texels) = match D::texels(storage) {
-            Some(v) => (info.width, info.height, level_slice(info, v)),
-            None => (1, 1, D::BLACK),
-        };
-        Level {
-            width,
-            height,
-            texels,
-            decode: self.decode,
-        }
-    }
-}
-
-/// A pyramid view that counts texel reads.
-pub(crate) struct Counted<P> {
-    pub inner: P,
-    pub count: Cell<u32>,
-}
-
-/// A level view that counts texel reads into its pyramid's counter.
-#[derive(Clone, Copy)]
-pub(crate) struct CountedLevel<'a, L> {
-    inner: L,
-    count: &'a Cell<u32>,
-}
-
-impl<L: Fetch> Fetch for CountedLevel<'_, L> {
-    #[inline(always)]
-    fn size(&self) -> (u32, u32) {
-        self.inner.size()
-    }
-    #[inline(always)]
-    fn texel(&self, i: u32, j: u32) -> Vec4 {
-        self.count.set(self.count.get().saturating_add(1));
-        self.inner.texel(i, j)
-    }
-    #[inline(always)]
-    fn quad(&self, i: u32, j: u32) -> [Vec4; 4] {
-        self.count.set(self.count.get().saturating_add(4));
-        self.inner.quad(i, j)
-    }
-}
-
-impl<P: Pyramid> Pyramid for Counted<P> {
-    type Level<'b>
-        = CountedLevel<'b, P::Level<'b>>
-    where
-        Self: 'b;
-    fn level_count(&self) -> usize {
-        self.inner.level_count()
-    }
-    fn level(&self, k: usize) -> Self::Level<'_> {
-        CountedLevel {
-            inner: self.inner.level(k),
-            count: &self.count,
-        }
-    }
-    fn texture(&self) -> &Texture {
-        self.inner.texture()
-    }
-    fn image<'s>(&'s self, info: &LevelInfo, storage: &'s Storage) -> Self::Level<'s> {
-        CountedLevel {
-            inner: self.inner.image(info, storage),
-            count: &self.count,
-        }
-    }
-    fn note_reads(&self, n: u32) {
-        self.count.set(self.count.get().saturating_add(n));
-    }
-}
-
-/// Call `$body` with `$p` bound to the texture's pyramid view (8-bit or float), monomorphising once
-/// per storage format; with `$lanes`, the linear 8-bit view blends bilinear quads with that
-/// kernel ([`crate::storage::lanes`]), else with the scalar one.
-macro_rules! with_pyramid {
-    ($tex:expr, |$p:ident| $body:expr) => {
-        $crate::storage::fetch::with_pyramid!($tex, $crate::storage::lanes::Lanes::scalar(), |$p| {
-            $body
-        })
-    };
-    ($tex:expr, $lanes:expr, |$p:ident| $body:expr) => {
-        match $crate::storage::fetch::pyramid_with($tex, $lanes) {
-            $crate::storage::fetch::AnyPyramid::U8($p) => $body,
-            $crate::storage::fetch::AnyPyramid::Unorm8($p) => $body,
-            $crate::storage::fetch::AnyPyramid::F32($p) => $body,
-        }
-    };
-}
-pub(crate) use with_pyramid;
-
-pub(crate) enum AnyPyramid<'a> {
-    /// 8-bit sRGB texels.
-    U8(Stored<'a, Table8>),
-    /// 8-bit linear texels.
-    Unorm8(Stored<'a, Unorm8>),
-    F32(Stored<'a, Float>),
-}
-
 /// The decoding of an 8-bit texture's texels in `format` (sRGB or linear colour table).
 pub(crate) fn table8(format: Format) -> Table8 {
     Table8 {
@@ -496,39 +307,16 @@ pub(crate) fn table8(format: Format) -> Table8 {
     }
 }
 
-/// The pyramid of an 8-bit texture read as stored codes ([`Codes8`]); `None` for float storage.
-pub(crate) fn codes_of(tex: &Texture) -> Option<Stored<'_, Codes8>> {
-    Some(Stored {
-        tex,
-        levels: tex.levels(),
-        texels: Codes8::texels(tex.storage())?,
-        decode: Codes8,
-    })
-}
-
-/// The texture's pyramid view (8-bit sRGB, linear 8-bit or float), whose linear 8-bit view
-/// blends bilinear quads with `lanes`' kernel.
-pub(crate) fn pyramid_with(tex: &Texture, lanes: Lanes) -> AnyPyramid<'_> {
-    match tex.storage() {
-        Storage::U8(v) if tex.format() == Format::Rgba8Unorm => AnyPyramid::Unorm8(Stored {
-            tex,
-            levels: tex.levels(),
-            texels: v,
-            decode: Unorm8 { lanes },
-        }),
-        Storage::U8(v) => AnyPyramid::U8(Stored {
-            tex,
-            levels: tex.levels(),
-            texels: v,
-            decode: table8(tex.format()),
-        }),
-        Storage::F32(v) => AnyPyramid::F32(Stored {
-            tex,
-            levels: tex.levels(),
-            texels: v,
-            decode: Float,
-        }),
-    }
+/// The 2x2 texels of taps `i`, `j` already wrapped into `level`, in [`Fetch::quad`]'s order: the
+/// texels bilinear's taps read near an edge where no tap takes the border colour.
+#[inline(always)]
+pub(crate) fn wrapped_quad<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2]) -> [Vec4; 4] {
+    [
+        level.texel(i[0], j[0]),
+        level.texel(i[1], j[0]),
+        level.texel(i[0], j[1]),
+        level.texel(i[1], j[1]),
+    ]
 }
 
 #[cfg(test)]

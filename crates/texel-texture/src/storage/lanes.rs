@@ -27,8 +27,30 @@
 use glam::Vec4;
 
 #[cfg(target_arch = "x86_64")]
-use crate::storage::fetch::quad_rows;
-use crate::storage::fetch::Run;
+use crate::base::color::{UNORM8_HI, UNORM8_LO};
+
+/// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level
+/// (`i + 1 < width`, `j + 1` below the height; out of bounds panics), by one range check: the
+/// rows lie in the `width + 2` texels from `(i, j)`, whose elements then need none.
+#[inline(always)]
+pub(crate) fn quad_rows<T: Copy>(texels: &[T], width: u32, i: u32, j: u32) -> ([T; 2], [T; 2]) {
+    let w = width as usize;
+    let k = j as usize * w + i as usize;
+    let q = &texels[k..k + w + 2];
+    ([q[0], q[1]], [q[w], q[w + 1]])
+}
+
+/// Stage 2's results for a run of samples whose taps all lie inside one level (the batched
+/// sampler's inside route, `batch.rs`): per sample its first tap `(i[k], j[k])` (non-negative)
+/// and fractions `a[k]`, `b[k]`. The four slices have the run's length.
+#[derive(Clone, Copy)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))] // read by the AVX2 run kernel
+pub(crate) struct Run<'r> {
+    pub i: &'r [i32],
+    pub j: &'r [i32],
+    pub a: &'r [f32],
+    pub b: &'r [f32],
+}
 
 /// Which quad kernel the batched sampler ([`crate::Sampler::sample_batch_lanes`]) uses for the
 /// bilinear blend of a 2x2 quad of linear 8-bit texels (`Rgba8Unorm`, its staged path: minifying
@@ -164,7 +186,6 @@ fn bilinear_unorm8_v3(
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn row_v3(simd: pulp::x86::V3, r: [[u8; 4]; 2]) -> std::arch::x86_64::__m256 {
-    use crate::storage::fetch::{UNORM8_HI, UNORM8_LO};
     let (avx, avx2, sse2) = (simd.avx, simd.avx2, simd.sse2);
     let bytes = u64::from(u32::from_le_bytes(r[0])) | u64::from(u32::from_le_bytes(r[1])) << 32;
     let x = sse2._mm_set_epi64x(0, bytes as i64);
@@ -178,8 +199,8 @@ fn row_v3(simd: pulp::x86::V3, r: [[u8; 4]; 2]) -> std::arch::x86_64::__m256 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::lerp::blend;
     use crate::base::rng::SplitMix64;
-    use crate::kernel::bilinear::blend;
     use crate::storage::fetch::{Decode, Unorm8};
 
     /// The eight-lane kernel equals the four-lane one bit for bit: random quads (every byte value

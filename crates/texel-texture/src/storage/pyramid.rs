@@ -15,7 +15,7 @@
 use glam::Vec4;
 use rayon::prelude::*;
 
-use crate::storage::texture::LevelInfo;
+use crate::storage::format::LevelInfo;
 
 /// Size of level `level` of a `width x height` texture: `max(1, side >> level)`.
 pub fn level_size(width: u32, height: u32, level: u32) -> (u32, u32) {

@@ -15,44 +15,13 @@ use std::sync::OnceLock;
 
 use glam::Vec4;
 
-use crate::base::color::{linear_to_srgb8, srgb_table, srgb_to_linear, unorm8, unorm8_table};
+use crate::base::color::{linear_to_srgb8, srgb_to_linear, unorm8};
 use crate::base::error::TextureError;
-use crate::engine::sampler::{FilterMode, Sampler, SamplerDescriptor};
 use crate::storage::fetch::{table8, Fetch, Float, Level};
+pub(crate) use crate::storage::format::{decode_rgba8, Storage};
+pub use crate::storage::format::{ColorSpace, Format, LevelInfo, LevelTexels};
 use crate::storage::pyramid;
-use crate::technique::ripmap::Ripmap;
-use crate::technique::sat::SummedAreaTable;
-
-/// How 8-bit colour channels are to be interpreted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ColorSpace {
-    /// RGB are sRGB-encoded and decoded to linear light before filtering (alpha is always linear).
-    /// Example: code 128 samples as 0.2159.
-    Srgb,
-    /// Bytes are linear values `b / 255` (a GPU sampling a `*Unorm` texture). Example: 128 -> 0.5020.
-    Linear,
-}
-
-/// Texel storage format of a [`Texture`] (and of every level of its pyramid).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Format {
-    /// 8-bit RGBA, RGB sRGB-encoded, alpha linear. 4 bytes per texel.
-    Rgba8Srgb,
-    /// 8-bit RGBA, all channels linear `b / 255`. 4 bytes per texel.
-    Rgba8Unorm,
-    /// 32-bit float RGBA, linear. 16 bytes per texel.
-    Rgba32Float,
-}
-
-impl Format {
-    /// Bytes one texel occupies.
-    pub fn texel_bytes(self) -> u64 {
-        match self {
-            Format::Rgba8Srgb | Format::Rgba8Unorm => 4,
-            Format::Rgba32Float => 16,
-        }
-    }
-}
+use crate::storage::tables::{Ripmap, SummedAreaTable};
 
 /// Size and memory limits checked before anything is allocated (after image-rs `io/limits.rs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -209,41 +178,15 @@ pub fn replace_non_finite(texels: &mut [[f32; 4]]) -> u64 {
 }
 
 fn check_jpeg_complete(bytes: &[u8], width: u32, height: u32) -> Result<(), TextureError> {
-    crate::input::check_jpeg_complete(bytes, width, height).map_err(TextureError::Truncated)
-}
-
-/// Where one mip level lives in the texture's storage.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct LevelInfo {
-    /// Width in texels: `max(1, W >> level)`.
-    pub width: u32,
-    /// Height in texels: `max(1, H >> level)`.
-    pub height: u32,
-    /// Index of the level's first texel in the contiguous storage.
-    pub offset: usize,
-}
-
-/// One level's stored texels ([`Texture::level_texels`]).
-#[derive(Clone, Copy, Debug)]
-pub enum LevelTexels<'a> {
-    /// 8-bit RGBA codes (decode RGB by the texture's colour space, alpha as `b / 255`).
-    Unorm8(&'a [[u8; 4]]),
-    /// Linear `f32` RGBA.
-    Float(&'a [[f32; 4]]),
-}
-
-#[derive(Clone, Debug)]
-pub(crate) enum Storage {
-    U8(Vec<[u8; 4]>),
-    F32(Vec<[f32; 4]>),
+    texel_io::check_jpeg_complete(bytes, width, height).map_err(TextureError::Truncated)
 }
 
 /// A 2D texture with its complete mip pyramid, ready to be sampled by a [`crate::Sampler`].
 ///
 /// Any size from 1x1 up to [`Limits::max_dimension`], power of two or not.
 ///
-/// The ripmap and the summed-area table that [`FilterMode::Ripmap`] and
-/// [`FilterMode::SummedArea`] need are built from level 0 on first use (thread-safe, once; `Texture`
+/// The ripmap and the summed-area table that [`crate::FilterMode::Ripmap`] and
+/// [`crate::FilterMode::SummedArea`] need are built from level 0 on first use (thread-safe, once; `Texture`
 /// is `Sync`), or ahead of time by [`Texture::build_structures`]. Their size is checked against the
 /// [`Limits`] the texture was created with before anything is allocated.
 #[derive(Debug)]
@@ -427,7 +370,7 @@ impl Texture {
     ///
     /// `color` applies to 8- and 16-bit images; float images (EXR) are always linear. The file
     /// must be a regular file (a FIFO or device is refused before it is opened, see
-    /// [`crate::input`]); everything else is as [`Texture::decode`] says.
+    /// [`texel_io`]); everything else is as [`Texture::decode`] says.
     ///
     /// # Errors
     /// [`TextureError::Io`], and those of [`Texture::decode`].
@@ -447,7 +390,7 @@ impl Texture {
         path: impl AsRef<Path>,
         options: &LoadOptions,
     ) -> Result<Loaded, TextureError> {
-        let bytes = crate::input::read_regular(path.as_ref(), options.limits.max_bytes)?;
+        let bytes = texel_io::read_regular(path.as_ref(), options.limits.max_bytes)?;
         Self::decode_with(&bytes, options)
     }
 
@@ -473,8 +416,8 @@ impl Texture {
     /// [`TextureError::Decode`] for an unknown format or a corrupt header.
     pub fn header(bytes: &[u8]) -> Result<(u32, u32, image::ColorType), TextureError> {
         let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format()?;
-        let decoder = crate::input::guarded(|| reader.into_decoder())
-            .map_err(TextureError::DecoderFailed)??;
+        let decoder =
+            texel_io::guarded(|| reader.into_decoder()).map_err(TextureError::DecoderFailed)??;
         let (w, h) = image::ImageDecoder::dimensions(&decoder);
         Ok((w, h, image::ImageDecoder::color_type(&decoder)))
     }
@@ -493,15 +436,15 @@ impl Texture {
         l.max_image_height = Some(limits.max_dimension);
         l.max_alloc = Some(limits.max_bytes);
         reader.limits(l);
-        let decoder = crate::input::guarded(|| reader.into_decoder())
-            .map_err(TextureError::DecoderFailed)??;
+        let decoder =
+            texel_io::guarded(|| reader.into_decoder()).map_err(TextureError::DecoderFailed)??;
         let (width, height) = image::ImageDecoder::dimensions(&decoder);
         let decoded_color = image::ImageDecoder::color_type(&decoder);
         limits.check_load(bytes.len() as u64, width, height, decoded_color)?;
         if format == Some(image::ImageFormat::Jpeg) {
             check_jpeg_complete(bytes, width, height)?;
         }
-        let img = crate::input::guarded(|| image::DynamicImage::from_decoder(decoder))
+        let img = texel_io::guarded(|| image::DynamicImage::from_decoder(decoder))
             .map_err(TextureError::DecoderFailed)??;
         use image::ColorType as C;
         match img.color() {
@@ -553,59 +496,6 @@ impl Texture {
     /// The limits the texture was created with (they also bound its ripmap and summed-area table).
     pub fn limits(&self) -> &Limits {
         &self.limits
-    }
-
-    /// The texture's ripmap, built from level 0 on first call (thread-safe, once).
-    ///
-    /// # Errors
-    /// [`TextureError::StructureOverMemoryLimit`] if it does not fit the texture's limits (the
-    /// failure is remembered; later calls return the same error without retrying).
-    pub fn ripmap(&self) -> Result<&Ripmap, TextureError> {
-        let r = self.ripmap.get_or_init(|| Ripmap::build_within(self));
-        r.as_ref()
-            .map_err(|&bytes| crate::technique::ripmap::over_limit(self, bytes))
-    }
-
-    /// The texture's summed-area table, built from level 0 on first call (thread-safe, once).
-    ///
-    /// # Errors
-    /// As [`Texture::ripmap`].
-    pub fn summed_area_table(&self) -> Result<&SummedAreaTable, TextureError> {
-        let r = self.sat.get_or_init(|| SummedAreaTable::build_within(self));
-        r.as_ref()
-            .map_err(|&bytes| crate::technique::sat::over_limit(self, bytes))
-    }
-
-    /// Build ahead of time whatever acceleration structure `sampler` needs (the ripmap for
-    /// [`FilterMode::Ripmap`], the summed-area table for [`FilterMode::SummedArea`]; nothing for the
-    /// other filters), so that later samples (and frame timings) do not pay for the build.
-    /// Idempotent and thread-safe.
-    ///
-    /// # Errors
-    /// [`TextureError::StructureOverMemoryLimit`] if the structure would exceed the texture's
-    /// [`Limits::max_bytes`]. Sampling still works then: it falls back to trilinear filtering.
-    pub fn build_structures(&self, sampler: &Sampler) -> Result<(), TextureError> {
-        match sampler.descriptor().min_filter {
-            FilterMode::Ripmap => self.ripmap().map(|_| ()),
-            FilterMode::SummedArea => self.summed_area_table().map(|_| ()),
-            _ => Ok(()),
-        }
-    }
-
-    /// Bytes of the structures a sampler configured by `desc` reads: the mip pyramid
-    /// ([`Texture::pyramid_bytes`]), plus the ripmap ([`Ripmap::bytes_for`]) for
-    /// [`FilterMode::Ripmap`] or the summed-area table ([`SummedAreaTable::bytes_for`]) for
-    /// [`FilterMode::SummedArea`], whether already built or not. Saturates at `u64::MAX`.
-    pub fn structure_bytes(&self, desc: &SamplerDescriptor) -> u64 {
-        let (w, h) = (self.width(), self.height());
-        let extra = match desc.min_filter {
-            FilterMode::Ripmap => Ripmap::bytes_for(w, h, self.format),
-            FilterMode::SummedArea => SummedAreaTable::bytes_for(w, h),
-            _ => Some(0),
-        };
-        extra
-            .and_then(|e| e.checked_add(self.pyramid_bytes()))
-            .unwrap_or(u64::MAX)
     }
 
     /// Whether a structure of `bytes` (plus `scratch` bytes while it is built) still fits this
@@ -719,19 +609,6 @@ impl Texture {
     pub(crate) fn storage(&self) -> &Storage {
         &self.storage
     }
-}
-
-/// One 8-bit texel to linear RGBA through the decode tables: RGB sRGB-decoded when `srgb`, else
-/// `b / 255`; alpha always `b / 255`.
-pub(crate) fn decode_rgba8(t: [u8; 4], srgb: bool) -> [f32; 4] {
-    let lin = unorm8_table();
-    let table = if srgb { srgb_table() } else { lin };
-    [
-        table[t[0] as usize],
-        table[t[1] as usize],
-        table[t[2] as usize],
-        lin[t[3] as usize],
-    ]
 }
 
 /// [`TextureError::NonFiniteTexel`] for the first non-finite value of row-major `texels` (rows

@@ -47,13 +47,16 @@
 
 use glam::{Vec2, Vec4};
 
+use crate::base::address::Address;
 use crate::base::floor::ceil_i32;
 use crate::base::footprint::{fast_log2, log2_normal, Footprint, Query};
-use crate::engine::batch::{self, Probes};
-use crate::engine::sampler::Sampler;
+use crate::base::lerp::lerp;
 use crate::kernel::bilinear::Bilinear;
-use crate::storage::fetch::{Fetch, Pyramid};
+use crate::kernel::staged::{Chunk, Pass, CHUNK};
+use crate::storage::fetch::Fetch;
+use crate::storage::view::Pyramid;
 use crate::technique::mip::{linear_levels, trilinear};
+use crate::technique::Params;
 
 /// Relative tolerance applied to `|Pmax| / |Pmin|` before rounding up (see the module docs).
 pub const RATIO_TOLERANCE: f32 = 1e-5;
@@ -79,9 +82,9 @@ pub fn probe_count(major: f32, minor: f32, max_anisotropy: u32) -> u32 {
 /// Anisotropic filtering of query `q` (whose lod, the isotropic one, is `> 0`) by `s`'s
 /// `anisotropy_clamp`: the formula above, as [`plan`] and [`filter_planned`] evaluate it.
 #[inline]
-pub(crate) fn anisotropic<P: Pyramid>(p: &P, s: &Sampler, q: &Query) -> Vec4 {
+pub(crate) fn anisotropic<P: Pyramid>(p: &P, s: &Params, q: &Query) -> Vec4 {
     let (plan, _) = plan(s, p.level(0).size(), &q.fp, fast_log2);
-    filter_planned(p, q, &plan, &mut Probes::new(s.address()))
+    filter_planned(p, q, &plan, &mut Probes::new(s.addr))
 }
 
 /// What a sample's probes need from its footprint ([`plan`]).
@@ -104,12 +107,12 @@ pub(crate) struct Plan {
 /// over a chunk pipelines.
 #[inline(always)]
 pub(crate) fn plan(
-    s: &Sampler,
+    s: &Params,
     (w, h): (u32, u32),
     fp: &Footprint,
     log2: impl Fn(f32) -> f32,
 ) -> (Plan, bool) {
-    let d = s.descriptor();
+    let d = s;
     let axes = fp.axes(w, h);
     let (major, minor) = (axes.major.length(), axes.minor.length());
     let n = if major.is_finite() && axes.major_uv.is_finite() {
@@ -132,14 +135,14 @@ pub(crate) fn plan(
     (Plan { n, lod, axis }, special)
 }
 
-/// The plans of a chunk of footprints (at most [`batch::CHUNK`]) on a `size` level 0: one
+/// The plans of a chunk of footprints (at most [`CHUNK`]) on a `size` level 0: one
 /// vectorised pass with [`log2_normal`], then the rare zero or subnormal `rho` again with
 /// [`fast_log2`], so every plan equals [`plan`] with [`fast_log2`] (what [`anisotropic`] uses).
 pub(crate) fn plan_chunk(
-    s: &Sampler,
+    s: &Params,
     size: (u32, u32),
-    chunk: &batch::Chunk<{ batch::CHUNK }>,
-    out: &mut [Plan; batch::CHUNK],
+    chunk: &Chunk<{ CHUNK }>,
+    out: &mut [Plan; CHUNK],
 ) {
     let n = chunk.n;
     let mut special = false;
@@ -176,7 +179,7 @@ pub(crate) fn filter_planned<P: Pyramid>(
     let inv = 1.0 / n as f32;
     let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
     // The probes' positions along the major axis (`n <= 64`: `plan`).
-    let n = (n as usize).min(batch::CHUNK);
+    let n = (n as usize).min(CHUNK);
     let at = &mut probes.at;
     at.n = n;
     for (i, (pu, pv)) in at.u[..n].iter_mut().zip(&mut at.v[..n]).enumerate() {
@@ -189,14 +192,77 @@ pub(crate) fn filter_planned<P: Pyramid>(
     probes.trilinear_sum(p, linear_levels(plan.lod, p.level_count() - 1)) * inv
 }
 
+/// The anisotropic probes' stage ([`crate::technique::aniso`]): their coordinates, written by the caller, and
+/// two bilinear level passes. Made once per [`crate::Sampler::sample_batch`] call and reused by
+/// every sample (zeroing scratch per sample costs measurable frame time: docs/decisions.md).
+/// Entries beyond a sample's probe count are stale and never read.
+pub(crate) struct Probes {
+    /// The probes' coordinates (`lod` unused), written by the caller for the first `at.n`.
+    pub at: Chunk<CHUNK>,
+    fine: Pass<CHUNK, Bilinear>,
+    next: Pass<CHUNK, Bilinear>,
+}
+
+impl Probes {
+    /// Scratch for probes under the address modes `addr`.
+    pub(crate) fn new(addr: Address) -> Self {
+        Probes {
+            at: Chunk::new(),
+            fine: Pass::new(Bilinear, addr),
+            next: Pass::new(Bilinear, addr),
+        }
+    }
+
+    /// The address modes the probes apply.
+    pub(crate) fn address(&self) -> &Address {
+        &self.fine.addr
+    }
+
+    /// The sum over the probes at `self.at` of a trilinear sample in `levels` (the finer level
+    /// and the blend weight from [`mip::linear_levels`]; the coarser level read only when weighed,
+    /// as in [`mip::trilinear`]): stages 2 and 3 of [`run`] with every probe in the same levels,
+    /// so their views are made once. Bit for bit the sum of [`mip::trilinear`] per probe, in order.
+    #[inline(always)]
+    pub(crate) fn trilinear_sum<P: Pyramid>(&mut self, p: &P, (k, delta): (usize, f32)) -> Vec4 {
+        let last = p.level_count() - 1;
+        let coarse = delta > 0.0 && k < last;
+        let n = self.at.n.min(CHUNK);
+        let fine_level = p.level(k);
+        let next_level = p.level(if coarse { k + 1 } else { k });
+        let size_of = |level: &P::Level<'_>| {
+            let (w, h) = level.size();
+            (w as f32, h as f32)
+        };
+        let fine_size = size_of(&fine_level);
+        let (us, vs) = (&self.at.u[..n], &self.at.v[..n]);
+        self.fine.coordinates(|_| fine_size, us, vs);
+        if coarse {
+            let next_size = size_of(&next_level);
+            self.next.coordinates(|_| next_size, us, vs);
+        }
+        let mut sum = Vec4::ZERO;
+        for i in 0..n {
+            let uv = self.at.uv(i);
+            let a = self.fine.filtered(&fine_level, i, uv);
+            sum += if coarse {
+                lerp(a, self.next.filtered(&next_level, i, uv), delta)
+            } else {
+                a
+            };
+        }
+        sum
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::sampler::SamplerDescriptor;
+    use crate::base::descriptor::SamplerDescriptor;
+    use crate::engine::sampler::Sampler;
     use crate::kernel::bilinear::bilinear;
-    use crate::storage::fetch::pyramid_with;
     use crate::storage::lanes::Lanes;
     use crate::storage::texture::{Format, Limits, Texture};
+    use crate::storage::view::pyramid_with;
 
     /// The staged probes (`Probes::trilinear_sum`) equal the formula's plain loop bit for bit:
     /// each probe a bilinear-in-two-levels trilinear sample in the shared levels, summed in order.
@@ -222,7 +288,7 @@ mod tests {
             ]
         })
         .unwrap();
-        let crate::storage::fetch::AnyPyramid::U8(p) = pyramid_with(&tex, Lanes::scalar()) else {
+        let crate::storage::view::AnyPyramid::U8(p) = pyramid_with(&tex, Lanes::scalar()) else {
             unreachable!()
         };
         let d = SamplerDescriptor {
@@ -268,7 +334,7 @@ mod tests {
                 };
             }
             let want = (sum * inv).to_array().map(f32::to_bits);
-            let got = anisotropic(&p, &sampler, &Query { fp, lod: 1.0 });
+            let got = anisotropic(&p, sampler.params(), &Query { fp, lod: 1.0 });
             assert_eq!(got.to_array().map(f32::to_bits), want, "{fp:?}");
             checked += 1;
         }

@@ -102,10 +102,12 @@ use glam::{DVec2, Vec2, Vec4};
 use crate::base::address::{Address, AddressMode};
 use crate::base::floor::{ceil_f64, floor_f64, floor_staged_f64};
 use crate::base::footprint::{lod_from_rho, Query};
-use crate::engine::sampler::Sampler;
-use crate::kernel::bilinear::{bilinear, lerp, texel_or_border, Bilinear};
-use crate::storage::fetch::{Fetch, Pyramid};
+use crate::base::lerp::lerp;
+use crate::kernel::bilinear::{bilinear, texel_or_border, Bilinear};
+use crate::storage::fetch::Fetch;
+use crate::storage::view::Pyramid;
 use crate::technique::mip::{linear_levels, trilinear};
+use crate::technique::Params;
 
 /// Entries of the Gaussian weight table, indexed by `floor(r^2 * LUT_SIZE)` for `r^2` in `[0, 1)`.
 pub const LUT_SIZE: usize = 128;
@@ -674,9 +676,9 @@ fn scan_wrapped<F: Fetch>(
 /// footprint's axes, its level `floor(lod)` and the next blended by `fract(lod)` ([`linear_levels`])
 /// with `lod = log2(minor semi-axis) + bias`; non-finite axes fall back to trilinear at `q.lod`.
 #[inline(always)]
-pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Sampler, q: &Query, max: f32) -> Vec4 {
-    let addr = s.address();
-    let d = s.descriptor();
+pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Params, q: &Query, max: f32) -> Vec4 {
+    let addr = s.addr;
+    let d = s;
     let (w0, h0) = p.level(0).size();
     let (px, py) = q.fp.texel_axes(w0, h0);
     let Some(e) = Ellipse::from_axes(px, py, max) else {
@@ -718,8 +720,9 @@ pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Sampler, q: &Query, max: f32) -> Vec4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::descriptor::SamplerDescriptor;
+    use crate::base::filter::FilterMode;
     use crate::base::footprint::Footprint;
-    use crate::engine::sampler::{FilterMode, SamplerDescriptor};
 
     /// An ellipse far larger than the texture ends at the 1x1 level, which is read once (it used
     /// to be revisited up to the 4096-texel area cap), and equals that level's texel.

@@ -11,37 +11,14 @@
 //! When `delta == 0` the second level is not read (the lerp would return the first value exactly),
 //! which halves the reads on integer lods and at the last level.
 
-use glam::{Vec2, Vec4};
+use glam::Vec4;
 
 use crate::base::address::Address;
 use crate::base::floor::{ceil_clamped, ceil_i32, floor_nonneg, floor_nonneg_staged};
 use crate::base::footprint::Query;
-use crate::engine::sampler::FilterMode;
-use crate::kernel::bicubic::bicubic;
-use crate::kernel::bilinear::{bilinear, lerp};
-use crate::kernel::nearest::nearest;
-use crate::storage::fetch::{Fetch, Pyramid};
-
-/// Filter one level with a within-level filter (Nearest, Linear or Cubic) at normalised `uv`.
-///
-/// The minification-only filters (`Ewa`, `Ripmap`, `SummedArea`) never reach this function (the
-/// sampler dispatches them first and rejects them as `mag_filter`); should one arrive it is
-/// treated as Linear.
-#[inline(always)]
-pub(crate) fn filter_level<F: Fetch>(
-    mode: &FilterMode,
-    level: &F,
-    addr: &Address,
-    uv: Vec2,
-) -> Vec4 {
-    match mode {
-        FilterMode::Nearest => nearest(level, addr, uv),
-        FilterMode::Cubic(c) => bicubic(level, addr, c, uv),
-        FilterMode::Linear | FilterMode::Ewa | FilterMode::Ripmap | FilterMode::SummedArea => {
-            bilinear(level, addr, uv)
-        }
-    }
-}
+use crate::base::lerp::lerp;
+use crate::kernel::LevelFilter;
+use crate::storage::view::Pyramid;
 
 /// The Vulkan nearest-level rule `ceil(clamp(lod, 0, last) + 1/2) - 1`; NaN gives level 0.
 #[inline]
@@ -84,22 +61,6 @@ fn linear_levels_by(lod: f32, last: usize, floor: impl Fn(f32) -> (i32, f32)) ->
     let d = lod.clamp(0.0, last as f32);
     let (k, fk) = floor(d);
     (k as usize, d - fk)
-}
-
-/// A filter inside one level at a normalised point: the kernels' own types (`bilinear::Bilinear`,
-/// `nearest::Point`) resolve at compile time, a `&FilterMode` at run time ([`filter_level`]).
-/// The mip rules below are generic over it, so each caller's filter is compiled into them (the
-/// anisotropic probes' bilinear costs no dispatch).
-pub(crate) trait LevelFilter: Copy {
-    /// Filter `level` at `uv` under `addr`.
-    fn filter<F: Fetch>(self, level: &F, addr: &Address, uv: Vec2) -> Vec4;
-}
-
-impl LevelFilter for &FilterMode {
-    #[inline(always)]
-    fn filter<F: Fetch>(self, level: &F, addr: &Address, uv: Vec2) -> Vec4 {
-        filter_level(self, level, addr, uv)
-    }
 }
 
 /// Nearest-level mipmapping: `filter` in level [`nearest_level`] of `q.lod`.

@@ -40,25 +40,26 @@ use rayon::prelude::*;
 use crate::base::color::{linear_to_srgb8, unorm8};
 use crate::base::error::TextureError;
 use crate::base::footprint::{lod_from_rho, Query};
-use crate::engine::sampler::Sampler;
-use crate::kernel::bilinear::{bilinear, lerp};
-use crate::storage::fetch::{with_pyramid, Fetch, Pyramid};
+use crate::base::lerp::lerp;
+use crate::kernel::bilinear::bilinear;
+use crate::storage::fetch::Fetch;
 use crate::storage::pyramid::{axis_taps, level_count};
+use crate::storage::tables::Ripmap;
 use crate::storage::texture::{Format, LevelInfo, Storage, Texture};
+use crate::storage::view::{with_pyramid, Pyramid};
 use crate::technique::mip::linear_levels;
+use crate::technique::Params;
 
-/// All anisotropic reductions of a texture's level 0 (see the module docs).
-#[derive(Debug)]
-pub struct Ripmap {
-    width: u32,
-    height: u32,
-    nx: usize,
-    ny: usize,
-    /// Image `(a, b)` at index `a * ny + b`; entry 0 is level 0 (stored in the texture).
-    infos: Vec<LevelInfo>,
-    storage: Storage,
-    /// 8-bit RGB stored sRGB-encoded (the texture's format is `Rgba8Srgb`).
-    srgb: bool,
+impl Texture {
+    /// The texture's ripmap, built from level 0 on first call (thread-safe, once).
+    ///
+    /// # Errors
+    /// [`TextureError::StructureOverMemoryLimit`] if it does not fit the texture's limits (the
+    /// failure is remembered; later calls return the same error without retrying).
+    pub fn ripmap(&self) -> Result<&Ripmap, TextureError> {
+        let r = self.ripmap.get_or_init(|| Ripmap::build_within(self));
+        r.as_ref().map_err(|&bytes| over_limit(self, bytes))
+    }
 }
 
 /// Sum over `k` of `max(1, n >> k)` for the `floor(log2 n) + 1` reductions of an axis.
@@ -100,14 +101,6 @@ impl Ripmap {
     pub(crate) fn build_within(texture: &Texture) -> Result<Ripmap, u64> {
         check(texture)?;
         Ok(with_pyramid!(texture, |p| build_from(texture, &p.level(0))))
-    }
-
-    /// Bytes the ripmap's texels occupy.
-    pub fn bytes(&self) -> u64 {
-        match &self.storage {
-            Storage::U8(v) => v.len() as u64 * 4,
-            Storage::F32(v) => v.len() as u64 * 16,
-        }
     }
 
     /// Number of reductions along x and along y (`floor(log2 W) + 1`, `floor(log2 H) + 1`).
@@ -272,8 +265,8 @@ fn encode_u8(c: Vec4, srgb: bool) -> [u8; 4] {
 /// clamped ([`lod_from_rho`]), where the extents are the footprint's bounding box
 /// (`|Px.x| + |Py.x|` by `|Px.y| + |Py.y|` texels of level 0); bilinear in each of the four images.
 #[inline]
-pub(crate) fn ripmap<P: Pyramid>(p: &P, rip: &Ripmap, s: &Sampler, q: &Query) -> Vec4 {
-    let (d, addr, uv) = (s.descriptor(), s.address(), q.uv());
+pub(crate) fn ripmap<P: Pyramid>(p: &P, rip: &Ripmap, s: &Params, q: &Query) -> Vec4 {
+    let (d, addr, uv) = (s, s.addr, q.uv());
     let (px, py) = q.fp.texel_axes(rip.width, rip.height);
     let bx = px.x.abs() + py.x.abs();
     let by = px.y.abs() + py.y.abs();

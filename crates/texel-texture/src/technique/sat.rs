@@ -49,9 +49,11 @@ use rayon::prelude::*;
 use crate::base::address::{Address, AddressMode};
 use crate::base::error::TextureError;
 use crate::base::footprint::{lod_from_rho, Query};
-use crate::engine::sampler::Sampler;
-use crate::storage::fetch::{with_pyramid, Fetch, Pyramid};
+use crate::storage::fetch::Fetch;
+use crate::storage::tables::SummedAreaTable;
 use crate::storage::texture::Texture;
+use crate::storage::view::{with_pyramid, Pyramid};
+use crate::technique::Params;
 
 /// Boxes narrower than this (texels) are widened to it, centred: the mean of a vanishing box is
 /// the texel under it, and `f64` cancellation makes narrower boxes meaningless.
@@ -60,13 +62,15 @@ pub const MIN_BOX_WIDTH: f64 = 1e-3;
 /// Largest box side used by the filter, as a log2 (`2^40` texels): keeps products finite.
 const MAX_LOD: f32 = 40.0;
 
-/// The summed-area table of a texture's level 0 (see the module docs).
-#[derive(Debug)]
-pub struct SummedAreaTable {
-    width: u32,
-    height: u32,
-    /// `(W + 1) x (H + 1)` entries, row-major, `[r, g, b, a]` sums in linear light.
-    table: Vec<[f64; 4]>,
+impl Texture {
+    /// The texture's summed-area table, built from level 0 on first call (thread-safe, once).
+    ///
+    /// # Errors
+    /// As [`Texture::ripmap`].
+    pub fn summed_area_table(&self) -> Result<&SummedAreaTable, TextureError> {
+        let r = self.sat.get_or_init(|| SummedAreaTable::build_within(self));
+        r.as_ref().map_err(|&bytes| over_limit(self, bytes))
+    }
 }
 
 /// Up to six `(coefficient, position)` terms of one axis.
@@ -207,11 +211,6 @@ impl SummedAreaTable {
     pub(crate) fn build_within(texture: &Texture) -> Result<SummedAreaTable, u64> {
         check(texture)?;
         Ok(with_pyramid!(texture, |p| build_from(&p.level(0))))
-    }
-
-    /// Bytes the table occupies.
-    pub fn bytes(&self) -> u64 {
-        self.table.len() as u64 * 32
     }
 
     /// Width of the summed texture (level 0) in texels.
@@ -370,8 +369,8 @@ fn build_from<F: Fetch + Sync>(level0: &F) -> SummedAreaTable {
 /// mean over the footprint's bounding box (`|Px.x| + |Py.x|` by `|Px.y| + |Py.y|` texels of level
 /// 0), each side `2^clamp(log2(extent) + bias)` texels, centred on `uv`.
 #[inline]
-pub(crate) fn summed_area<P: Pyramid>(p: &P, t: &SummedAreaTable, s: &Sampler, q: &Query) -> Vec4 {
-    let (d, addr) = (s.descriptor(), s.address());
+pub(crate) fn summed_area<P: Pyramid>(p: &P, t: &SummedAreaTable, s: &Params, q: &Query) -> Vec4 {
+    let (d, addr) = (s, s.addr);
     let (px, py) = q.fp.texel_axes(t.width, t.height);
     let side = |extent: f32| {
         let l = lod_from_rho(extent, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);

@@ -23,9 +23,7 @@
 
 use glam::DVec2;
 
-use crate::base::footprint::Footprint;
-use crate::engine::sampler::Sampler;
-use crate::storage::texture::Texture;
+use texel_texture::{Footprint, Sampler, Texture};
 
 /// A projective map from the unit square `(s, t)` onto a quadrilateral (Heckbert 1989).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -247,12 +245,12 @@ mod tests {
         let tex = Texture::from_fn(
             2,
             2,
-            crate::Format::Rgba8Unorm,
-            &crate::Limits::default(),
+            texel_texture::Format::Rgba8Unorm,
+            &texel_texture::Limits::default(),
             |_, _| [1.0; 4],
         )
         .unwrap();
-        let s = Sampler::new(crate::SamplerDescriptor::default()).unwrap();
+        let s = Sampler::new(texel_texture::SamplerDescriptor::default()).unwrap();
         for (w, h) in [(0, 5), (u32::MAX, u32::MAX), (16384, 16384)] {
             assert!(matches!(
                 warp_perspective(&tex, &s, quad(), w, h),
@@ -281,10 +279,10 @@ mod tests {
         ));
     }
 
-    fn sampler(min: crate::MipmapFilterMode) -> Sampler {
-        Sampler::new(crate::SamplerDescriptor {
-            mag_filter: crate::FilterMode::Linear,
-            min_filter: crate::FilterMode::Linear,
+    fn sampler(min: texel_texture::MipmapFilterMode) -> Sampler {
+        Sampler::new(texel_texture::SamplerDescriptor {
+            mag_filter: texel_texture::FilterMode::Linear,
+            min_filter: texel_texture::FilterMode::Linear,
             mipmap_filter: min,
             ..Default::default()
         })
@@ -296,8 +294,8 @@ mod tests {
         let tex = Texture::from_fn(
             16,
             8,
-            crate::Format::Rgba32Float,
-            &crate::Limits::default(),
+            texel_texture::Format::Rgba32Float,
+            &texel_texture::Limits::default(),
             |i, j| {
                 [
                     i as f32 / 16.0,
@@ -316,7 +314,7 @@ mod tests {
         ];
         let out = warp_perspective(
             &tex,
-            &sampler(crate::MipmapFilterMode::Linear),
+            &sampler(texel_texture::MipmapFilterMode::Linear),
             corners,
             16,
             8,
@@ -343,8 +341,8 @@ mod tests {
         let tex = Texture::from_fn(
             128,
             128,
-            crate::Format::Rgba32Float,
-            &crate::Limits::default(),
+            texel_texture::Format::Rgba32Float,
+            &texel_texture::Limits::default(),
             |i, j| {
                 let c = ((i + j) % 2) as f32;
                 [c, c, c, 1.0]
@@ -363,7 +361,7 @@ mod tests {
                 .map(|p| (p[0] - 0.5).abs())
                 .fold(0.0f32, f32::max)
         };
-        assert!(spread(crate::MipmapFilterMode::Linear) < 1e-3);
-        assert!(spread(crate::MipmapFilterMode::None) > 0.4);
+        assert!(spread(texel_texture::MipmapFilterMode::Linear) < 1e-3);
+        assert!(spread(texel_texture::MipmapFilterMode::None) > 0.4);
     }
 }
