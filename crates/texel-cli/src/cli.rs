@@ -8,6 +8,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use crate::budget::ByteSize;
 use crate::filters::{filter_parser, Filter};
 
+/// `--tolerance`'s default: half an 8-bit step of the displayed value.
+pub const DEFAULT_TOLERANCE_STEPS: f64 = 0.5;
+
 /// texel: texture mapping and texture filtering on the CPU, measured.
 #[derive(Debug, Parser)]
 #[command(name = "texel", version, about, long_about = None, propagate_version = true)]
@@ -76,52 +79,12 @@ pub enum Command {
     /// Example: texel view builtin:ground --size 1280x720
     ///
     /// Example (scripted, as the tests run it): texel view --keys 5 --frames 3 --no-hud --screenshot s.png
-    #[command(after_help = crate::view::controls::key_table())]
+    #[command(after_help = crate::controls::key_table())]
     View(ViewArgs),
     /// List the Vulkan and GL adapters the GPU path (`render --gpu`) can use.
     ///
     /// Example: texel gpu-info
     GpuInfo,
-}
-
-/// Where texture-space derivatives come from (see texel-raster).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum DerivativesArg {
-    /// Exact derivatives from the triangle's plane equations.
-    #[default]
-    Analytic,
-    /// Differences within 2x2 pixel quads, as GPUs compute them.
-    Quad,
-}
-
-/// Attribute interpolation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum PerspectiveArg {
-    /// Perspective-correct (interpolate a/w and 1/w).
-    #[default]
-    Correct,
-    /// Affine in screen space (the lectures' incorrect image).
-    Affine,
-}
-
-/// What each pixel shows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum ViewArg {
-    /// The textured image.
-    #[default]
-    Color,
-    /// fract(u) in red, fract(v) in green.
-    Uv,
-    /// Integer mip level, one colour per level.
-    Mip,
-    /// Continuous level of detail.
-    Lod,
-    /// Footprint anisotropy ratio.
-    Aniso,
-    /// Texels read per pixel (heat map).
-    Fetches,
-    /// Barycentric weights as RGB.
-    Barycentric,
 }
 
 /// The scene and colour options every rendering command shares.
@@ -135,7 +98,7 @@ pub struct SceneArgs {
     pub scene: String,
     /// Colour handling.
     #[arg(long, value_enum, default_value_t)]
-    pub color: ColorArg,
+    pub color: texel::ColorHandling,
     /// Output size WIDTHxHEIGHT, each side 1 to 16384, overriding the scene's (e.g. 640x360).
     #[arg(long)]
     pub size: Option<Size>,
@@ -143,7 +106,7 @@ pub struct SceneArgs {
     /// with lights and materials, e.g. builtin:glossy). The reference ignores it: its normals
     /// are exact.
     #[arg(long, value_enum)]
-    pub specular_aa: Option<SpecularAaArg>,
+    pub specular_aa: Option<texel::raster::SpecularAa>,
     /// Adaptive shading supersampling for every material, overriding the scene's
     /// `shading_samples`: where the shading normal turns from one pixel to the next by more
     /// than the specular lobe is wide, shade up to N x N sub-samples per pixel (1 to 8; 1 is
@@ -153,7 +116,7 @@ pub struct SceneArgs {
     /// What every material's height map does, overriding the scene's `displacement` (materials
     /// without a height map are unaffected).
     #[arg(long, value_enum)]
-    pub displacement: Option<DisplacementArg>,
+    pub displacement: Option<texel_scene::Displacement>,
     /// With displacement = tessellate: the longest projected edge kept, in pixels (0.25 to 256;
     /// default 4).
     #[arg(long, value_name = "PX", value_parser = parse_edge_px)]
@@ -161,98 +124,22 @@ pub struct SceneArgs {
     /// Where every layered material blends its layers, overriding the scene's `layer_order`
     /// (e.g. builtin:terrain).
     #[arg(long, value_enum)]
-    pub layer_order: Option<LayerOrderArg>,
+    pub layer_order: Option<texel_scene::LayerOrder>,
     /// Lay the scene's procedural sky out as this mapping, at about the same texel angle
     /// (e.g. builtin:mirror-plane; a map from files keeps its own layout).
     #[arg(long, value_enum, value_name = "MAPPING")]
-    pub environment_mapping: Option<EnvironmentMappingArg>,
+    pub environment_mapping: Option<texel_scene::Mapping>,
     /// Where meshes with a sphere mapping (builtin:sphere, builtin:globe, `sphere_uv` in a scene)
     /// get their uv: exactly at every pixel (the default), or at the vertices, interpolated.
     #[arg(long, value_enum, value_name = "AT")]
-    pub surface_uv: Option<SurfaceUvArg>,
+    pub surface_uv: Option<texel::raster::UvEvaluation>,
     /// Filtering arithmetic for 8-bit unorm textures (`--color raw`) with nearest, bilinear,
     /// mip-nearest or trilinear: exact f32, or as GPUs blend unorm8 texels (8-bit sub-texel and
     /// mip weights, each blend rounded to 8 bits; within about a code of exact, and on this CPU
     /// path slower than exact from bilinear on: README.md). sRGB textures, the other filters and
     /// the reference stay exact.
     #[arg(long, value_enum, default_value_t)]
-    pub precision: PrecisionArg,
-}
-
-/// The filtering arithmetic (see texel-raster's `Precision`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum PrecisionArg {
-    /// f32 throughout.
-    #[default]
-    Exact,
-    /// 8-bit weights and 8-bit results per blend, as GPUs filter unorm8 textures.
-    Gpu,
-}
-
-impl From<PrecisionArg> for texel::raster::Precision {
-    fn from(a: PrecisionArg) -> Self {
-        match a {
-            PrecisionArg::Exact => texel::raster::Precision::Exact,
-            PrecisionArg::Gpu => texel::raster::Precision::Gpu,
-        }
-    }
-}
-
-/// Where a sphere mapping is evaluated (see texel-raster's `UvMapping`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SurfaceUvArg {
-    /// The projection of each pixel's position, with its analytic derivatives.
-    Pixel,
-    /// The vertices' uv, interpolated across each triangle.
-    Vertex,
-}
-
-impl From<SurfaceUvArg> for texel::raster::UvEvaluation {
-    fn from(a: SurfaceUvArg) -> Self {
-        match a {
-            SurfaceUvArg::Pixel => texel::raster::UvEvaluation::PerPixel,
-            SurfaceUvArg::Vertex => texel::raster::UvEvaluation::PerVertex,
-        }
-    }
-}
-
-/// An environment map's layout (see texel-texture's `sphere` module).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum EnvironmentMappingArg {
-    /// Latitude-longitude, twice as wide as high.
-    Equirect,
-    /// Six faces with Vulkan's orientation, filtered across their edges.
-    Cube,
-    /// pbrt-v4's equal-area octahedral square.
-    Octahedral,
-}
-
-impl From<EnvironmentMappingArg> for texel_scene::Mapping {
-    fn from(a: EnvironmentMappingArg) -> Self {
-        match a {
-            EnvironmentMappingArg::Equirect => texel_scene::Mapping::Equirect,
-            EnvironmentMappingArg::Cube => texel_scene::Mapping::Cube,
-            EnvironmentMappingArg::Octahedral => texel_scene::Mapping::Octahedral,
-        }
-    }
-}
-
-/// Where a layered material blends (see texel-raster's `layers` module).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum LayerOrderArg {
-    /// Every layer's maps and the mask filtered over the pixel, then blended (a shader's way).
-    FilterThenBlend,
-    /// The layers blended texel by texel at level 0 into baked maps, which are then filtered.
-    BlendThenFilter,
-}
-
-impl From<LayerOrderArg> for texel_scene::LayerOrder {
-    fn from(a: LayerOrderArg) -> Self {
-        match a {
-            LayerOrderArg::FilterThenBlend => texel_scene::LayerOrder::FilterThenBlend,
-            LayerOrderArg::BlendThenFilter => texel_scene::LayerOrder::BlendThenFilter,
-        }
-    }
+    pub precision: texel::raster::Precision,
 }
 
 /// A finite number in `[lo, hi]` of `unit` (the error names both).
@@ -273,57 +160,6 @@ fn parse_edge_px(s: &str) -> Result<f32, String> {
     parse_in(s, 0.25, 256.0, "pixels per edge")
 }
 
-/// How height maps shape the surface (see texel-raster's `Displacement`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum DisplacementArg {
-    /// The height map is not used.
-    None,
-    /// Bump mapping: normals from the height map, flat geometry.
-    Bump,
-    /// Parallax occlusion mapping (Tatarchuk 2006): the view ray marched through the heights.
-    Pom,
-    /// True displacement: the mesh tessellated to --edge-px and its vertices moved by the
-    /// heights, filtered to the edge length.
-    Tessellate,
-}
-
-impl From<DisplacementArg> for texel_scene::Displacement {
-    fn from(a: DisplacementArg) -> Self {
-        match a {
-            DisplacementArg::None => texel_scene::Displacement::None,
-            DisplacementArg::Bump => texel_scene::Displacement::Bump,
-            DisplacementArg::Pom => texel_scene::Displacement::Pom,
-            DisplacementArg::Tessellate => texel_scene::Displacement::Tessellate,
-        }
-    }
-}
-
-/// Specular antialiasing (see texel-raster's `material` module).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SpecularAaArg {
-    /// None: the filtered normal is normalised and used as if exact.
-    None,
-    /// Toksvig (2005): roughness widened by how much the filtered normal shortened.
-    Toksvig,
-    /// LEAN mapping (Olano & Baker 2010): slope moments filtered with the normals; the lobe
-    /// convolved with their covariance (anisotropic).
-    Lean,
-    /// Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021): roughness widened by the
-    /// normal's change to the neighbouring pixels, as GPUs ship it.
-    Projected,
-}
-
-impl From<SpecularAaArg> for texel_raster::SpecularAa {
-    fn from(a: SpecularAaArg) -> Self {
-        match a {
-            SpecularAaArg::None => texel_raster::SpecularAa::None,
-            SpecularAaArg::Toksvig => texel_raster::SpecularAa::Toksvig,
-            SpecularAaArg::Lean => texel_raster::SpecularAa::Lean,
-            SpecularAaArg::Projected => texel_raster::SpecularAa::Projected,
-        }
-    }
-}
-
 /// `texel render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
@@ -337,13 +173,13 @@ pub struct RenderArgs {
     pub lab_mode: Option<u8>,
     /// Texture derivatives.
     #[arg(long, value_enum, default_value_t)]
-    pub derivatives: DerivativesArg,
+    pub derivatives: texel::raster::Derivatives,
     /// Attribute interpolation.
     #[arg(long, value_enum, default_value_t)]
-    pub perspective: PerspectiveArg,
+    pub perspective: texel::raster::Perspective,
     /// What each pixel shows.
     #[arg(long, value_enum, default_value_t)]
-    pub view: ViewArg,
+    pub view: texel::raster::View,
     /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
@@ -410,10 +246,10 @@ pub struct ReferenceArgs {
     pub max_spp: u32,
     /// Half-width of a converged pixel's 95 % interval, in 8-bit steps of the displayed value
     /// (clipped to 0..255, sRGB-encoded unless --color raw), 0 to 255.
-    #[arg(long, default_value_t = crate::cmd_reference::DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
+    #[arg(long, default_value_t = DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
     pub tolerance: f64,
     /// Seed of the jitter; two seeds give independent estimates.
-    #[arg(long, default_value_t = crate::cmd_reference::SEED)]
+    #[arg(long, default_value_t = texel_raster::adaptive::DEFAULT_SEED)]
     pub seed: u64,
     /// Worker threads, 1 to 1024 (default: all cores); the image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
@@ -458,7 +294,7 @@ pub struct CompareArgs {
     pub max_spp: Option<u32>,
     /// With --max-spp: half-width of a converged reference pixel's 95 % interval, in 8-bit steps
     /// of the displayed value, 0 to 255 (also the converged share the report gives).
-    #[arg(long, default_value_t = crate::cmd_reference::DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
+    #[arg(long, default_value_t = DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
     pub tolerance: f64,
     /// An image rendered elsewhere to score against the same reference: LABEL=PATH (repeatable;
     /// labels must differ from each other and from the filters compared).
@@ -551,8 +387,8 @@ pub struct BenchArgs {
     /// larger than the last-level cache in scratch and streams them out with non-temporal
     /// stores (and clears it so); `always` and `never` force either way, to measure the
     /// difference (images are the same).
-    #[arg(long, value_enum, default_value_t = StreamingArg::Auto)]
-    pub streaming: StreamingArg,
+    #[arg(long, value_enum, default_value_t = texel::raster::Streaming::Auto)]
+    pub streaming: texel::raster::Streaming,
     /// Time texel's shaders on a Vulkan or GL device instead (texel-gpu; the filters it has, and
     /// the device's own sampler as `hw-trilinear` and `hw-aniso16` in `--filters`; `all` is all of
     /// them): wall time per frame (submission, rendering, reading the frame back) and, where the
@@ -564,37 +400,6 @@ pub struct BenchArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
-}
-
-/// How frames are written (`texel_raster::Streaming`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum StreamingArg {
-    /// Stream frames larger than the last-level cache.
-    Auto,
-    /// Stream every frame.
-    Always,
-    /// Draw every frame in place.
-    Never,
-}
-
-impl StreamingArg {
-    /// The library's policy for this choice.
-    pub fn policy(self) -> texel_raster::Streaming {
-        match self {
-            StreamingArg::Auto => texel_raster::Streaming::Auto,
-            StreamingArg::Always => texel_raster::Streaming::Always,
-            StreamingArg::Never => texel_raster::Streaming::Never,
-        }
-    }
-
-    /// The name the report prints.
-    pub fn name(self) -> &'static str {
-        match self {
-            StreamingArg::Auto => "auto",
-            StreamingArg::Always => "always",
-            StreamingArg::Never => "never",
-        }
-    }
 }
 
 /// Which instruction-set copy the tile rasterizer and the sampler's batch kernels run
@@ -631,25 +436,6 @@ pub enum TargetArg {
     Rgba8,
     /// Linear RGBA `f32`, 16 bytes a pixel.
     Float,
-}
-
-/// How 8-bit texture bytes and output bytes are interpreted ([`texel::ColorHandling`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum ColorArg {
-    /// Textures marked sRGB are decoded to linear light for filtering; output is sRGB-encoded.
-    #[default]
-    Srgb,
-    /// Every texture's bytes are linear; output bytes are linear (as a GPU sampling plain RGBA8).
-    Raw,
-}
-
-impl From<ColorArg> for texel::ColorHandling {
-    fn from(c: ColorArg) -> Self {
-        match c {
-            ColorArg::Srgb => texel::ColorHandling::Srgb,
-            ColorArg::Raw => texel::ColorHandling::Raw,
-        }
-    }
 }
 
 /// Output size `WIDTHxHEIGHT`, each side 1 to 16384.
@@ -738,7 +524,7 @@ pub struct WarpArgs {
     pub filter: Filter,
     /// Colour handling.
     #[arg(long, value_enum, default_value_t)]
-    pub color: ColorArg,
+    pub color: texel::ColorHandling,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
     #[arg(short, long, value_parser = image_output())]
@@ -752,7 +538,7 @@ pub struct MipsArgs {
     pub texture: PathBuf,
     /// Colour handling: srgb averages in linear light, raw averages the bytes.
     #[arg(long, value_enum, default_value_t)]
-    pub color: ColorArg,
+    pub color: texel::ColorHandling,
     /// Output directory: created, or replaced as a whole if texel wrote it before.
     #[arg(long)]
     pub out: PathBuf,

@@ -10,7 +10,7 @@ use texel::ao::{bake_ao, protected_levels, AoMap, AoMesh, AoSettings};
 use texel::quality::{Encoding, Image8};
 use texel_scene::{load_gltf_with, load_obj_with, Mesh, Scene};
 
-use crate::cli::{BakeAoArgs, ColorArg};
+use crate::cli::BakeAoArgs;
 use crate::input::{scene_limits, Input};
 use crate::output::{is_exr, write_image, write_linear};
 use crate::progress;
@@ -45,7 +45,13 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
     let seconds = started.elapsed().as_secs_f64();
     if is_exr(&args.output) {
         let pixels: Vec<[f32; 4]> = map.values.iter().map(|&v| [v, v, v, 1.0]).collect();
-        write_linear(&args.output, map.size, map.size, &pixels, ColorArg::Raw)?;
+        write_linear(
+            &args.output,
+            map.size,
+            map.size,
+            &pixels,
+            texel::ColorHandling::Raw,
+        )?;
     } else {
         write_image(&args.output, &map_image(&map)?)?;
     }

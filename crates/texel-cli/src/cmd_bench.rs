@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
-use crate::cli::{BenchArgs, PrecisionArg, TargetArg};
+use crate::cli::{BenchArgs, TargetArg};
 use crate::filters::{parse_gpu_list, parse_list, GpuJob};
 use crate::input::{load_scene, Input};
 use crate::threads::{thread_count, with_threads};
@@ -209,7 +209,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     };
     let budget = &mut input.budget;
     texel_raster::limit_level(args.simd.limit());
-    texel_raster::set_streaming(args.streaming.policy());
+    texel_raster::set_streaming(args.streaming);
     let gpu = if args.gpu {
         Some(texel_gpu::Gpu::new(args.adapter.as_deref())?)
     } else {
@@ -356,10 +356,10 @@ fn simd_level() -> String {
 }
 
 /// `--precision`'s value as the bench prints it.
-fn precision_name(p: PrecisionArg) -> &'static str {
+fn precision_name(p: texel::raster::Precision) -> &'static str {
     match p {
-        PrecisionArg::Exact => "exact",
-        PrecisionArg::Gpu => "gpu",
+        texel::raster::Precision::Exact => "exact",
+        texel::raster::Precision::Gpu => "gpu",
     }
 }
 

@@ -16,7 +16,7 @@ use texel_quality::{
 };
 use texel_raster::{render, Frame, ReferencePlan, RenderSettings};
 
-use crate::cli::{ColorArg, CompareArgs};
+use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
 use crate::cmd_reference::{self as reference, reference_estimate, ADAPTIVE_BYTES_PER_PIXEL};
 use crate::filters::{parse_list, Filter};
@@ -498,8 +498,8 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         args.spp,
         args.max_spp.unwrap_or(args.spp),
         args.tolerance,
-        args.scene.color == ColorArg::Srgb,
-        reference::SEED,
+        args.scene.color == texel::ColorHandling::Srgb,
+        texel_raster::adaptive::DEFAULT_SEED,
     )?;
     let scene = load_scene(&args.scene, input)?;
     let frames = if args.gpu {

@@ -12,10 +12,11 @@ use indicatif::ProgressBar;
 use texel_quality::html::escape;
 use texel_quality::{publish_dir, write_atomic, Report};
 
-use crate::cli::{ColorArg, DemoArgs};
+use crate::cli::DemoArgs;
+use crate::cli::DEFAULT_TOLERANCE_STEPS;
 use crate::cmd_bake_ao::{demo_page, DemoAo};
 use crate::cmd_compare::{compare, Extras, COMPARE_BYTES_PER_PIXEL};
-use crate::cmd_reference::{plan, DEFAULT_TOLERANCE_STEPS, SEED};
+use crate::cmd_reference::plan;
 use crate::filters::Filter;
 use crate::input::{load_scene_with, Input};
 use crate::progress;
@@ -50,7 +51,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
             let size = scene_size(args, name)?;
             let scene = load_scene_with(
                 &label,
-                ColorArg::Srgb,
+                texel::ColorHandling::Srgb,
                 size,
                 Default::default(),
                 &mut scene_input,
@@ -135,7 +136,13 @@ fn report_in(
         scene,
         label,
         filters,
-        &plan(spp, spp, DEFAULT_TOLERANCE_STEPS, true, SEED)?,
+        &plan(
+            spp,
+            spp,
+            DEFAULT_TOLERANCE_STEPS,
+            true,
+            texel_raster::adaptive::DEFAULT_SEED,
+        )?,
         &Extras {
             progress: Some(pb.clone()),
             ..Extras::default()
@@ -187,7 +194,7 @@ fn mapping_rows(
         };
         let mut scene = load_scene_with(
             &label,
-            ColorArg::Srgb,
+            texel::ColorHandling::Srgb,
             scene_size(args, scene_name)?,
             Default::default(),
             &mut scene_input,

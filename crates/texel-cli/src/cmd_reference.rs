@@ -7,19 +7,13 @@ use anyhow::{Context, Result};
 use texel_quality::{viridis, Image8};
 use texel_raster::{render_reference_adaptive, ReferenceEstimate, ReferencePlan, ReferenceStatus};
 
-use crate::cli::{ColorArg, ReferenceArgs};
+use crate::cli::ReferenceArgs;
 use crate::filters::Filter;
 use crate::input::{load_scene, Input};
 use crate::interrupt;
 use crate::output::{encoding, write_frame, write_image};
 use crate::progress;
 use texel::PreparedScene;
-
-/// Seed of the reference's jitter: fixed, so references are reproducible.
-pub const SEED: u64 = texel_raster::adaptive::DEFAULT_SEED;
-
-/// `--tolerance`'s default: half an 8-bit step of the displayed value.
-pub const DEFAULT_TOLERANCE_STEPS: f64 = 0.5;
 
 /// A reference plan from the command line's numbers: `min_spp` to `max_spp` samples a pixel,
 /// converged within `tolerance_steps` 8-bit steps of the display (sRGB-encoded when `srgb`), jitter
@@ -91,7 +85,7 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
         args.spp,
         args.max_spp,
         args.tolerance,
-        args.scene.color == ColorArg::Srgb,
+        args.scene.color == texel::ColorHandling::Srgb,
         args.seed,
     )?;
     if let Some(map) = &args.error_map {

@@ -2,9 +2,9 @@
 
 use anyhow::{bail, Result};
 use texel_gpu::{Gpu, GpuFilter};
-use texel_raster::{render, ColorTarget, Derivatives, Perspective, UvEvaluation, View};
+use texel_raster::{render, ColorTarget, Derivatives, UvEvaluation, View};
 
-use crate::cli::{ColorArg, DerivativesArg, PerspectiveArg, RenderArgs, ViewArg};
+use crate::cli::RenderArgs;
 use crate::filters::Filter;
 use crate::input::{load_scene, Input};
 use crate::output::{encoding, is_exr, write_frame};
@@ -30,30 +30,16 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     };
     scene.build_structures_within(&samplers, &mut input.budget)?;
     let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
-    settings.derivatives = match args.derivatives {
-        DerivativesArg::Analytic => Derivatives::Analytic,
-        DerivativesArg::Quad => Derivatives::Quad,
-    };
-    settings.perspective = match args.perspective {
-        PerspectiveArg::Correct => Perspective::Correct,
-        PerspectiveArg::Affine => Perspective::Affine,
-    };
-    settings.view = match args.view {
-        ViewArg::Color => View::Color,
-        ViewArg::Uv => View::Uv,
-        ViewArg::Mip => View::Mip,
-        ViewArg::Lod => View::Lod,
-        ViewArg::Aniso => View::Aniso,
-        ViewArg::Fetches => View::Fetches,
-        ViewArg::Barycentric => View::Barycentric,
-    };
+    settings.derivatives = args.derivatives;
+    settings.perspective = args.perspective;
+    settings.view = args.view;
     // The frame is rendered into the 8-bit target the PNG holds; debug views hold display values
     // meant for sRGB encoding whatever --color says.
     let color = if settings.view == View::Color {
         args.scene.color
     } else {
         settings.target = ColorTarget::Srgb8;
-        ColorArg::Srgb
+        texel::ColorHandling::Srgb
     };
     if is_exr(&args.output) {
         // OpenEXR keeps the colour in float, unclamped.

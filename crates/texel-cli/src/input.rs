@@ -8,7 +8,7 @@ use texel_texture::{ColorSpace, Limits, LoadOptions, TextureError};
 
 use texel_raster::SpecularAa;
 
-use crate::cli::{ColorArg, SceneArgs, Size, SpecularAaArg};
+use crate::cli::{SceneArgs, Size};
 
 /// How a command reads its inputs: the memory account and the non-finite-texel policy.
 pub struct Input {
@@ -21,10 +21,10 @@ pub struct Input {
 impl Input {
     /// How a command-line image is read: `color` for 8-bit data, `--sanitize`, and a memory limit
     /// of what the account has left.
-    pub fn texture_options(&self, color: ColorArg) -> LoadOptions {
+    pub fn texture_options(&self, color: texel::ColorHandling) -> LoadOptions {
         let color = match color {
-            ColorArg::Srgb => ColorSpace::Srgb,
-            ColorArg::Raw => ColorSpace::Linear,
+            texel::ColorHandling::Srgb => ColorSpace::Srgb,
+            texel::ColorHandling::Raw => ColorSpace::Linear,
         };
         LoadOptions {
             replace_non_finite: self.sanitize,
@@ -126,14 +126,14 @@ impl MaterialOverrides {
     /// The overrides a command's [`SceneArgs`] give.
     pub fn of(args: &SceneArgs) -> Self {
         MaterialOverrides {
-            specular_aa: args.specular_aa.map(SpecularAaArg::into),
+            specular_aa: args.specular_aa,
             shading_samples: args.shading_samples,
-            displacement: args.displacement.map(Into::into),
+            displacement: args.displacement,
             edge_px: args.edge_px,
-            layer_order: args.layer_order.map(Into::into),
-            environment_mapping: args.environment_mapping.map(Into::into),
-            surface_uv: args.surface_uv.map(Into::into),
-            precision: args.precision.into(),
+            layer_order: args.layer_order,
+            environment_mapping: args.environment_mapping,
+            surface_uv: args.surface_uv,
+            precision: args.precision,
         }
     }
 }
@@ -142,7 +142,7 @@ impl MaterialOverrides {
 /// `color` handling, an output `size` and the material `overrides`.
 pub fn load_scene_with(
     scene: &str,
-    color: ColorArg,
+    color: texel::ColorHandling,
     size: Option<Size>,
     overrides: MaterialOverrides,
     input: &mut Input,
@@ -175,7 +175,7 @@ pub fn load_scene_with(
     })?;
     let options = SceneOptions {
         size: size.map(|s| (s.width, s.height)),
-        color: color.into(),
+        color,
         replace_non_finite: input.sanitize,
         specular_aa: overrides.specular_aa,
         shading_samples: overrides.shading_samples,

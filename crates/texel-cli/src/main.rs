@@ -14,6 +14,7 @@ mod cmd_mips;
 mod cmd_reference;
 mod cmd_render;
 mod cmd_warp;
+mod controls;
 mod filters;
 mod input;
 mod interrupt;

@@ -11,8 +11,6 @@ use texel_quality::{Encoding, Image8};
 use texel::ColorHandling;
 use texel_raster::Frame;
 
-use crate::cli::ColorArg;
-
 /// The 8-bit encoding `--color` asks for: sRGB-encoded RGB, or raw `round(255 x)`.
 pub fn encoding(color: impl Into<ColorHandling>) -> Encoding {
     match color.into() {
@@ -83,7 +81,7 @@ pub fn write_linear(
     width: u32,
     height: u32,
     pixels: &[[f32; 4]],
-    color: ColorArg,
+    color: texel::ColorHandling,
 ) -> Result<()> {
     if is_exr(path) {
         return write_exr(path, width, height, pixels);

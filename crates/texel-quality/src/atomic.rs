@@ -34,7 +34,7 @@ use std::time::SystemTime;
 use image::ImageEncoder;
 
 use crate::error::QualityError;
-use crate::image8::check_data_len;
+use crate::size::check_data_len;
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 

@@ -11,7 +11,7 @@ use std::path::Path;
 use texel_texture::base::color::{rgba_to_srgb8, rgba_to_unorm8};
 
 use crate::error::QualityError;
-use crate::MAX_SIDE;
+use crate::size::{check_data_len, checked_len, MAX_SIDE};
 
 /// How linear RGBA floats become 8-bit display values.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -39,41 +39,6 @@ pub struct Image8 {
     width: u32,
     height: u32,
     pixels: Vec<[u8; 4]>,
-}
-
-/// Check `width x height` against the size rules and return the pixel count.
-pub(crate) fn checked_len(width: u32, height: u32) -> Result<usize, QualityError> {
-    if width == 0 || height == 0 {
-        return Err(QualityError::EmptyImage { width, height });
-    }
-    if width > MAX_SIDE || height > MAX_SIDE {
-        return Err(QualityError::TooLarge {
-            width,
-            height,
-            max: MAX_SIDE,
-        });
-    }
-    Ok(width as usize * height as usize)
-}
-
-/// [`checked_len`], then that `got` elements are `per_pixel` for each of the `width * height`
-/// pixels ([`QualityError::DataLength`] otherwise). Returns the pixel count.
-pub(crate) fn check_data_len(
-    width: u32,
-    height: u32,
-    per_pixel: usize,
-    got: usize,
-) -> Result<usize, QualityError> {
-    let n = checked_len(width, height)?;
-    if got != per_pixel * n {
-        return Err(QualityError::DataLength {
-            width,
-            height,
-            expected: per_pixel * n,
-            got,
-        });
-    }
-    Ok(n)
 }
 
 pub(crate) fn check_same(a: (u32, u32), b: (u32, u32)) -> Result<(), QualityError> {

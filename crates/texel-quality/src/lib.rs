@@ -49,11 +49,11 @@ mod mask;
 mod psnr;
 mod report;
 mod scores;
+mod size;
 pub mod ssim;
 mod uncertainty;
 
-/// The largest image side, in pixels, any function here accepts (16384, the common GPU limit).
-pub const MAX_SIDE: u32 = 16384;
+pub use size::MAX_SIDE;
 
 pub use atomic::{
     encode_exr, publish_dir, remove_pending_and_exit, write_atomic, write_exr_atomic,

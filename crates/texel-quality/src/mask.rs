@@ -1,7 +1,7 @@
 //! [`Mask`]: which pixels a measurement averages over (usually the geometry's coverage).
 
 use crate::error::QualityError;
-use crate::image8::{check_data_len, checked_len};
+use crate::size::{check_data_len, checked_len};
 
 /// A row-major boolean image; `true` pixels are measured. Sides are `1..=MAX_SIDE`.
 #[derive(Clone, Debug, PartialEq, Eq)]

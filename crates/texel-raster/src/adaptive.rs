@@ -259,7 +259,9 @@ pub fn render_reference_adaptive(
     if !valid {
         return Err(RasterError::InvalidReferencePlan {
             min_spp: plan.min_spp,
+            min_max: max_min,
             max_spp: plan.max_spp,
+            max_max: MAX_ADAPTIVE_SPP,
             tolerance: plan.tolerance,
         });
     }

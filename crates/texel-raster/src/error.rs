@@ -95,14 +95,16 @@ pub enum RasterError {
     /// A converging reference's plan is outside its ranges.
     #[error(
         "reference plan is invalid: min_spp {min_spp} must be in 1..={min_max}, max_spp {max_spp} in min_spp..={max_max}, tolerance {tolerance} finite and not negative",
-        min_max = crate::reference::MAX_SPP_SIDE * crate::reference::MAX_SPP_SIDE,
-        max_max = crate::adaptive::MAX_ADAPTIVE_SPP
     )]
     InvalidReferencePlan {
         /// The minimum samples per pixel asked for.
         min_spp: u32,
+        /// The largest minimum allowed (`MAX_SPP_SIDE^2`).
+        min_max: u32,
         /// The maximum samples per pixel asked for.
         max_spp: u32,
+        /// The largest maximum allowed (`MAX_ADAPTIVE_SPP`).
+        max_max: u32,
         /// The tolerance asked for.
         tolerance: f64,
     },

@@ -26,7 +26,7 @@
 use glam::{Vec3, Vec4};
 use texel_texture::{Footprint, Format, Sampler};
 
-use crate::material::{read, read_channel, ChannelInput, MomentMap, TextureInput};
+use crate::inputs::{read, read_channel, ChannelInput, MomentMap, TextureInput};
 
 /// The most layers a material has (one per mask channel).
 pub const MAX_LAYERS: usize = 4;

@@ -48,6 +48,7 @@ mod draw;
 pub mod environment;
 mod error;
 mod frame;
+mod inputs;
 pub mod interp;
 pub mod layers;
 pub mod material;

@@ -31,8 +31,10 @@
 //! interpolated vertex normal.
 
 use glam::{Vec3, Vec4};
-use texel_texture::{Footprint, Sampler, Texture};
+use texel_texture::{Footprint, Texture};
 
+use crate::inputs::read_channel;
+pub use crate::inputs::{ChannelInput, MomentMap, TextureInput};
 use crate::layers::Layers;
 
 /// The most lights a frame has (as fixed-function GPUs had 8).
@@ -91,10 +93,15 @@ impl Light {
 
 /// How the specular lobe is widened where the normal varies within a pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum SpecularAa {
     /// None: the filtered normal is normalised and used as if it were exact (sparkles and aliases
     /// at a distance).
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "None: the filtered normal is normalised and used as if exact.")
+    )]
     None,
     /// Toksvig (2005): the filtered (averaged) tangent-space normal is shorter than 1 where the
     /// normals under the footprint disagree. With `|n|` its length and the Blinn-Phong exponent
@@ -102,6 +109,12 @@ pub enum SpecularAa {
     /// `s' = s |n| / (|n| + s (1 - |n|))`, i.e. `alpha'^2 = 2 / (s' + 2)`. The widening is taken
     /// as an isotropic slope variance `(alpha'^2 - alpha^2) / 2` about the mean normal and shaped
     /// by [`SlopeSpread::d`].
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Toksvig (2005): roughness widened by how much the filtered normal shortened."
+        )
+    )]
     Toksvig,
     /// LEAN mapping (Olano & Baker 2010): the map's slopes `b = (n_x, n_y) / n_z` and their second
     /// moments `(b_x^2, b_y^2, b_x b_y)` are stored in float textures ([`lean_map`]) and filtered
@@ -113,6 +126,12 @@ pub enum SpecularAa {
     /// mean of the clamped cosine over the spread ([`SlopeSpread::clamped_cosine`]). Needs
     /// [`Material::lean`] for a normal map, or [`Material::height_moments`] for a height map
     /// (whose slopes are the height's gradient).
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "LEAN mapping (Olano & Baker 2010): slope moments filtered with the normals; the lobe convolved with their covariance (anisotropic)."
+        )
+    )]
     Lean,
     /// Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021, "Stable Geometric Specular
     /// Antialiasing with Projected-Space NDF Filtering", JCGT 10(2), eq. 14 and listing 5), what
@@ -122,6 +141,12 @@ pub enum SpecularAa {
     /// `alpha'^2 = min(1, alpha^2 + min(sigma^2 (|dn/dx|^2 + |dn/dy|^2), kappa))` with the paper's
     /// clamp `kappa = 0.18`. Covers normal maps, bump maps and curved geometry alike, at the price
     /// of two more normal evaluations. The lobe stays the widened GGX, as the paper ships it.
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021): roughness widened by the normal's change to the neighbouring pixels, as GPUs ship it."
+        )
+    )]
     Projected,
 }
 
@@ -142,24 +167,6 @@ pub enum Displacement {
     /// and every map is read where it meets the relief; the normal is bump mapping's at that
     /// point. Silhouettes and self-shadowing are not modelled.
     Pom,
-}
-
-/// A texture read through a sampler (a material's map).
-#[derive(Clone, Copy, Debug)]
-pub struct TextureInput<'a> {
-    /// The texture.
-    pub texture: &'a Texture,
-    /// How it is filtered (normally the same filter as the draw's colour texture).
-    pub sampler: &'a Sampler,
-}
-
-/// One channel of a texture read through a sampler (`0` red ... `3` alpha), multiplying a factor.
-#[derive(Clone, Copy, Debug)]
-pub struct ChannelInput<'a> {
-    /// The texture and its sampler.
-    pub input: TextureInput<'a>,
-    /// The channel read, `0..=3`.
-    pub channel: usize,
 }
 
 /// A draw's material. The base colour texture is the draw call's own texture; everything here
@@ -575,63 +582,6 @@ pub fn radiance(surface: &Surface, eye: Vec3, lights: &[Light], lambert: bool) -
 /// surface normal): grazing map normals would make the moments explode.
 pub const LEAN_MAX_SLOPE: f32 = 16.0;
 
-/// A slope moment map ([`lean_map`], [`height_moments`]): the first and second moments of a
-/// normal or height map's slopes `m`, in two float textures with their own pyramids, read through
-/// the map's sampler. Every filter is linear in its texels, so averaged over a footprint they
-/// give the mean slope and the slopes' covariance under it (Olano & Baker 2010).
-#[derive(Debug)]
-pub struct MomentMap {
-    /// `[m_x, m_y, m_x^2, m_y^2]`.
-    pub moments: Texture,
-    /// `[m_x m_y, 0, 0, 0]`: the cross moment, which orients the covariance.
-    pub cross: Texture,
-}
-
-impl MomentMap {
-    /// The moment map of level-0 slopes `slope(i, j)` over a `w x h` map.
-    ///
-    /// # Errors
-    /// The size errors of `Texture::from_fn` for a float texture of that size.
-    pub fn from_slopes(
-        w: u32,
-        h: u32,
-        limits: &texel_texture::Limits,
-        slope: impl Fn(u32, u32) -> glam::Vec2,
-    ) -> Result<MomentMap, texel_texture::TextureError> {
-        let format = texel_texture::Format::Rgba32Float;
-        let moments = Texture::from_fn(w, h, format, limits, |i, j| {
-            let b = slope(i, j);
-            [b.x, b.y, b.x * b.x, b.y * b.y]
-        })?;
-        let cross = Texture::from_fn(w, h, format, limits, |i, j| {
-            let b = slope(i, j);
-            [b.x * b.y, 0.0, 0.0, 0.0]
-        })?;
-        Ok(MomentMap { moments, cross })
-    }
-
-    /// Bytes the texels of both pyramids occupy.
-    pub fn pyramid_bytes(&self) -> u64 {
-        self.moments.pyramid_bytes() + self.cross.pyramid_bytes()
-    }
-
-    /// The filtered moments `[m_x, m_y, m_x^2, m_y^2, m_x m_y]` at `fp` through `sampler`, adding
-    /// the texels read to `texels` when `count`.
-    pub(crate) fn read(
-        &self,
-        sampler: &Sampler,
-        fp: &Footprint,
-        count: bool,
-        texels: &mut u32,
-    ) -> [f32; 5] {
-        let at =
-            |texture, texels: &mut u32| read(&TextureInput { texture, sampler }, fp, count, texels);
-        let e = at(&self.moments, texels);
-        let c = at(&self.cross, texels);
-        [e[0], e[1], e[2], e[3], c[0]]
-    }
-}
-
 /// The LEAN moment map of a tangent-space normal map (Olano & Baker 2010): the moments of
 /// `b = (n_x, n_y) / n_z` for each level-0 texel's normal `n = normalize(2 rgb - 1)` (slopes
 /// clamped to [`LEAN_MAX_SLOPE`]).
@@ -724,32 +674,6 @@ pub fn height_moments(
             (at(i, j + 1) - h0) * h as f32,
         )
     })
-}
-
-/// Read `input` at `fp`, adding the texels read to `texels` when `count`.
-pub(crate) fn read(
-    input: &TextureInput,
-    fp: &Footprint,
-    count: bool,
-    texels: &mut u32,
-) -> [f32; 4] {
-    if count {
-        let (t, n) = input.sampler.sample_counted(input.texture, fp);
-        *texels += n;
-        t
-    } else {
-        input.sampler.sample(input.texture, fp)
-    }
-}
-
-/// One channel of `input` at `fp`, adding the texels read to `texels` when `count`.
-pub(crate) fn read_channel(
-    input: &ChannelInput,
-    fp: &Footprint,
-    count: bool,
-    texels: &mut u32,
-) -> f32 {
-    read(&input.input, fp, count, texels)[input.channel]
 }
 
 #[cfg(test)]

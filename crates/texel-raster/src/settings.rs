@@ -16,61 +16,96 @@ pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// How the screen-space derivatives of `uv` handed to the sampler are computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Derivatives {
     /// Exact derivatives of the perspective-correct `uv` at the pixel centre, from the plane
     /// equations: with `q = u/w` and `r = 1/w`, `du/dx = (q_x r - q r_x) / r^2` (conventions.md).
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Exact derivatives from the triangle's plane equations.")
+    )]
     Analytic,
     /// GPU-style differences over aligned 2x2 quads ("fine" derivatives, D3D `ddx_fine`): for a pixel
     /// in quad row `y`, `du/dx = u(right, y) - u(left, y)`; for quad column `x`,
     /// `du/dy = u(x, bottom) - u(x, top)`. Pixels of the quad outside the triangle (helper pixels)
     /// are evaluated from the same plane equations.
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Differences within 2x2 pixel quads, as GPUs compute them.")
+    )]
     Quad,
 }
 
 /// How attributes are interpolated across a triangle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Perspective {
     /// Perspective-correct: `a/w` and `1/w` are linear in screen space, `a = (a/w) / (1/w)`.
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Perspective-correct (interpolate a/w and 1/w).")
+    )]
     Correct,
     /// Affine (screen-space linear) interpolation of the attributes of each clipped triangle: the
     /// "incorrect" image of the lectures (textures swim and bend). Depth stays correct.
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Affine in screen space (the lectures' incorrect image).")
+    )]
     Affine,
 }
 
 /// What each pixel shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum View {
     /// Texture colour times vertex colour, optionally lit (the normal image).
     #[default]
+    #[cfg_attr(feature = "clap", value(help = "The textured image."))]
     Color,
     /// `fract(u)` in red, `fract(v)` in green (as displayed: 8-bit red = `fract(u) * 255`).
+    #[cfg_attr(feature = "clap", value(help = "fract(u) in red, fract(v) in green."))]
     Uv,
     /// The integer mip level the nearest-level rule reads (`ceil(lod + 1/2) - 1`), one colour per
     /// level from [`crate::views::MIP_PALETTE`].
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Integer mip level, one colour per level.")
+    )]
     Mip,
     /// The continuous lod: the palette of [`View::Mip`] interpolated between integer levels.
+    #[cfg_attr(feature = "clap", value(help = "Continuous level of detail."))]
     Lod,
     /// The footprint's anisotropy `|Pmax| / |Pmin|` on a colour ramp, 1 to 16 on a log2 scale.
+    #[cfg_attr(feature = "clap", value(help = "Footprint anisotropy ratio."))]
     Aniso,
     /// Texels the filter read for the pixel, as a heat map (log2 scale, see [`crate::views`]).
     /// Turns on texel counting.
+    #[cfg_attr(feature = "clap", value(help = "Texels read per pixel (heat map)."))]
     Fetches,
     /// The perspective-correct barycentric weights of the original (unclipped) triangle as RGB.
+    #[cfg_attr(feature = "clap", value(help = "Barycentric weights as RGB."))]
     Barycentric,
 }
 
 /// How the colour view filters textures stored as 8-bit unorm (`Rgba8Unorm`) with the core
 /// filters (nearest or bilinear within a level, any mipmap filter).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Precision {
     /// `f32` throughout: texels decoded to floats, exact weights, one encode at the end.
     #[default]
+    #[cfg_attr(feature = "clap", value(help = "f32 throughout."))]
     Exact,
     /// As GPUs filter unorm8 texels: 8-bit sub-texel and mip weights and a rounding to 8 bits
     /// per blend ([`texel_texture::kernel::fixed8`]; the CLI's `--precision gpu`). Other textures, other
     /// filters and the reference keep [`Precision::Exact`].
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "8-bit weights and 8-bit results per blend, as GPUs filter unorm8 textures.")
+    )]
     Gpu,
 }
 

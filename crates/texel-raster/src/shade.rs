@@ -416,7 +416,7 @@ fn shade_grid(
                 dvdy: fp.dvdy * sy,
             };
             let l = lambda + dlambda[0] * f64::from(ox) + dlambda[1] * f64::from(oy);
-            let tex = material::read(&base, &fp, count, &mut texels);
+            let tex = crate::inputs::read(&base, &fp, count, &mut texels);
             let (c, t, _) = shade_once(ctx, verts, l, dl, tex, &fp, lighting, count, false);
             sum += Vec4::from_array(c);
             texels += t;
@@ -495,7 +495,7 @@ fn shade_once(
                 texture: ctx.texture,
                 sampler: ctx.sampler,
             };
-            tex = material::read(&base, &fp, count, &mut texels);
+            tex = crate::inputs::read(&base, &fp, count, &mut texels);
         }
     }
     let needs = Needs {
@@ -515,14 +515,14 @@ fn shade_once(
     }
     let mut metallic = m.metallic;
     if let Some(map) = &m.roughness_map {
-        roughness *= material::read_channel(map, &fp, count, &mut texels);
+        roughness *= crate::inputs::read_channel(map, &fp, count, &mut texels);
     }
     if let Some(map) = &m.metallic_map {
-        metallic *= material::read_channel(map, &fp, count, &mut texels);
+        metallic *= crate::inputs::read_channel(map, &fp, count, &mut texels);
     }
     let mut occlusion = 1.0;
     if let Some(map) = m.occlusion_map.as_ref().filter(|_| lighting.ambient) {
-        let ao = material::read_channel(map, &fp, count, &mut texels);
+        let ao = crate::inputs::read_channel(map, &fp, count, &mut texels);
         occlusion = (1.0 + m.occlusion_strength * (ao - 1.0)).clamp(0.0, 1.0);
     }
     let mut shading = relief::shading_normal(

@@ -19,15 +19,33 @@ use std::sync::OnceLock;
 /// How draws write frames: whether [`crate::Frame::reset`] and a draw into a frame that holds
 /// its clear use non-temporal stores. Process-wide ([`set_streaming`]); images do not depend on it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Streaming {
     /// Stream frames larger than the last-level cache ([`last_level_cache_bytes`]): frames that
     /// fit in the cache draw no faster streamed, larger ones do (figures in docs/decisions.md).
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Stream frames larger than the last-level cache.")
+    )]
     Auto,
     /// Stream every frame (for measuring: a frame that fits the cache draws slower this way).
+    #[cfg_attr(feature = "clap", value(help = "Stream every frame."))]
     Always,
     /// Never stream: tiles draw in place into the frame.
+    #[cfg_attr(feature = "clap", value(help = "Draw every frame in place."))]
     Never,
+}
+
+impl Streaming {
+    /// The policy's name, as reports and the command line write it: `auto`, `always`, `never`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Streaming::Auto => "auto",
+            Streaming::Always => "always",
+            Streaming::Never => "never",
+        }
+    }
 }
 
 /// The process-wide policy, as its index in `[Auto, Always, Never]`.

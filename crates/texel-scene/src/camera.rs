@@ -2,6 +2,12 @@
 
 use glam::{Mat4, Vec3};
 
+/// The narrowest vertical field of view a camera may have, in degrees. At 0.01 degrees a pixel of
+/// a 4096-row image subtends 4.3e-8 radians, about f32's relative precision (6e-8), so view
+/// coordinates still place a point within about a pixel; narrower views quantise the image into
+/// blocks of pixels and, far narrower, overflow the projection and draw nothing. They are refused.
+pub const MIN_FOVY_DEG: f32 = 0.01;
+
 /// A perspective camera looking from `eye` towards `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {

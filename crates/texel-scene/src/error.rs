@@ -62,7 +62,7 @@ pub enum SceneError {
         far: f32,
     },
     /// `fovy_deg` outside `[MIN_FOVY_DEG, 180)`.
-    #[error("camera fovy_deg = {0}: must be at least {min} degrees (f32 view coordinates do not resolve a narrower view) and below 180", min = crate::validate::MIN_FOVY_DEG)]
+    #[error("camera fovy_deg = {0}: must be at least {min} degrees (f32 view coordinates do not resolve a narrower view) and below 180", min = crate::camera::MIN_FOVY_DEG)]
     CameraFov(f32),
     /// `eye == target`, or `up` parallel to the view direction (or zero).
     #[error("camera eye {eye:?}, target {target:?}, up {up:?} do not define a view: eye must differ from target and up must not be parallel to the view direction")]

@@ -43,7 +43,7 @@ mod procedural;
 mod tangents;
 mod texture;
 mod validate;
-pub use validate::MIN_FOVY_DEG;
+pub use camera::MIN_FOVY_DEG;
 
 pub use builtin::{
     builtin, builtin_names, knot_mesh, shaded_builtin_names, GLOSSY_TOML, GROUND_ROTATION_DEG,

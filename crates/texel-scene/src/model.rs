@@ -116,15 +116,33 @@ impl ScalarInput {
 
 /// How a material's height map displaces the surface (`displacement = ...`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Displacement {
     /// `"none"`.
     #[default]
+    #[cfg_attr(feature = "clap", value(help = "The height map is not used."))]
     None,
     /// `"bump"`: normals from the height map.
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Bump mapping: normals from the height map, flat geometry.")
+    )]
     Bump,
     /// `"pom"`: parallax occlusion mapping.
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Parallax occlusion mapping (Tatarchuk 2006): the view ray marched through the heights."
+        )
+    )]
     Pom,
     /// `"tessellate"`: true displacement of tessellated geometry.
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "True displacement: the mesh tessellated to --edge-px and its vertices moved by the heights, filtered to the edge length."
+        )
+    )]
     Tessellate,
 }
 
@@ -246,13 +264,26 @@ pub enum LayerBlendSpec {
 
 /// Where a layered material's blend happens relative to texture filtering (`layer_order = ...`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum LayerOrder {
     /// `"filter-then-blend"`: every map is filtered over the pixel's footprint, then the
     /// filtered values are blended (what a shader does).
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Every layer's maps and the mask filtered over the pixel, then blended (a shader's way)."
+        )
+    )]
     FilterThenBlend,
     /// `"blend-then-filter"`: the layers are blended texel by texel at level 0 into one set of
     /// maps when the scene is prepared, and those are filtered (a baked material).
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "The layers blended texel by texel at level 0 into baked maps, which are then filtered."
+        )
+    )]
     BlendThenFilter,
 }
 

@@ -2,6 +2,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::camera::MIN_FOVY_DEG;
 use crate::error::SceneError;
 use crate::model::{
     ColorInput, Displacement, LightSpec, MaterialSpec, ScalarInput, Scene, MAX_LAYERS,
@@ -34,12 +35,6 @@ fn finite_all<T: Copy>(
         }),
     }
 }
-
-/// The narrowest vertical field of view a camera may have, in degrees. At 0.01 degrees a pixel of
-/// a 4096-row image subtends 4.3e-8 radians, about f32's relative precision (6e-8), so view
-/// coordinates still place a point within about a pixel; narrower views quantise the image into
-/// blocks of pixels and, far narrower, overflow the projection and draw nothing. They are refused.
-pub const MIN_FOVY_DEG: f32 = 0.01;
 
 impl Scene {
     /// Check everything a renderer relies on:

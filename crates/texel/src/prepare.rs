@@ -30,11 +30,24 @@ const _: () =
 
 /// How 8-bit texture bytes and output bytes are interpreted (the CLI's `--color`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ColorHandling {
     /// Textures marked sRGB are decoded to linear light for filtering; output is sRGB-encoded.
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Textures marked sRGB are decoded to linear light for filtering; output is sRGB-encoded."
+        )
+    )]
     Srgb,
     /// Every texture's bytes are linear and output bytes are linear (a GPU sampling plain RGBA8).
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Every texture's bytes are linear; output bytes are linear (as a GPU sampling plain RGBA8)."
+        )
+    )]
     Raw,
 }
 

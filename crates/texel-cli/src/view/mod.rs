@@ -7,7 +7,6 @@
 //!   the accumulating reference, HUD statistics);
 //! - [`window`]: winit's event loop and softbuffer's surface.
 
-pub mod controls;
 pub mod fly;
 pub mod hud;
 pub mod window;
@@ -20,8 +19,8 @@ use texel_gpu::Gpu;
 use winit::event_loop::EventLoop;
 
 use crate::cli::ViewArgs;
+use crate::controls::{parse_keys, Mode, ViewState};
 use crate::input::{load_scene, Input};
-use controls::{parse_keys, Mode, ViewState};
 use fly::Fly;
 use window::{App, Options};
 use worker::{Rendered, Shared, Worker};

@@ -17,11 +17,10 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow};
 use winit::keyboard::{KeyCode, ModifiersState, PhysicalKey};
 use winit::window::{Window, WindowId};
 
-use super::controls::{key_table, view_name, Effect, Key, Mode, Press, ViewState};
 use super::fly::{Fly, Motion};
 use super::hud::{scale_for, Canvas};
 use super::worker::{part_rects, Rendered, Request, Shared, MAX_REFERENCE_SAMPLES};
-use crate::cli::ColorArg;
+use crate::controls::{key_table, view_name, Effect, Key, Mode, Press, ViewState};
 
 /// How long after the last movement the camera counts as still (then frames refine).
 const SETTLE: Duration = Duration::from_millis(200);
@@ -359,8 +358,8 @@ impl App {
             },
             self.state.lod_bias,
             match self.state.color {
-                ColorArg::Srgb => "sRGB",
-                ColorArg::Raw => "raw",
+                texel::ColorHandling::Srgb => "sRGB",
+                texel::ColorHandling::Raw => "raw",
             },
             self.fly.camera.fovy_deg,
         ));

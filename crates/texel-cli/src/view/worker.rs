@@ -30,8 +30,8 @@ use texel_raster::{
     draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, RenderSettings, View,
 };
 
-use super::controls::{Mode, ViewState};
-use crate::cli::ColorArg;
+use crate::controls::{Mode, ViewState};
+
 use crate::input::{load_scene_with, Input};
 use crate::output::encoding;
 
@@ -180,7 +180,7 @@ pub struct Worker {
     pub size: Option<crate::cli::Size>,
     /// `--specular-aa` and `--displacement`, passed on to reloads.
     pub overrides: crate::input::MaterialOverrides,
-    /// The scene as loaded for each colour handling (index: `ColorArg as usize`).
+    /// The scene as loaded for each colour handling (index: `texel::ColorHandling as usize`).
     pub scenes: [Option<PreparedScene>; 2],
     /// Memory account and input policy.
     pub input: Input,
@@ -338,7 +338,7 @@ pub fn part_rects(state: &ViewState, w: u32, h: u32) -> Vec<[u32; 4]> {
 }
 
 impl FrameContext<'_, '_> {
-    fn scene(&mut self, color: ColorArg) -> Result<&PreparedScene> {
+    fn scene(&mut self, color: texel::ColorHandling) -> Result<&PreparedScene> {
         let w = &mut *self.worker;
         let slot = color as usize;
         if w.scenes[slot].is_none() {
@@ -796,7 +796,7 @@ mod tests {
             });
             let scene = load_scene_with(
                 "builtin:ground",
-                ColorArg::Srgb,
+                texel::ColorHandling::Srgb,
                 size,
                 Default::default(),
                 &mut input,
@@ -838,8 +838,9 @@ mod tests {
         }
 
         fn request(&self, keys: &str, moving: bool) -> Request {
-            let mut state = ViewState::new(Mode::Filter(Filter::Trilinear), ColorArg::Srgb);
-            for p in crate::view::controls::parse_keys(keys).unwrap() {
+            let mut state =
+                ViewState::new(Mode::Filter(Filter::Trilinear), texel::ColorHandling::Srgb);
+            for p in crate::controls::parse_keys(keys).unwrap() {
                 state.apply(p);
             }
             let scene = self.worker.scenes[0].as_ref().unwrap();
@@ -1034,7 +1035,7 @@ mod tests {
 
     #[test]
     fn halves_meet_at_the_divider() {
-        let mut s = ViewState::new(Mode::Reference, ColorArg::Srgb);
+        let mut s = ViewState::new(Mode::Reference, texel::ColorHandling::Srgb);
         assert_eq!(part_rects(&s, 100, 50), vec![[0, 0, 100, 50]]);
         s.split = true;
         s.divider = 0.3;

@@ -25,13 +25,26 @@ use glam::{DVec2, DVec3};
 
 /// The environment-map layouts.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Mapping {
     /// Latitude-longitude, one image twice as wide as high.
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Latitude-longitude, twice as wide as high.")
+    )]
     Equirect,
     /// Six square faces ([`cube_face`]).
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "Six faces with Vulkan's orientation, filtered across their edges.")
+    )]
     Cube,
     /// One square image ([`octahedral_uv`]).
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "pbrt-v4's equal-area octahedral square.")
+    )]
     Octahedral,
 }
 

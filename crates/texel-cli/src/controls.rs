@@ -5,8 +5,6 @@
 use texel::Filter;
 use texel_raster::{Derivatives, Perspective, View};
 
-use crate::cli::ColorArg;
-
 /// What one half of the screen (or the whole screen) shows: a filter, or the progressive
 /// supersampled reference.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -174,7 +172,7 @@ pub struct ViewState {
     /// Added to every sampler's lod (`SamplerDescriptor::lod_bias`), in `[-MAX_BIAS, MAX_BIAS]`.
     pub lod_bias: f32,
     /// Colour handling of textures and output.
-    pub color: ColorArg,
+    pub color: texel::ColorHandling,
     /// Heads-up display (and the divider line) shown.
     pub hud: bool,
     /// The key table shown.
@@ -226,7 +224,7 @@ pub enum Effect {
 impl ViewState {
     /// The start: `mode` on the whole screen (trilinear on the right when split), colour view,
     /// perspective-correct, analytic derivatives, no bias, HUD on.
-    pub fn new(mode: Mode, color: ColorArg) -> ViewState {
+    pub fn new(mode: Mode, color: texel::ColorHandling) -> ViewState {
         ViewState {
             left: mode,
             right: Mode::Filter(Filter::Trilinear),
@@ -289,8 +287,8 @@ impl ViewState {
             Key::BracketRight => self.lod_bias = (self.lod_bias + 0.5).min(MAX_BIAS),
             Key::Letter('c') => {
                 self.color = match self.color {
-                    ColorArg::Srgb => ColorArg::Raw,
-                    ColorArg::Raw => ColorArg::Srgb,
+                    texel::ColorHandling::Srgb => texel::ColorHandling::Raw,
+                    texel::ColorHandling::Raw => texel::ColorHandling::Srgb,
                 }
             }
             Key::Letter('h') => self.help = !self.help,
@@ -327,7 +325,7 @@ impl ViewState {
         if self.lod_bias != 0.0 {
             s.push_str(&format!("-bias{:+.1}", self.lod_bias));
         }
-        if self.color == ColorArg::Raw {
+        if self.color == texel::ColorHandling::Raw {
             s.push_str("-raw");
         }
         s.push_str(".png");
@@ -409,7 +407,7 @@ mod tests {
 
     #[test]
     fn digits_are_the_lab_modes_and_the_other_filter_keys() {
-        let mut s = ViewState::new(Mode::Filter(Filter::Nearest), ColorArg::Srgb);
+        let mut s = ViewState::new(Mode::Filter(Filter::Nearest), texel::ColorHandling::Srgb);
         for d in 1..=8u8 {
             assert_eq!(s.apply(press(Key::Digit(d))), Effect::None);
             assert_eq!(s.left, Mode::Filter(Filter::from_lab_mode(d).unwrap()));
@@ -431,7 +429,7 @@ mod tests {
 
     #[test]
     fn shift_sets_the_right_half_and_tab_toggles_the_split() {
-        let mut s = ViewState::new(Mode::Filter(Filter::Trilinear), ColorArg::Srgb);
+        let mut s = ViewState::new(Mode::Filter(Filter::Trilinear), texel::ColorHandling::Srgb);
         s.apply(shift(Key::Digit(8)));
         assert!(s.split);
         assert_eq!(s.left, Mode::Filter(Filter::Trilinear));
@@ -446,7 +444,7 @@ mod tests {
 
     #[test]
     fn v_cycles_every_view_both_ways() {
-        let mut s = ViewState::new(Mode::Reference, ColorArg::Srgb);
+        let mut s = ViewState::new(Mode::Reference, texel::ColorHandling::Srgb);
         let mut seen = vec![s.view];
         for _ in 0..VIEWS.len() - 1 {
             s.apply(press(Key::Letter('v')));
@@ -461,7 +459,7 @@ mod tests {
 
     #[test]
     fn toggles_bias_and_effects() {
-        let mut s = ViewState::new(Mode::Reference, ColorArg::Srgb);
+        let mut s = ViewState::new(Mode::Reference, texel::ColorHandling::Srgb);
         s.apply(press(Key::Letter('p')));
         assert_eq!(s.perspective, Perspective::Affine);
         s.apply(press(Key::Letter('p')));
@@ -469,7 +467,7 @@ mod tests {
         s.apply(press(Key::Letter('q')));
         assert_eq!(s.derivatives, Derivatives::Quad);
         s.apply(press(Key::Letter('c')));
-        assert_eq!(s.color, ColorArg::Raw);
+        assert_eq!(s.color, texel::ColorHandling::Raw);
         s.apply(press(Key::Letter('h')));
         assert!(s.help);
         s.apply(press(Key::BracketRight));
@@ -525,7 +523,7 @@ mod tests {
         }
         // Every letter the state reacts to appears in the table.
         for c in 'a'..='z' {
-            let mut s = ViewState::new(Mode::Reference, ColorArg::Srgb);
+            let mut s = ViewState::new(Mode::Reference, texel::ColorHandling::Srgb);
             let before = s.clone();
             let effect = s.apply(press(Key::Letter(c)));
             if effect != Effect::None || s != before {
