@@ -91,25 +91,25 @@ pub struct UvMapping {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum UvEvaluation {
-    /// At the vertices (the mesh's `uv`), interpolated across each triangle.
-    #[cfg_attr(
-        feature = "clap",
-        value(
-            name = "vertex",
-            help = "The vertices' uv, interpolated across each triangle."
-        )
-    )]
-    PerVertex,
     /// Exactly, at every pixel (the default).
     #[default]
     #[cfg_attr(
         feature = "clap",
         value(
             name = "pixel",
-            help = "The projection of each pixel's position, with its analytic derivatives."
+            help = "The projection of each pixel's position, with its analytic derivatives"
         )
     )]
     PerPixel,
+    /// At the vertices (the mesh's `uv`), interpolated across each triangle.
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            name = "vertex",
+            help = "The vertices' uv, interpolated across each triangle"
+        )
+    )]
+    PerVertex,
 }
 
 impl UvEvaluation {

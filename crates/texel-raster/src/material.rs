@@ -100,7 +100,7 @@ pub enum SpecularAa {
     #[default]
     #[cfg_attr(
         feature = "clap",
-        value(help = "None: the filtered normal is normalised and used as if exact.")
+        value(help = "None: the filtered normal is normalised and used as if exact")
     )]
     None,
     /// Toksvig (2005): the filtered (averaged) tangent-space normal is shorter than 1 where the
@@ -112,7 +112,7 @@ pub enum SpecularAa {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "Toksvig (2005): roughness widened by how much the filtered normal shortened."
+            help = "Toksvig (2005): roughness widened by how much the filtered normal shortened"
         )
     )]
     Toksvig,
@@ -129,7 +129,7 @@ pub enum SpecularAa {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "LEAN mapping (Olano & Baker 2010): slope moments filtered with the normals; the lobe convolved with their covariance (anisotropic)."
+            help = "LEAN mapping (Olano & Baker 2010): slope moments filtered with the normals; the lobe convolved with their covariance (anisotropic)"
         )
     )]
     Lean,
@@ -144,7 +144,7 @@ pub enum SpecularAa {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021): roughness widened by the normal's change to the neighbouring pixels, as GPUs ship it."
+            help = "Projected-space NDF filtering (Tokuyoshi & Kaplanyan 2021): roughness widened by the normal's change to the neighbouring pixels, as GPUs ship it"
         )
     )]
     Projected,

@@ -23,7 +23,7 @@ pub enum Derivatives {
     #[default]
     #[cfg_attr(
         feature = "clap",
-        value(help = "Exact derivatives from the triangle's plane equations.")
+        value(help = "Exact derivatives from the triangle's plane equations")
     )]
     Analytic,
     /// GPU-style differences over aligned 2x2 quads ("fine" derivatives, D3D `ddx_fine`): for a pixel
@@ -32,7 +32,7 @@ pub enum Derivatives {
     /// are evaluated from the same plane equations.
     #[cfg_attr(
         feature = "clap",
-        value(help = "Differences within 2x2 pixel quads, as GPUs compute them.")
+        value(help = "Differences within 2x2 pixel quads, as GPUs compute them")
     )]
     Quad,
 }
@@ -45,14 +45,14 @@ pub enum Perspective {
     #[default]
     #[cfg_attr(
         feature = "clap",
-        value(help = "Perspective-correct (interpolate a/w and 1/w).")
+        value(help = "Perspective-correct (interpolate a/w and 1/w)")
     )]
     Correct,
     /// Affine (screen-space linear) interpolation of the attributes of each clipped triangle: the
     /// "incorrect" image of the lectures (textures swim and bend). Depth stays correct.
     #[cfg_attr(
         feature = "clap",
-        value(help = "Affine in screen space (the lectures' incorrect image).")
+        value(help = "Affine in screen space (the lectures' incorrect image)")
     )]
     Affine,
 }
@@ -63,30 +63,30 @@ pub enum Perspective {
 pub enum View {
     /// Texture colour times vertex colour, optionally lit (the normal image).
     #[default]
-    #[cfg_attr(feature = "clap", value(help = "The textured image."))]
+    #[cfg_attr(feature = "clap", value(help = "The textured image"))]
     Color,
     /// `fract(u)` in red, `fract(v)` in green (as displayed: 8-bit red = `fract(u) * 255`).
-    #[cfg_attr(feature = "clap", value(help = "fract(u) in red, fract(v) in green."))]
+    #[cfg_attr(feature = "clap", value(help = "fract(u) in red, fract(v) in green"))]
     Uv,
     /// The integer mip level the nearest-level rule reads (`ceil(lod + 1/2) - 1`), one colour per
     /// level from [`crate::views::MIP_PALETTE`].
     #[cfg_attr(
         feature = "clap",
-        value(help = "Integer mip level, one colour per level.")
+        value(help = "Integer mip level, one colour per level")
     )]
     Mip,
     /// The continuous lod: the palette of [`View::Mip`] interpolated between integer levels.
-    #[cfg_attr(feature = "clap", value(help = "Continuous level of detail."))]
+    #[cfg_attr(feature = "clap", value(help = "Continuous level of detail"))]
     Lod,
     /// The footprint's anisotropy `|Pmax| / |Pmin|` on a colour ramp, 1 to 16 on a log2 scale.
-    #[cfg_attr(feature = "clap", value(help = "Footprint anisotropy ratio."))]
+    #[cfg_attr(feature = "clap", value(help = "Footprint anisotropy ratio"))]
     Aniso,
     /// Texels the filter read for the pixel, as a heat map (log2 scale, see [`crate::views`]).
     /// Turns on texel counting.
-    #[cfg_attr(feature = "clap", value(help = "Texels read per pixel (heat map)."))]
+    #[cfg_attr(feature = "clap", value(help = "Texels read per pixel (heat map)"))]
     Fetches,
     /// The perspective-correct barycentric weights of the original (unclipped) triangle as RGB.
-    #[cfg_attr(feature = "clap", value(help = "Barycentric weights as RGB."))]
+    #[cfg_attr(feature = "clap", value(help = "Barycentric weights as RGB"))]
     Barycentric,
 }
 
@@ -97,14 +97,14 @@ pub enum View {
 pub enum Precision {
     /// `f32` throughout: texels decoded to floats, exact weights, one encode at the end.
     #[default]
-    #[cfg_attr(feature = "clap", value(help = "f32 throughout."))]
+    #[cfg_attr(feature = "clap", value(help = "f32 throughout"))]
     Exact,
     /// As GPUs filter unorm8 texels: 8-bit sub-texel and mip weights and a rounding to 8 bits
     /// per blend ([`texel_texture::kernel::fixed8`]; the CLI's `--precision gpu`). Other textures, other
     /// filters and the reference keep [`Precision::Exact`].
     #[cfg_attr(
         feature = "clap",
-        value(help = "8-bit weights and 8-bit results per blend, as GPUs filter unorm8 textures.")
+        value(help = "8-bit weights and 8-bit results per blend, as GPUs filter unorm8 textures")
     )]
     Gpu,
 }

@@ -26,14 +26,14 @@ pub enum Streaming {
     #[default]
     #[cfg_attr(
         feature = "clap",
-        value(help = "Stream frames larger than the last-level cache.")
+        value(help = "Stream frames larger than the last-level cache")
     )]
     Auto,
     /// Stream every frame (for measuring: a frame that fits the cache draws slower this way).
-    #[cfg_attr(feature = "clap", value(help = "Stream every frame."))]
+    #[cfg_attr(feature = "clap", value(help = "Stream every frame"))]
     Always,
     /// Never stream: tiles draw in place into the frame.
-    #[cfg_attr(feature = "clap", value(help = "Draw every frame in place."))]
+    #[cfg_attr(feature = "clap", value(help = "Draw every frame in place"))]
     Never,
 }
 

@@ -120,19 +120,19 @@ impl ScalarInput {
 pub enum Displacement {
     /// `"none"`.
     #[default]
-    #[cfg_attr(feature = "clap", value(help = "The height map is not used."))]
+    #[cfg_attr(feature = "clap", value(help = "The height map is not used"))]
     None,
     /// `"bump"`: normals from the height map.
     #[cfg_attr(
         feature = "clap",
-        value(help = "Bump mapping: normals from the height map, flat geometry.")
+        value(help = "Bump mapping: normals from the height map, flat geometry")
     )]
     Bump,
     /// `"pom"`: parallax occlusion mapping.
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "Parallax occlusion mapping (Tatarchuk 2006): the view ray marched through the heights."
+            help = "Parallax occlusion mapping (Tatarchuk 2006): the view ray marched through the heights"
         )
     )]
     Pom,
@@ -140,7 +140,7 @@ pub enum Displacement {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "True displacement: the mesh tessellated to --edge-px and its vertices moved by the heights, filtered to the edge length."
+            help = "True displacement: the mesh tessellated to --edge-px and its vertices moved by the heights, filtered to the edge length"
         )
     )]
     Tessellate,
@@ -272,7 +272,7 @@ pub enum LayerOrder {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "Every layer's maps and the mask filtered over the pixel, then blended (a shader's way)."
+            help = "Every layer's maps and the mask filtered over the pixel, then blended (a shader's way)"
         )
     )]
     FilterThenBlend,
@@ -281,7 +281,7 @@ pub enum LayerOrder {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "The layers blended texel by texel at level 0 into baked maps, which are then filtered."
+            help = "The layers blended texel by texel at level 0 into baked maps, which are then filtered"
         )
     )]
     BlendThenFilter,

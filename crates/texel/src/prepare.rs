@@ -37,7 +37,7 @@ pub enum ColorHandling {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "Textures marked sRGB are decoded to linear light for filtering; output is sRGB-encoded."
+            help = "Textures marked sRGB are decoded to linear light for filtering; output is sRGB-encoded"
         )
     )]
     Srgb,
@@ -45,7 +45,7 @@ pub enum ColorHandling {
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "Every texture's bytes are linear; output bytes are linear (as a GPU sampling plain RGBA8)."
+            help = "Every texture's bytes are linear; output bytes are linear (as a GPU sampling plain RGBA8)"
         )
     )]
     Raw,

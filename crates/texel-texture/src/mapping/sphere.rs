@@ -31,19 +31,19 @@ pub enum Mapping {
     #[default]
     #[cfg_attr(
         feature = "clap",
-        value(help = "Latitude-longitude, twice as wide as high.")
+        value(help = "Latitude-longitude, twice as wide as high")
     )]
     Equirect,
     /// Six square faces ([`cube_face`]).
     #[cfg_attr(
         feature = "clap",
-        value(help = "Six faces with Vulkan's orientation, filtered across their edges.")
+        value(help = "Six faces with Vulkan's orientation, filtered across their edges")
     )]
     Cube,
     /// One square image ([`octahedral_uv`]).
     #[cfg_attr(
         feature = "clap",
-        value(help = "pbrt-v4's equal-area octahedral square.")
+        value(help = "pbrt-v4's equal-area octahedral square")
     )]
     Octahedral,
 }
