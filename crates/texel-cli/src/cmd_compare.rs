@@ -9,9 +9,10 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
+use texel_io::publish_dir;
 use texel_quality::{
     block_psnr, crop_enlarge, default_band_rows, excess_change, heat_map, horizon_crop_rect,
-    mean_abs_change, psnr, publish_dir, Encoding, FilterRow, Image8, Mask, Orbit, ReferenceError,
+    mean_abs_change, psnr, Encoding, FilterRow, Image8, Mask, Orbit, ReferenceError,
     ReferenceSummary, Report, Scores, DEFAULT_BLOCK,
 };
 use texel_raster::{render, Frame, ReferencePlan, RenderSettings};
@@ -239,7 +240,7 @@ fn reference_summary(
 
 /// Compare `filters` on a prepared scene against a reference made as `plan` says, write
 /// everything into `dir` (which must exist: the caller publishes it, see
-/// [`texel_quality::publish_dir`]) and return the report. `label` names the scene in the report.
+/// [`texel_io::publish_dir`]) and return the report. `label` names the scene in the report.
 /// With an `orbit`, the filters' rows also get their flicker and orbit PSNR ([`orbit_scores`]).
 /// Every row gets its block-mean PSNR and the rows the reference cannot rank it against.
 #[allow(clippy::too_many_arguments)]

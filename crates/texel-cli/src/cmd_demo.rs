@@ -9,8 +9,9 @@ use std::fmt::Write as _;
 
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
+use texel_io::{publish_dir, write_atomic};
 use texel_quality::html::escape;
-use texel_quality::{publish_dir, write_atomic, Report};
+use texel_quality::Report;
 
 use crate::cli::DemoArgs;
 use crate::cli::DEFAULT_TOLERANCE_STEPS;

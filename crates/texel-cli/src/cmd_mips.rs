@@ -3,10 +3,11 @@
 //! Memory: the texture loads within what `--max-memory` leaves (see [`texel_texture::Limits`]);
 //! then each level is encoded straight from the pyramid to an 8-bit image and written before the
 //! next (4 bytes per pixel plus the encoder's copies, [`ENCODE_BYTES_PER_PIXEL`]), and the chain
-//! likewise. The directory is published as a whole ([`texel_quality::publish_dir`]).
+//! likewise. The directory is published as a whole ([`texel_io::publish_dir`]).
 
 use anyhow::{Context, Result};
-use texel_quality::{publish_dir, Image8, MAX_SIDE};
+use texel_io::publish_dir;
+use texel_quality::{Image8, MAX_SIDE};
 use texel_texture::Texture;
 
 use crate::cli::MipsArgs;

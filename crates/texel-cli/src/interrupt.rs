@@ -20,7 +20,7 @@ pub fn on_signal() {
         eprintln!("\ntexel: stopping after the current pass (a second signal aborts)");
         return;
     }
-    texel_quality::remove_pending_and_exit(INTERRUPTED)
+    texel_io::remove_pending_and_exit(INTERRUPTED)
 }
 
 /// While alive, the first signal raises [`Graceful::flag`] instead of exiting.

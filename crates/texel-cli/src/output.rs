@@ -96,7 +96,7 @@ fn write_exr(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]]) -> Resul
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Publish an 8-bit image as PNG at `path` ([`texel_quality::write_atomic`]: atomically over a
+/// Publish an 8-bit image as PNG at `path` ([`texel_io::write_atomic`]: atomically over a
 /// regular file or a new path, through to a device or FIFO), or on standard output for `-`.
 pub fn write_image(path: &Path, image: &Image8) -> Result<()> {
     if is_exr(path) {

@@ -109,3 +109,12 @@ pub enum QualityError {
     #[error("report JSON: {0}")]
     Json(#[from] serde_json::Error),
 }
+
+impl From<texel_io::OutputError> for QualityError {
+    fn from(e: texel_io::OutputError) -> Self {
+        QualityError::Io {
+            path: e.path,
+            source: e.source,
+        }
+    }
+}

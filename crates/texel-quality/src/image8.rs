@@ -238,15 +238,15 @@ impl Image8 {
     /// # Errors
     /// [`QualityError::Image`] (with an empty path) if the encoder fails.
     pub fn to_png(&self) -> Result<Vec<u8>, QualityError> {
-        crate::atomic::encode_png(self.width, self.height, &self.to_rgba_bytes())
+        crate::encode::encode_png(self.width, self.height, &self.to_rgba_bytes())
     }
 
     /// Write as PNG atomically ([`crate::write_png_atomic`]).
     ///
     /// # Errors
-    /// As [`crate::write_atomic`].
+    /// As [`texel_io::write_atomic`].
     pub fn write_png(&self, path: impl AsRef<Path>) -> Result<(), QualityError> {
-        crate::atomic::write_atomic(path.as_ref(), &self.to_png()?)
+        Ok(texel_io::write_atomic(path.as_ref(), &self.to_png()?)?)
     }
 }
 

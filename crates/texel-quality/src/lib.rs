@@ -9,8 +9,9 @@
 //! - [`horizon_band`]: the strip just below the horizon, where minification is extreme.
 //! - [`heat_map`], [`legend_svg`], [`crop_enlarge`], [`horizon_crop_rect`]: pictures of the error.
 //! - [`Report`] / [`FilterRow`]: JSON, Markdown and a self-contained `index.html` with a chart.
-//! - [`write_atomic`] / [`write_png_atomic`] / [`publish_dir`]: no truncated output after an
-//!   interruption, and only regular files (or new paths) ever replaced.
+//! - [`write_png_atomic`] / [`write_exr_atomic`]: encoded and published through
+//!   [`texel_io::write_atomic`] (whole directories: [`texel_io::publish_dir`]), so no output is
+//!   truncated by an interruption and only regular files (or new paths) are ever replaced.
 //!
 //! Decision: quality is measured on the 8-bit display values (sRGB-encoded, or linear bytes under
 //! `--color raw`), i.e. exactly what is written to the PNG files and what a person sees, so that
@@ -37,9 +38,9 @@
 //! # Ok::<(), texel_quality::QualityError>(())
 //! ```
 
-mod atomic;
 mod band;
 mod crop;
+mod encode;
 mod error;
 mod flicker;
 mod heatmap;
@@ -55,12 +56,9 @@ mod uncertainty;
 
 pub use size::MAX_SIDE;
 
-pub use atomic::{
-    encode_exr, publish_dir, remove_pending_and_exit, write_atomic, write_exr_atomic,
-    write_png_atomic, OUTPUT_MARKER,
-};
 pub use band::{default_band_rows, horizon_band};
 pub use crop::{crop_enlarge, horizon_crop_rect, Rect};
+pub use encode::{encode_exr, write_exr_atomic, write_png_atomic};
 pub use error::QualityError;
 pub use flicker::{excess_change, mean_abs_change};
 pub use heatmap::{error_map, heat_map, legend_image, legend_svg, viridis, OUTSIDE, VIRIDIS};

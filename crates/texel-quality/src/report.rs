@@ -9,9 +9,9 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::atomic::write_atomic;
 use crate::error::QualityError;
 use crate::scores::Scores;
+use texel_io::write_atomic;
 
 /// A whole report: the scene, its settings and one row per filter or external image.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -374,7 +374,10 @@ impl Report {
     pub fn write(&self, dir: &Path) -> Result<(), QualityError> {
         write_atomic(&dir.join("report.json"), self.to_json().as_bytes())?;
         write_atomic(&dir.join("report.md"), self.to_markdown().as_bytes())?;
-        write_atomic(&dir.join("index.html"), self.to_html().as_bytes())
+        Ok(write_atomic(
+            &dir.join("index.html"),
+            self.to_html().as_bytes(),
+        )?)
     }
 }
 

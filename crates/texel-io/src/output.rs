@@ -31,10 +31,17 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
 use std::time::SystemTime;
 
-use image::ImageEncoder;
+use thiserror::Error;
 
-use crate::error::QualityError;
-use crate::size::check_data_len;
+/// A file or directory could not be published: the path concerned and why.
+#[derive(Debug, Error)]
+#[error("{path}: {source}")]
+pub struct OutputError {
+    /// The file or directory concerned.
+    pub path: PathBuf,
+    /// The underlying error.
+    pub source: std::io::Error,
+}
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
@@ -52,15 +59,15 @@ fn pending() -> MutexGuard<'static, Vec<PathBuf>> {
     PENDING.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> QualityError + '_ {
-    move |source| QualityError::Io {
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
+    move |source| OutputError {
         path: path.to_path_buf(),
         source,
     }
 }
 
-fn refuse(path: &Path, kind: std::io::ErrorKind, why: &str) -> QualityError {
-    QualityError::Io {
+fn refuse(path: &Path, kind: std::io::ErrorKind, why: &str) -> OutputError {
+    OutputError {
         path: path.to_path_buf(),
         source: std::io::Error::new(kind, why.to_string()),
     }
@@ -150,7 +157,7 @@ const O_ACCMODE: u32 = 0o3;
 /// by reopening its link: appending where it appends, and a pipe, terminal or device as it is. A
 /// descriptor open for reading only, or a regular file's that does not append (its offset could
 /// not be moved past texel's bytes), is refused. Nothing is truncated, renamed or created.
-fn write_descriptor(d: &FdLink, bytes: &[u8], path: &Path) -> Result<(), QualityError> {
+fn write_descriptor(d: &FdLink, bytes: &[u8], path: &Path) -> Result<(), OutputError> {
     if d.own && (d.fd == 1 || d.fd == 2) {
         let written = if d.fd == 1 {
             let mut out = std::io::stdout().lock();
@@ -206,7 +213,7 @@ fn write_descriptor(d: &FdLink, bytes: &[u8], path: &Path) -> Result<(), Quality
 
 /// Follow `path` through symbolic links (without following the last component of a missing one)
 /// and classify what it names.
-fn resolve(path: &Path) -> Result<Destination, QualityError> {
+fn resolve(path: &Path) -> Result<Destination, OutputError> {
     // A path that reaches an open descriptor's link is that descriptor, whatever it holds: a
     // shell's `>> log.txt` behind /dev/stdout is appended to, never replaced, and a deleted file
     // behind the link is not recreated under its link text's name.
@@ -266,7 +273,7 @@ fn resolve(path: &Path) -> Result<Destination, QualityError> {
 }
 
 /// Follow `path`'s chain of symbolic links by hand and return the first `/proc/*/fd` entry on it.
-fn descriptor_on_path(path: &Path) -> Result<Option<FdLink>, QualityError> {
+fn descriptor_on_path(path: &Path) -> Result<Option<FdLink>, OutputError> {
     let mut p = path.to_path_buf();
     for _ in 0..=MAX_LINKS {
         if let Some(d) = fd_link(&p) {
@@ -306,7 +313,7 @@ fn name_tag(name: &std::ffi::OsStr) -> String {
     format!(".texel-{h:016x}.")
 }
 
-fn split_dest(path: &Path) -> Result<(PathBuf, String), QualityError> {
+fn split_dest(path: &Path) -> Result<(PathBuf, String), OutputError> {
     let name = path.file_name().ok_or_else(|| {
         refuse(
             path,
@@ -406,10 +413,10 @@ fn unregister(guard: &mut MutexGuard<'static, Vec<PathBuf>>, p: &Path) {
 /// through to a device or FIFO, to a symbolic link's target.
 ///
 /// # Errors
-/// [`QualityError::Io`] naming `path`: its directory is missing or not writable, it is a
+/// [`OutputError`] naming `path`: its directory is missing or not writable, it is a
 /// directory or a socket, it has no file name, the disk or device is full. No temporary file is
 /// left behind.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), QualityError> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     let target = match resolve(path)? {
         Destination::Descriptor(d) => return write_descriptor(&d, bytes, path),
         Destination::Special(p) => {
@@ -655,13 +662,13 @@ fn visible_sibling(target: &Path, what: &str) -> PathBuf {
 /// since publishing could replace or move it.
 ///
 /// # Errors
-/// [`QualityError::Io`] (converted into `E`) when `dest` is a file or device, a directory that
+/// [`OutputError`] (converted into `E`) when `dest` is a file or device, a directory that
 /// texel did not write, an open descriptor's link, holds one of `inputs`, or cannot be created or
 /// renamed; when, at the moment of publishing, `dest` holds a file texel did not write under a
 /// name the new output uses (the new output is then left beside `dest` as `NAME.texel-new`, and
 /// `dest` is unchanged); any error of `fill`, after which the staging directory is deleted and
 /// `dest` is unchanged.
-pub fn publish_dir<T, E: From<QualityError>>(
+pub fn publish_dir<T, E: From<OutputError>>(
     dest: &Path,
     inputs: &[&Path],
     fill: impl FnOnce(&Path) -> Result<T, E>,
@@ -739,7 +746,7 @@ pub fn publish_dir<T, E: From<QualityError>>(
 }
 
 /// Refuse when one of `inputs` lies inside the existing directory `target`.
-fn check_inputs_outside(dest: &Path, target: &Path, inputs: &[&Path]) -> Result<(), QualityError> {
+fn check_inputs_outside(dest: &Path, target: &Path, inputs: &[&Path]) -> Result<(), OutputError> {
     let Ok(dir) = fs::canonicalize(target) else {
         return Ok(());
     };
@@ -770,7 +777,7 @@ fn swap_in(
     staging: &Path,
     marked: bool,
     (parent, tag): (&Path, &str),
-) -> Result<(), QualityError> {
+) -> Result<(), OutputError> {
     let exists = fs::symlink_metadata(target).is_ok();
     if !exists {
         return fs::rename(staging, target).map_err(io_err(dest));
@@ -827,91 +834,9 @@ fn swap_in(
     Ok(())
 }
 
-/// Encode packed `RGBARGBA...` 8-bit bytes as PNG in memory.
-pub(crate) fn encode_png(width: u32, height: u32, rgba8: &[u8]) -> Result<Vec<u8>, QualityError> {
-    check_data_len(width, height, 4, rgba8.len())?;
-    let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(rgba8, width, height, image::ExtendedColorType::Rgba8)
-        .map_err(|source| QualityError::Image {
-            path: PathBuf::new(),
-            source,
-        })?;
-    Ok(out)
-}
-
-/// Encode `width x height` packed 8-bit RGBA bytes (`4 * width * height`, row 0 at the top) as PNG
-/// and write it with [`write_atomic`].
-///
-/// # Errors
-/// Size errors ([`QualityError::DataLength`], ...), [`QualityError::Image`] from the encoder, and
-/// the errors of [`write_atomic`].
-pub fn write_png_atomic(
-    path: &Path,
-    width: u32,
-    height: u32,
-    rgba8: &[u8],
-) -> Result<(), QualityError> {
-    write_atomic(path, &encode_png(width, height, rgba8)?)
-}
-
-/// Encode `width x height` linear RGBA floats (row 0 at the top) as OpenEXR (32-bit float
-/// channels R, G, B, A) in memory.
-///
-/// # Errors
-/// Size errors ([`QualityError::DataLength`], ...) and [`QualityError::Image`] from the encoder.
-pub fn encode_exr(width: u32, height: u32, rgba: &[[f32; 4]]) -> Result<Vec<u8>, QualityError> {
-    check_data_len(width, height, 1, rgba.len())?;
-    let bytes: Vec<u8> = rgba
-        .iter()
-        .flatten()
-        .flat_map(|c| c.to_le_bytes())
-        .collect();
-    let mut out = std::io::Cursor::new(Vec::new());
-    image::codecs::openexr::OpenExrEncoder::new(&mut out)
-        .write_image(&bytes, width, height, image::ExtendedColorType::Rgba32F)
-        .map_err(|source| QualityError::Image {
-            path: PathBuf::new(),
-            source,
-        })?;
-    Ok(out.into_inner())
-}
-
-/// Encode linear RGBA floats as OpenEXR ([`encode_exr`]) and write them with [`write_atomic`].
-///
-/// # Errors
-/// As [`encode_exr`] and [`write_atomic`].
-pub fn write_exr_atomic(
-    path: &Path,
-    width: u32,
-    height: u32,
-    rgba: &[[f32; 4]],
-) -> Result<(), QualityError> {
-    write_atomic(path, &encode_exr(width, height, rgba)?)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn exr_round_trips_floats_exactly() {
-        let px: Vec<[f32; 4]> = (0..6)
-            .map(|k| [k as f32 * 0.25, 3.5e3, -1.0 / 3.0, 1.0])
-            .collect();
-        let bytes = encode_exr(3, 2, &px).unwrap();
-        let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::OpenExr)
-            .unwrap()
-            .to_rgba32f();
-        assert_eq!((img.width(), img.height()), (3, 2));
-        for (got, want) in img.pixels().zip(&px) {
-            assert_eq!(&got.0, want);
-        }
-        assert!(matches!(
-            encode_exr(3, 2, &px[..5]),
-            Err(QualityError::DataLength { .. })
-        ));
-    }
 
     fn scratch(tag: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("texel-quality-{tag}-{}", std::process::id()));
@@ -937,40 +862,6 @@ mod tests {
         write_atomic(&p, b"second, longer").unwrap();
         assert_eq!(fs::read(&p).unwrap(), b"second, longer");
         assert_eq!(names(&d), vec!["r.json"]);
-        fs::remove_dir_all(&d).unwrap();
-    }
-
-    #[test]
-    fn failure_leaves_nothing_behind() {
-        let d = scratch("atomic-err");
-        // A directory is refused before anything is written.
-        let target = d.join("out.png");
-        fs::create_dir_all(target.join("inside")).unwrap();
-        let e = write_atomic(&target, b"data").unwrap_err();
-        assert!(e.to_string().contains("out.png"), "{e}");
-        assert!(e.to_string().contains("is a directory"), "{e}");
-        assert_eq!(names(&d), vec!["out.png"]);
-        // A missing directory: the error names the path.
-        let missing = d.join("no/such/dir/x.png");
-        let e = write_png_atomic(&missing, 1, 1, &[1, 2, 3, 4]).unwrap_err();
-        assert!(matches!(e, QualityError::Io { .. }));
-        assert!(e.to_string().contains("no/such/dir/x.png"), "{e}");
-        fs::remove_dir_all(&d).unwrap();
-    }
-
-    #[test]
-    fn png_length_checked() {
-        let d = scratch("atomic-len");
-        let e = write_png_atomic(&d.join("a.png"), 2, 2, &[0; 15]).unwrap_err();
-        assert!(matches!(
-            e,
-            QualityError::DataLength {
-                expected: 16,
-                got: 15,
-                ..
-            }
-        ));
-        assert!(names(&d).is_empty());
         fs::remove_dir_all(&d).unwrap();
     }
 
@@ -1002,7 +893,7 @@ mod tests {
         assert!(!fs::symlink_metadata("/dev/null").unwrap().is_file());
         let e = write_atomic(Path::new("/dev/full"), b"x").unwrap_err();
         assert!(e.to_string().contains("/dev/full"), "{e}");
-        assert!(matches!(&e, QualityError::Io { source, .. } if source.raw_os_error() == Some(28)));
+        assert!(matches!(&e, OutputError { source, .. } if source.raw_os_error() == Some(28)));
     }
 
     #[test]
@@ -1030,19 +921,19 @@ mod tests {
     fn publish_dir_replaces_whole() {
         let d = scratch("atomic-dir");
         let out = d.join("report");
-        publish_dir::<_, QualityError>(&out, &[], |s| {
+        publish_dir::<_, OutputError>(&out, &[], |s| {
             fs::write(s.join("a.png"), b"1").map_err(io_err(s))
         })
         .unwrap();
         assert_eq!(names(&out), vec![OUTPUT_MARKER, "a.png"]);
         // A second run replaces everything: no file of the first run survives.
-        publish_dir::<_, QualityError>(&out, &[], |s| {
+        publish_dir::<_, OutputError>(&out, &[], |s| {
             fs::write(s.join("b.png"), b"2").map_err(io_err(s))
         })
         .unwrap();
         assert_eq!(names(&out), vec![OUTPUT_MARKER, "b.png"]);
         // A failing run leaves the last published output and no staging directory.
-        let e = publish_dir::<(), QualityError>(&out, &[], |s| {
+        let e = publish_dir::<(), OutputError>(&out, &[], |s| {
             fs::write(s.join("c.png"), b"3").unwrap();
             Err(refuse(s, std::io::ErrorKind::Other, "stopped"))
         });
@@ -1053,11 +944,11 @@ mod tests {
         let mine = d.join("mine");
         fs::create_dir_all(&mine).unwrap();
         fs::write(mine.join("notes.txt"), b"keep").unwrap();
-        let e = publish_dir::<(), QualityError>(&mine, &[], |_| Ok(())).unwrap_err();
+        let e = publish_dir::<(), OutputError>(&mine, &[], |_| Ok(())).unwrap_err();
         assert!(e.to_string().contains("did not write"), "{e}");
         assert_eq!(names(&mine), vec!["notes.txt"]);
         fs::write(d.join("file"), b"f").unwrap();
-        let e = publish_dir::<(), QualityError>(&d.join("file"), &[], |_| Ok(())).unwrap_err();
+        let e = publish_dir::<(), OutputError>(&d.join("file"), &[], |_| Ok(())).unwrap_err();
         assert!(e.to_string().contains("not a directory"), "{e}");
         fs::remove_dir_all(&d).unwrap();
     }
@@ -1065,7 +956,7 @@ mod tests {
     fn fill_with<'a>(
         files: &'a [&'a str],
         also: impl FnOnce() + 'a,
-    ) -> impl FnOnce(&Path) -> Result<(), QualityError> + 'a {
+    ) -> impl FnOnce(&Path) -> Result<(), OutputError> + 'a {
         move |s| {
             for f in files {
                 fs::write(s.join(f), f.as_bytes()).map_err(io_err(s))?;
@@ -1277,7 +1168,7 @@ mod tests {
         assert_eq!(all, b"01Z");
         assert_eq!(names(&d), vec!["alias", "g.bin", "log.txt"]);
         // A descriptor link is never an output directory.
-        let e = publish_dir::<(), QualityError>(&link, &[], |_| Ok(())).unwrap_err();
+        let e = publish_dir::<(), OutputError>(&link, &[], |_| Ok(())).unwrap_err();
         assert!(e.to_string().contains("descriptor"), "{e}");
         drop(h);
         fs::remove_dir_all(&d).unwrap();
