@@ -839,7 +839,7 @@ mod tests {
     use super::*;
 
     fn scratch(tag: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("texel-quality-{tag}-{}", std::process::id()));
+        let d = std::env::temp_dir().join(format!("texel-io-{tag}-{}", std::process::id()));
         let _ = fs::remove_dir_all(&d);
         fs::create_dir_all(&d).unwrap();
         d
