@@ -152,12 +152,12 @@ impl Sampler {
             return false;
         }
         let border = match texture.format() {
-            Format::Rgba8Srgb => rgba_to_srgb8(self.addr.border.to_array()),
-            _ => rgba_to_unorm8(self.addr.border.to_array()),
+            Format::Rgba8Srgb => rgba_to_srgb8(self.params.addr.border.to_array()),
+            _ => rgba_to_unorm8(self.params.addr.border.to_array()),
         };
         let addr = Address {
             border: Vec4::from_array(border.map(f32::from)),
-            ..self.addr
+            ..self.params.addr
         };
         if !fixed && self.desc.mipmap_filter == MipmapFilterMode::None {
             // Nearest in level 0 (`applies`: both filters nearest): copy the bytes.
@@ -240,7 +240,7 @@ impl Sampler {
         with_pyramid!(texture, lanes, |p| {
             if self.batched && staged::staged(p.level(0).size()) {
                 // `batch::run` dispatches per within-level filter.
-                return batch::run(&p, self, self.addr, footprints, out);
+                return batch::run(&p, self, self.params.addr, footprints, out);
             }
             crate::engine::dispatch::run(BatchJob {
                 s: self,
@@ -270,7 +270,7 @@ impl Sampler {
             // A third stage between the two: every sample's probe plan (axes, probe count,
             // probe lod), vectorised as the lods are; the probes' scratch is made once.
             let mut plans = [Plan::default(); CHUNK];
-            let mut probes = Probes::new(self.addr);
+            let mut probes = Probes::new(self.params.addr);
             for (fps, outs) in parts {
                 batch::queries(self, size, fps, &mut chunk);
                 plan_chunk(&self.params, size, &chunk, &mut plans);
@@ -338,7 +338,7 @@ impl Sampler {
     #[inline(always)]
     fn filter<P: Pyramid>(&self, p: &P, q: &Query) -> Vec4 {
         let d = &self.desc;
-        let addr = &self.addr;
+        let addr = &self.params.addr;
         if q.lod <= 0.0 {
             return filter_level(&d.mag_filter, &p.level(0), addr, q.uv());
         }

@@ -89,7 +89,6 @@ pub struct Sampler {
     /// [`Sampler::sample_batch`] runs the staged core kernels (`batch::run`): nearest or bilinear
     /// inside the levels, any `mipmap_filter`, `mag_filter == min_filter`.
     pub(super) batched: bool,
-    pub(super) addr: Address,
     /// What the techniques read of the descriptor.
     pub(super) params: Params,
 }
@@ -158,14 +157,13 @@ impl Sampler {
             technique,
             lod_free,
             batched,
-            addr: Address::of(&desc),
             params: Params::of(&desc),
         })
     }
 
     /// The address modes and border colour samples are read with.
     pub fn address(&self) -> Address {
-        self.addr
+        self.params.addr
     }
 
     /// Whether samples depend on the footprint's derivatives. `false` when there is no
