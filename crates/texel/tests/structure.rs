@@ -1,9 +1,10 @@
-//! No crate of the workspace has modules that import each other in a circle: for every crate's
-//! `src/`, the graph whose nodes are its top-level modules (a file, or a folder with everything in
-//! it) and whose edges are the `crate::module` paths of the library code (comments and
-//! `#[cfg(test)]` modules aside) has no cycle. So each crate reads bottom up, as
-//! docs/guide/architecture.md lays it out. (texel-texture's own floors, file by file, are checked
-//! by its `tests/floors.rs`.)
+//! The workspace's structure, as docs/guide/architecture.md lays it out, read from the library
+//! code (comments and `#[cfg(test)]` modules aside: a unit test may use its whole crate):
+//! - no crate has top-level modules (a file, or a folder with everything in it) that import each
+//!   other through `crate::` paths in a circle;
+//! - texel-texture's floors only look down: every `crate::floor::file` path names a file on the
+//!   same floor or a lower one, paths name modules rather than the root's re-exports, and its
+//!   files import each other in no circle.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -114,6 +115,104 @@ fn cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
         }
     }
     None
+}
+
+/// texel-texture's floors, lowest first. `mapping` stands beside them and may use only `base`.
+const FLOORS: [&str; 5] = ["base", "storage", "kernel", "technique", "engine"];
+
+fn rank(floor: &str) -> Option<usize> {
+    if floor == "mapping" {
+        return Some(0);
+    }
+    FLOORS.iter().position(|&f| f == floor)
+}
+
+/// The `floor/file` names that `code` names through `crate::floor::file` (or
+/// `crate::floor::{file, ..}`), and every root re-export it names (`crate::Name`).
+fn floor_imports(code: &str) -> (BTreeSet<String>, BTreeSet<String>) {
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let (mut files, mut root) = (BTreeSet::new(), BTreeSet::new());
+    for (i, _) in code.match_indices("crate::") {
+        let rest = &code[i + "crate::".len()..];
+        let floor = ident(rest);
+        if rank(&floor).is_none() {
+            root.insert(floor);
+            continue;
+        }
+        let Some(after) = rest[floor.len()..].strip_prefix("::") else {
+            continue;
+        };
+        if let Some(group) = after.strip_prefix('{') {
+            let group = &group[..group.find('}').unwrap_or(group.len())];
+            for name in group.split(',').map(|p| ident(p.trim())) {
+                if !name.is_empty() {
+                    files.insert(format!("{floor}/{name}"));
+                }
+            }
+        } else {
+            files.insert(format!("{floor}/{}", ident(after)));
+        }
+    }
+    (files, root)
+}
+
+#[test]
+fn texture_floors_only_look_down_and_no_file_imports_in_a_circle() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../texel-texture/src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut graph = BTreeMap::new();
+    let mut wrong = Vec::new();
+    for file in &files {
+        let rel = file.strip_prefix(&src).unwrap().with_extension("");
+        let Some(floor) = rel
+            .parent()
+            .and_then(|p| p.to_str())
+            .filter(|p| !p.is_empty())
+        else {
+            continue; // lib.rs: the root re-exports
+        };
+        let node = rel.to_string_lossy().into_owned();
+        let own = rank(floor).unwrap_or_else(|| panic!("src/{floor} is not a floor"));
+        let (imports, root) = floor_imports(&library_code(&fs::read_to_string(file).unwrap()));
+        wrong.extend(
+            root.iter()
+                .map(|r| format!("src/{node}.rs names crate::{r} (name the module)")),
+        );
+        let mut edges = BTreeSet::new();
+        for to in imports {
+            let to_floor = to.split('/').next().unwrap();
+            if to.ends_with("/mod") || to == node {
+                continue;
+            }
+            if rank(to_floor).unwrap() > own
+                || (floor == "mapping" && !matches!(to_floor, "base" | "mapping"))
+            {
+                wrong.push(format!("src/{node}.rs looks up at src/{to}.rs"));
+            }
+            edges.insert(to);
+        }
+        graph.insert(node, edges);
+    }
+    assert!(graph.len() >= 25, "found {} files on floors", graph.len());
+    if let Some(c) = cycle(&graph) {
+        wrong.push(format!("circle: {}", c.join(" -> ")));
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn floor_paths_are_read_in_groups_paths_and_root_names() {
+    let (files, root) = floor_imports(
+        "use crate::base::{floor, rng::Mix};\nlet x = crate::kernel::bilinear::blend;\nuse crate::Lanes;",
+    );
+    let want = ["base/floor", "base/rng", "kernel/bilinear"].map(String::from);
+    assert_eq!(files, BTreeSet::from(want));
+    assert_eq!(root, BTreeSet::from(["Lanes".to_string()]));
 }
 
 #[test]
