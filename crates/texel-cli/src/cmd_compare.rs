@@ -19,12 +19,13 @@ use texel_raster::{render, Frame, ReferencePlan, RenderSettings};
 
 use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
-use crate::cmd_reference::{self as reference, reference_estimate, ADAPTIVE_BYTES_PER_PIXEL};
+use crate::cmd_reference::{self as reference, reference_estimate};
 use crate::filters::{parse_list, Filter};
 use crate::input::{load_scene, Input};
 use crate::output::encoding;
 use crate::progress;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
+use texel::REFERENCE_BYTES_PER_PIXEL;
 use texel::{MemoryBudget, PreparedScene};
 use texel_gpu::GpuFilter;
 
@@ -102,13 +103,13 @@ impl Scoring<'_> {
 }
 
 /// What a comparison holds per pixel besides the prepared scene's one frame: the reference frame
-/// ([`FRAME_BYTES_PER_PIXEL`]) and its statistics ([`ADAPTIVE_BYTES_PER_PIXEL`]), the coverage
+/// ([`FRAME_BYTES_PER_PIXEL`]) and its statistics ([`REFERENCE_BYTES_PER_PIXEL`]), the coverage
 /// mask (1), the reference and current 8-bit images (8), the heat map (4) and the encoder's
 /// copies (8), rounded up; each row's 8-bit image is kept besides ([`ROW_BYTES_PER_PIXEL`]) to rank
 /// the rows against each other. An `--extra` image, checked
 /// against the comparison's size from its header first, adds [`EXTRA_BYTES_PER_PIXEL`] while it
 /// is decoded and scored.
-pub const COMPARE_BYTES_PER_PIXEL: u64 = FRAME_BYTES_PER_PIXEL + ADAPTIVE_BYTES_PER_PIXEL + 32;
+pub const COMPARE_BYTES_PER_PIXEL: u64 = FRAME_BYTES_PER_PIXEL + REFERENCE_BYTES_PER_PIXEL + 32;
 
 /// Each row's 8-bit image, kept until the rows are ranked.
 pub const ROW_BYTES_PER_PIXEL: u64 = 4;

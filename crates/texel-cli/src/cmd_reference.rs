@@ -5,10 +5,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use texel_quality::{viridis, Image8};
-use texel_raster::{render_reference_adaptive, ReferenceEstimate, ReferencePlan, ReferenceStatus};
+use texel_raster::{ReferenceEstimate, ReferencePlan, ReferenceStatus};
 
 use crate::cli::ReferenceArgs;
-use crate::filters::Filter;
 use crate::input::{load_scene, Input};
 use crate::interrupt;
 use crate::output::{encoding, write_frame, write_image};
@@ -52,12 +51,6 @@ pub fn reference_estimate(
     pb: &indicatif::ProgressBar,
     stop: Option<&std::sync::atomic::AtomicBool>,
 ) -> Result<ReferenceEstimate> {
-    // The reference samples level 0 bilinearly with each mesh's address modes; the filter only
-    // supplies those.
-    let samplers = scene.samplers(Filter::Bilinear)?;
-    let draws = scene.reference_draws_from(&samplers, camera)?;
-    let mut settings = scene.settings_for(&samplers, camera);
-    settings.threads = threads;
     let status = |s: &ReferenceStatus| {
         pb.set_length(s.total.max(1));
         pb.set_position(s.done);
@@ -69,8 +62,15 @@ pub fn reference_estimate(
             100.0 * s.converged
         ));
     };
-    render_reference_adaptive(&settings, &draws, plan, Some(&status), stop).map_err(|e| match e {
-        texel_raster::RasterError::Interrupted => {
+    let run = texel::ReferenceRun {
+        plan: *plan,
+        threads,
+        scissor: None,
+        progress: Some(&status),
+        stop,
+    };
+    scene.reference(camera, &run).map_err(|e| match e {
+        texel::Error::Raster(e @ texel_raster::RasterError::Interrupted) => {
             anyhow::Error::new(interrupt::Interrupted(e.to_string()))
         }
         e => e.into(),
@@ -99,7 +99,7 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     let scene = load_scene(&args.scene, input)?;
     input.budget.take(
         "the reference's per-pixel statistics",
-        u64::from(scene.width) * u64::from(scene.height) * ADAPTIVE_BYTES_PER_PIXEL,
+        u64::from(scene.width) * u64::from(scene.height) * texel::REFERENCE_BYTES_PER_PIXEL,
     )?;
     let started = Instant::now();
     let pb = progress::bar(1, "reference");
@@ -151,9 +151,6 @@ fn same_destination(a: &std::path::Path, b: &std::path::Path) -> bool {
         _ => std::path::absolute(a).ok() == std::path::absolute(b).ok(),
     }
 }
-
-/// Bytes per pixel a converging reference holds: its running statistics, masks and results.
-pub const ADAPTIVE_BYTES_PER_PIXEL: u64 = 192;
 
 /// One line: the share converged, the samples taken and the time.
 pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> String {

@@ -15,6 +15,9 @@ pub enum Error {
     /// Rendering.
     #[error(transparent)]
     Raster(#[from] texel_raster::RasterError),
+    /// Turning a frame into an image, or scoring one.
+    #[error(transparent)]
+    Quality(#[from] texel_quality::QualityError),
     /// An allocation the memory budget cannot hold ([`crate::MemoryBudget::take`]).
     #[error(
         "{what} needs about {}{}, over {limit}: raise the limit or make the input smaller",

@@ -1,0 +1,227 @@
+//! The few calls that do a whole job on a [`Scene`]: render it ([`render_scene`], and as the
+//! 8-bit image `texel render` writes, [`render_image`]) and make its converging reference
+//! ([`reference_scene`], or [`PreparedScene::reference`] on a scene already prepared).
+
+use std::sync::atomic::AtomicBool;
+
+use texel_raster::{
+    render, render_reference_adaptive, ColorTarget, Frame, RasterError, ReferenceEstimate,
+    ReferencePlan, ReferenceStatus, View,
+};
+use texel_scene::{Camera, Scene};
+
+use crate::{quality, ColorHandling, Error, Filter, MemoryBudget, PreparedScene, SceneOptions};
+
+/// Bytes per pixel a converging reference holds besides its frame: its running statistics,
+/// masks and results.
+pub const REFERENCE_BYTES_PER_PIXEL: u64 = 192;
+
+/// How [`render_scene`] renders.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderOptions {
+    /// The filter of every mesh; `None`: a glTF mesh's own sampler filters, else trilinear.
+    pub filter: Option<Filter>,
+    /// Output size `(width, height)`, overriding the scene's.
+    pub size: Option<(u32, u32)>,
+    /// Colour handling of textures and output.
+    pub color: ColorHandling,
+    /// What each pixel shows (the textured colour, or a debug view).
+    pub view: View,
+    /// Most bytes the render may hold at once (meshes, textures, frame); `None`: the process's
+    /// default ([`MemoryBudget::process_default`]).
+    pub max_memory: Option<u64>,
+    /// Worker threads; `None`: all cores.
+    pub threads: Option<usize>,
+}
+
+/// The memory account of an optional limit: `limit` bytes, or the process's default.
+fn budget_of(limit: Option<u64>) -> MemoryBudget {
+    match limit {
+        Some(b) => MemoryBudget::new(b, format!("the memory limit of {}", crate::memory::mib(b))),
+        None => MemoryBudget::process_default(),
+    }
+}
+
+/// A frame's colour as an 8-bit image in `encoding`: an 8-bit frame of that encoding as stored,
+/// anything else through [`Frame::to_8bit`] (a float frame is quantised exactly as an 8-bit
+/// target of the same draws would store it).
+///
+/// # Errors
+/// [`quality::QualityError`] for a frame of no pixels or sides beyond [`quality::MAX_SIDE`].
+pub fn frame_image(
+    frame: &Frame,
+    encoding: quality::Encoding,
+) -> Result<quality::Image8, quality::QualityError> {
+    let target = match encoding {
+        quality::Encoding::Srgb => ColorTarget::Srgb8,
+        quality::Encoding::Linear => ColorTarget::Unorm8,
+    };
+    quality::Image8::from_rgba_bytes(frame.width, frame.height, &frame.to_8bit(target))
+}
+
+/// The 8-bit encoding of `color`: sRGB, or the raw values.
+pub fn encoding(color: ColorHandling) -> quality::Encoding {
+    match color {
+        ColorHandling::Srgb => quality::Encoding::Srgb,
+        ColorHandling::Raw => quality::Encoding::Linear,
+    }
+}
+
+/// Render `scene` as the options say: load its textures, build the samplers (and any ripmap or
+/// summed-area table) and draw every mesh. The frame's colour target is the 8-bit one the
+/// colour handling encodes to ([`PreparedScene::settings`]); a debug view's, whose values are
+/// meant for display, is sRGB whatever the colour handling. [`render_image`] gives the image.
+///
+/// # Errors
+/// [`Error::OverBudget`], [`Error::Scene`] (textures that cannot be loaded), [`Error::Texture`],
+/// [`Error::Raster`] (an invalid size).
+pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Error> {
+    let mut budget = budget_of(options.max_memory);
+    let prepared = PreparedScene::new(
+        scene.clone(),
+        &SceneOptions {
+            size: options.size,
+            color: options.color,
+            replace_non_finite: false,
+            ..SceneOptions::default()
+        },
+        &mut budget,
+    )?;
+    let samplers = match options.filter {
+        Some(f) => prepared.samplers(f)?,
+        None => prepared.default_samplers()?,
+    };
+    prepared.build_structures_within(&samplers, &mut budget)?;
+    let mut settings = prepared.settings_for(&samplers, &prepared.scene.camera);
+    settings.view = options.view;
+    settings.threads = options.threads;
+    if options.view != View::Color {
+        settings.target = ColorTarget::Srgb8;
+    }
+    Ok(render(&settings, &prepared.draws(&samplers))?)
+}
+
+/// [`render_scene`]'s frame as the 8-bit RGBA image `texel render -o FILE.png` writes: encoded
+/// as the colour handling says, a debug view in sRGB.
+///
+/// # Errors
+/// As [`render_scene`].
+pub fn render_image(scene: &Scene, options: &RenderOptions) -> Result<quality::Image8, Error> {
+    let frame = render_scene(scene, options)?;
+    let color = match options.view {
+        View::Color => options.color,
+        _ => ColorHandling::Srgb,
+    };
+    Ok(frame_image(&frame, encoding(color))?)
+}
+
+/// How [`PreparedScene::reference`] runs a converging reference.
+#[derive(Clone, Copy, Default)]
+pub struct ReferenceRun<'a> {
+    /// Samples, tolerance and seed ([`ReferencePlan`]).
+    pub plan: ReferencePlan,
+    /// Worker threads; `None`: all cores.
+    pub threads: Option<usize>,
+    /// Only the pixels `x0 <= i < x1, y0 <= j < y1` of `[x0, y0, x1, y1]`, each exactly what the
+    /// whole frame gives it; the others hold the background with zero error. `None`: every pixel.
+    pub scissor: Option<[u32; 4]>,
+    /// Called from worker threads as passes finish.
+    pub progress: Option<&'a (dyn Fn(&ReferenceStatus) + Sync)>,
+    /// Once set, the reference ends after the current pass, marked interrupted.
+    pub stop: Option<&'a AtomicBool>,
+}
+
+impl PreparedScene {
+    /// The converging reference of this scene seen by `camera` ([`texel_raster::adaptive`]): its
+    /// textures at level 0 with each mesh's address modes, the reference geometry, and every
+    /// pixel's mean and standard error.
+    ///
+    /// # Errors
+    /// [`Error::Raster`]: an invalid plan or scissor, or [`RasterError::Interrupted`] for a stop
+    /// before the first pass finished.
+    pub fn reference(
+        &self,
+        camera: &Camera,
+        run: &ReferenceRun<'_>,
+    ) -> Result<ReferenceEstimate, Error> {
+        // The reference samples level 0 bilinearly with each mesh's address modes; the filter
+        // only supplies those.
+        let samplers = self.samplers(Filter::Bilinear)?;
+        let draws = self.reference_draws_from(&samplers, camera)?;
+        let mut settings = self.settings_for(&samplers, camera);
+        settings.threads = run.threads;
+        settings.scissor = run.scissor;
+        Ok(render_reference_adaptive(
+            &settings,
+            &draws,
+            &run.plan,
+            run.progress,
+            run.stop,
+        )?)
+    }
+}
+
+/// How [`reference_scene`] makes a reference.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReferenceOptions {
+    /// Samples, tolerance and seed; its display encoding follows `color`.
+    pub plan: ReferencePlan,
+    /// Output size `(width, height)`, overriding the scene's.
+    pub size: Option<(u32, u32)>,
+    /// Colour handling of textures and output.
+    pub color: ColorHandling,
+    /// Worker threads; `None`: all cores.
+    pub threads: Option<usize>,
+    /// Only these pixels ([`ReferenceRun::scissor`]).
+    pub scissor: Option<[u32; 4]>,
+    /// Most bytes the reference may hold at once; `None`: the process's default.
+    pub max_memory: Option<u64>,
+}
+
+/// The converging reference of `scene` as `texel reference` makes it: the scene prepared as the
+/// options say, [`REFERENCE_BYTES_PER_PIXEL`] charged for the statistics, then
+/// [`PreparedScene::reference`] from the scene's camera. `stop`, once set, ends it after the
+/// current pass (the estimate says it was interrupted).
+///
+/// # Errors
+/// As [`render_scene`] and [`PreparedScene::reference`].
+pub fn reference_scene(
+    scene: &Scene,
+    options: &ReferenceOptions,
+    stop: Option<&AtomicBool>,
+) -> Result<ReferenceEstimate, Error> {
+    let mut budget = budget_of(options.max_memory);
+    let prepared = PreparedScene::new(
+        scene.clone(),
+        &SceneOptions {
+            size: options.size,
+            color: options.color,
+            replace_non_finite: false,
+            ..SceneOptions::default()
+        },
+        &mut budget,
+    )?;
+    budget.take(
+        "the reference's per-pixel statistics",
+        u64::from(prepared.width) * u64::from(prepared.height) * REFERENCE_BYTES_PER_PIXEL,
+    )?;
+    let plan = ReferencePlan {
+        srgb_display: options.color == ColorHandling::Srgb,
+        ..options.plan
+    };
+    prepared
+        .reference(
+            &prepared.scene.camera,
+            &ReferenceRun {
+                plan,
+                threads: options.threads,
+                scissor: options.scissor,
+                progress: None,
+                stop,
+            },
+        )
+        .map_err(|e| match e {
+            Error::Raster(RasterError::Interrupted) => Error::Cancelled,
+            e => e,
+        })
+}
