@@ -13,6 +13,7 @@ mod meshes;
 mod mips;
 mod nothing_lost;
 mod outputs;
+mod python;
 mod reference;
 mod render;
 mod shading;

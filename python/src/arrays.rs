@@ -1,0 +1,198 @@
+//! Numpy arrays in and out, with the checks a caller's mistakes need: dtype, shape, memory
+//! layout and finite values, each refused with a message that names the argument.
+
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+/// An image's texels as RGBA, as the array held them (8-bit or float).
+pub(crate) enum Texels {
+    /// From a `uint8` array.
+    U8(Vec<[u8; 4]>),
+    /// From a `float32` array.
+    F32(Vec<[f32; 4]>),
+}
+
+/// An `H x W x C` image array, its channels widened to RGBA.
+pub(crate) struct ImageIn {
+    pub width: u32,
+    pub height: u32,
+    pub texels: Texels,
+}
+
+/// The dtype's name of any object (`"float64"`, or its Python type for a non-array).
+fn dtype_name(obj: &Bound<'_, PyAny>) -> String {
+    obj.getattr("dtype")
+        .and_then(|d| d.str().map(|s| s.to_string()))
+        .unwrap_or_else(|_| {
+            obj.get_type()
+                .name()
+                .map_or_else(|_| "?".into(), |n| n.to_string())
+        })
+}
+
+/// Widen `C` channels (1: grey, 2: grey and alpha, 3: RGB, 4: RGBA) to RGBA with `one` as opaque.
+fn widen<T: Copy>(data: &[T], c: usize, one: T) -> Vec<[T; 4]> {
+    data.chunks_exact(c)
+        .map(|p| match c {
+            1 => [p[0], p[0], p[0], one],
+            2 => [p[0], p[0], p[0], p[1]],
+            3 => [p[0], p[1], p[2], one],
+            _ => [p[0], p[1], p[2], p[3]],
+        })
+        .collect()
+}
+
+/// The shape `(H, W, C)` of an image array (`(H, W)` is one channel), checked.
+fn image_shape(shape: &[usize], what: &str) -> PyResult<(u32, u32, usize)> {
+    let (h, w, c) = match *shape {
+        [h, w] => (h, w, 1),
+        [h, w, c] => (h, w, c),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "{what} must have shape (H, W) or (H, W, C); got {shape:?}"
+            )))
+        }
+    };
+    if !(1..=4).contains(&c) {
+        return Err(PyValueError::new_err(format!(
+            "{what} has {c} channels; texel takes 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA)"
+        )));
+    }
+    if h == 0 || w == 0 {
+        return Err(PyValueError::new_err(format!(
+            "{what} is empty: shape {shape:?}"
+        )));
+    }
+    let side = |n: usize| {
+        u32::try_from(n).map_err(|_| {
+            PyValueError::new_err(format!("{what} has a side of {n} texels, too large"))
+        })
+    };
+    Ok((side(h)?, side(w)?, c))
+}
+
+/// The message for an array that is not C-contiguous.
+fn not_contiguous(what: &str) -> PyErr {
+    PyValueError::new_err(format!(
+        "{what} is not C-contiguous (a strided view or a transpose): pass numpy.ascontiguousarray({what})"
+    ))
+}
+
+/// Read an `H x W x C` `uint8` or `float32` image array.
+pub(crate) fn image_in(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<ImageIn> {
+    if let Ok(a) = obj.cast::<PyArrayDyn<u8>>() {
+        let (height, width, c) = image_shape(a.shape(), what)?;
+        let ro = a.try_readonly()?;
+        let data = ro.as_slice().map_err(|_| not_contiguous(what))?;
+        return Ok(ImageIn {
+            width,
+            height,
+            texels: Texels::U8(widen(data, c, 255)),
+        });
+    }
+    if let Ok(a) = obj.cast::<PyArrayDyn<f32>>() {
+        let (height, width, c) = image_shape(a.shape(), what)?;
+        let ro = a.try_readonly()?;
+        let data = ro.as_slice().map_err(|_| not_contiguous(what))?;
+        return Ok(ImageIn {
+            width,
+            height,
+            texels: Texels::F32(widen(data, c, 1.0)),
+        });
+    }
+    Err(PyTypeError::new_err(format!(
+        "{what} must be a numpy array of dtype uint8 or float32; got {}",
+        dtype_name(obj)
+    )))
+}
+
+/// A `(..., 2)` array's values: borrowed from a `float32` array, or converted from `float64`.
+pub(crate) enum Pairs<'py> {
+    /// A C-contiguous `float32` array, read in place.
+    Borrowed(PyReadonlyArrayDyn<'py, f32>),
+    /// Converted from `float64`.
+    Owned(Vec<f32>),
+}
+
+impl Pairs<'_> {
+    /// The values, two per point.
+    pub(crate) fn values(&self) -> &[f32] {
+        match self {
+            // Contiguity was checked when the pairs were read.
+            Pairs::Borrowed(a) => a.as_slice().unwrap_or(&[]),
+            Pairs::Owned(v) => v,
+        }
+    }
+}
+
+/// Read a `(..., 2)` array of `float32` or `float64` pairs, C-contiguous, every value finite;
+/// returns the leading shape and the values.
+pub(crate) fn pairs_in<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<(Vec<usize>, Pairs<'py>)> {
+    let leading = |shape: &[usize]| -> PyResult<Vec<usize>> {
+        if shape.last() != Some(&2) {
+            return Err(PyValueError::new_err(format!(
+                "{what} must have shape (..., 2); got {shape:?}"
+            )));
+        }
+        Ok(shape[..shape.len() - 1].to_vec())
+    };
+    let non_finite = |k: usize| {
+        PyValueError::new_err(format!(
+            "{what} holds a NaN or infinite value at flat index {k}"
+        ))
+    };
+    if let Ok(a) = obj.cast::<PyArrayDyn<f32>>() {
+        let shape = leading(a.shape())?;
+        let ro = a.try_readonly()?;
+        let data = ro.as_slice().map_err(|_| not_contiguous(what))?;
+        if let Some(k) = data.iter().position(|x| !x.is_finite()) {
+            return Err(non_finite(k));
+        }
+        return Ok((shape, Pairs::Borrowed(ro)));
+    }
+    if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
+        let shape = leading(a.shape())?;
+        let ro = a.try_readonly()?;
+        let data = ro.as_slice().map_err(|_| not_contiguous(what))?;
+        // A finite double beyond f32's range would become infinite.
+        let values: Vec<f32> = data.iter().map(|&x| x as f32).collect();
+        if let Some(k) = values.iter().position(|x| !x.is_finite()) {
+            return Err(non_finite(k));
+        }
+        return Ok((shape, Pairs::Owned(values)));
+    }
+    Err(PyTypeError::new_err(format!(
+        "{what} must be a numpy array of dtype float32 or float64; got {}",
+        dtype_name(obj)
+    )))
+}
+
+/// A flat vector as an array of `shape`.
+pub(crate) fn array_out<'py, T: numpy::Element>(
+    py: Python<'py>,
+    shape: &[usize],
+    flat: Vec<T>,
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    let a = ArrayD::from_shape_vec(IxDyn(shape), flat)
+        .map_err(|e| PyValueError::new_err(format!("internal shape error: {e}")))?;
+    Ok(a.into_pyarray(py))
+}
+
+/// RGBA pixels as an `H x W x 4` array.
+pub(crate) fn rgba_out<'py, T: numpy::Element + Copy>(
+    py: Python<'py>,
+    width: u32,
+    height: u32,
+    pixels: &[[T; 4]],
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    array_out(
+        py,
+        &[height as usize, width as usize, 4],
+        pixels.iter().flatten().copied().collect(),
+    )
+}

@@ -1,0 +1,83 @@
+"""render, reference and compare give what the texel command writes."""
+
+import json
+
+import numpy as np
+import pytest
+
+import texel
+from conftest import ROOT, read_png
+
+
+@pytest.mark.parametrize(
+    "filter,color,view",
+    [("trilinear", "srgb", "color"), ("aniso16", "raw", "color"), ("ewa", "srgb", "color"),
+     ("trilinear", "raw", "mip")],
+)
+def test_render_equals_the_cli_png(cli, tmp_path, filter, color, view):
+    out = tmp_path / "cli.png"
+    cli("render", "builtin:ground", "--size", "96x54", "--filter", filter, "--color", color,
+        "--view", view, "-o", out)
+    got = texel.render("builtin:ground", filter=filter, size=(96, 54), color=color, view=view)
+    assert got.shape == (54, 96, 4) and got.dtype == np.uint8
+    np.testing.assert_array_equal(got, read_png(out))
+
+
+def test_scene_text_renders_as_its_file():
+    text = (ROOT / "scenes" / "ground.toml").read_text()
+    a = texel.render(text, size=(48, 27))
+    b = texel.render(str(ROOT / "scenes" / "ground.toml"), size=(48, 27))
+    np.testing.assert_array_equal(a, b)
+
+
+def test_reference_equals_the_cli_png_and_its_error_bars_hold(cli, tmp_path):
+    out = tmp_path / "ref.png"
+    cli("reference", "builtin:ground", "--size", "64x36", "--spp", "16", "--max-spp", "64",
+        "-o", out)
+    est = texel.reference_estimate("builtin:ground", spp=16, max_spp=64, size=(64, 36))
+    np.testing.assert_array_equal(est["image"], read_png(out))
+    np.testing.assert_array_equal(
+        texel.reference("builtin:ground", spp=16, max_spp=64, size=(64, 36)), est["image"]
+    )
+    assert est["spp"].min() >= 16 and est["spp"].max() <= 64
+    assert est["std_error"].shape == (36, 64, 4) and np.all(est["std_error"] >= 0)
+    # The image is the encoding of the linear mean.
+    np.testing.assert_array_equal(texel.encode(est["linear"]), est["image"])
+
+
+def test_a_scissored_reference_is_that_part_of_the_whole():
+    whole = texel.reference_estimate("builtin:ground", spp=16, max_spp=64, size=(40, 24))
+    part = texel.reference_estimate(
+        "builtin:ground", spp=16, max_spp=64, size=(40, 24), scissor=(7, 10, 31, 24)
+    )
+    for key in ("image", "linear", "std_error", "spp", "converged"):
+        np.testing.assert_array_equal(part[key], whole[key][10:24, 7:31], err_msg=key)
+
+
+def test_compare_scores_what_the_cli_reports(cli, tmp_path):
+    filters = ["nearest", "trilinear", "aniso16"]
+    cli("compare", "builtin:ground", "--size", "64x36", "--spp", "16", "--filters",
+        ",".join(filters), "--out", tmp_path / "report")
+    report = json.loads((tmp_path / "report" / "report.json").read_text())
+    rows = {r["name"]: r for r in report["rows"]}
+    got = texel.compare("builtin:ground", filters=filters, spp=16, size=(64, 36))
+    assert list(got) == filters
+    for name in filters:
+        assert got[name]["psnr"] == pytest.approx(rows[name]["psnr_all"], abs=1e-9)
+        assert got[name]["ssim"] == pytest.approx(rows[name]["ssim"], abs=1e-12)
+        assert got[name]["texels_per_pixel"] == pytest.approx(
+            rows[name]["texels_per_pixel_mean"], abs=1e-9
+        )
+        assert got[name]["ms_per_frame"] > 0
+        assert got[name]["psnr"] < got[name]["noise_floor"] + 1e-9
+    # Nearest aliases at the horizon: trilinear and aniso16 score higher.
+    assert got["aniso16"]["psnr"] > got["nearest"]["psnr"]
+    assert got["trilinear"]["texels_per_pixel"] > got["nearest"]["texels_per_pixel"]
+
+
+def test_the_readme_example_runs(capsys):
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## From Python"):]
+    code = section.split("```python\n", 1)[1].split("```", 1)[0]
+    exec(compile(code, "README.md", "exec"), {})
+    assert "dB against" in capsys.readouterr().out

@@ -1,0 +1,74 @@
+"""texel: texture mapping and every texture filter, from nearest to EWA, on numpy arrays.
+
+``Texture`` holds an image and its mip pyramid and samples it with any filter at arrays of points
+and footprints; ``render``, ``reference`` and ``compare`` run texel's scenes (a path, a
+``"builtin:NAME"`` or TOML text) exactly as the ``texel`` command does; ``warp`` maps an image in
+perspective without aliasing. ``texel.distributed`` runs renders and references over Ray.
+
+Every call releases the GIL and uses texel's own threads. texel's errors arrive as Python
+exceptions with texel's messages: ``ValueError`` for bad values, ``OSError`` for files,
+``MemoryError`` for what the memory limit refuses, ``KeyboardInterrupt`` after Ctrl-C.
+"""
+
+from __future__ import annotations
+
+from typing import Optional, Sequence, Tuple
+
+from ._texel import (
+    BUILTIN_SCENES,
+    DEFAULT_SEED,
+    FILTERS,
+    Texture,
+    compare,
+    encode,
+    reference_estimate,
+    render,
+    scene_size,
+    warp,
+)
+
+__all__ = [
+    "BUILTIN_SCENES",
+    "DEFAULT_SEED",
+    "FILTERS",
+    "Texture",
+    "compare",
+    "encode",
+    "reference",
+    "reference_estimate",
+    "render",
+    "scene_size",
+    "warp",
+]
+
+
+def reference(
+    scene: str,
+    spp: int = 256,
+    size: Optional[Tuple[int, int]] = None,
+    max_spp: int = 65536,
+    tolerance: float = 0.5,
+    seed: int = DEFAULT_SEED,
+    color: str = "srgb",
+    threads: Optional[int] = None,
+    max_memory: Optional[int] = None,
+):
+    """The supersampled reference of ``scene``: the ``H x W x 4`` ``uint8`` image that
+    ``texel reference SCENE --spp SPP --max-spp MAX_SPP -o FILE.png`` writes, bit for bit.
+
+    Every pixel gets at least ``spp`` samples; pixels whose 95 % interval of the displayed value
+    is wider than ``tolerance`` 8-bit steps get more, doubling, up to ``max_spp``. The result
+    depends on ``seed`` only, not on the thread count. ``reference_estimate`` returns the error
+    bars too.
+    """
+    return reference_estimate(
+        scene,
+        spp=spp,
+        max_spp=max_spp,
+        tolerance=tolerance,
+        seed=seed,
+        size=size,
+        color=color,
+        threads=threads,
+        max_memory=max_memory,
+    )["image"]

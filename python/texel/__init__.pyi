@@ -1,0 +1,94 @@
+"""Type stubs of texel's Python package (see docs/guide/python.md)."""
+
+from typing import Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+FILTERS: List[str]
+BUILTIN_SCENES: List[str]
+DEFAULT_SEED: int
+
+_Coords = npt.NDArray[Union[np.float32, np.float64]]
+
+class Texture:
+    """A texture and its mip pyramid, with the address modes and border colour its samples use."""
+
+    def __init__(
+        self,
+        array: npt.NDArray[Union[np.uint8, np.float32]],
+        color: str = "srgb",
+        address: str = "repeat",
+        address_u: Optional[str] = None,
+        address_v: Optional[str] = None,
+        border: str = "transparent-black",
+    ) -> None: ...
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def dtype(self) -> str: ...
+    def levels(self) -> List[npt.NDArray[Union[np.uint8, np.float32]]]: ...
+    def sample(
+        self,
+        uv: _Coords,
+        duv_dx: Optional[_Coords] = None,
+        duv_dy: Optional[_Coords] = None,
+        filter: str = "trilinear",
+        lod_bias: float = 0.0,
+    ) -> npt.NDArray[np.float32]: ...
+
+def render(
+    scene: str,
+    filter: Optional[str] = "trilinear",
+    size: Optional[Tuple[int, int]] = None,
+    color: str = "srgb",
+    view: str = "color",
+    threads: Optional[int] = None,
+    max_memory: Optional[int] = None,
+) -> npt.NDArray[np.uint8]: ...
+def reference(
+    scene: str,
+    spp: int = 256,
+    size: Optional[Tuple[int, int]] = None,
+    max_spp: int = 65536,
+    tolerance: float = 0.5,
+    seed: int = ...,
+    color: str = "srgb",
+    threads: Optional[int] = None,
+    max_memory: Optional[int] = None,
+) -> npt.NDArray[np.uint8]: ...
+def reference_estimate(
+    scene: str,
+    spp: int = 256,
+    max_spp: int = 65536,
+    tolerance: float = 0.5,
+    seed: int = ...,
+    size: Optional[Tuple[int, int]] = None,
+    color: str = "srgb",
+    threads: Optional[int] = None,
+    scissor: Optional[Tuple[int, int, int, int]] = None,
+    max_memory: Optional[int] = None,
+) -> Dict[str, Union[np.ndarray, bool]]: ...
+def compare(
+    scene: str,
+    filters: Optional[Sequence[str]] = None,
+    spp: int = 256,
+    max_spp: Optional[int] = None,
+    tolerance: float = 0.5,
+    seed: int = ...,
+    size: Optional[Tuple[int, int]] = None,
+    color: str = "srgb",
+    threads: Optional[int] = None,
+    max_memory: Optional[int] = None,
+) -> Dict[str, Dict[str, Union[float, int, List[str]]]]: ...
+def warp(
+    image: npt.NDArray[Union[np.uint8, np.float32]],
+    corners: Sequence[float],
+    size: Optional[Tuple[int, int]] = None,
+    filter: str = "ewa",
+    color: str = "srgb",
+) -> npt.NDArray[Union[np.uint8, np.float32]]: ...
+def encode(linear: npt.NDArray[np.float32], color: str = "srgb") -> npt.NDArray[np.uint8]: ...
+def scene_size(scene: str, size: Optional[Tuple[int, int]] = None) -> Tuple[int, int]: ...
