@@ -137,9 +137,9 @@ fn time_gpu(
 ) -> Result<Vec<Timing>> {
     let mut out = Vec::new();
     for &(label, filter, gpu_filter) in jobs {
-        let samplers = scene.samplers(filter)?;
-        let draws = scene.draws(&samplers);
-        let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
+        let plan = scene.plan(Some(filter), budget)?;
+        let draws = plan.draws();
+        let mut settings = plan.settings();
         settings.derivatives = texel_raster::Derivatives::Quad;
         if args.target == TargetArg::Float {
             settings.target = texel::ColorTarget::Float;
@@ -221,10 +221,9 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         with_threads(args.threads, || -> Result<Vec<Timing>> {
             let mut out = Vec::new();
             for filter in &filters {
-                let samplers = scene.samplers(*filter)?;
-                scene.build_structures_within(&samplers, budget)?;
-                let draws = scene.draws(&samplers);
-                let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
+                let plan = scene.plan(Some(*filter), budget)?;
+                let draws = plan.draws();
+                let mut settings = plan.settings();
                 if args.target == TargetArg::Float {
                     settings.target = texel::ColorTarget::Float;
                 }

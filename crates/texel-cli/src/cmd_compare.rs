@@ -187,14 +187,14 @@ fn gpu_rows(
             "a GPU frame and its read-back",
             texel_gpu::frame_bytes(settings.width, settings.height),
         )?;
-        let samplers = scene.samplers(filter)?;
-        let draws = scene.draws(&samplers);
+        let frame_plan = scene.plan(Some(filter), budget)?;
+        let draws = frame_plan.draws();
         // The uploads are held while this row renders; its frame is kept.
         let uploads = texel_gpu::prepare_bytes(&draws);
         budget.take("the GPU's copies of the textures and meshes", uploads)?;
         let prepared = gpu.prepare(&draws, gpu_filter)?;
         let settings = RenderSettings {
-            environment: scene.environment(&samplers, &scene.scene.camera),
+            environment: frame_plan.settings().environment,
             ..settings
         };
         let mut times = Vec::new();
@@ -316,10 +316,10 @@ pub fn compare(
             Some(_) => pb.set_message(format!("{label}: {}", filter.name())),
             None => pb.set_message(filter.name()),
         }
-        let samplers = scene.samplers(filter)?;
-        let bytes = scene.build_structures_within(&samplers, budget)?;
-        let draws = scene.draws(&samplers);
-        let settings = scene.settings_for(&samplers, &scene.scene.camera);
+        let frame_plan = scene.plan(Some(filter), budget)?;
+        let bytes = frame_plan.structure_bytes();
+        let draws = frame_plan.draws();
+        let settings = frame_plan.settings();
         let mut times = time_frames(&settings, &draws, 1, Duration::ZERO, TIMED_FRAMES)?;
         let mut counting = settings;
         counting.count_texels = true;
@@ -346,6 +346,7 @@ pub fn compare(
             spec,
             (&scoring, &images),
             &mut rows,
+            budget,
         )?),
         None => None,
     };
@@ -425,6 +426,7 @@ fn orbit_scores(
     spec: OrbitSpec,
     (scoring, images): (&Scoring, &[Image8]),
     rows: &mut [FilterRow],
+    budget: &mut MemoryBudget,
 ) -> Result<Orbit> {
     let enc = encoding(scene.color);
     let (w, h) = (scene.width, scene.height);
@@ -445,9 +447,11 @@ fn orbit_scores(
         let coverage = Mask::new(w, h, reference.coverage())?;
         ref_change += mean_abs_change(&prev_ref, &ref_image, &prev_cov, &coverage)?;
         for (i, &filter) in filters.iter().enumerate() {
-            let samplers = scene.samplers(filter)?;
-            let settings = scene.settings_for(&samplers, &camera);
-            let frame = render(&settings, &scene.draws_from(&samplers, &camera))?;
+            let frame_plan = scene.plan(Some(filter), budget)?;
+            let frame = render(
+                &frame_plan.settings_from(&camera),
+                &frame_plan.draws_from(&camera),
+            )?;
             let image = texel::frame_image(&frame, enc)?;
             change[i] += excess_change(
                 [&prev[i], &image],

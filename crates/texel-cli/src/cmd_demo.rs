@@ -218,12 +218,11 @@ fn mapping_rows(
                     (sub, report)
                 }
             };
-            let samplers = scene.samplers(Filter::Trilinear)?;
-            scene.build_structures_within(&samplers, &mut scene_input.budget)?;
-            let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
+            let frame_plan = scene.plan(Some(Filter::Trilinear), &mut scene_input.budget)?;
+            let mut settings = frame_plan.settings();
             settings.view = View::Lod;
             settings.target = ColorTarget::Srgb8;
-            let frame = render(&settings, &scene.draws(&samplers))?;
+            let frame = render(&settings, &frame_plan.draws())?;
             let lod_image = format!("{scene_name}-lod-{}.png", evaluation.name());
             texel::frame_image(&frame, Encoding::Srgb)?.write_png(views.join(&lod_image))?;
             rows.push(MappingRow {

@@ -24,12 +24,8 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         );
         scene.set_surface_uv(UvEvaluation::PerVertex);
     }
-    let samplers = match filter {
-        Some(f) => scene.samplers(f)?,
-        None => scene.default_samplers()?,
-    };
-    scene.build_structures_within(&samplers, &mut input.budget)?;
-    let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
+    let plan = scene.plan(filter, &mut input.budget)?;
+    let mut settings = plan.settings();
     settings.derivatives = args.derivatives;
     settings.perspective = args.perspective;
     settings.view = args.view;
@@ -45,7 +41,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         // OpenEXR keeps the colour in float, unclamped.
         settings.target = ColorTarget::Float;
     }
-    let draws = scene.draws(&samplers);
+    let draws = plan.draws();
     let frame = if args.gpu {
         let filter = filter.unwrap_or(Filter::Trilinear);
         let Some(gpu_filter) = GpuFilter::of(filter) else {

@@ -7,7 +7,7 @@
 //! `SCENE` is a TOML scene file or `builtin:NAME` (default `builtin:ground`); the filter defaults to
 //! trilinear (a glTF mesh's own sampler filters when none is given); the PNG defaults to
 //! `render_scene.png`. The steps are the ones `texel::render_scene` takes, spelled out: load the
-//! scene, prepare it within a memory budget, build samplers, render, encode.
+//! scene, prepare it within a memory budget, plan the frame for the filter, render, encode.
 
 use texel::quality::Encoding;
 use texel::{render, Filter, MemoryBudget, PreparedScene, Scene, SceneOptions};
@@ -34,14 +34,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scene = Scene::load(&scene_arg)?;
     let mut budget = MemoryBudget::half_of_machine();
     let prepared = PreparedScene::new(scene, &SceneOptions::default(), &mut budget)?;
-    let samplers = match filter {
-        Some(f) => prepared.samplers(f)?,
-        None => prepared.default_samplers()?,
-    };
-    let structure_bytes = prepared.build_structures(&samplers)?;
+    // The filter's samplers, with any ripmap or summed-area table built within the budget.
+    let plan = prepared.plan(filter, &mut budget)?;
+    let structure_bytes = plan.structure_bytes();
     let started = std::time::Instant::now();
-    let settings = prepared.settings_for(&samplers, &prepared.scene.camera);
-    let frame = render(&settings, &prepared.draws(&samplers))?;
+    let frame = render(&plan.settings(), &plan.draws())?;
     let ms = started.elapsed().as_secs_f64() * 1e3;
     texel::frame_image(&frame, Encoding::Srgb)?.write_png(&out)?;
     println!(

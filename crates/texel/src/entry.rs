@@ -87,18 +87,14 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Err
         },
         &mut budget,
     )?;
-    let samplers = match options.filter {
-        Some(f) => prepared.samplers(f)?,
-        None => prepared.default_samplers()?,
-    };
-    prepared.build_structures_within(&samplers, &mut budget)?;
-    let mut settings = prepared.settings_for(&samplers, &prepared.scene.camera);
+    let plan = prepared.plan(options.filter, &mut budget)?;
+    let mut settings = plan.settings();
     settings.view = options.view;
     settings.threads = options.threads;
     if options.view != View::Color {
         settings.target = ColorTarget::Srgb8;
     }
-    Ok(render(&settings, &prepared.draws(&samplers))?)
+    Ok(render(&settings, &plan.draws())?)
 }
 
 /// [`render_scene`]'s frame as the 8-bit RGBA image `texel render -o FILE.png` writes: encoded
@@ -144,11 +140,9 @@ impl PreparedScene {
         camera: &Camera,
         run: &ReferenceRun<'_>,
     ) -> Result<ReferenceEstimate, Error> {
-        // The reference samples level 0 bilinearly with each mesh's address modes; the filter
-        // only supplies those.
-        let samplers = self.samplers(Filter::Bilinear)?;
-        let draws = self.reference_draws_from(&samplers, camera)?;
-        let mut settings = self.settings_for(&samplers, camera);
+        let plan = self.reference_plan()?;
+        let draws = plan.reference_draws_from(camera)?;
+        let mut settings = plan.settings_from(camera);
         settings.threads = run.threads;
         settings.scissor = run.scissor;
         Ok(render_reference_adaptive(

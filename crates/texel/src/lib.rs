@@ -33,6 +33,7 @@ mod entry;
 mod error;
 mod filter;
 pub mod memory;
+mod plan;
 mod prepare;
 pub mod tessellate;
 
@@ -48,6 +49,7 @@ pub use entry::{
 pub use error::Error;
 pub use filter::Filter;
 pub use memory::MemoryBudget;
+pub use plan::FramePlan;
 pub use prepare::{ColorHandling, PreparedScene, SceneOptions};
 pub use texel_raster::{render, ColorTarget, DrawCall, Frame, RenderSettings, View};
 pub use texel_scene::{Scene, SceneLimits};
