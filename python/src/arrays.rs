@@ -3,8 +3,11 @@
 
 use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use texel::texture::{Format, Limits};
+
+use crate::errors::to_py;
 
 /// An image's texels as RGBA, as the array held them (8-bit or float).
 pub(crate) enum Texels {
@@ -33,15 +36,44 @@ fn dtype_name(obj: &Bound<'_, PyAny>) -> String {
 }
 
 /// Widen `C` channels (1: grey, 2: grey and alpha, 3: RGB, 4: RGBA) to RGBA with `one` as opaque.
-fn widen<T: Copy>(data: &[T], c: usize, one: T) -> Vec<[T; 4]> {
-    data.chunks_exact(c)
-        .map(|p| match c {
-            1 => [p[0], p[0], p[0], one],
-            2 => [p[0], p[0], p[0], p[1]],
-            3 => [p[0], p[1], p[2], one],
-            _ => [p[0], p[1], p[2], p[3]],
-        })
-        .collect()
+fn widen<T: Copy>(data: &[T], c: usize, one: T, what: &str) -> PyResult<Vec<[T; 4]>> {
+    let mut out = Vec::new();
+    reserve(&mut out, data.len() / c, what)?;
+    out.extend(data.chunks_exact(c).map(|p| match c {
+        1 => [p[0], p[0], p[0], one],
+        2 => [p[0], p[0], p[0], p[1]],
+        3 => [p[0], p[1], p[2], one],
+        _ => [p[0], p[1], p[2], p[3]],
+    }));
+    Ok(out)
+}
+
+/// Reserve room for `n` more values, or raise `MemoryError` naming `what`.
+pub(crate) fn reserve<T>(v: &mut Vec<T>, n: usize, what: &str) -> PyResult<()> {
+    v.try_reserve_exact(n).map_err(|_| {
+        PyMemoryError::new_err(format!(
+            "cannot allocate {n} values of {} bytes for {what}",
+            std::mem::size_of::<T>()
+        ))
+    })
+}
+
+/// A read-only view of `a` whose slice is its data in row-major order: refused unless the array
+/// is C-contiguous (a Fortran-ordered array is contiguous too, but its slice is column-major)
+/// and aligned for `T`.
+fn c_order<'py, T: numpy::Element>(
+    a: &Bound<'py, PyArrayDyn<T>>,
+    what: &str,
+) -> PyResult<PyReadonlyArrayDyn<'py, T>> {
+    if !a.is_c_contiguous() {
+        return Err(not_contiguous(what));
+    }
+    if !(a.data() as usize).is_multiple_of(std::mem::align_of::<T>()) {
+        return Err(PyValueError::new_err(format!(
+            "{what} is not aligned for its dtype (a view at an odd byte offset): pass numpy.require({what}, requirements=\"CA\")"
+        )));
+    }
+    Ok(a.try_readonly()?)
 }
 
 /// The shape `(H, W, C)` of an image array (`(H, W)` is one channel), checked.
@@ -73,10 +105,17 @@ fn image_shape(shape: &[usize], what: &str) -> PyResult<(u32, u32, usize)> {
     Ok((side(h)?, side(w)?, c))
 }
 
+/// Refuse an image beyond a texture's default limits before its texels are copied.
+fn check_size(width: u32, height: u32, format: Format, what: &str) -> PyResult<()> {
+    Limits::default()
+        .check(width, height, format)
+        .map_err(|e| to_py(e.into(), &format!("{what} cannot be a texture")))
+}
+
 /// The message for an array that is not C-contiguous.
 fn not_contiguous(what: &str) -> PyErr {
     PyValueError::new_err(format!(
-        "{what} is not C-contiguous (a strided view or a transpose): pass numpy.ascontiguousarray({what})"
+        "{what} is not C-contiguous (a strided view, a transpose or Fortran order): pass numpy.ascontiguousarray({what})"
     ))
 }
 
@@ -84,22 +123,24 @@ fn not_contiguous(what: &str) -> PyErr {
 pub(crate) fn image_in(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<ImageIn> {
     if let Ok(a) = obj.cast::<PyArrayDyn<u8>>() {
         let (height, width, c) = image_shape(a.shape(), what)?;
-        let ro = a.try_readonly()?;
+        check_size(width, height, Format::Rgba8Unorm, what)?;
+        let ro = c_order(a, what)?;
         let data = ro.as_slice().map_err(|_| not_contiguous(what))?;
         return Ok(ImageIn {
             width,
             height,
-            texels: Texels::U8(widen(data, c, 255)),
+            texels: Texels::U8(widen(data, c, 255, what)?),
         });
     }
     if let Ok(a) = obj.cast::<PyArrayDyn<f32>>() {
         let (height, width, c) = image_shape(a.shape(), what)?;
-        let ro = a.try_readonly()?;
+        check_size(width, height, Format::Rgba32Float, what)?;
+        let ro = c_order(a, what)?;
         let data = ro.as_slice().map_err(|_| not_contiguous(what))?;
         return Ok(ImageIn {
             width,
             height,
-            texels: Texels::F32(widen(data, c, 1.0)),
+            texels: Texels::F32(widen(data, c, 1.0, what)?),
         });
     }
     Err(PyTypeError::new_err(format!(
@@ -127,6 +168,14 @@ impl Pairs<'_> {
     }
 }
 
+/// Whether every value is finite: a fold without early exit over blocks, which the compiler
+/// vectorises (a search for the first non-finite value does not).
+fn all_finite(values: &[f32]) -> bool {
+    values
+        .chunks(1024)
+        .all(|block| block.iter().fold(true, |ok, x| ok & x.is_finite()))
+}
+
 /// Read a `(..., 2)` array of `float32` or `float64` pairs, C-contiguous, every value finite;
 /// returns the leading shape and the values.
 pub(crate) fn pairs_in<'py>(
@@ -148,20 +197,24 @@ pub(crate) fn pairs_in<'py>(
     };
     if let Ok(a) = obj.cast::<PyArrayDyn<f32>>() {
         let shape = leading(a.shape())?;
-        let ro = a.try_readonly()?;
+        let ro = c_order(a, what)?;
         let data = ro.as_slice().map_err(|_| not_contiguous(what))?;
-        if let Some(k) = data.iter().position(|x| !x.is_finite()) {
+        if !all_finite(data) {
+            let k = data.iter().position(|x| !x.is_finite()).unwrap_or(0);
             return Err(non_finite(k));
         }
         return Ok((shape, Pairs::Borrowed(ro)));
     }
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
         let shape = leading(a.shape())?;
-        let ro = a.try_readonly()?;
+        let ro = c_order(a, what)?;
         let data = ro.as_slice().map_err(|_| not_contiguous(what))?;
         // A finite double beyond f32's range would become infinite.
-        let values: Vec<f32> = data.iter().map(|&x| x as f32).collect();
-        if let Some(k) = values.iter().position(|x| !x.is_finite()) {
+        let mut values = Vec::new();
+        reserve(&mut values, data.len(), what)?;
+        values.extend(data.iter().map(|&x| x as f32));
+        if !all_finite(&values) {
+            let k = values.iter().position(|x| !x.is_finite()).unwrap_or(0);
             return Err(non_finite(k));
         }
         return Ok((shape, Pairs::Owned(values)));

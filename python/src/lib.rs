@@ -75,7 +75,12 @@ fn _texel(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(texture::warp, m)?)?;
     m.add_function(wrap_pyfunction!(texture::encode, m)?)?;
     m.add("FILTERS", texel::Filter::NAMES.to_vec())?;
-    m.add("BUILTIN_SCENES", texel::scene::builtin_names().to_vec())?;
+    let builtins: Vec<&str> = texel::scene::builtin_names()
+        .iter()
+        .chain(texel::scene::shaded_builtin_names())
+        .copied()
+        .collect();
+    m.add("BUILTIN_SCENES", builtins)?;
     m.add("DEFAULT_SEED", texel::raster::adaptive::DEFAULT_SEED)?;
     Ok(())
 }

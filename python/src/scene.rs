@@ -1,7 +1,7 @@
 //! Scenes from Python: `render` (the image `texel render` writes), the converging reference with
 //! its error bars (whole, or one scissor rectangle of it) and `compare`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
@@ -26,16 +26,39 @@ use crate::texture::{filter_named, srgb_named};
 /// Timed frames per filter in `compare`, after one warm-up frame (the command's count).
 const TIMED_FRAMES: usize = 3;
 
-/// Whether a scene argument is TOML text rather than a path: it spans lines, or holds `=` and
-/// names no file.
-fn is_toml_text(arg: &str) -> bool {
-    arg.contains('\n') || (arg.contains('=') && !Path::new(arg).exists())
+/// The most worker threads a call may ask for.
+const MAX_THREADS: usize = 1024;
+
+/// A `threads=` argument, checked: 1 to [`MAX_THREADS`], or `None` for all cores.
+fn threads_of(threads: Option<usize>) -> PyResult<Option<usize>> {
+    match threads {
+        Some(n) if !(1..=MAX_THREADS).contains(&n) => Err(PyValueError::new_err(format!(
+            "threads must be 1 to {MAX_THREADS}, or None for all cores; got {n}"
+        ))),
+        t => Ok(t),
+    }
 }
 
-/// Load a scene: `"builtin:NAME"`, a path to a TOML, OBJ or glTF file, or TOML text (whose
-/// relative paths resolve from the working directory).
-pub(crate) fn load_scene(arg: &str) -> PyResult<Scene> {
-    if !arg.starts_with("builtin:") && is_toml_text(arg) {
+/// A `tolerance=` argument in 8-bit steps, checked, in display units.
+fn tolerance_of(steps: f64) -> PyResult<f64> {
+    if !(steps.is_finite() && steps >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "tolerance must be a finite number of 8-bit steps, 0 or more; got {steps}"
+        )));
+    }
+    Ok(steps / 255.0)
+}
+
+/// Load a scene: `"builtin:NAME"`, a path (`str` or `os.PathLike`) to a TOML, OBJ or glTF file,
+/// or TOML text of more than one line (whose relative paths resolve from the working directory).
+pub(crate) fn load_scene(arg: &Path) -> PyResult<Scene> {
+    let Some(arg) = arg.to_str() else {
+        return Err(PyValueError::new_err(format!(
+            "scene path {} is not UTF-8",
+            arg.display()
+        )));
+    };
+    if arg.contains('\n') {
         return Scene::from_toml_str(arg, Path::new("<scene text>"))
             .map_err(py_err("cannot load the scene text"));
     }
@@ -80,8 +103,8 @@ fn size_of(size: Option<(u32, u32)>) -> PyResult<Option<(u32, u32)>> {
 /// The size a scene renders at: `size`, else the scene's own.
 #[pyfunction]
 #[pyo3(signature = (scene, size = None))]
-pub fn scene_size(scene: &str, size: Option<(u32, u32)>) -> PyResult<(u32, u32)> {
-    let loaded = load_scene(scene)?;
+pub fn scene_size(scene: PathBuf, size: Option<(u32, u32)>) -> PyResult<(u32, u32)> {
+    let loaded = load_scene(&scene)?;
     Ok(size_of(size)?.unwrap_or((loaded.output.width, loaded.output.height)))
 }
 
@@ -92,7 +115,7 @@ pub fn scene_size(scene: &str, size: Option<(u32, u32)>) -> PyResult<(u32, u32)>
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
-    scene: &str,
+    scene: PathBuf,
     filter: Option<&str>,
     size: Option<(u32, u32)>,
     color: &str,
@@ -106,9 +129,9 @@ pub fn render<'py>(
         color: color_named(color)?,
         view: view_named(view)?,
         max_memory,
-        threads,
+        threads: threads_of(threads)?,
     };
-    let loaded = load_scene(scene)?;
+    let loaded = load_scene(&scene)?;
     let image = run_released(py, move |_| {
         texel::render_image(&loaded, &options).map_err(|e| to_py(e, ""))
     })?;
@@ -125,7 +148,7 @@ pub fn render<'py>(
 #[allow(clippy::too_many_arguments)]
 pub fn reference_estimate<'py>(
     py: Python<'py>,
-    scene: &str,
+    scene: PathBuf,
     spp: u32,
     max_spp: u32,
     tolerance: f64,
@@ -145,17 +168,17 @@ pub fn reference_estimate<'py>(
         plan: ReferencePlan {
             min_spp: spp,
             max_spp,
-            tolerance: tolerance / 255.0,
+            tolerance: tolerance_of(tolerance)?,
             seed,
             ..ReferencePlan::default()
         },
         size: size_of(size)?,
         color: color_named(color)?,
-        threads,
+        threads: threads_of(threads)?,
         scissor: scissor.map(|(a, b, c, d)| [a, b, c, d]),
         max_memory,
     };
-    let loaded = load_scene(scene)?;
+    let loaded = load_scene(&scene)?;
     let e = run_released(py, move |stop| {
         texel::reference_scene(&loaded, &options, Some(stop)).map_err(|e| to_py(e, ""))
     })?;
@@ -243,10 +266,10 @@ fn score_filter(
     budget: &mut MemoryBudget,
 ) -> Result<Row, Error> {
     let (ref_image, coverage) = reference;
-    let samplers = scene.samplers(filter)?;
-    let texture_bytes = scene.build_structures_within(&samplers, budget)?;
-    let draws = scene.draws(&samplers);
-    let mut settings = scene.settings_for(&samplers, &scene.scene.camera);
+    let plan = scene.plan(Some(filter), budget)?;
+    let texture_bytes = plan.structure_bytes();
+    let draws = plan.draws();
+    let mut settings = plan.settings();
     settings.threads = threads;
     let mut frame = Frame::new(&settings);
     let mut ms = Vec::new();
@@ -298,7 +321,7 @@ fn score_filter(
 #[allow(clippy::too_many_arguments)]
 pub fn compare<'py>(
     py: Python<'py>,
-    scene: &str,
+    scene: PathBuf,
     filters: Option<Vec<String>>,
     spp: u32,
     max_spp: Option<u32>,
@@ -310,13 +333,11 @@ pub fn compare<'py>(
     max_memory: Option<u64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let filters = match filters {
-        Some(names) if names.is_empty() => return Err(to_py(Error::EmptyFilterList, "")),
-        Some(names) => names
-            .iter()
-            .map(|n| filter_named(n))
-            .collect::<PyResult<Vec<_>>>()?,
+        // The command line's list syntax: names, or "all".
+        Some(names) => Filter::parse_list(&names.join(",")).map_err(py_err(""))?,
         None => Filter::ALL.to_vec(),
     };
+    let threads = threads_of(threads)?;
     let color = color_named(color)?;
     let size = size_of(size)?;
     let max_spp = max_spp.unwrap_or(spp);
@@ -328,11 +349,11 @@ pub fn compare<'py>(
     let plan = ReferencePlan {
         min_spp: spp,
         max_spp,
-        tolerance: tolerance / 255.0,
+        tolerance: tolerance_of(tolerance)?,
         srgb_display: color == ColorHandling::Srgb,
         seed,
     };
-    let loaded = load_scene(scene)?;
+    let loaded = load_scene(&scene)?;
     let (rows, floors, ties) = run_released(py, move |stop| {
         let run = || -> Result<_, Error> {
             let mut budget = match max_memory {

@@ -5,8 +5,8 @@ use std::str::FromStr;
 use std::sync::Arc;
 
 use glam::DVec2;
-use numpy::{PyArrayDyn, PyArrayMethods};
-use pyo3::exceptions::PyValueError;
+use numpy::PyArrayDyn;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use texel::quality::{Encoding, Image8};
@@ -16,7 +16,7 @@ use texel::texture::{
 };
 use texel::Filter;
 
-use crate::arrays::{image_in, pairs_in, rgba_out, ImageIn, Pairs, Texels};
+use crate::arrays::{array_out, image_in, pairs_in, reserve, rgba_out, ImageIn, Pairs, Texels};
 use crate::errors::py_err;
 use crate::run_released;
 
@@ -229,11 +229,14 @@ impl Texture {
         let sampler = Sampler::new(desc).map_err(py_err(""))?;
         let mut full = shape;
         full.push(4);
-        let out = PyArrayDyn::<f32>::zeros(py, full, false);
-        let mut write = out.try_readwrite()?;
-        let dst = write
-            .as_slice_mut()
-            .map_err(|_| PyValueError::new_err("internal: the output is not contiguous"))?;
+        let values = full
+            .iter()
+            .try_fold(1usize, |n, &d| n.checked_mul(d))
+            .ok_or_else(|| PyValueError::new_err(format!("uv's shape {full:?} is too large")))?;
+        let mut samples: Vec<f32> = Vec::new();
+        reserve(&mut samples, values, "the samples")?;
+        samples.resize(values, 0.0);
+        let dst = samples.as_mut_slice();
         let (uv, dx, dy) = (
             points.values(),
             dx.as_ref().map(Pairs::values),
@@ -268,8 +271,7 @@ impl Texture {
                 });
             Ok(())
         })?;
-        drop(write);
-        Ok(out)
+        array_out(py, &full, samples)
     }
 
     fn __repr__(&self) -> String {
@@ -296,16 +298,25 @@ impl Texture {
 pub fn warp<'py>(
     py: Python<'py>,
     image: &Bound<'py, PyAny>,
-    corners: Vec<f64>,
+    corners: &Bound<'py, PyAny>,
     size: Option<(u32, u32)>,
     filter: &str,
     color: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     let filter = filter_named(filter)?;
     let srgb = srgb_named(color)?;
+    let corners: Vec<f64> = match corners.extract::<Vec<f64>>() {
+        Ok(flat) => flat,
+        Err(_) => corners
+            .extract::<Vec<(f64, f64)>>()
+            .map(|pairs| pairs.into_iter().flat_map(|(x, y)| [x, y]).collect())
+            .map_err(|_| {
+                PyTypeError::new_err("corners must be eight numbers or four (x, y) pairs")
+            })?,
+    };
     if corners.len() != 8 {
         return Err(PyValueError::new_err(format!(
-            "corners must be eight numbers (four x, y pairs); got {}",
+            "corners must be eight numbers (four x, y pairs); got {} numbers",
             corners.len()
         )));
     }
@@ -350,9 +361,7 @@ pub fn encode<'py>(
     let srgb = srgb_named(color)?;
     let image = image_in(linear, "linear")?;
     let Texels::F32(pixels) = image.texels else {
-        return Err(pyo3::exceptions::PyTypeError::new_err(
-            "linear must be a float32 array",
-        ));
+        return Err(PyTypeError::new_err("linear must be a float32 array"));
     };
     let e = encoded(image.width, image.height, &pixels, srgb)?;
     rgba_out(py, image.width, image.height, e.pixels())

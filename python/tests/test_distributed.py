@@ -86,3 +86,23 @@ def test_tiled_reference_equals_the_local_reference(local_ray):
     np.testing.assert_array_equal(
         distributed.reference("builtin:ground", tiles=(2, 2), **args), local["image"]
     )
+
+
+def test_bundles_ship_only_named_files_and_stay_in_their_directory(tmp_path):
+    from texel import distributed
+
+    (tmp_path / "secret.txt").write_bytes(b"secret")
+    (tmp_path / "a.png").write_bytes(b"png")
+    (tmp_path / "s.toml").write_text(
+        'title = "secret.txt"\n[textures.a]\npath = "a.png"\n[environment]\nfaces = ["/etc/hostname"]\n'
+    )
+    b = distributed.bundle(tmp_path / "s.toml")
+    assert sorted(b["files"]) == ["a.png", "s.toml"]
+    work = tmp_path / "work"
+    work.mkdir()
+    for bad in ({"path": "s.toml", "files": {"../escaped.txt": b"x"}},
+                {"path": "s.toml", "files": {str(tmp_path / "abs.txt"): b"y"}},
+                {"path": "../s.toml", "files": {}}):
+        with pytest.raises(ValueError, match="outside"):
+            distributed._unpacked(bad, str(work))
+    assert not (tmp_path / "escaped.txt").exists() and not (tmp_path / "abs.txt").exists()

@@ -79,3 +79,53 @@ def test_files_memory_and_malformed_scenes():
         texel.reference("builtin:ground", spp=64, max_spp=16, size=(8, 8))
     with pytest.raises(ValueError):
         texel.warp(np.zeros((4, 4, 3), dtype=np.uint8), [0, 0, 1, 1])
+
+
+def test_fortran_order_and_misaligned_arrays_are_refused():
+    a = np.arange(16, dtype=np.float32).reshape(4, 4)
+    with pytest.raises(ValueError, match="C-contiguous"):
+        texel.Texture(np.asfortranarray(a[:, :3]))
+    t = texel.Texture(a)
+    uv = np.array([[0.125, 0.125], [0.875, 0.125], [0.125, 0.875]])
+    with pytest.raises(ValueError, match="C-contiguous"):
+        t.sample(np.asfortranarray(uv), filter="nearest")
+    odd = np.frombuffer(bytearray(257), np.float32, offset=1, count=64).reshape(4, 4, 4)
+    with pytest.raises(ValueError, match="aligned"):
+        texel.Texture(odd)
+    odd_uv = np.frombuffer(bytearray(8 * 6 + 1), np.float64, offset=1, count=6).reshape(3, 2)
+    with pytest.raises(ValueError, match="aligned"):
+        t.sample(odd_uv, filter="nearest")
+
+
+def test_sizes_are_checked_before_copying():
+    # A 1 x 2^30 view costs nothing; the texture limit refuses it before texels are widened.
+    wide = np.lib.stride_tricks.as_strided(np.zeros(1, np.uint8), shape=(1, 2**30), strides=(0, 0))
+    with pytest.raises(ValueError, match="cannot be a texture"):
+        texel.Texture(np.ascontiguousarray(wide[:, :20000]))
+
+
+def test_threads_and_tolerance_are_checked():
+    with pytest.raises(ValueError, match="threads must be 1 to 1024"):
+        texel.render("builtin:ground", size=(8, 8), threads=5000)
+    with pytest.raises(ValueError, match="threads must be"):
+        texel.render("builtin:ground", size=(8, 8), threads=0)
+    with pytest.raises(ValueError, match="tolerance must be"):
+        texel.reference("builtin:ground", size=(8, 8), spp=4, max_spp=4, tolerance=-1)
+
+
+def test_friendly_spellings():
+    import pathlib
+
+    from conftest import ROOT
+
+    img = np.zeros((8, 8, 4), dtype=np.uint8)
+    flat = texel.warp(img, [0, 0, 8, 0, 8, 8, 0, 8], size=(4, 4), filter="bilinear")
+    pairs = texel.warp(img, [(0, 0), (8, 0), (8, 8), (0, 8)], size=(4, 4), filter="bilinear")
+    np.testing.assert_array_equal(flat, pairs)
+    path = pathlib.Path(ROOT / "scenes" / "ground.toml")
+    np.testing.assert_array_equal(
+        texel.render(path, size=(16, 9)), texel.render(str(path), size=(16, 9))
+    )
+    assert "glossy" in texel.BUILTIN_SCENES and "ground" in texel.BUILTIN_SCENES
+    got = texel.compare("builtin:ground", filters=["all"], spp=4, size=(48, 27))
+    assert list(got) == texel.FILTERS

@@ -1,5 +1,6 @@
 """Type stubs of texel's Python package (see docs/guide/python.md)."""
 
+import os
 from typing import Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -9,6 +10,7 @@ FILTERS: List[str]
 BUILTIN_SCENES: List[str]
 DEFAULT_SEED: int
 
+_Scene = Union[str, "os.PathLike[str]"]
 _Coords = npt.NDArray[Union[np.float32, np.float64]]
 
 class Texture:
@@ -40,7 +42,7 @@ class Texture:
     ) -> npt.NDArray[np.float32]: ...
 
 def render(
-    scene: str,
+    scene: _Scene,
     filter: Optional[str] = "trilinear",
     size: Optional[Tuple[int, int]] = None,
     color: str = "srgb",
@@ -49,7 +51,7 @@ def render(
     max_memory: Optional[int] = None,
 ) -> npt.NDArray[np.uint8]: ...
 def reference(
-    scene: str,
+    scene: _Scene,
     spp: int = 256,
     size: Optional[Tuple[int, int]] = None,
     max_spp: int = 65536,
@@ -60,7 +62,7 @@ def reference(
     max_memory: Optional[int] = None,
 ) -> npt.NDArray[np.uint8]: ...
 def reference_estimate(
-    scene: str,
+    scene: _Scene,
     spp: int = 256,
     max_spp: int = 65536,
     tolerance: float = 0.5,
@@ -72,7 +74,7 @@ def reference_estimate(
     max_memory: Optional[int] = None,
 ) -> Dict[str, Union[np.ndarray, bool]]: ...
 def compare(
-    scene: str,
+    scene: _Scene,
     filters: Optional[Sequence[str]] = None,
     spp: int = 256,
     max_spp: Optional[int] = None,
@@ -91,4 +93,4 @@ def warp(
     color: str = "srgb",
 ) -> npt.NDArray[Union[np.uint8, np.float32]]: ...
 def encode(linear: npt.NDArray[np.float32], color: str = "srgb") -> npt.NDArray[np.uint8]: ...
-def scene_size(scene: str, size: Optional[Tuple[int, int]] = None) -> Tuple[int, int]: ...
+def scene_size(scene: _Scene, size: Optional[Tuple[int, int]] = None) -> Tuple[int, int]: ...

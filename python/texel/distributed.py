@@ -19,7 +19,8 @@ import json
 import os
 import re
 import tempfile
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from urllib.parse import unquote
 
 import numpy as np
 
@@ -27,6 +28,8 @@ import texel
 
 __all__ = ["render", "reference", "reference_estimate", "bundle"]
 
+# The scene-file keys whose values name files: texture and environment images, mesh files.
+_FILE_KEYS = re.compile(r'^\s*(path|obj|gltf|faces)\s*=(.*)$', re.MULTILINE)
 _QUOTED = re.compile(r'"((?:[^"\\]|\\.)*)"|\'([^\']*)\'')
 
 
@@ -51,45 +54,58 @@ def _connect(address: Optional[str]):
 
 
 def _named_files(path: str) -> List[str]:
-    """Files a scene, OBJ, MTL or glTF file names, relative to its directory, that exist."""
+    """Files a scene, OBJ, MTL or glTF file names by relative path, that exist."""
     base = os.path.dirname(path)
     with open(path, "rb") as f:
         text = f.read().decode("utf-8", errors="replace")
     ext = os.path.splitext(path)[1].lower()
     names: List[str] = []
     if ext == ".obj":
-        names = [l.split(None, 1)[1].strip() for l in text.splitlines() if l.startswith("mtllib ")]
+        for line in text.splitlines():
+            parts = line.split()
+            if parts and parts[0] == "mtllib":
+                names.extend(parts[1:])
     elif ext == ".mtl":
         for line in text.splitlines():
             parts = line.split()
-            if parts and (parts[0].startswith("map_") or parts[0] in ("bump", "norm", "disp")):
+            if len(parts) > 1 and (parts[0].startswith("map_") or parts[0] in ("bump", "norm", "disp")):
                 names.append(parts[-1])
     elif ext == ".gltf":
         try:
             doc = json.loads(text)
         except ValueError:
-            doc = {}
-        for key in ("buffers", "images"):
-            for item in doc.get(key, []):
-                uri = item.get("uri", "")
-                if uri and not uri.startswith("data:"):
-                    names.append(uri)
+            doc = None
+        if isinstance(doc, dict):
+            for key in ("buffers", "images"):
+                items = doc.get(key)
+                for item in items if isinstance(items, list) else []:
+                    uri = item.get("uri") if isinstance(item, dict) else None
+                    if isinstance(uri, str) and uri and not uri.startswith("data:"):
+                        names.append(unquote(uri))
     elif ext == ".toml":
-        names = [a or b for a, b in _QUOTED.findall(text)]
+        for _, value in _FILE_KEYS.findall(text):
+            names.extend(a or b for a, b in _QUOTED.findall(value))
     found = []
     for name in names:
+        # An absolute path is read where the task runs (a shared file system), not shipped.
+        if not name or os.path.isabs(name):
+            continue
         full = os.path.normpath(os.path.join(base, name))
-        if name and os.path.isfile(full):
+        if os.path.isfile(full):
             found.append(full)
     return found
 
 
-def bundle(scene: str) -> Dict[str, Any]:
+def bundle(scene: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
     """What a scene argument needs on another machine: ``{"scene": TEXT}`` for a builtin scene or
     TOML text, else ``{"path": RELATIVE, "files": {RELATIVE: BYTES}}`` with the file and every
-    file it names, transitively, relative to their common directory."""
-    if scene.startswith("builtin:") or not os.path.isfile(scene):
+    file it names by relative path (``path``, ``obj``, ``gltf`` and ``faces`` in a scene file; what
+    OBJ, MTL and glTF files name in turn), relative to their common directory."""
+    scene = os.fspath(scene)
+    if scene.startswith("builtin:") or "\n" in scene:
         return {"scene": scene}
+    if not os.path.isfile(scene):
+        raise FileNotFoundError(f"cannot load scene {scene}: no such file")
     todo = [os.path.abspath(scene)]
     seen: List[str] = []
     while todo:
@@ -110,12 +126,18 @@ def _unpacked(b: Dict[str, Any], work: str) -> str:
     """The scene argument of bundle ``b`` on this machine, its files written under ``work``."""
     if "scene" in b:
         return b["scene"]
+    top = os.path.realpath(work)
     for rel, data in b["files"].items():
-        full = os.path.join(work, rel)
+        full = os.path.realpath(os.path.join(top, rel))
+        if os.path.isabs(rel) or os.path.commonpath([top, full]) != top:
+            raise ValueError(f"a scene bundle names {rel!r}, outside its directory")
         os.makedirs(os.path.dirname(full), exist_ok=True)
         with open(full, "wb") as f:
             f.write(data)
-    return os.path.join(work, b["path"])
+    scene = os.path.realpath(os.path.join(top, b["path"]))
+    if os.path.commonpath([top, scene]) != top:
+        raise ValueError(f"a scene bundle's scene {b['path']!r} lies outside its directory")
+    return scene
 
 
 def _run_render(b: Dict[str, Any], kwargs: Dict[str, Any]) -> np.ndarray:
@@ -144,7 +166,7 @@ def render(
         job = dict(job)
         if "scene" not in job:
             raise ValueError(f"a job needs a scene: {job!r}")
-        scene = job.pop("scene")
+        scene = os.fspath(job.pop("scene"))
         if scene not in refs:
             refs[scene] = ray.put(bundle(scene))
         job.setdefault("threads", cpus_per_job)
