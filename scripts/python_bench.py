@@ -74,7 +74,7 @@ def bench_distributed(args):
     import texel
     from texel import distributed
 
-    jobs = [{"scene": "builtin:ground", "filter": "aniso16", "size": (320, 180)}] * args.frames
+    jobs = [{"scene": "builtin:ground", "filter": "aniso16", "size": (640, 360)}] * args.frames
     rows = []
     for workers in (1, 2):
         ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
@@ -89,7 +89,7 @@ def bench_distributed(args):
     for j in jobs:
         texel.render(threads=1, **j)
     local = time.perf_counter() - t0
-    print(f"\n{args.frames} frames of builtin:ground at 320x180, aniso16, one thread per job")
+    print(f"\n{args.frames} frames of builtin:ground at 640x360, aniso16, one thread per job")
     print("\n| run | s | frames/s | speed-up |\n|---|--:|--:|--:|")
     print(f"| texel.render in a loop, 1 thread | {local:.2f} | {args.frames / local:.1f} | - |")
     for workers, t in rows:

@@ -233,19 +233,6 @@ pub fn reference_estimate<'py>(
     Ok(out)
 }
 
-/// Texels read per covered pixel: the mean and the largest.
-fn texel_stats(frame: &Frame) -> (f64, u64) {
-    let (mut sum, mut n, mut max) = (0u64, 0u64, 0u64);
-    for (k, &t) in frame.texels_read.iter().enumerate() {
-        if frame.covered(k) {
-            sum += u64::from(t);
-            n += 1;
-            max = max.max(u64::from(t));
-        }
-    }
-    (if n == 0 { 0.0 } else { sum as f64 / n as f64 }, max)
-}
-
 /// One filter's scores against the reference.
 struct Row {
     filter: Filter,
@@ -302,7 +289,7 @@ fn score_filter(
         filter,
         scores,
         psnr_block,
-        texels: texel_stats(&counted),
+        texels: counted.texels_per_pixel(),
         ms: ms[ms.len() / 2],
         texture_bytes,
         image,
@@ -356,10 +343,7 @@ pub fn compare<'py>(
     let loaded = load_scene(&scene)?;
     let (rows, floors, ties) = run_released(py, move |stop| {
         let run = || -> Result<_, Error> {
-            let mut budget = match max_memory {
-                Some(b) => MemoryBudget::new(b, format!("max_memory={b}")),
-                None => MemoryBudget::process_default(),
-            };
+            let mut budget = MemoryBudget::limit_or_default(max_memory);
             let options = SceneOptions {
                 size,
                 color,

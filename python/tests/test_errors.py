@@ -129,3 +129,26 @@ def test_friendly_spellings():
     assert "glossy" in texel.BUILTIN_SCENES and "ground" in texel.BUILTIN_SCENES
     got = texel.compare("builtin:ground", filters=["all"], spp=4, size=(48, 27))
     assert list(got) == texel.FILTERS
+
+
+def test_ctrl_c_stops_a_reference_with_keyboard_interrupt():
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    code = (
+        "import texel\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        "    texel.reference('builtin:glossy', size=(320, 180), spp=256, max_spp=65536)\n"
+        "    print('finished')\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(1.0)
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=300)
+    assert p.returncode == 0 and out.strip() == "interrupted", out

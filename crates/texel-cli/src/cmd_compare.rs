@@ -326,7 +326,7 @@ pub fn compare(
         let frame = render(&counting, &draws)?;
         let image = texel::frame_image(&frame, enc)?;
         let mut row = scoring.row(filter.name(), filter.name(), &image, true)?;
-        let (mean, max) = texel_stats(&frame);
+        let (mean, max) = frame.texels_per_pixel();
         row.texels_per_pixel_mean = Some(mean);
         row.texels_per_pixel_max = Some(max);
         row.ms_per_frame = Some(median(&mut times.draw_ms));
@@ -474,21 +474,6 @@ fn orbit_scores(
         step_deg: spec.step_deg,
         reference_flicker,
     })
-}
-
-/// Mean texels read over covered pixels, and the maximum.
-fn texel_stats(frame: &Frame) -> (f64, u64) {
-    let mut sum = 0u64;
-    let mut n = 0u64;
-    let mut max = 0u64;
-    for (k, &t) in frame.texels_read.iter().enumerate() {
-        if frame.covered(k) {
-            sum += u64::from(t);
-            n += 1;
-            max = max.max(u64::from(t));
-        }
-    }
-    (if n == 0 { 0.0 } else { sum as f64 / n as f64 }, max)
 }
 
 /// Run `texel compare`.

@@ -292,6 +292,9 @@ fn run_document(doc: &Path) -> usize {
             }
             // The suite itself, and building the binary the tour uses.
             ["cargo", "test" | "build" | "install", ..] => {}
+            // Installing the Python package: `python::python_package_tests_pass` installs it from
+            // this checkout and runs its tests, the README's example among them.
+            ["pip", "install", "./python" | "./python[ray]"] => {}
             _ => {
                 let scripts: Vec<&String> = w.iter().filter(|a| a.contains("scripts/")).collect();
                 assert!(

@@ -229,6 +229,20 @@ impl Frame {
         self.depth.iter().filter(|&&z| z < f32::INFINITY).count()
     }
 
+    /// Texels read per covered pixel ([`Frame::texels_read`], filled when counting): the mean
+    /// and the largest; `(0.0, 0)` when nothing is covered or nothing was counted.
+    pub fn texels_per_pixel(&self) -> (f64, u64) {
+        let (mut sum, mut n, mut max) = (0u64, 0u64, 0u64);
+        for (k, &t) in self.texels_read.iter().enumerate() {
+            if self.covered(k) {
+                sum += u64::from(t);
+                n += 1;
+                max = max.max(u64::from(t));
+            }
+        }
+        (if n == 0 { 0.0 } else { sum as f64 / n as f64 }, max)
+    }
+
     /// The colour as linear RGBA floats: borrowed from a float target; decoded from an 8-bit one
     /// ([`ColorTarget::decode`], so re-encoding gives the stored bytes back).
     pub fn linear(&self) -> Cow<'_, [[f32; 4]]> {

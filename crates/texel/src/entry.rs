@@ -34,12 +34,21 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
 }
 
-/// The memory account of an optional limit: `limit` bytes, or the process's default.
-fn budget_of(limit: Option<u64>) -> MemoryBudget {
-    match limit {
-        Some(b) => MemoryBudget::new(b, format!("the memory limit of {}", crate::memory::mib(b))),
-        None => MemoryBudget::process_default(),
-    }
+/// `scene` prepared as a command prepares it: at `size` (or its own), with `color` handling,
+/// non-finite texels refused, every other option at its default.
+fn prepare(
+    scene: &Scene,
+    size: Option<(u32, u32)>,
+    color: ColorHandling,
+    budget: &mut MemoryBudget,
+) -> Result<PreparedScene, Error> {
+    let options = SceneOptions {
+        size,
+        color,
+        replace_non_finite: false,
+        ..SceneOptions::default()
+    };
+    PreparedScene::new(scene.clone(), &options, budget)
 }
 
 /// A frame's colour as an 8-bit image in `encoding`: an 8-bit frame of that encoding as stored,
@@ -76,17 +85,8 @@ pub fn encoding(color: ColorHandling) -> quality::Encoding {
 /// [`Error::OverBudget`], [`Error::Scene`] (textures that cannot be loaded), [`Error::Texture`],
 /// [`Error::Raster`] (an invalid size).
 pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Error> {
-    let mut budget = budget_of(options.max_memory);
-    let prepared = PreparedScene::new(
-        scene.clone(),
-        &SceneOptions {
-            size: options.size,
-            color: options.color,
-            replace_non_finite: false,
-            ..SceneOptions::default()
-        },
-        &mut budget,
-    )?;
+    let mut budget = MemoryBudget::limit_or_default(options.max_memory);
+    let prepared = prepare(scene, options.size, options.color, &mut budget)?;
     let plan = prepared.plan(options.filter, &mut budget)?;
     let mut settings = plan.settings();
     settings.view = options.view;
@@ -184,17 +184,8 @@ pub fn reference_scene(
     options: &ReferenceOptions,
     stop: Option<&AtomicBool>,
 ) -> Result<ReferenceEstimate, Error> {
-    let mut budget = budget_of(options.max_memory);
-    let prepared = PreparedScene::new(
-        scene.clone(),
-        &SceneOptions {
-            size: options.size,
-            color: options.color,
-            replace_non_finite: false,
-            ..SceneOptions::default()
-        },
-        &mut budget,
-    )?;
+    let mut budget = MemoryBudget::limit_or_default(options.max_memory);
+    let prepared = prepare(scene, options.size, options.color, &mut budget)?;
     budget.take(
         "the reference's per-pixel statistics",
         u64::from(prepared.width) * u64::from(prepared.height) * REFERENCE_BYTES_PER_PIXEL,

@@ -257,6 +257,15 @@ impl MemoryBudget {
         }
     }
 
+    /// A budget of `limit` bytes when given (named "the memory limit of N MiB"), else
+    /// [`MemoryBudget::process_default`].
+    pub fn limit_or_default(limit: Option<u64>) -> Self {
+        match limit {
+            Some(b) => Self::new(b, format!("the memory limit of {}", mib(b))),
+            None => Self::process_default(),
+        }
+    }
+
     /// The default budget: [`default_limit`], named after the limit that set it.
     pub fn process_default() -> Self {
         let (limit, why) = default_limit();
