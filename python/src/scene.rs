@@ -39,14 +39,43 @@ fn threads_of(threads: Option<usize>) -> PyResult<Option<usize>> {
     }
 }
 
-/// A `tolerance=` argument in 8-bit steps, checked, in display units.
-fn tolerance_of(steps: f64) -> PyResult<f64> {
-    if !(steps.is_finite() && steps >= 0.0) {
+/// A reference plan from Python's arguments, checked: `spp` to `max_spp` samples a pixel,
+/// `tolerance` in 8-bit steps of the display `color` encodes to.
+fn plan_of(
+    spp: u32,
+    max_spp: u32,
+    tolerance: f64,
+    seed: u64,
+    color: ColorHandling,
+) -> PyResult<ReferencePlan> {
+    if max_spp < spp {
         return Err(PyValueError::new_err(format!(
-            "tolerance must be a finite number of 8-bit steps, 0 or more; got {steps}"
+            "max_spp {max_spp} is below spp {spp}: the maximum must be at least the minimum"
         )));
     }
-    Ok(steps / 255.0)
+    if !(tolerance.is_finite() && tolerance >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "tolerance must be a finite number of 8-bit steps, 0 or more; got {tolerance}"
+        )));
+    }
+    Ok(ReferencePlan {
+        min_spp: spp,
+        max_spp,
+        tolerance: tolerance / 255.0,
+        srgb_display: color == ColorHandling::Srgb,
+        seed,
+    })
+}
+
+/// The values of the pixels inside `[x0, y0, x1, y1]` of a `width`-wide frame (a rectangle the
+/// reference accepted), row by row.
+fn crop<T: Copy>(values: &[T], width: u32, [x0, y0, x1, y1]: [u32; 4]) -> Vec<T> {
+    values
+        .chunks(width as usize)
+        .skip(y0 as usize)
+        .take((y1 - y0) as usize)
+        .flat_map(|row| row[x0 as usize..x1 as usize].iter().copied())
+        .collect()
 }
 
 /// Load a scene: `"builtin:NAME"`, a path (`str` or `os.PathLike`) to a TOML, OBJ or glTF file,
@@ -159,21 +188,11 @@ pub fn reference_estimate<'py>(
     scissor: Option<(u32, u32, u32, u32)>,
     max_memory: Option<u64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if max_spp < spp {
-        return Err(PyValueError::new_err(format!(
-            "max_spp {max_spp} is below spp {spp}: the maximum must be at least the minimum"
-        )));
-    }
+    let color = color_named(color)?;
     let options = ReferenceOptions {
-        plan: ReferencePlan {
-            min_spp: spp,
-            max_spp,
-            tolerance: tolerance_of(tolerance)?,
-            seed,
-            ..ReferencePlan::default()
-        },
+        plan: plan_of(spp, max_spp, tolerance, seed, color)?,
         size: size_of(size)?,
-        color: color_named(color)?,
+        color,
         threads: threads_of(threads)?,
         scissor: scissor.map(|(a, b, c, d)| [a, b, c, d]),
         max_memory,
@@ -183,35 +202,12 @@ pub fn reference_estimate<'py>(
         texel::reference_scene(&loaded, &options, Some(stop)).map_err(|e| to_py(e, ""))
     })?;
     let (w, h) = (e.frame.width, e.frame.height);
-    let [x0, y0, x1, y1] = options.scissor.unwrap_or([0, 0, w, h]);
-    let crop = |k: usize| {
-        let (i, j) = ((k % w as usize) as u32, (k / w as usize) as u32);
-        (x0..x1).contains(&i) && (y0..y1).contains(&j)
-    };
-    let pick = |v: &[[f32; 4]]| -> Vec<[f32; 4]> {
-        v.iter()
-            .enumerate()
-            .filter(|(k, _)| crop(*k))
-            .map(|(_, c)| *c)
-            .collect()
-    };
+    let rect @ [x0, y0, x1, y1] = options.scissor.unwrap_or([0, 0, w, h]);
     let (tw, th) = (x1 - x0, y1 - y0);
-    let linear = pick(&e.frame.color);
-    let std_error = pick(&e.std_error);
-    let spp: Vec<u32> = e
-        .spp
-        .iter()
-        .enumerate()
-        .filter(|(k, _)| crop(*k))
-        .map(|(_, n)| *n)
-        .collect();
-    let converged: Vec<bool> = e
-        .converged
-        .iter()
-        .enumerate()
-        .filter(|(k, _)| crop(*k))
-        .map(|(_, c)| *c)
-        .collect();
+    let linear = crop(&e.frame.color, w, rect);
+    let std_error = crop(&e.std_error, w, rect);
+    let spp = crop(&e.spp, w, rect);
+    let converged = crop(&e.converged, w, rect);
     let out = PyDict::new(py);
     if tw > 0 && th > 0 {
         let image = crate::texture::encoded(tw, th, &linear, options.color == ColorHandling::Srgb)?;
@@ -327,19 +323,7 @@ pub fn compare<'py>(
     let threads = threads_of(threads)?;
     let color = color_named(color)?;
     let size = size_of(size)?;
-    let max_spp = max_spp.unwrap_or(spp);
-    if max_spp < spp {
-        return Err(PyValueError::new_err(format!(
-            "max_spp {max_spp} is below spp {spp}: the maximum must be at least the minimum"
-        )));
-    }
-    let plan = ReferencePlan {
-        min_spp: spp,
-        max_spp,
-        tolerance: tolerance_of(tolerance)?,
-        srgb_display: color == ColorHandling::Srgb,
-        seed,
-    };
+    let plan = plan_of(spp, max_spp.unwrap_or(spp), tolerance, seed, color)?;
     let loaded = load_scene(&scene)?;
     let (rows, floors, ties) = run_released(py, move |stop| {
         let run = || -> Result<_, Error> {

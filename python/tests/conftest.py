@@ -17,7 +17,7 @@ def texel_bin():
     return path if os.path.isfile(path) and os.access(path, os.X_OK) else None
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def cli():
     """Run the texel command; tests that compare with it need it built."""
     path = texel_bin()
