@@ -26,9 +26,11 @@ use std::cell::RefCell;
 use std::fmt;
 use std::sync::mpsc;
 
-use texel::Filter;
 use texel_raster::{DrawCall, Frame, RenderSettings, View};
-use texel_texture::{AddressMode, Format, LevelTexels, Texture};
+use texel_texture::{
+    AddressMode, Filter, FilterMode, Format, LevelTexels, MipmapFilterMode, SamplerDescriptor,
+    Texture,
+};
 
 /// Environment variable that picks an adapter by name (a case-insensitive substring), as
 /// `--adapter` does.
@@ -85,32 +87,46 @@ pub enum GpuError {
     Failed(String),
 }
 
-/// The filters the GPU path renders.
+/// What the GPU path renders with: one of texel's filters evaluated by the shader, or the
+/// device's own sampler.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GpuFilter {
-    /// The lab's modes 1-8: nearest, bilinear, bilinear with the nearest mip level, trilinear,
-    /// anisotropic 2x, 4x, 8x, 16x (trilinear probes).
-    Lab(u8),
-    /// Bicubic Catmull-Rom in level 0.
-    Bicubic,
-    /// EWA (eccentricity clamp 16), texel-texture's weight table.
-    Ewa,
+    /// A texel filter, evaluated by `filters.wgsl` from texel fetches (every filter but the
+    /// ripmap and the summed-area table: [`GpuFilter::of`]).
+    Shader(Filter),
     /// The device's sampler, trilinear (`textureSampleGrad`).
     HwTrilinear,
     /// The device's sampler, trilinear with `anisotropy_clamp` 16.
     HwAniso16,
 }
 
+/// The shader's mode (`MODE` and `params.mode.x` in `filters.wgsl`) and its anisotropy clamp
+/// (`params.mode.z`), read off the sampler descriptor a filter means: 1 nearest, 2 bilinear, 3
+/// mip-nearest, 4 trilinear, 5-8 anisotropic 2x-16x, 9 bicubic, 10 EWA; `None` where the shader
+/// has no such filter.
+pub fn shader_mode(d: &SamplerDescriptor) -> Option<(u32, u32)> {
+    use FilterMode::{Cubic, Ewa, Linear, Nearest};
+    use MipmapFilterMode as Mip;
+    let aniso = u32::from(d.anisotropy_clamp);
+    let mode = match (d.min_filter, d.mipmap_filter, aniso) {
+        (Nearest, Mip::None, 1) => 1,
+        (Linear, Mip::None, 1) => 2,
+        (Linear, Mip::Nearest, 1) => 3,
+        (Linear, Mip::Linear, 1) => 4,
+        (Linear, Mip::Linear, 2 | 4 | 8 | 16) => 4 + aniso.trailing_zeros(),
+        (Cubic(_), Mip::None, 1) => 9,
+        (Ewa, _, _) => 10,
+        _ => return None,
+    };
+    Some((mode, aniso))
+}
+
 impl GpuFilter {
     /// The GPU path's version of texel's `filter`, if it has one (every filter but the ripmap and
     /// the summed-area table).
     pub fn of(filter: Filter) -> Option<GpuFilter> {
-        Some(match filter {
-            Filter::Bicubic => GpuFilter::Bicubic,
-            Filter::Ewa => GpuFilter::Ewa,
-            Filter::Ripmap | Filter::Sat => return None,
-            lab => GpuFilter::Lab(lab.lab_mode()?),
-        })
+        let d = filter.descriptor(AddressMode::ClampToEdge, AddressMode::ClampToEdge);
+        shader_mode(&d).map(|_| GpuFilter::Shader(filter))
     }
 
     /// Every texel filter the GPU path has, in [`Filter::ALL`]'s order.
@@ -123,9 +139,10 @@ impl GpuFilter {
     /// The shader's mode number and anisotropy clamp.
     fn mode(self) -> (u32, u32) {
         match self {
-            GpuFilter::Lab(m) => (u32::from(m), if m >= 5 { 1 << (m - 4) } else { 1 }),
-            GpuFilter::Bicubic => (9, 1),
-            GpuFilter::Ewa => (10, u32::from(texel_texture::EWA_DEFAULT_ANISOTROPY)),
+            GpuFilter::Shader(f) => {
+                let d = f.descriptor(AddressMode::ClampToEdge, AddressMode::ClampToEdge);
+                shader_mode(&d).expect("GpuFilter::of checks the shader has the filter")
+            }
             GpuFilter::HwTrilinear => (20, 1),
             GpuFilter::HwAniso16 => (21, 16),
         }
@@ -1092,5 +1109,45 @@ impl ReadBack {
             out.extend_from_slice(&data[r * self.padded..r * self.padded + self.row]);
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each filter's shader mode and clamp, as `filters.wgsl` numbers them, derived from its
+    /// descriptor; the ripmap and the summed-area table have none.
+    #[test]
+    fn shader_modes_follow_the_descriptors() {
+        let want = [
+            (Filter::Nearest, Some((1, 1))),
+            (Filter::Bilinear, Some((2, 1))),
+            (Filter::Bicubic, Some((9, 1))),
+            (Filter::MipNearest, Some((3, 1))),
+            (Filter::Trilinear, Some((4, 1))),
+            (Filter::Aniso2, Some((5, 2))),
+            (Filter::Aniso4, Some((6, 4))),
+            (Filter::Aniso8, Some((7, 8))),
+            (Filter::Aniso16, Some((8, 16))),
+            (Filter::Ewa, Some((10, 16))),
+            (Filter::Ripmap, None),
+            (Filter::Sat, None),
+        ];
+        assert_eq!(want.map(|w| w.0), Filter::ALL);
+        for (f, mode) in want {
+            assert_eq!(GpuFilter::of(f).map(GpuFilter::mode), mode, "{f}");
+            assert_eq!(GpuFilter::of(f).is_some(), mode.is_some());
+        }
+        // Lab mode m is shader mode m.
+        for m in 1..=8 {
+            let f = Filter::from_lab_mode(m).unwrap();
+            assert_eq!(GpuFilter::of(f).unwrap().mode().0, u32::from(m));
+        }
+        assert_eq!(GpuFilter::HwAniso16.mode(), (21, 16));
+        assert!(
+            GpuFilter::HwTrilinear.is_hardware()
+                && !GpuFilter::of(Filter::Ewa).unwrap().is_hardware()
+        );
     }
 }

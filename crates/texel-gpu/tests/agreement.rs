@@ -133,7 +133,9 @@ fn device_time_is_measured_when_the_device_can() {
     let prepared = small("builtin:ground");
     let samplers = prepared.samplers(Filter::Trilinear).unwrap();
     let draws = prepared.draws(&samplers);
-    let gpu_draws = gpu.prepare(&draws, GpuFilter::Lab(4)).unwrap();
+    let gpu_draws = gpu
+        .prepare(&draws, GpuFilter::Shader(Filter::Trilinear))
+        .unwrap();
     let t0 = std::time::Instant::now();
     let (frame, ms) = gpu_draws.render_timed(&prepared.settings()).unwrap();
     let wall = t0.elapsed().as_secs_f64() * 1e3;
@@ -156,7 +158,9 @@ fn passes_timed_back_to_back() {
     let prepared = small("builtin:ground");
     let samplers = prepared.samplers(Filter::Trilinear).unwrap();
     let draws = prepared.draws(&samplers);
-    let gpu_draws = gpu.prepare(&draws, GpuFilter::Lab(4)).unwrap();
+    let gpu_draws = gpu
+        .prepare(&draws, GpuFilter::Shader(Filter::Trilinear))
+        .unwrap();
     let mut settings = prepared.settings();
     settings.target = ColorTarget::Float;
     let before = gpu_draws.render(&settings).unwrap();
@@ -195,7 +199,9 @@ fn a_moved_camera_and_a_scissor_match_fresh_draws() {
     let mut draws = prepared.draws(&samplers);
     let mut settings = prepared.settings();
     settings.target = ColorTarget::Float;
-    let first = gpu.prepare(&draws, GpuFilter::Lab(8)).unwrap();
+    let first = gpu
+        .prepare(&draws, GpuFilter::Shader(Filter::Aniso16))
+        .unwrap();
     let mut camera = prepared.scene.camera;
     camera.eye.y += 0.7;
     camera.target.x += 1.5;
@@ -205,7 +211,8 @@ fn a_moved_camera_and_a_scissor_match_fresh_draws() {
     for d in &mut draws {
         d.clip_from_world = moved;
     }
-    let fresh = texel_gpu::render(&gpu, &settings, &draws, GpuFilter::Lab(8)).unwrap();
+    let fresh =
+        texel_gpu::render(&gpu, &settings, &draws, GpuFilter::Shader(Filter::Aniso16)).unwrap();
     assert_eq!(via_update.color, fresh.color);
     assert!(fresh.covered_pixels() > 1000);
 

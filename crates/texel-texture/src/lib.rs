@@ -43,6 +43,7 @@ pub use base::error::TextureError;
 pub use base::filter::{Cubic, FilterMode, MipmapFilterMode, EWA_DEFAULT_ANISOTROPY};
 pub use base::footprint::{Axes, Footprint};
 pub use base::footprint_batch::{FootprintBatch, FootprintLanes};
+pub use base::named::Filter;
 pub use engine::sampler::Sampler;
 pub use storage::lanes::Lanes;
 pub use storage::tables::{Ripmap, SummedAreaTable};

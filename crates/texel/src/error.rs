@@ -34,22 +34,10 @@ pub enum Error {
         /// The limit, as its owner describes it (e.g. `--max-memory 512.0 MiB`).
         limit: String,
     },
-    /// A filter name that is not one of [`crate::Filter::NAMES`].
-    #[error("unknown filter {name:?}: valid filters are {}, or all", crate::Filter::NAMES.join(", "))]
-    UnknownFilter {
-        /// The name given.
-        name: String,
-    },
-    /// A filter list with no names.
-    #[error("the filter list is empty: name at least one filter, or all")]
-    EmptyFilterList,
     /// Ambient occlusion bake settings out of range, or a mesh it cannot bake.
     #[error("cannot bake ambient occlusion: {0}")]
     Bake(String),
     /// The work was cancelled (a signal, or the caller's flag).
     #[error("cancelled")]
     Cancelled,
-    /// A lab mode outside `1..=8`.
-    #[error("unknown lab mode {0}: valid modes are 1 (nearest) to 8 (anisotropic 16x)")]
-    UnknownLabMode(u8),
 }

@@ -31,7 +31,6 @@ pub mod bake;
 pub mod bvh;
 mod entry;
 mod error;
-mod filter;
 pub mod memory;
 mod plan;
 mod prepare;
@@ -47,10 +46,9 @@ pub use entry::{
     ReferenceRun, RenderOptions, REFERENCE_BYTES_PER_PIXEL,
 };
 pub use error::Error;
-pub use filter::Filter;
 pub use memory::MemoryBudget;
 pub use plan::FramePlan;
 pub use prepare::{ColorHandling, PreparedScene, SceneOptions};
 pub use texel_raster::{render, ColorTarget, DrawCall, Frame, RenderSettings, View};
 pub use texel_scene::{Scene, SceneLimits};
-pub use texel_texture::{Sampler, SamplerDescriptor, Texture};
+pub use texel_texture::{Filter, Sampler, SamplerDescriptor, Texture};

@@ -3,7 +3,6 @@
 //! [`crate::engine::sampler::Sampler`] by `Sampler::new`.
 
 use crate::base::address::{Address, AddressMode, BorderColor};
-use crate::base::error::TextureError;
 use crate::base::filter::{FilterMode, MipmapFilterMode, EWA_DEFAULT_ANISOTROPY};
 
 /// Everything that configures a [`Sampler`](crate::Sampler). Field names follow WebGPU's `GPUSamplerDescriptor`.
@@ -60,32 +59,6 @@ impl Address {
 }
 
 impl SamplerDescriptor {
-    /// The lab's numbered modes: 1 nearest, 2 bilinear, 3 bilinear with the nearest mip level,
-    /// 4 trilinear, 5-8 anisotropic 2x/4x/8x/16x (trilinear probes). Address modes are left at
-    /// their defaults (set them with [`SamplerDescriptor::with_address_mode`]).
-    ///
-    /// # Errors
-    /// [`TextureError::UnknownLabMode`] for other numbers.
-    pub fn lab_mode(mode: u8) -> Result<Self, TextureError> {
-        let linear = |mipmap_filter| SamplerDescriptor {
-            mag_filter: FilterMode::Linear,
-            min_filter: FilterMode::Linear,
-            mipmap_filter,
-            ..Default::default()
-        };
-        Ok(match mode {
-            1 => SamplerDescriptor {
-                mipmap_filter: MipmapFilterMode::None,
-                ..Default::default()
-            },
-            2 => linear(MipmapFilterMode::None),
-            3 => linear(MipmapFilterMode::Nearest),
-            4 => linear(MipmapFilterMode::Linear),
-            5..=8 => Self::anisotropic(1 << (mode - 4)),
-            _ => return Err(TextureError::UnknownLabMode(mode)),
-        })
-    }
-
     /// Hardware-style anisotropic filtering with at most `max_anisotropy` trilinear probes
     /// (linear mag/min/mipmap filters). `max_anisotropy` 1 is plain trilinear; values outside
     /// 1..=64 are rejected by [`Sampler::new`](crate::Sampler::new).

@@ -133,4 +133,15 @@ pub enum TextureError {
     /// A lab mode outside 1..=8.
     #[error("unknown lab mode {0}: valid modes are 1 (nearest) to 8 (anisotropic 16x)")]
     UnknownLabMode(u8),
+    /// A filter name that is not one of [`crate::Filter::NAMES`].
+    #[error("unknown filter {name:?}: valid filters are {}, or all", valid.join(", "))]
+    UnknownFilter {
+        /// The name given.
+        name: String,
+        /// The valid names ([`crate::Filter::NAMES`]).
+        valid: &'static [&'static str],
+    },
+    /// A filter list with no names.
+    #[error("the filter list is empty: name at least one filter, or all")]
+    EmptyFilterList,
 }

@@ -1,6 +1,6 @@
 //! The ground floor: the vocabulary every other floor speaks. Numbers (staged floors and
 //! roundings, a small deterministic generator), address modes, colour encodings, footprints and
-//! their batches, the sampler's descriptor and the crate's errors. Nothing here imports from a
+//! their batches, the sampler's descriptor, the filters by name and the crate's errors. Nothing here imports from a
 //! floor above.
 
 pub mod address;
@@ -12,4 +12,5 @@ pub mod floor;
 pub mod footprint;
 pub(crate) mod footprint_batch;
 pub mod lerp;
+pub mod named;
 pub mod rng;

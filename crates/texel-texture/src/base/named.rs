@@ -1,9 +1,13 @@
-//! Every texture filter texel offers, by name, with the lab's numbered modes and the sampler
-//! descriptor each one means. The one list of filter names: the CLI, reports and benches use it.
+//! Every texture filter texel offers, by name: the one type a filter choice has, from the
+//! command line to the GPU's uniforms. Each filter derives the sampler descriptor the CPU
+//! sampler validates ([`Filter::descriptor`]), the lab's mode number ([`Filter::lab_mode`]),
+//! and, in texel-gpu, the shader's mode. The one list of filter names: the CLI, reports, benches
+//! and the Python package use it.
 
-use texel_texture::{AddressMode, Cubic, FilterMode, MipmapFilterMode, SamplerDescriptor};
-
-use crate::Error;
+use crate::base::address::AddressMode;
+use crate::base::descriptor::SamplerDescriptor;
+use crate::base::error::TextureError;
+use crate::base::filter::{Cubic, FilterMode, MipmapFilterMode};
 
 /// A texture filter, as the command line and the reports name it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -82,8 +86,8 @@ impl Filter {
     /// anisotropic 2x-16x.
     ///
     /// # Errors
-    /// [`Error::UnknownLabMode`] outside `1..=8`.
-    pub fn from_lab_mode(mode: u8) -> Result<Self, Error> {
+    /// [`TextureError::UnknownLabMode`] outside `1..=8`.
+    pub fn from_lab_mode(mode: u8) -> Result<Self, TextureError> {
         Ok(match mode {
             1 => Filter::Nearest,
             2 => Filter::Bilinear,
@@ -93,7 +97,7 @@ impl Filter {
             6 => Filter::Aniso4,
             7 => Filter::Aniso8,
             8 => Filter::Aniso16,
-            _ => return Err(Error::UnknownLabMode(mode)),
+            _ => return Err(TextureError::UnknownLabMode(mode)),
         })
     }
 
@@ -138,8 +142,9 @@ impl Filter {
     /// Parse a filter list: `all`, or comma-separated names (duplicates dropped, order kept).
     ///
     /// # Errors
-    /// [`Error::UnknownFilter`] naming the valid filters, [`Error::EmptyFilterList`].
-    pub fn parse_list(list: &str) -> Result<Vec<Filter>, Error> {
+    /// [`TextureError::UnknownFilter`] naming the valid filters,
+    /// [`TextureError::EmptyFilterList`].
+    pub fn parse_list(list: &str) -> Result<Vec<Filter>, TextureError> {
         if list.trim() == "all" {
             return Ok(Filter::ALL.to_vec());
         }
@@ -151,9 +156,23 @@ impl Filter {
             }
         }
         if out.is_empty() {
-            return Err(Error::EmptyFilterList);
+            return Err(TextureError::EmptyFilterList);
         }
         Ok(out)
+    }
+}
+
+impl SamplerDescriptor {
+    /// The descriptor of the lab's mode `mode` ([`Filter::from_lab_mode`]): 1 nearest, 2
+    /// bilinear, 3 bilinear with the nearest mip level, 4 trilinear, 5-8 anisotropic
+    /// 2x/4x/8x/16x (trilinear probes). Address modes are left at their defaults (set them with
+    /// [`SamplerDescriptor::with_address_mode`]).
+    ///
+    /// # Errors
+    /// [`TextureError::UnknownLabMode`] for other numbers.
+    pub fn lab_mode(mode: u8) -> Result<Self, TextureError> {
+        let d = SamplerDescriptor::default();
+        Ok(Filter::from_lab_mode(mode)?.descriptor(d.address_mode_u, d.address_mode_v))
     }
 }
 
@@ -164,15 +183,16 @@ impl std::fmt::Display for Filter {
 }
 
 impl std::str::FromStr for Filter {
-    type Err = Error;
+    type Err = TextureError;
     /// A filter by name, ASCII case ignored (`Trilinear`, `mip-nearest`).
-    fn from_str(s: &str) -> Result<Self, Error> {
+    fn from_str(s: &str) -> Result<Self, TextureError> {
         Filter::NAMES
             .iter()
             .position(|n| n.eq_ignore_ascii_case(s.trim()))
             .map(|k| Filter::ALL[k])
-            .ok_or_else(|| Error::UnknownFilter {
+            .ok_or_else(|| TextureError::UnknownFilter {
                 name: s.to_string(),
+                valid: &Filter::NAMES,
             })
     }
 }
@@ -197,16 +217,24 @@ mod tests {
             .to_string();
         assert!(e.contains("\"bogus\"") && e.contains("mip-nearest"), "{e}");
         assert!(Filter::parse_list(" , ").is_err());
-        for m in 1..=8 {
+        // The lab's table: 1-4 the core filters, 5-8 anisotropic 2x-16x with trilinear probes.
+        let core = [
+            (FilterMode::Nearest, MipmapFilterMode::None, 1),
+            (FilterMode::Linear, MipmapFilterMode::None, 1),
+            (FilterMode::Linear, MipmapFilterMode::Nearest, 1),
+            (FilterMode::Linear, MipmapFilterMode::Linear, 1),
+            (FilterMode::Linear, MipmapFilterMode::Linear, 2),
+            (FilterMode::Linear, MipmapFilterMode::Linear, 4),
+            (FilterMode::Linear, MipmapFilterMode::Linear, 8),
+            (FilterMode::Linear, MipmapFilterMode::Linear, 16),
+        ];
+        for (m, want) in (1..=8).zip(core) {
             let f = Filter::from_lab_mode(m).unwrap();
             assert_eq!(f.lab_mode(), Some(m));
-            let d = f.descriptor(AddressMode::Repeat, AddressMode::Repeat);
-            assert_eq!(
-                d,
-                SamplerDescriptor::lab_mode(m)
-                    .unwrap()
-                    .with_address_mode(AddressMode::Repeat)
-            );
+            let d = SamplerDescriptor::lab_mode(m).unwrap();
+            assert_eq!((d.min_filter, d.mipmap_filter, d.anisotropy_clamp), want);
+            assert_eq!(d.mag_filter, d.min_filter);
+            assert_eq!(d, f.descriptor(d.address_mode_u, d.address_mode_v));
         }
         assert!(Filter::from_lab_mode(9).is_err());
         let modes = Filter::ALL.iter().filter_map(|f| f.lab_mode()).count();
