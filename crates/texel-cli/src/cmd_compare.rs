@@ -239,22 +239,36 @@ fn reference_summary(
     })
 }
 
-/// Compare `filters` on a prepared scene against a reference made as `plan` says, write
-/// everything into `dir` (which must exist: the caller publishes it, see
-/// [`texel_io::publish_dir`]) and return the report. `label` names the scene in the report.
-/// With an `orbit`, the filters' rows also get their flicker and orbit PSNR ([`orbit_scores`]).
-/// Every row gets its block-mean PSNR and the rows the reference cannot rank it against.
-#[allow(clippy::too_many_arguments)]
+/// What one comparison measures: the scene's name in the report, the filters, how the
+/// reference is made and, optionally, an orbit.
+pub struct Comparison<'a> {
+    /// Names the scene in the report.
+    pub label: &'a str,
+    /// The filters, one row each.
+    pub filters: &'a [Filter],
+    /// How the reference is made.
+    pub plan: &'a ReferencePlan,
+    /// With an orbit, the filters' rows also get their flicker and orbit PSNR
+    /// ([`orbit_scores`]).
+    pub orbit: Option<OrbitSpec>,
+}
+
+/// Run comparison `job` on a prepared scene, write everything into `dir` (which must exist: the
+/// caller publishes it, see [`texel_io::publish_dir`]) and return the report. Every row gets its
+/// block-mean PSNR and the rows the reference cannot rank it against.
 pub fn compare(
     scene: &PreparedScene,
-    label: &str,
-    filters: &[Filter],
-    plan: &ReferencePlan,
+    job: &Comparison,
     extras: &Extras,
-    orbit: Option<OrbitSpec>,
     dir: &Path,
     budget: &mut MemoryBudget,
 ) -> Result<Report> {
+    let Comparison {
+        label,
+        filters,
+        plan,
+        orbit,
+    } = *job;
     let enc = encoding(scene.color);
     if let Some(pb) = &extras.progress {
         pb.set_message(format!("{label}: reference"));
@@ -528,16 +542,13 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     let mut inputs: Vec<&Path> = vec![Path::new(&args.scene.scene)];
     inputs.extend(extras.files.iter().map(|(_, p)| p.as_path()));
     let report = publish_dir(&args.out, &inputs, |dir| {
-        compare(
-            &scene,
-            &args.scene.scene,
-            &filters,
-            &plan,
-            &extras,
+        let job = Comparison {
+            label: &args.scene.scene,
+            filters: &filters,
+            plan: &plan,
             orbit,
-            dir,
-            &mut input.budget,
-        )
+        };
+        compare(&scene, &job, &extras, dir, &mut input.budget)
     })
     .with_context(|| format!("cannot write the report to {}", args.out.display()))?;
     print!("{}", report.to_markdown());

@@ -16,7 +16,7 @@ use texel_quality::Report;
 use crate::cli::DemoArgs;
 use crate::cli::DEFAULT_TOLERANCE_STEPS;
 use crate::cmd_bake_ao::{demo_page, DemoAo};
-use crate::cmd_compare::{compare, Extras, COMPARE_BYTES_PER_PIXEL};
+use crate::cmd_compare::{compare, Comparison, Extras, COMPARE_BYTES_PER_PIXEL};
 use crate::cmd_reference::plan;
 use crate::filters::Filter;
 use crate::input::{load_scene_with, Input};
@@ -133,25 +133,24 @@ fn report_in(
         u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
     )?;
     std::fs::create_dir(sub).with_context(|| format!("cannot create {}", sub.display()))?;
-    compare(
-        scene,
+    let plan = plan(
+        spp,
+        spp,
+        DEFAULT_TOLERANCE_STEPS,
+        true,
+        texel_raster::adaptive::DEFAULT_SEED,
+    )?;
+    let job = Comparison {
         label,
         filters,
-        &plan(
-            spp,
-            spp,
-            DEFAULT_TOLERANCE_STEPS,
-            true,
-            texel_raster::adaptive::DEFAULT_SEED,
-        )?,
-        &Extras {
-            progress: Some(pb.clone()),
-            ..Extras::default()
-        },
-        None,
-        sub,
-        &mut input.budget,
-    )
+        plan: &plan,
+        orbit: None,
+    };
+    let extras = Extras {
+        progress: Some(pb.clone()),
+        ..Extras::default()
+    };
+    compare(scene, &job, &extras, sub, &mut input.budget)
 }
 
 /// The globes the demo compares evaluated per pixel (their reports from the scene loop) and

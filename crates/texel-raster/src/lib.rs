@@ -52,6 +52,7 @@ mod inputs;
 pub mod interp;
 pub mod layers;
 pub mod material;
+mod point;
 pub mod reference;
 mod relief;
 mod settings;

@@ -41,9 +41,10 @@ use crate::environment::{Environment, ViewRays};
 use crate::error::RasterError;
 use crate::frame::Frame;
 use crate::material::{ChannelInput, Material, SpecularAa, TextureInput};
+use crate::point::ShadingPoint;
 use crate::settings::{ColorTarget, Perspective, RenderSettings};
 use crate::setup::{setup_draws, validate_draws, TriangleSetup, SUBPIXEL};
-use crate::shade::{shade, DrawContext, Lighting};
+use crate::shade::{shade, DrawContext, Lighting, Shader};
 use crate::tile::{bin, split_rows, tile_counts, TILE};
 use texel_texture::base::rng::SplitMix64;
 
@@ -439,17 +440,18 @@ fn reference_row(
             };
             let fp = dc.footprint(uv, DVec2::ZERO, DVec2::ZERO);
             let tex = dc.sampler.sample(dc.texture, &fp);
-            let lit = ctx.lighting.as_ref();
-            let (c, _) = shade(
-                dc,
-                dc.vertices(t),
+            let shader = Shader {
+                draw: dc,
+                lighting: ctx.lighting.as_ref(),
+                count: false,
+            };
+            let p = ShadingPoint {
+                verts: dc.vertices(t),
                 lambda,
-                [DVec3::ZERO; 2],
-                tex,
-                &fp,
-                lit,
-                false,
-            );
+                dlambda: [DVec3::ZERO; 2],
+                fp,
+            };
+            let (c, _) = shade(&shader, &p, tex);
             sum += Vec4::from_array(c);
         }
         *out = (sum * inv_spp).to_array();

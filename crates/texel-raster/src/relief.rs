@@ -15,10 +15,21 @@ use texel_texture::Footprint;
 use crate::draw::Vertex;
 use crate::layers::{read_normal, LayerSample};
 use crate::material::{self, Material, SlopeSpread, SpecularAa};
+use crate::point::ShadingPoint;
 
 /// The fewest and the most linear steps of the parallax march (at normal incidence and at
 /// grazing angles; Tatarchuk 2006 interpolates between them by `n.v`).
 pub const POM_STEPS: (u32, u32) = (8, 64);
+
+/// The specular lobe a shading normal is read for: the antialiasing method and the perceptual
+/// roughness before it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lobe {
+    /// How the spread of the normals under the footprint widens the lobe.
+    pub aa: SpecularAa,
+    /// Perceptual roughness before antialiasing.
+    pub roughness: f32,
+}
 
 /// A fragment's shading normal and what specular antialiasing made of it.
 #[derive(Clone, Copy, Debug)]
@@ -105,24 +116,22 @@ fn bump_step(d_dx: f32, d_dy: f32, size: u32) -> f32 {
     }
 }
 
-/// The shading normal and roughness of material `m` at a fragment with interpolated unit normal
-/// `n`, barycentrics `l` and footprint `fp`, with specular antialiasing `aa` (what
+/// The shading normal and roughness of material `m` at fragment `p` (its barycentrics and
+/// footprint) with interpolated unit normal `n`, for the lobe's roughness and its specular
+/// antialiasing `aa` (what
 /// [`SpecularAa::Projected`] adds is the caller's: it needs the neighbours' normals). `layered`
 /// is the fragment's [`LayerSample`] for a layered material (its blended normal, if any, is used
 /// in place of the normal map).
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn shading_normal(
     m: &Material,
     layered: Option<&LayerSample>,
-    verts: [&Vertex; 3],
-    l: Vec3,
+    p: &ShadingPoint,
     n: Vec3,
-    fp: &Footprint,
-    aa: SpecularAa,
-    roughness: f32,
+    Lobe { aa, roughness }: Lobe,
     count: bool,
     texels: &mut u32,
 ) -> Shading {
+    let (verts, l, fp) = (p.verts, p.l(), &p.fp);
     let plain = Shading {
         normal: n,
         diffuse_normal: None,
@@ -252,22 +261,22 @@ pub(crate) struct Parallax {
 }
 
 /// Parallax occlusion mapping (Tatarchuk 2006) of material `m` (which has heights) for the
-/// fragment at `position` with unit normal `n` and footprint `fp`, seen from `eye`: march the view
+/// fragment `p` at `position` with unit normal `n`, read through `p`'s footprint, seen from
+/// `eye`: march the view
 /// ray below the polygon in [`POM_STEPS`] linear steps of depth, reading the height through the
 /// footprint, until it passes below the relief, then intersect the last segment with the relief
 /// by the secant rule. `None` where the ray is parallel to or leaving the surface, the relief is
 /// flat (`height_scale` 0) or the texture coordinates are degenerate.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn parallax(
     m: &Material,
-    verts: [&Vertex; 3],
+    p: &ShadingPoint,
     n: Vec3,
     position: Vec3,
     eye: Vec3,
-    fp: &Footprint,
     count: bool,
     texels: &mut u32,
 ) -> Option<Parallax> {
+    let (verts, fp) = (p.verts, &p.fp);
     let s = m.height_scale;
     if s <= 0.0 {
         return None;

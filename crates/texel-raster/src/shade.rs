@@ -27,7 +27,8 @@ use crate::material::{
     self, Displacement, Light, Material, SpecularAa, Surface, TextureInput, MAX_SHADING_SAMPLES,
     MIN_ROUGHNESS,
 };
-use crate::relief;
+use crate::point::ShadingPoint;
+use crate::relief::{self, Lobe};
 use crate::settings::{Perspective, RenderSettings};
 use crate::setup::TriangleSetup;
 
@@ -260,20 +261,28 @@ impl<'a> Lighting<'a> {
     }
 }
 
-/// The environment's light on `surface` (linear RGB), adding the texels read to `texels`:
-/// diffuse from the irradiance along the diffuse normal and, unless `lambert`, specular from the
-/// direction the view reflects to ([`reflection`]) through the split sum (see
+/// What every fragment of a draw is shaded with: the draw, the frame's lights (`None` for an
+/// unlit frame), and whether the texels the material's maps read are counted.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Shader<'c, 'a> {
+    /// The draw's resolved state.
+    pub draw: &'c DrawContext<'a>,
+    /// The frame's lights and environment.
+    pub lighting: Option<&'c Lighting<'a>>,
+    /// Count the texels the maps read.
+    pub count: bool,
+}
+
+/// The environment's light on `surface` (linear RGB) at `p`, adding the texels read to
+/// `texels`: diffuse from the irradiance along the diffuse normal and, unless `lambert`,
+/// specular from the direction the view reflects to ([`reflection`]) through the split sum (see
 /// [`crate::environment`]). Scaled by the surface's occlusion.
-#[allow(clippy::too_many_arguments)]
 fn environment_light(
+    s: &Shader,
     lighting: &Lighting,
-    verts: [&Vertex; 3],
-    lambda: DVec3,
-    dlambda: [DVec3; 2],
+    p: &ShadingPoint,
     surface: &Surface,
-    eye: Vec3,
     lambert: bool,
-    count: bool,
     texels: &mut u32,
 ) -> Vec3 {
     let Some(env) = &lighting.environment else {
@@ -283,13 +292,13 @@ fn environment_light(
         .diffuse_normal
         .as_dvec3()
         .normalize_or(surface.normal.as_dvec3());
-    let (irr, k) = env.irradiance(nd, count);
+    let (irr, k) = env.irradiance(nd, s.count);
     *texels += k;
     let mut out = surface.base * (1.0 - surface.metallic) * irr;
     if !lambert {
         let derivatives = !lighting.reference;
-        let (r, dr, n_dot_v) = reflection(verts, lambda, dlambda, surface, eye, derivatives);
-        let (spec, k) = env.specular(r, dr, surface.roughness, lighting.reference, count);
+        let (r, dr, n_dot_v) = reflection(p, surface, s.draw.eye, derivatives);
+        let (spec, k) = env.specular(r, dr, surface.roughness, lighting.reference, s.count);
         *texels += k;
         let f0 = Vec3::splat(0.04).lerp(surface.base, surface.metallic);
         let (a, b) = environment::dfg(n_dot_v.max(1e-4) as f32, surface.roughness);
@@ -301,11 +310,9 @@ fn environment_light(
 /// The direction `r = 2 (n.v) n - v` the view reflects to about the surface's normal, its
 /// screen derivatives when `derivatives` (zero otherwise), and `n.v`. The derivatives are
 /// pbrt-v4's, `dr = 2 ((dn.v + n.dv) n + (n.v) dn) - dv`, with `dp` and `dn` (of the
-/// interpolated vertex normals) from the barycentrics' derivatives `dlambda`, and `dv` from `dp`.
+/// interpolated vertex normals) from the barycentrics' derivatives at `p`, and `dv` from `dp`.
 fn reflection(
-    verts: [&Vertex; 3],
-    lambda: DVec3,
-    dlambda: [DVec3; 2],
+    p: &ShadingPoint,
     surface: &Surface,
     eye: Vec3,
     derivatives: bool,
@@ -319,10 +326,11 @@ fn reflection(
     if !derivatives {
         return (r, [DVec3::ZERO; 2], n_dot_v);
     }
-    let m = lerp3(verts, lambda, |v| v.normal);
+    let verts = p.verts;
+    let m = lerp3(verts, p.lambda, |v| v.normal);
     let len = m.length();
     let ng = if len > 0.0 { m / len } else { DVec3::ZERO };
-    let dr = dlambda.map(|dl| {
+    let dr = p.dlambda.map(|dl| {
         let dp = lerp3(verts, dl, |v| v.position);
         let dm = lerp3(verts, dl, |v| v.normal);
         // Without vertex normals the normal does not turn.
@@ -345,33 +353,20 @@ fn lerp3(verts: [&Vertex; 3], lambda: DVec3, f: impl Fn(&Vertex) -> Vec3) -> DVe
         + f(verts[2]).as_dvec3() * lambda.z
 }
 
-/// The shaded colour of a fragment with base texture colour `tex` (linear RGBA), barycentrics
-/// `lambda` and their screen derivatives `dlambda` (per pixel right and down; zero where not
-/// known, as for the reference's sub-samples), and footprint `fp` (for the material's maps); also
-/// the texels the maps read when `count`. Unlit frames show `tex * base_color * vertex colour`;
-/// lit frames [`crate::material::radiance`] with the normal and roughness of [`crate::relief`],
-/// averaged over a grid of shading sub-samples where [`Material::shading_samples`] asks for one
-/// (see [`shade_grid`]).
+/// The shaded colour of the fragment at `p` with base texture colour `tex` (linear RGBA); also
+/// the texels the maps read when `s.count`. The footprint `p.fp` reads the material's maps.
+/// Unlit frames show `tex * base_color * vertex colour`; lit frames
+/// [`crate::material::radiance`] with the normal and roughness of [`crate::relief`], averaged
+/// over a grid of shading sub-samples where [`Material::shading_samples`] asks for one (see
+/// [`shade_grid`]).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn shade(
-    ctx: &DrawContext,
-    verts: [&Vertex; 3],
-    lambda: DVec3,
-    dlambda: [DVec3; 2],
-    tex: [f32; 4],
-    fp: &Footprint,
-    lighting: Option<&Lighting>,
-    count: bool,
-) -> ([f32; 4], u32) {
-    let adaptive = lighting.is_some() && ctx.material.is_some_and(|m| m.shading_samples > 1);
-    let (c, texels, grid) = shade_once(
-        ctx, verts, lambda, dlambda, tex, fp, lighting, count, adaptive,
-    );
+pub(crate) fn shade(s: &Shader, p: &ShadingPoint, tex: [f32; 4]) -> ([f32; 4], u32) {
+    let adaptive = s.lighting.is_some() && s.draw.material.is_some_and(|m| m.shading_samples > 1);
+    let (c, texels, grid) = shade_once(s, p, tex, adaptive);
     if grid == [1, 1] {
         return (c, texels);
     }
-    let (c, more) = shade_grid(ctx, verts, (lambda, dlambda), fp, lighting, count, grid);
+    let (c, more) = shade_grid(s, p, grid);
     (c, texels + more)
 }
 
@@ -381,24 +376,16 @@ pub(crate) fn shade(
 /// (`lambda + dlambda . o`, `uv + J o`) and the footprint's derivatives shrink to the sub-sample's
 /// spacing (`J / k` per axis), so every map, the base colour included, is filtered over the
 /// sub-sample's own footprint. The sub-samples are averaged in linear light (as the reference
-/// averages its own), and return the texels they read when `count`. The sub-samples read the
+/// averages its own), and return the texels they read when counting. The sub-samples read the
 /// base colour with the `f32` sampler even where the pixel's own sample took the `--precision gpu`
 /// fixed-point route (`tile.rs`'s `Route::Fixed8`): sub-sampling is a quality feature, and the
 /// fixed-point route exists for the plain filters' speed.
-#[allow(clippy::too_many_arguments)]
-fn shade_grid(
-    ctx: &DrawContext,
-    verts: [&Vertex; 3],
-    (lambda, dlambda): (DVec3, [DVec3; 2]),
-    fp: &Footprint,
-    lighting: Option<&Lighting>,
-    count: bool,
-    [kx, ky]: [u32; 2],
-) -> ([f32; 4], u32) {
+fn shade_grid(s: &Shader, p: &ShadingPoint, [kx, ky]: [u32; 2]) -> ([f32; 4], u32) {
     let base = TextureInput {
-        texture: ctx.texture,
-        sampler: ctx.sampler,
+        texture: s.draw.texture,
+        sampler: s.draw.sampler,
     };
+    let (fp, dlambda) = (&p.fp, p.dlambda);
     let (sx, sy) = (1.0 / kx as f32, 1.0 / ky as f32);
     let dl = [dlambda[0] * f64::from(sx), dlambda[1] * f64::from(sy)];
     let mut texels = 0;
@@ -407,17 +394,21 @@ fn shade_grid(
         let oy = (b as f32 + 0.5) * sy - 0.5;
         for a in 0..kx {
             let ox = (a as f32 + 0.5) * sx - 0.5;
-            let fp = Footprint {
-                u: fp.u + fp.dudx * ox + fp.dudy * oy,
-                v: fp.v + fp.dvdx * ox + fp.dvdy * oy,
-                dudx: fp.dudx * sx,
-                dvdx: fp.dvdx * sx,
-                dudy: fp.dudy * sy,
-                dvdy: fp.dvdy * sy,
+            let sub = ShadingPoint {
+                verts: p.verts,
+                lambda: p.lambda + dlambda[0] * f64::from(ox) + dlambda[1] * f64::from(oy),
+                dlambda: dl,
+                fp: Footprint {
+                    u: fp.u + fp.dudx * ox + fp.dudy * oy,
+                    v: fp.v + fp.dvdx * ox + fp.dvdy * oy,
+                    dudx: fp.dudx * sx,
+                    dvdx: fp.dvdx * sx,
+                    dudy: fp.dudy * sy,
+                    dvdy: fp.dvdy * sy,
+                },
             };
-            let l = lambda + dlambda[0] * f64::from(ox) + dlambda[1] * f64::from(oy);
-            let tex = crate::inputs::read(&base, &fp, count, &mut texels);
-            let (c, t, _) = shade_once(ctx, verts, l, dl, tex, &fp, lighting, count, false);
+            let tex = crate::inputs::read(&base, &sub.fp, s.count, &mut texels);
+            let (c, t, _) = shade_once(s, &sub, tex, false);
             sum += Vec4::from_array(c);
             texels += t;
         }
@@ -434,37 +425,25 @@ fn shade_grid(
 /// width at half maximum (`2 alpha sqrt(sqrt(2) - 1) = 1.29 alpha`), so the pixel's mean
 /// highlight is integrated rather than point-sampled.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn shade_once(
-    ctx: &DrawContext,
-    verts: [&Vertex; 3],
-    lambda: DVec3,
-    dlambda: [DVec3; 2],
+    s: &Shader,
+    p: &ShadingPoint,
     tex: [f32; 4],
-    fp: &Footprint,
-    lighting: Option<&Lighting>,
-    count: bool,
     measure: bool,
 ) -> ([f32; 4], u32, [u32; 2]) {
-    let l = lambda.as_vec3();
+    let ctx = s.draw;
+    let (verts, l, count) = (p.verts, p.l(), s.count);
     let mut texels = 0;
-    let Some(lighting) = lighting else {
+    let Some(lighting) = s.lighting else {
         let mut c = base_color(ctx, verts, l, tex);
         if let Some(layers) = ctx.material.as_ref().and_then(|m| m.layers.as_ref()) {
             let needs = Needs {
                 color: true,
                 ..Needs::default()
             };
-            c *= layers.sample(fp, needs, count, &mut texels).base;
+            c *= layers.sample(&p.fp, needs, count, &mut texels).base;
         }
         return (c.to_array(), texels, [1, 1]);
-    };
-    // The lights' and the environment's radiance; `lambert` drops the specular lobe.
-    let light = |surface: &Surface, lambert: bool, texels: &mut u32| {
-        material::radiance(surface, ctx.eye, &lighting.lights, lambert)
-            + environment_light(
-                lighting, verts, lambda, dlambda, surface, ctx.eye, lambert, count, texels,
-            )
     };
     let mut position = relief::interpolate(verts, l, |v| v.position);
     let normal = relief::geometric_normal(verts, l);
@@ -480,24 +459,25 @@ fn shade_once(
             occlusion: 1.0,
             spread: None,
         };
-        let rgb = light(&surface, true, &mut texels);
+        let rgb = radiance(s, lighting, p, &surface, true, &mut texels);
         return (rgb.extend(c.w).to_array(), texels, [1, 1]);
     };
     // Parallax occlusion mapping moves every read to where the view ray meets the relief.
-    let mut fp = *fp;
+    let mut at = *p;
     let mut tex = tex;
     if m.displacement == Displacement::Pom && m.has_height() {
-        let hit = relief::parallax(m, verts, normal, position, ctx.eye, &fp, count, &mut texels);
+        let hit = relief::parallax(m, &at, normal, position, ctx.eye, count, &mut texels);
         if let Some(hit) = hit {
-            fp = hit.footprint;
+            at.fp = hit.footprint;
             position = hit.position;
             let base = TextureInput {
                 texture: ctx.texture,
                 sampler: ctx.sampler,
             };
-            tex = crate::inputs::read(&base, &fp, count, &mut texels);
+            tex = crate::inputs::read(&base, &at.fp, count, &mut texels);
         }
     }
+    let fp = &at.fp;
     let needs = Needs {
         color: true,
         normal: true,
@@ -506,7 +486,7 @@ fn shade_once(
     let layered = m
         .layers
         .as_ref()
-        .map(|layers| layers.sample(&fp, needs, count, &mut texels));
+        .map(|layers| layers.sample(fp, needs, count, &mut texels));
     let mut c = base_color(ctx, verts, l, tex);
     let mut roughness = m.roughness;
     if let Some(s) = &layered {
@@ -515,66 +495,26 @@ fn shade_once(
     }
     let mut metallic = m.metallic;
     if let Some(map) = &m.roughness_map {
-        roughness *= crate::inputs::read_channel(map, &fp, count, &mut texels);
+        roughness *= crate::inputs::read_channel(map, fp, count, &mut texels);
     }
     if let Some(map) = &m.metallic_map {
-        metallic *= crate::inputs::read_channel(map, &fp, count, &mut texels);
+        metallic *= crate::inputs::read_channel(map, fp, count, &mut texels);
     }
     let mut occlusion = 1.0;
     if let Some(map) = m.occlusion_map.as_ref().filter(|_| lighting.ambient) {
-        let ao = crate::inputs::read_channel(map, &fp, count, &mut texels);
+        let ao = crate::inputs::read_channel(map, fp, count, &mut texels);
         occlusion = (1.0 + m.occlusion_strength * (ao - 1.0)).clamp(0.0, 1.0);
     }
-    let mut shading = relief::shading_normal(
-        m,
-        layered.as_ref(),
-        verts,
-        l,
-        normal,
-        &fp,
-        m.specular_aa,
+    let lobe = Lobe {
+        aa: m.specular_aa,
         roughness,
-        count,
-        &mut texels,
-    );
+    };
+    let mut shading =
+        relief::shading_normal(m, layered.as_ref(), &at, normal, lobe, count, &mut texels);
     let mut grid = [1, 1];
     let projected = m.specular_aa == SpecularAa::Projected;
     if projected || measure {
-        // The normals one pixel right and one down, as a fragment quad's ddx and ddy see them.
-        let neighbour = |dl: DVec3, duv: [f32; 2], texels: &mut u32| {
-            let l = (lambda + dl).as_vec3();
-            let n = relief::geometric_normal(verts, l);
-            let fp = Footprint {
-                u: fp.u + duv[0],
-                v: fp.v + duv[1],
-                ..fp
-            };
-            let needs = Needs {
-                normal: true,
-                ..Needs::default()
-            };
-            let layered = m
-                .layers
-                .as_ref()
-                .map(|ly| ly.sample(&fp, needs, count, texels));
-            let aa = SpecularAa::None;
-            relief::shading_normal(
-                m,
-                layered.as_ref(),
-                verts,
-                l,
-                n,
-                &fp,
-                aa,
-                roughness,
-                count,
-                texels,
-            )
-            .normal
-        };
-        let nx = neighbour(dlambda[0], [fp.dudx, fp.dvdx], &mut texels);
-        let ny = neighbour(dlambda[1], [fp.dudy, fp.dvdy], &mut texels);
-        let (dn_dx, dn_dy) = (nx - shading.normal, ny - shading.normal);
+        let (dn_dx, dn_dy) = normal_differences(s, m, &at, shading.normal, roughness, &mut texels);
         if measure {
             let alpha = shading.roughness.clamp(MIN_ROUGHNESS, 1.0).powi(2);
             let most = m.shading_samples.clamp(1, MAX_SHADING_SAMPLES);
@@ -596,8 +536,65 @@ fn shade_once(
         occlusion,
         spread: shading.spread,
     };
-    let rgb = light(&surface, false, &mut texels);
+    let rgb = radiance(s, lighting, &at, &surface, false, &mut texels);
     (rgb.extend(c.w).to_array(), texels, grid)
+}
+
+/// The lights' and the environment's radiance on `surface` at `p`; `lambert` drops the
+/// specular lobe.
+#[inline(always)]
+fn radiance(
+    s: &Shader,
+    lighting: &Lighting,
+    p: &ShadingPoint,
+    surface: &Surface,
+    lambert: bool,
+    texels: &mut u32,
+) -> Vec3 {
+    material::radiance(surface, s.draw.eye, &lighting.lights, lambert)
+        + environment_light(s, lighting, p, surface, lambert, texels)
+}
+
+/// How the shading normal changes one pixel right and one down from `p` (where it is `normal`),
+/// as a fragment quad's `ddx` and `ddy` see it: the normals there, read without antialiasing
+/// under the lobe's `roughness`, less `normal`.
+fn normal_differences(
+    s: &Shader,
+    m: &Material,
+    p: &ShadingPoint,
+    normal: Vec3,
+    roughness: f32,
+    texels: &mut u32,
+) -> (Vec3, Vec3) {
+    let fp = p.fp;
+    let mut neighbour = |dl: DVec3, duv: [f32; 2]| {
+        let at = ShadingPoint {
+            lambda: p.lambda + dl,
+            fp: Footprint {
+                u: fp.u + duv[0],
+                v: fp.v + duv[1],
+                ..fp
+            },
+            ..*p
+        };
+        let n = relief::geometric_normal(at.verts, at.l());
+        let needs = Needs {
+            normal: true,
+            ..Needs::default()
+        };
+        let layered = m
+            .layers
+            .as_ref()
+            .map(|ly| ly.sample(&at.fp, needs, s.count, texels));
+        let lobe = Lobe {
+            aa: SpecularAa::None,
+            roughness,
+        };
+        relief::shading_normal(m, layered.as_ref(), &at, n, lobe, s.count, texels).normal
+    };
+    let nx = neighbour(p.dlambda[0], [fp.dudx, fp.dvdx]);
+    let ny = neighbour(p.dlambda[1], [fp.dudy, fp.dvdy]);
+    (nx - normal, ny - normal)
 }
 
 /// The unlit colour: texture times vertex colour times the material's factor.

@@ -68,9 +68,10 @@ use crate::draw::DrawCall;
 use crate::environment::{Environment, ViewRays};
 use crate::frame::{Clear, Frame};
 use crate::interp::{self, quad_differences, UvPlanes};
+use crate::point::ShadingPoint;
 use crate::settings::{ColorTarget, Derivatives, Perspective, Precision, RenderSettings, View};
 use crate::setup::{pixel_center_fixed, setup_chunks, TriangleSetup, SUBPIXEL};
-use crate::shade::{shade, DrawContext, Lighting, MappedTriangle, UvSource};
+use crate::shade::{shade, DrawContext, Lighting, MappedTriangle, Shader, UvSource};
 use crate::views;
 use crate::RasterError;
 
@@ -1029,7 +1030,11 @@ fn shade_span(
     }
     let verts = dc.vertices(t);
     // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).
-    let lit = ctx.lighting.as_ref();
+    let shader = Shader {
+        draw: dc,
+        lighting: ctx.lighting.as_ref(),
+        count: false,
+    };
     if ctx.shades(dc) {
         for k in 0..n {
             let lambda = DVec3::new(span.l[0][k], span.l[1][k], span.l[2][k]);
@@ -1037,8 +1042,13 @@ fn shade_span(
                 DVec3::new(span.ldx[0][k], span.ldx[1][k], span.ldx[2][k]),
                 DVec3::new(span.ldy[0][k], span.ldy[1][k], span.ldy[2][k]),
             ];
-            let (tex, fp) = (span.texs[k], span.footprint(k));
-            span.texs[k] = shade(dc, verts, lambda, dlambda, tex, &fp, lit, false).0;
+            let p = ShadingPoint {
+                verts,
+                lambda,
+                dlambda,
+                fp: span.footprint(k),
+            };
+            span.texs[k] = shade(&shader, &p, span.texs[k]).0;
         }
     }
     // Fragments arrive row by row: look each row's buffers up once per run of equal rows, with
@@ -1239,16 +1249,18 @@ fn write_fragment(
     // with the counts of the colour view).
     let (shaded, map_texels) =
         if ctx.settings.view == View::Color || (ctx.counting && lit.is_some()) {
-            shade(
-                dc,
-                dc.vertices(t),
-                f.lambda,
-                f.dlambda,
-                tex,
-                &fp,
-                lit,
-                ctx.counting,
-            )
+            let shader = Shader {
+                draw: dc,
+                lighting: lit,
+                count: ctx.counting,
+            };
+            let p = ShadingPoint {
+                verts: dc.vertices(t),
+                lambda: f.lambda,
+                dlambda: f.dlambda,
+                fp,
+            };
+            shade(&shader, &p, tex)
         } else {
             ([0.0; 4], 0)
         };
