@@ -435,14 +435,7 @@ fn shade_once(
     let (verts, l, count) = (p.verts, p.l(), s.count);
     let mut texels = 0;
     let Some(lighting) = s.lighting else {
-        let mut c = base_color(ctx, verts, l, tex);
-        if let Some(layers) = ctx.material.as_ref().and_then(|m| m.layers.as_ref()) {
-            let needs = Needs {
-                color: true,
-                ..Needs::default()
-            };
-            c *= layers.sample(&p.fp, needs, count, &mut texels).base;
-        }
+        let c = unlit(ctx, p, tex, count, &mut texels);
         return (c.to_array(), texels, [1, 1]);
     };
     let mut position = relief::interpolate(verts, l, |v| v.position);
@@ -493,18 +486,8 @@ fn shade_once(
         c *= s.base;
         roughness *= s.roughness;
     }
-    let mut metallic = m.metallic;
-    if let Some(map) = &m.roughness_map {
-        roughness *= crate::inputs::read_channel(map, fp, count, &mut texels);
-    }
-    if let Some(map) = &m.metallic_map {
-        metallic *= crate::inputs::read_channel(map, fp, count, &mut texels);
-    }
-    let mut occlusion = 1.0;
-    if let Some(map) = m.occlusion_map.as_ref().filter(|_| lighting.ambient) {
-        let ao = crate::inputs::read_channel(map, fp, count, &mut texels);
-        occlusion = (1.0 + m.occlusion_strength * (ao - 1.0)).clamp(0.0, 1.0);
-    }
+    let (roughness, metallic, occlusion) =
+        scalar_maps(m, fp, roughness, lighting.ambient, count, &mut texels);
     let lobe = Lobe {
         aa: m.specular_aa,
         roughness,
@@ -538,6 +521,53 @@ fn shade_once(
     };
     let rgb = radiance(s, lighting, &at, &surface, false, &mut texels);
     (rgb.extend(c.w).to_array(), texels, grid)
+}
+
+/// An unlit fragment's colour: [`base_color`] times its layers' blended colour.
+#[inline(always)]
+fn unlit(
+    ctx: &DrawContext,
+    p: &ShadingPoint,
+    tex: [f32; 4],
+    count: bool,
+    texels: &mut u32,
+) -> Vec4 {
+    let mut c = base_color(ctx, p.verts, p.l(), tex);
+    if let Some(layers) = ctx.material.as_ref().and_then(|m| m.layers.as_ref()) {
+        let needs = Needs {
+            color: true,
+            ..Needs::default()
+        };
+        c *= layers.sample(&p.fp, needs, count, texels).base;
+    }
+    c
+}
+
+/// The material's scalar maps read through `fp`: `roughness` times the roughness map, the
+/// metallic factor times the metallic map, and the occlusion (read only under `ambient` light;
+/// 1 without a map).
+#[inline(always)]
+fn scalar_maps(
+    m: &Material,
+    fp: &Footprint,
+    mut roughness: f32,
+    ambient: bool,
+    count: bool,
+    texels: &mut u32,
+) -> (f32, f32, f32) {
+    let mut metallic = m.metallic;
+    if let Some(map) = &m.roughness_map {
+        roughness *= crate::inputs::read_channel(map, fp, count, texels);
+    }
+    if let Some(map) = &m.metallic_map {
+        metallic *= crate::inputs::read_channel(map, fp, count, texels);
+    }
+    let mut occlusion = 1.0;
+    if let Some(map) = m.occlusion_map.as_ref().filter(|_| ambient) {
+        let ao = crate::inputs::read_channel(map, fp, count, texels);
+        occlusion = (1.0 + m.occlusion_strength * (ao - 1.0)).clamp(0.0, 1.0);
+    }
+    (roughness, metallic, occlusion)
 }
 
 /// The lights' and the environment's radiance on `surface` at `p`; `lambert` drops the

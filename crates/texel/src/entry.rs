@@ -4,13 +4,16 @@
 
 use std::sync::atomic::AtomicBool;
 
-use texel_raster::{
-    render, render_reference_adaptive, ColorTarget, Frame, RasterError, ReferenceEstimate,
-    ReferencePlan, ReferenceStatus, View,
+use texel_prepare::{
+    ColorHandling, Error, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
 };
-use texel_scene::{Camera, Scene};
+use texel_raster::{
+    render, ColorTarget, Frame, RasterError, ReferenceEstimate, ReferencePlan, View,
+};
+use texel_scene::Scene;
+use texel_texture::Filter;
 
-use crate::{quality, ColorHandling, Error, Filter, MemoryBudget, PreparedScene, SceneOptions};
+use crate::quality;
 
 /// Bytes per pixel a converging reference holds besides its frame: its running statistics,
 /// masks and results.
@@ -109,50 +112,6 @@ pub fn render_image(scene: &Scene, options: &RenderOptions) -> Result<quality::I
         _ => ColorHandling::Srgb,
     };
     Ok(frame_image(&frame, encoding(color))?)
-}
-
-/// How [`PreparedScene::reference`] runs a converging reference.
-#[derive(Clone, Copy, Default)]
-pub struct ReferenceRun<'a> {
-    /// Samples, tolerance and seed ([`ReferencePlan`]).
-    pub plan: ReferencePlan,
-    /// Worker threads; `None`: all cores.
-    pub threads: Option<usize>,
-    /// Only the pixels `x0 <= i < x1, y0 <= j < y1` of `[x0, y0, x1, y1]`, each exactly what the
-    /// whole frame gives it; the others hold the background with zero error. `None`: every pixel.
-    pub scissor: Option<[u32; 4]>,
-    /// Called from worker threads as passes finish.
-    pub progress: Option<&'a (dyn Fn(&ReferenceStatus) + Sync)>,
-    /// Once set, the reference ends after the current pass, marked interrupted.
-    pub stop: Option<&'a AtomicBool>,
-}
-
-impl PreparedScene {
-    /// The converging reference of this scene seen by `camera` ([`texel_raster::adaptive`]): its
-    /// textures at level 0 with each mesh's address modes, the reference geometry, and every
-    /// pixel's mean and standard error.
-    ///
-    /// # Errors
-    /// [`Error::Raster`]: an invalid plan or scissor, or [`RasterError::Interrupted`] for a stop
-    /// before the first pass finished.
-    pub fn reference(
-        &self,
-        camera: &Camera,
-        run: &ReferenceRun<'_>,
-    ) -> Result<ReferenceEstimate, Error> {
-        let plan = self.reference_plan()?;
-        let draws = plan.reference_draws_from(camera)?;
-        let mut settings = plan.settings_from(camera);
-        settings.threads = run.threads;
-        settings.scissor = run.scissor;
-        Ok(render_reference_adaptive(
-            &settings,
-            &draws,
-            &run.plan,
-            run.progress,
-            run.stop,
-        )?)
-    }
 }
 
 /// How [`reference_scene`] makes a reference.

@@ -3,9 +3,9 @@
 //! This crate is the front door to the texel libraries: it re-exports them
 //! ([`texture`]: textures, mip pyramids and every filter behind a [`Sampler`]; [`raster`]: the
 //! clipped, perspective-correct rasterizer and the supersampled reference; [`scene`]: scene files,
-//! OBJ and glTF meshes, built-in scenes; [`quality`]: PSNR, SSIM and reports) and owns the step
-//! between a [`Scene`] and draw calls ([`PreparedScene`]), so that a program renders a scene the
-//! way the `texel` command does:
+//! OBJ and glTF meshes, built-in scenes; [`quality`]: PSNR, SSIM and reports; [`prepare`]: the
+//! step between a [`Scene`] and draw calls, [`PreparedScene`]) and adds the few calls that do a
+//! whole job, so that a program renders a scene the way the `texel` command does:
 //!
 //! ```
 //! use texel::{render_scene, Filter, RenderOptions, Scene};
@@ -26,15 +26,7 @@
 //! For more control (several filters on one loaded scene, debug views, threads, timing), use
 //! [`PreparedScene`] with [`raster::render`] as `examples/render_scene.rs` does.
 
-pub mod ao;
-pub mod bake;
-pub mod bvh;
 mod entry;
-mod error;
-pub mod memory;
-mod plan;
-mod prepare;
-pub mod tessellate;
 
 pub use texel_quality as quality;
 pub use texel_raster as raster;
@@ -43,12 +35,13 @@ pub use texel_texture as texture;
 
 pub use entry::{
     encoding, frame_image, reference_scene, render_image, render_scene, ReferenceOptions,
-    ReferenceRun, RenderOptions, REFERENCE_BYTES_PER_PIXEL,
+    RenderOptions, REFERENCE_BYTES_PER_PIXEL,
 };
-pub use error::Error;
-pub use memory::MemoryBudget;
-pub use plan::FramePlan;
-pub use prepare::{ColorHandling, PreparedScene, SceneOptions};
+pub use texel_prepare as prepare;
+pub use texel_prepare::{ao, bake, bvh, memory, tessellate};
+pub use texel_prepare::{
+    ColorHandling, Error, FramePlan, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
+};
 pub use texel_raster::{render, ColorTarget, DrawCall, Frame, RenderSettings, View};
 pub use texel_scene::{Scene, SceneLimits};
 pub use texel_texture::{Filter, Sampler, SamplerDescriptor, Texture};

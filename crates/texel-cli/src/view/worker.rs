@@ -337,6 +337,45 @@ pub fn part_rects(state: &ViewState, w: u32, h: u32) -> Vec<[u32; 4]> {
     }
 }
 
+/// One mode's share of a frame ([`FrameContext::draw_part`]).
+struct Part {
+    mode: Mode,
+    /// Its pixels `[x0, y0, x1, y1]`.
+    rect: [u32; 4],
+    /// Drawn by the GPU path.
+    gpu: bool,
+    /// The fly camera's `clip_from_world`.
+    clip: glam::Mat4,
+}
+
+/// The reference's stratified samples per pixel in one pass: 1 x 1 while moving, else 2 x 2.
+fn reference_spp(req: &Request) -> [u32; 2] {
+    if req.moving {
+        [1, 1]
+    } else {
+        [2, 2]
+    }
+}
+
+/// The scene's settings for a `w x h` frame of `state`'s view, perspective and derivatives, on
+/// every thread, into linear floats (progressive passes accumulate them).
+fn view_settings(
+    scene: &PreparedScene,
+    state: &ViewState,
+    w: u32,
+    h: u32,
+) -> RenderSettings<'static> {
+    let mut settings = scene.settings();
+    settings.width = w;
+    settings.height = h;
+    settings.view = state.view;
+    settings.perspective = state.perspective;
+    settings.derivatives = state.derivatives;
+    settings.threads = None;
+    settings.target = ColorTarget::Float;
+    settings
+}
+
 impl FrameContext<'_, '_> {
     fn scene(&mut self, color: texel::ColorHandling) -> Result<&PreparedScene> {
         let w = &mut *self.worker;
@@ -375,59 +414,18 @@ impl FrameContext<'_, '_> {
     /// Render one frame of `req`; `None` when a newer request superseded it mid-way.
     fn render(&mut self, req: &Request) -> Result<Option<Rendered>> {
         let state = &req.state;
-        let same = self
-            .progress
-            .image
-            .as_ref()
-            .is_some_and(|r| r.same_image(req));
-        if !same || req.moving {
-            *self.progress = Progress {
-                image: (!req.moving).then(|| req.clone()),
-                ..Progress::default()
-            };
-        }
+        self.restart_progress(req);
         let modes = state.modes();
-        // The GPU path has no lighting, materials or per-pixel sphere mappings: such scenes
-        // stay on the CPU.
-        let lit = self.worker.scenes[state.color as usize]
-            .as_ref()
-            .or(self.worker.scenes.iter().flatten().next())
-            .is_some_and(|s| {
-                !s.scene.lights.is_empty() || !s.scene.materials.is_empty() || s.maps_uv_per_pixel()
-            });
-        let has_gpu = self.gpu.is_some() && !lit;
+        let gpu_scene = self.gpu.is_some() && !self.lit(state.color);
         let use_gpu = |m: Mode| {
-            has_gpu
+            gpu_scene
                 && state.view == View::Color
                 && matches!(m, Mode::Filter(f) if GpuFilter::of(f).is_some())
         };
-        // Resolution: full unless moving over budget.
-        let full_rects = part_rects(state, req.width, req.height);
-        let predicted: f64 = modes
-            .iter()
-            .zip(&full_rects)
-            .map(|(&m, r)| {
-                let px = f64::from(r[2] - r[0]) * f64::from(r[3] - r[1]);
-                self.cost(m, state.view, use_gpu(m)) * px
-            })
-            .sum();
-        let scale = if req.moving {
-            ((predicted / BUDGET_MS).sqrt().ceil() as u32).clamp(1, MAX_SCALE)
-        } else {
-            1
-        };
+        let scale = self.scale(req, &modes, use_gpu);
         let (w, h) = (req.width.div_ceil(scale), req.height.div_ceil(scale));
         let rects = part_rects(state, w, h);
-        let scene = self.scene(state.color)?;
-        let mut settings = scene.settings();
-        settings.width = w;
-        settings.height = h;
-        settings.view = state.view;
-        settings.perspective = state.perspective;
-        settings.derivatives = state.derivatives;
-        settings.threads = None;
-        // Progressive passes accumulate linear floats.
-        settings.target = ColorTarget::Float;
+        let settings = view_settings(self.scene(state.color)?, state, w, h);
         let clip = req.camera.clip_from_world(w as f32 / h as f32);
         let mut frame = match self.frame.take() {
             Some(mut f) if f.width == w && f.height == h => {
@@ -441,72 +439,17 @@ impl FrameContext<'_, '_> {
         }
         let t0 = Instant::now();
         let mut parts = Vec::new();
-        let spp = if req.moving { [1, 1] } else { [2, 2] };
         for (&mode, &rect) in modes.iter().zip(&rects) {
             let started = Instant::now();
             let gpu = use_gpu(mode);
-            let filter = match mode {
-                Mode::Filter(f) => f,
-                Mode::Reference => Filter::Trilinear,
+            let part = Part {
+                mode,
+                rect,
+                gpu,
+                clip,
             };
-            let key = self.samplers(filter, state)?;
-            let draws = camera_draws(&self.worker.scenes, self.samplers, key, clip);
-            let settings =
-                with_environment(&settings, &self.worker.scenes, self.samplers, key, clip);
-            match mode {
-                Mode::Filter(f) if gpu => {
-                    let gpu_dev = self.gpu.expect("use_gpu checked");
-                    let g = match self.gpu_draws.entry(key) {
-                        std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-                        std::collections::hash_map::Entry::Vacant(e) => {
-                            e.insert(gpu_dev.prepare(&draws, GpuFilter::of(f).expect("checked"))?)
-                        }
-                    };
-                    g.set_clip_from_world(clip);
-                    let out = g.render(&RenderSettings {
-                        scissor: Some(rect),
-                        derivatives: texel_raster::Derivatives::Quad,
-                        ..settings
-                    })?;
-                    copy_rect(&out.color, &mut frame.color, w, rect);
-                    // Written by hand: later draws must load it, not redraw from the clear.
-                    frame.forget_clear();
-                }
-                Mode::Filter(_) => {
-                    for band in bands(rect, self.cost(mode, state.view, false), req.moving) {
-                        if self.shared.superseded(req.generation) {
-                            return Ok(self.abandon(frame));
-                        }
-                        let s = RenderSettings {
-                            scissor: Some(band),
-                            ..settings
-                        };
-                        draw_into(&s, &draws, &mut frame)?;
-                    }
-                }
-                Mode::Reference => {
-                    self.progress.passes += 1;
-                    let seed = self.progress.passes;
-                    for band in bands(rect, self.cost(mode, state.view, false), req.moving) {
-                        if self.shared.superseded(req.generation) {
-                            return Ok(self.abandon(frame));
-                        }
-                        let s = RenderSettings {
-                            scissor: Some(band),
-                            view: View::Color,
-                            ..settings
-                        };
-                        let pass = render_reference_strata(&s, &draws, spp, seed, None)?;
-                        // The pass holds means of spp[0] x spp[1] samples: add their sums.
-                        let n = (spp[0] * spp[1]) as f32;
-                        for_rect(band, w, |k| {
-                            let (a, b) = (&mut self.progress.sum[k], pass.color[k]);
-                            for c in 0..4 {
-                                a[c] += b[c] * n;
-                            }
-                        });
-                    }
-                }
+            if !self.draw_part(req, &part, &settings, &mut frame)? {
+                return Ok(self.abandon(frame));
             }
             let px = f64::from(rect[2] - rect[0]) * f64::from(rect[3] - rect[1]);
             let ms = started.elapsed().as_secs_f64() * 1e3;
@@ -519,40 +462,11 @@ impl FrameContext<'_, '_> {
                 stats: None,
             });
         }
-        // The reference halves show the mean so far.
-        let per_pass = spp[0] * spp[1];
-        let has_reference = modes.contains(&Mode::Reference);
-        if has_reference {
-            self.progress.samples += per_pass;
-        }
-        let samples = self.progress.samples;
-        for (part, &rect) in parts.iter_mut().zip(&rects) {
-            if part.mode == Mode::Reference {
-                part.samples = Some(samples);
-                let inv = 1.0 / samples as f32;
-                for_rect(rect, w, |k| {
-                    frame.color[k] = self.progress.sum[k].map(|c| c * inv);
-                });
-            }
-        }
+        self.show_reference_mean(req, &rects, &mut parts, &mut frame);
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         // Statistics once per still image, after its first frame.
         if !req.moving && scale == 1 {
-            if let Some(stats) = &self.progress.stats {
-                for (p, s) in parts.iter_mut().zip(stats) {
-                    p.stats = *s;
-                }
-            } else if self.progress.image.is_some() && self.progress.first_done {
-                let stats = self.measure(req, &rects, &settings, clip)?;
-                if let Some(stats) = stats {
-                    for (p, s) in parts.iter_mut().zip(&stats) {
-                        p.stats = *s;
-                    }
-                    self.progress.stats = Some(stats);
-                }
-            } else {
-                self.progress.first_done = true;
-            }
+            self.attach_stats(req, &rects, &settings, clip, &mut parts)?;
         }
         let pixels = display(&frame, &rects, &modes, state, scale, req.width, req.height);
         *self.frame = Some(frame);
@@ -566,6 +480,184 @@ impl FrameContext<'_, '_> {
             parts,
             error: None,
         }))
+    }
+
+    /// Start the reference's accumulation and the statistics again unless `req` shows the same
+    /// still image as the last request.
+    fn restart_progress(&mut self, req: &Request) {
+        let same = self
+            .progress
+            .image
+            .as_ref()
+            .is_some_and(|r| r.same_image(req));
+        if !same || req.moving {
+            *self.progress = Progress {
+                image: (!req.moving).then(|| req.clone()),
+                ..Progress::default()
+            };
+        }
+    }
+
+    /// Whether the scene has lights, materials or per-pixel sphere mappings, which the GPU path
+    /// lacks: such scenes stay on the CPU.
+    fn lit(&self, color: texel::ColorHandling) -> bool {
+        let scenes = &self.worker.scenes;
+        scenes[color as usize]
+            .as_ref()
+            .or(scenes.iter().flatten().next())
+            .is_some_and(|s| {
+                !s.scene.lights.is_empty() || !s.scene.materials.is_empty() || s.maps_uv_per_pixel()
+            })
+    }
+
+    /// The resolution divisor: 1, or while moving the smallest that keeps the predicted frame
+    /// time within [`BUDGET_MS`] (at most [`MAX_SCALE`]).
+    fn scale(&self, req: &Request, modes: &[Mode], use_gpu: impl Fn(Mode) -> bool) -> u32 {
+        if !req.moving {
+            return 1;
+        }
+        let full_rects = part_rects(&req.state, req.width, req.height);
+        let predicted: f64 = modes
+            .iter()
+            .zip(&full_rects)
+            .map(|(&m, r)| {
+                let px = f64::from(r[2] - r[0]) * f64::from(r[3] - r[1]);
+                self.cost(m, req.state.view, use_gpu(m)) * px
+            })
+            .sum();
+        ((predicted / BUDGET_MS).sqrt().ceil() as u32).clamp(1, MAX_SCALE)
+    }
+
+    /// Draw one mode into its rectangle of `frame`: on the GPU, on the CPU in bands, or as one
+    /// more reference pass added to the accumulation. `false` when a newer request superseded
+    /// this one between bands.
+    fn draw_part(
+        &mut self,
+        req: &Request,
+        part: &Part,
+        settings: &RenderSettings,
+        frame: &mut Frame,
+    ) -> Result<bool> {
+        let (state, rect, w) = (&req.state, part.rect, frame.width);
+        let filter = match part.mode {
+            Mode::Filter(f) => f,
+            Mode::Reference => Filter::Trilinear,
+        };
+        let key = self.samplers(filter, state)?;
+        let draws = camera_draws(&self.worker.scenes, self.samplers, key, part.clip);
+        let settings =
+            with_environment(settings, &self.worker.scenes, self.samplers, key, part.clip);
+        let bands = bands(rect, self.cost(part.mode, state.view, false), req.moving);
+        match part.mode {
+            Mode::Filter(f) if part.gpu => {
+                let gpu_dev = self.gpu.expect("use_gpu checked");
+                let g = match self.gpu_draws.entry(key) {
+                    std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                    std::collections::hash_map::Entry::Vacant(e) => {
+                        e.insert(gpu_dev.prepare(&draws, GpuFilter::of(f).expect("checked"))?)
+                    }
+                };
+                g.set_clip_from_world(part.clip);
+                let out = g.render(&RenderSettings {
+                    scissor: Some(rect),
+                    derivatives: texel_raster::Derivatives::Quad,
+                    ..settings
+                })?;
+                copy_rect(&out.color, &mut frame.color, w, rect);
+                // Written by hand: later draws must load it, not redraw from the clear.
+                frame.forget_clear();
+            }
+            Mode::Filter(_) => {
+                for band in bands {
+                    if self.shared.superseded(req.generation) {
+                        return Ok(false);
+                    }
+                    let s = RenderSettings {
+                        scissor: Some(band),
+                        ..settings
+                    };
+                    draw_into(&s, &draws, frame)?;
+                }
+            }
+            Mode::Reference => {
+                self.progress.passes += 1;
+                let seed = self.progress.passes;
+                let spp = reference_spp(req);
+                for band in bands {
+                    if self.shared.superseded(req.generation) {
+                        return Ok(false);
+                    }
+                    let s = RenderSettings {
+                        scissor: Some(band),
+                        view: View::Color,
+                        ..settings
+                    };
+                    let pass = render_reference_strata(&s, &draws, spp, seed, None)?;
+                    // The pass holds means of spp[0] x spp[1] samples: add their sums.
+                    let n = (spp[0] * spp[1]) as f32;
+                    for_rect(band, w, |k| {
+                        let (a, b) = (&mut self.progress.sum[k], pass.color[k]);
+                        for c in 0..4 {
+                            a[c] += b[c] * n;
+                        }
+                    });
+                }
+            }
+        }
+        Ok(true)
+    }
+
+    /// Count this frame's reference samples, and show in the reference's parts the mean of
+    /// every pass so far.
+    fn show_reference_mean(
+        &mut self,
+        req: &Request,
+        rects: &[[u32; 4]],
+        parts: &mut [PartInfo],
+        frame: &mut Frame,
+    ) {
+        if req.state.modes().contains(&Mode::Reference) {
+            let [a, b] = reference_spp(req);
+            self.progress.samples += a * b;
+        }
+        let samples = self.progress.samples;
+        let w = frame.width;
+        for (part, &rect) in parts.iter_mut().zip(rects) {
+            if part.mode == Mode::Reference {
+                part.samples = Some(samples);
+                let inv = 1.0 / samples as f32;
+                for_rect(rect, w, |k| {
+                    frame.color[k] = self.progress.sum[k].map(|c| c * inv);
+                });
+            }
+        }
+    }
+
+    /// Give each part its statistics: measured once per still image, after its first frame,
+    /// then kept.
+    fn attach_stats(
+        &mut self,
+        req: &Request,
+        rects: &[[u32; 4]],
+        settings: &RenderSettings,
+        clip: glam::Mat4,
+        parts: &mut [PartInfo],
+    ) -> Result<()> {
+        if let Some(stats) = &self.progress.stats {
+            for (p, s) in parts.iter_mut().zip(stats) {
+                p.stats = *s;
+            }
+        } else if self.progress.image.is_some() && self.progress.first_done {
+            if let Some(stats) = self.measure(req, rects, settings, clip)? {
+                for (p, s) in parts.iter_mut().zip(&stats) {
+                    p.stats = *s;
+                }
+                self.progress.stats = Some(stats);
+            }
+        } else {
+            self.progress.first_done = true;
+        }
+        Ok(())
     }
 
     /// Give up the frame for a newer request: keep its buffers, and forget the reference's

@@ -248,41 +248,8 @@ impl PreparedScene {
         let (width, height) = options
             .size
             .unwrap_or((scene.output.width, scene.output.height));
-        let (verts, tris) = scene.meshes.iter().fold((0u64, 0u64), |(v, t), m| {
-            (v + m.positions.len() as u64, t + m.triangles.len() as u64)
-        });
-        budget.take("the meshes", verts * VERTEX_BYTES + tris * TRIANGLE_BYTES)?;
-        budget.take(
-            &format!("rasterizing {tris} triangles at {width}x{height}"),
-            raster_bytes(&scene, width, height),
-        )?;
-        budget.take(
-            &format!("a {width}x{height} frame"),
-            u64::from(width) * u64::from(height) * FRAME_BYTES_PER_PIXEL,
-        )?;
-        let override_space = match options.color {
-            ColorHandling::Srgb => None,
-            ColorHandling::Raw => Some(ColorSpace::Linear),
-        };
-        let mut textures = BTreeMap::new();
-        let mut replaced = Vec::new();
-        for u in scene.used_textures() {
-            let spec = scene.texture_spec(&u)?;
-            let limits = Limits {
-                max_bytes: budget.remaining(),
-                ..Limits::default()
-            };
-            let space = if u.color { override_space } else { None };
-            let loaded = spec.load_with(u.name, space, &limits, options.replace_non_finite)?;
-            if loaded.replaced > 0 {
-                replaced.push((u.name.to_string(), loaded.replaced));
-            }
-            budget.take(
-                &format!("texture {:?}", u.name),
-                loaded.texture.pyramid_bytes(),
-            )?;
-            textures.insert(u.name.to_string(), loaded.texture);
-        }
+        charge_geometry(&scene, (width, height), budget)?;
+        let (textures, mut replaced) = load_textures(&scene, options, budget)?;
         if let Some(spec) = &scene.environment {
             scene.environment = Some(relay_sky(spec, options.environment_mapping)?);
         }
@@ -296,145 +263,23 @@ impl PreparedScene {
             }
             None => None,
         };
-        let mut own_samplers: Vec<TextureSampler> = Vec::new();
-        let mut own_sampler_of = BTreeMap::new();
-        for u in scene.used_textures() {
-            let Some(own) = scene.texture_spec(&u)?.sampler else {
-                continue;
-            };
-            let i = match own_samplers.iter().position(|s| *s == own) {
-                Some(i) => i,
-                None => {
-                    own_samplers.push(own);
-                    own_samplers.len() - 1
-                }
-            };
-            own_sampler_of.insert(u.name.to_string(), i);
-        }
-        // LEAN reads moment maps made from the normal maps (a layered material's too), and LEAN
-        // and Toksvig on bump maps moment maps made from the height maps (float, charged like
-        // any texture). Layered materials that blend then filter, or whose heights displace,
-        // are baked, and their baked maps get moment maps by the same rule.
-        let mut lean_maps = BTreeMap::new();
-        let mut height_moments = BTreeMap::new();
-        let mut composites = BTreeMap::new();
-        for (material, mat) in &scene.materials {
-            let aa = specular_aa(mat, options.specular_aa);
-            let shape = displacement(mat, options.displacement);
-            let bumped = shape != texel_scene::Displacement::None;
-            let jobs: Vec<(&String, Moments)> = if !mat.layers.is_empty() {
-                let normals = mat.layers.iter().filter_map(|l| l.normal.as_ref());
-                let lean = aa == SpecularAa::Lean;
-                normals
-                    .filter(|_| lean)
-                    .map(|n| (n, Moments::Lean))
-                    .collect()
-            } else {
-                moment_source(aa, bumped, mat.normal.as_ref(), mat.height.as_ref())
-                    .into_iter()
-                    .collect()
-            };
-            for (name, kind) in jobs {
-                let out = match kind {
-                    Moments::Lean => &mut lean_maps,
-                    Moments::Slopes => &mut height_moments,
-                };
-                let Some(map) = textures.get(name) else {
-                    continue;
-                };
-                if !out.contains_key(name) {
-                    let moments = moment_map(kind, map, budget, name)?;
-                    out.insert(name.clone(), moments);
-                }
-            }
-            let order = options.layer_order.unwrap_or(mat.layer_order);
-            let displaced = bumped || mat.displacement != texel_scene::Displacement::None;
-            let wanted = order == LayerOrder::BlendThenFilter || (displaced && mat.layer_heights());
-            if mat.layers.is_empty() || !wanted {
-                continue;
-            }
-            let modes = scene
-                .meshes
-                .iter()
-                .find(|m| m.material.as_ref() == Some(material))
-                .map_or((AddressMode::Repeat, AddressMode::Repeat), |m| {
-                    (m.address_mode_u, m.address_mode_v)
-                });
-            let level0 = bake::level0_sampler(modes)?;
-            let maps = MapInputs {
-                textures: &textures,
-                mesh: &level0,
-                own: &[],
-                own_of: &BTreeMap::new(),
-            };
-            let layers = layers_of(mat, maps, &lean_maps);
-            let limits = Limits {
-                max_bytes: budget.remaining(),
-                ..Limits::default()
-            };
-            let what = format!("{material} (its layers baked)");
-            let composite = bake::bake(&layers, &level0, &limits).map_err(|source| {
-                texel_scene::SceneError::Texture {
-                    name: what.clone(),
-                    path: None,
-                    source,
-                }
-            })?;
-            budget.take(
-                &format!("the baked layers of material {material:?}"),
-                composite.bytes(),
-            )?;
-            let mut baked = Baked {
-                lean: None,
-                slope_moments: None,
-                composite,
-            };
-            let c = &baked.composite;
-            if let Some((map, kind)) =
-                moment_source(aa, bumped, c.normal.as_ref(), c.height.as_ref())
-            {
-                let moments = Some(moment_map(kind, map, budget, &what)?);
-                match kind {
-                    Moments::Lean => baked.lean = moments,
-                    Moments::Slopes => baked.slope_moments = moments,
-                }
-            }
-            composites.insert(material.clone(), baked);
-        }
-        // Normal maps need tangents: MikkTSpace where the mesh brings none.
-        for m in &mut scene.meshes {
-            let mapped = m
-                .material
-                .as_ref()
-                .and_then(|n| scene.materials.get(n))
-                .is_some_and(|mat| {
-                    mat.normal.is_some() || mat.layers.iter().any(|l| l.normal.is_some())
-                });
-            if mapped && m.tangents.is_none() {
-                m.generate_tangents();
-            }
-        }
+        let (own_samplers, own_sampler_of) = own_samplers(&scene)?;
+        let derived = derive_maps(&scene, options, &textures, budget)?;
+        generate_tangents(&mut scene);
         let vertices: Vec<Vec<Vertex>> = scene.meshes.iter().map(texel_vertices).collect();
-        let mut tessellated = Vec::new();
-        for (mesh, verts) in scene.meshes.iter().zip(&vertices) {
-            let geometry = displaced_geometry(
-                &scene,
-                mesh,
-                verts,
-                heights_of(mesh, &scene, &textures, &composites),
-                (width, height),
-                options,
-                Geometry::Render,
-            )?;
-            if let Some(g) = &geometry {
-                budget.take(
-                    "the tessellated geometry",
-                    g.vertices.len() as u64 * VERTEX_BYTES
-                        + g.triangles.len() as u64 * TRIANGLE_BYTES,
-                )?;
-            }
-            tessellated.push(geometry);
-        }
+        let tessellated = tessellate(
+            &scene,
+            &vertices,
+            (&textures, &derived.composites),
+            (width, height),
+            options,
+            budget,
+        )?;
+        let Derived {
+            lean_maps,
+            height_moments,
+            composites,
+        } = derived;
         Ok(PreparedScene {
             scene,
             textures,
@@ -906,6 +751,257 @@ impl PreparedScene {
         s.environment = self.environment(samplers, camera);
         s
     }
+}
+
+/// Charge `budget` for `scene`'s meshes, for rasterizing them at `(width, height)` and for one
+/// frame of that size.
+fn charge_geometry(
+    scene: &Scene,
+    (width, height): (u32, u32),
+    budget: &mut MemoryBudget,
+) -> Result<(), Error> {
+    let (verts, tris) = scene.meshes.iter().fold((0u64, 0u64), |(v, t), m| {
+        (v + m.positions.len() as u64, t + m.triangles.len() as u64)
+    });
+    budget.take("the meshes", verts * VERTEX_BYTES + tris * TRIANGLE_BYTES)?;
+    budget.take(
+        &format!("rasterizing {tris} triangles at {width}x{height}"),
+        raster_bytes(scene, width, height),
+    )?;
+    budget.take(
+        &format!("a {width}x{height} frame"),
+        u64::from(width) * u64::from(height) * FRAME_BYTES_PER_PIXEL,
+    )?;
+    Ok(())
+}
+
+/// Textures by name, and the names whose non-finite texels were replaced, with their counts.
+type Loaded = (BTreeMap<String, Texture>, Vec<(String, u64)>);
+
+/// Every texture the meshes use, each loaded within what `budget` has left and charged its
+/// pyramid; also the textures whose non-finite texels were replaced, with their counts.
+fn load_textures(
+    scene: &Scene,
+    options: &SceneOptions,
+    budget: &mut MemoryBudget,
+) -> Result<Loaded, Error> {
+    let override_space = match options.color {
+        ColorHandling::Srgb => None,
+        ColorHandling::Raw => Some(ColorSpace::Linear),
+    };
+    let mut textures = BTreeMap::new();
+    let mut replaced = Vec::new();
+    for u in scene.used_textures() {
+        let spec = scene.texture_spec(&u)?;
+        let limits = Limits {
+            max_bytes: budget.remaining(),
+            ..Limits::default()
+        };
+        let space = if u.color { override_space } else { None };
+        let loaded = spec.load_with(u.name, space, &limits, options.replace_non_finite)?;
+        if loaded.replaced > 0 {
+            replaced.push((u.name.to_string(), loaded.replaced));
+        }
+        budget.take(
+            &format!("texture {:?}", u.name),
+            loaded.texture.pyramid_bytes(),
+        )?;
+        textures.insert(u.name.to_string(), loaded.texture);
+    }
+    Ok((textures, replaced))
+}
+
+/// The distinct samplers textures bring of their own (glTF textures' `wrapS`/`wrapT`), and
+/// which of them each such texture is read through.
+fn own_samplers(scene: &Scene) -> Result<(Vec<TextureSampler>, BTreeMap<String, usize>), Error> {
+    let mut own_samplers: Vec<TextureSampler> = Vec::new();
+    let mut own_sampler_of = BTreeMap::new();
+    for u in scene.used_textures() {
+        let Some(own) = scene.texture_spec(&u)?.sampler else {
+            continue;
+        };
+        let i = match own_samplers.iter().position(|s| *s == own) {
+            Some(i) => i,
+            None => {
+                own_samplers.push(own);
+                own_samplers.len() - 1
+            }
+        };
+        own_sampler_of.insert(u.name.to_string(), i);
+    }
+    Ok((own_samplers, own_sampler_of))
+}
+
+/// The maps a scene's materials derive from their textures ([`derive_maps`]).
+struct Derived {
+    /// LEAN moment maps of normal maps, by texture name.
+    lean_maps: BTreeMap<String, MomentMap>,
+    /// Slope moment maps of height maps, by texture name.
+    height_moments: BTreeMap<String, MomentMap>,
+    /// Baked layered materials, by material name.
+    composites: BTreeMap<String, Baked>,
+}
+
+/// The maps the materials derive, each charged to `budget`. LEAN reads moment maps made from
+/// the normal maps (a layered material's too), and LEAN and Toksvig on bump maps moment maps
+/// made from the height maps (float, charged like any texture). Layered materials that blend
+/// then filter, or whose heights displace, are baked ([`bake_layers`]).
+fn derive_maps(
+    scene: &Scene,
+    options: &SceneOptions,
+    textures: &BTreeMap<String, Texture>,
+    budget: &mut MemoryBudget,
+) -> Result<Derived, Error> {
+    let mut derived = Derived {
+        lean_maps: BTreeMap::new(),
+        height_moments: BTreeMap::new(),
+        composites: BTreeMap::new(),
+    };
+    for (material, mat) in &scene.materials {
+        let aa = specular_aa(mat, options.specular_aa);
+        let shape = displacement(mat, options.displacement);
+        let bumped = shape != texel_scene::Displacement::None;
+        let jobs: Vec<(&String, Moments)> = if !mat.layers.is_empty() {
+            let normals = mat.layers.iter().filter_map(|l| l.normal.as_ref());
+            let lean = aa == SpecularAa::Lean;
+            normals
+                .filter(|_| lean)
+                .map(|n| (n, Moments::Lean))
+                .collect()
+        } else {
+            moment_source(aa, bumped, mat.normal.as_ref(), mat.height.as_ref())
+                .into_iter()
+                .collect()
+        };
+        for (name, kind) in jobs {
+            let out = match kind {
+                Moments::Lean => &mut derived.lean_maps,
+                Moments::Slopes => &mut derived.height_moments,
+            };
+            let Some(map) = textures.get(name) else {
+                continue;
+            };
+            if !out.contains_key(name) {
+                let moments = moment_map(kind, map, budget, name)?;
+                out.insert(name.clone(), moments);
+            }
+        }
+        let order = options.layer_order.unwrap_or(mat.layer_order);
+        let displaced = bumped || mat.displacement != texel_scene::Displacement::None;
+        let wanted = order == LayerOrder::BlendThenFilter || (displaced && mat.layer_heights());
+        if mat.layers.is_empty() || !wanted {
+            continue;
+        }
+        let maps = (textures, &derived.lean_maps);
+        let baked = bake_layers(scene, (material, mat), maps, (aa, bumped), budget)?;
+        derived.composites.insert(material.clone(), baked);
+    }
+    Ok(derived)
+}
+
+/// Material `mat` (named `material`) with its layers baked into one set of maps through a
+/// level-0 sampler with its mesh's address modes, charged to `budget`, and the moment map its
+/// specular antialiasing `aa` reads of the baked normals or (where `bumped`) heights.
+fn bake_layers(
+    scene: &Scene,
+    (material, mat): (&String, &texel_scene::MaterialSpec),
+    (textures, lean_maps): (&BTreeMap<String, Texture>, &BTreeMap<String, MomentMap>),
+    (aa, bumped): (SpecularAa, bool),
+    budget: &mut MemoryBudget,
+) -> Result<Baked, Error> {
+    let modes = scene
+        .meshes
+        .iter()
+        .find(|m| m.material.as_ref() == Some(material))
+        .map_or((AddressMode::Repeat, AddressMode::Repeat), |m| {
+            (m.address_mode_u, m.address_mode_v)
+        });
+    let level0 = bake::level0_sampler(modes)?;
+    let maps = MapInputs {
+        textures,
+        mesh: &level0,
+        own: &[],
+        own_of: &BTreeMap::new(),
+    };
+    let layers = layers_of(mat, maps, lean_maps);
+    let limits = Limits {
+        max_bytes: budget.remaining(),
+        ..Limits::default()
+    };
+    let what = format!("{material} (its layers baked)");
+    let composite = bake::bake(&layers, &level0, &limits).map_err(|source| {
+        texel_scene::SceneError::Texture {
+            name: what.clone(),
+            path: None,
+            source,
+        }
+    })?;
+    budget.take(
+        &format!("the baked layers of material {material:?}"),
+        composite.bytes(),
+    )?;
+    let mut baked = Baked {
+        lean: None,
+        slope_moments: None,
+        composite,
+    };
+    let c = &baked.composite;
+    if let Some((map, kind)) = moment_source(aa, bumped, c.normal.as_ref(), c.height.as_ref()) {
+        let moments = Some(moment_map(kind, map, budget, &what)?);
+        match kind {
+            Moments::Lean => baked.lean = moments,
+            Moments::Slopes => baked.slope_moments = moments,
+        }
+    }
+    Ok(baked)
+}
+
+/// Normal maps need tangents: MikkTSpace where the mesh brings none.
+fn generate_tangents(scene: &mut Scene) {
+    for m in &mut scene.meshes {
+        let mapped = m
+            .material
+            .as_ref()
+            .and_then(|n| scene.materials.get(n))
+            .is_some_and(|mat| {
+                mat.normal.is_some() || mat.layers.iter().any(|l| l.normal.is_some())
+            });
+        if mapped && m.tangents.is_none() {
+            m.generate_tangents();
+        }
+    }
+}
+
+/// Each mesh's displaced geometry for rendering at `size` (`None` where its material does not
+/// tessellate), charged to `budget`.
+fn tessellate(
+    scene: &Scene,
+    vertices: &[Vec<Vertex>],
+    (textures, composites): (&BTreeMap<String, Texture>, &BTreeMap<String, Baked>),
+    size: (u32, u32),
+    options: &SceneOptions,
+    budget: &mut MemoryBudget,
+) -> Result<Vec<Option<Tessellated>>, Error> {
+    let mut tessellated = Vec::new();
+    for (mesh, verts) in scene.meshes.iter().zip(vertices) {
+        let geometry = displaced_geometry(
+            scene,
+            mesh,
+            verts,
+            heights_of(mesh, scene, textures, composites),
+            size,
+            options,
+            Geometry::Render,
+        )?;
+        if let Some(g) = &geometry {
+            budget.take(
+                "the tessellated geometry",
+                g.vertices.len() as u64 * VERTEX_BYTES + g.triangles.len() as u64 * TRIANGLE_BYTES,
+            )?;
+        }
+        tessellated.push(geometry);
+    }
+    Ok(tessellated)
 }
 
 /// The specular antialiasing a material gets: `overridden` (the CLI's `--specular-aa`) or its own.
