@@ -236,6 +236,68 @@ impl Stats {
     }
 }
 
+/// `plan` checked against its ranges.
+fn check_plan(plan: &ReferencePlan) -> Result<(), RasterError> {
+    let max_min = MAX_SPP_SIDE * MAX_SPP_SIDE;
+    let valid = (1..=max_min).contains(&plan.min_spp)
+        && (plan.min_spp..=MAX_ADAPTIVE_SPP).contains(&plan.max_spp)
+        && plan.tolerance >= 0.0
+        && plan.tolerance.is_finite();
+    if !valid {
+        return Err(RasterError::InvalidReferencePlan {
+            min_spp: plan.min_spp,
+            min_max: max_min,
+            max_spp: plan.max_spp,
+            max_max: MAX_ADAPTIVE_SPP,
+            tolerance: plan.tolerance,
+        });
+    }
+    Ok(())
+}
+
+/// The estimate the passes' statistics make: each pixel's mean, standard error, interval
+/// half-width on the display, samples and whether it converged.
+fn estimate(
+    settings: &RenderSettings,
+    stats: &[Stats],
+    depth: Vec<f32>,
+    plan: &ReferencePlan,
+    per_pass: u32,
+    interrupted: bool,
+) -> ReferenceEstimate {
+    // An interrupted round leaves its pixels with more passes than the others: each is still the
+    // mean of whole passes, and its own statistics say how far it got.
+    let half: Vec<f64> = stats
+        .iter()
+        .map(|s| s.display_half_width(plan.srgb_display))
+        .collect();
+    let converged = half.iter().map(|&h| h <= plan.tolerance).collect();
+    let frame = Frame {
+        width: settings.width,
+        height: settings.height,
+        target: crate::settings::ColorTarget::Float,
+        // Every pixel has at least one pass (an earlier stop is an error above).
+        color: stats.iter().map(|s| s.mean.map(|m| m as f32)).collect(),
+        color8: Vec::new(),
+        texels_read: Vec::new(),
+        depth,
+        footprints: Vec::new(),
+        cleared: Default::default(),
+    };
+    ReferenceEstimate {
+        frame,
+        std_error: stats
+            .iter()
+            .map(|s| s.std_error().map(|e| e as f32))
+            .collect(),
+        display_half_width: half.iter().map(|&h| h as f32).collect(),
+        spp: stats.iter().map(|s| s.n * per_pass).collect(),
+        converged,
+        interrupted,
+        plan: *plan,
+    }
+}
+
 /// Render a reference of `draws` that converges as `plan` says (see the module docs).
 ///
 /// `progress`, if given, is called from worker threads as pixels finish. `stop`, if given, is
@@ -251,20 +313,7 @@ pub fn render_reference_adaptive(
     progress: Option<&(dyn Fn(&ReferenceStatus) + Sync)>,
     stop: Option<&AtomicBool>,
 ) -> Result<ReferenceEstimate, RasterError> {
-    let max_min = MAX_SPP_SIDE * MAX_SPP_SIDE;
-    let valid = (1..=max_min).contains(&plan.min_spp)
-        && (plan.min_spp..=MAX_ADAPTIVE_SPP).contains(&plan.max_spp)
-        && plan.tolerance >= 0.0
-        && plan.tolerance.is_finite();
-    if !valid {
-        return Err(RasterError::InvalidReferencePlan {
-            min_spp: plan.min_spp,
-            min_max: max_min,
-            max_spp: plan.max_spp,
-            max_max: MAX_ADAPTIVE_SPP,
-            tolerance: plan.tolerance,
-        });
-    }
+    check_plan(plan)?;
     let (first_passes, strata) = pass_layout(plan.min_spp);
     let per_pass = strata[0] * strata[1];
     let max_passes = plan.max_spp / per_pass;
@@ -335,37 +384,14 @@ pub fn render_reference_adaptive(
         }
         Ok(())
     })?;
-    // An interrupted round leaves its pixels with more passes than the others: each is still the
-    // mean of whole passes, and its own statistics say how far it got.
-    let half: Vec<f64> = stats
-        .iter()
-        .map(|s| s.display_half_width(plan.srgb_display))
-        .collect();
-    let converged = half.iter().map(|&h| h <= plan.tolerance).collect();
-    let frame = Frame {
-        width: settings.width,
-        height: settings.height,
-        target: crate::settings::ColorTarget::Float,
-        // Every pixel has at least one pass (an earlier stop is an error above).
-        color: stats.iter().map(|s| s.mean.map(|m| m as f32)).collect(),
-        color8: Vec::new(),
-        texels_read: Vec::new(),
+    Ok(estimate(
+        settings,
+        &stats,
         depth,
-        footprints: Vec::new(),
-        cleared: Default::default(),
-    };
-    Ok(ReferenceEstimate {
-        frame,
-        std_error: stats
-            .iter()
-            .map(|s| s.std_error().map(|e| e as f32))
-            .collect(),
-        display_half_width: half.iter().map(|&h| h as f32).collect(),
-        spp: stats.iter().map(|s| s.n * per_pass).collect(),
-        converged,
+        plan,
+        per_pass,
         interrupted,
-        plan: *plan,
-    })
+    ))
 }
 
 #[cfg(test)]

@@ -130,51 +130,8 @@ pub(crate) fn with_passes<T: Send>(
         .iter()
         .map(|d| level0(d.sampler))
         .collect::<Result<Vec<_>, _>>()?;
-    // The materials' maps are read at level 0 too, and the normals exactly (no specular
-    // antialiasing: the sub-samples resolve the variation it approximates).
-    let map_samplers = draws
-        .iter()
-        .map(|d| -> Result<[Option<Sampler>; 6], RasterError> {
-            let Some(m) = d.material else {
-                return Ok([None, None, None, None, None, None]);
-            };
-            Ok([
-                m.roughness_map
-                    .map(|c| level0(c.input.sampler))
-                    .transpose()?,
-                m.metallic_map
-                    .map(|c| level0(c.input.sampler))
-                    .transpose()?,
-                m.normal_map.map(|t| level0(t.sampler)).transpose()?,
-                m.height_map.map(|c| level0(c.input.sampler)).transpose()?,
-                // Every input of a layered material is read through the draw's own filter.
-                m.layers.map(|_| level0(d.sampler)).transpose()?,
-                m.occlusion_map
-                    .map(|c| level0(c.input.sampler))
-                    .transpose()?,
-            ])
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let materials: Vec<Option<Material>> = draws
-        .iter()
-        .zip(&map_samplers)
-        .map(|(d, [r, m, n, h, ly, o])| {
-            d.material.map(|mat| Material {
-                layers: mat.layers.zip(ly.as_ref()).map(|(l, s)| l.with_sampler(s)),
-                roughness_map: channel(mat.roughness_map, r),
-                metallic_map: channel(mat.metallic_map, m),
-                height_map: channel(mat.height_map, h),
-                occlusion_map: channel(mat.occlusion_map, o),
-                normal_map: mat
-                    .normal_map
-                    .zip(n.as_ref())
-                    .map(|(t, s)| TextureInput { sampler: s, ..t }),
-                specular_aa: SpecularAa::None,
-                shading_samples: 1,
-                ..mat
-            })
-        })
-        .collect();
+    let map_samplers = map_samplers(draws)?;
+    let materials = reference_materials(draws, &map_samplers);
     crate::with_threads(settings.threads, || {
         // Triangle setup, binning and the draws' contexts serve every pass.
         let (width, height) = (settings.width, settings.height);
@@ -228,6 +185,63 @@ pub(crate) fn with_passes<T: Send>(
         };
         body(&mut pass)
     })
+}
+
+/// The level-0 samplers of each draw's material maps: roughness, metallic, normal, height,
+/// layers (read through the draw's own filter), occlusion; `None` where the draw has no such map.
+fn map_samplers(draws: &[DrawCall]) -> Result<Vec<[Option<Sampler>; 6]>, RasterError> {
+    draws
+        .iter()
+        .map(|d| -> Result<[Option<Sampler>; 6], RasterError> {
+            let Some(m) = d.material else {
+                return Ok([None, None, None, None, None, None]);
+            };
+            Ok([
+                m.roughness_map
+                    .map(|c| level0(c.input.sampler))
+                    .transpose()?,
+                m.metallic_map
+                    .map(|c| level0(c.input.sampler))
+                    .transpose()?,
+                m.normal_map.map(|t| level0(t.sampler)).transpose()?,
+                m.height_map.map(|c| level0(c.input.sampler)).transpose()?,
+                // Every input of a layered material is read through the draw's own filter.
+                m.layers.map(|_| level0(d.sampler)).transpose()?,
+                m.occlusion_map
+                    .map(|c| level0(c.input.sampler))
+                    .transpose()?,
+            ])
+        })
+        .collect()
+}
+
+/// Each draw's material as the reference reads it: its maps at level 0 through `samplers`
+/// ([`map_samplers`]), and the normals exactly (no specular antialiasing, one shading sample:
+/// the sub-samples resolve the variation those approximate).
+fn reference_materials<'a>(
+    draws: &[DrawCall<'a>],
+    samplers: &'a [[Option<Sampler>; 6]],
+) -> Vec<Option<Material<'a>>> {
+    draws
+        .iter()
+        .zip(samplers)
+        .map(|(d, [r, m, n, h, ly, o])| {
+            d.material.map(|mat| Material {
+                layers: mat.layers.zip(ly.as_ref()).map(|(l, s)| l.with_sampler(s)),
+                roughness_map: channel(mat.roughness_map, r),
+                metallic_map: channel(mat.metallic_map, m),
+                height_map: channel(mat.height_map, h),
+                occlusion_map: channel(mat.occlusion_map, o),
+                normal_map: mat
+                    .normal_map
+                    .zip(n.as_ref())
+                    .map(|(t, s)| TextureInput { sampler: s, ..t }),
+                specular_aa: SpecularAa::None,
+                shading_samples: 1,
+                ..mat
+            })
+        })
+        .collect()
 }
 
 /// `c` read through sampler `s` instead of its own.
@@ -339,7 +353,8 @@ struct Scratch {
     winner: Vec<u32>,
 }
 
-/// Render the pixels `x0 .. x0 + color.len()` of row `j` (those the context's mask holds).
+/// Render the pixels `x0 .. x0 + color.len()` of row `j` (those the context's mask holds):
+/// place their stratified samples, find the nearest triangle at each, and shade.
 fn reference_row(
     ctx: &Context,
     bin: &[u32],
@@ -349,15 +364,26 @@ fn reference_row(
     depth: &mut [f32],
     s: &mut Scratch,
 ) {
+    let w = color.len();
+    if !place_samples(ctx, x0, j, w, s) {
+        return;
+    }
+    nearest_triangles(ctx, bin, (x0, j), w, s);
+    shade_samples(ctx, color, depth, s);
+}
+
+/// The row's pixels to render (`w` from `x0` in row `j`, those the mask holds) and their
+/// stratified sample positions, exact and in the rasterizer's fixed point; the samples' depth
+/// and triangle reset. `false` when the row has no pixel to render.
+fn place_samples(ctx: &Context, x0: u32, j: u32, w: usize, s: &mut Scratch) -> bool {
     let [nx, ny] = ctx.strata.map(|k| k as usize);
     let spp = nx * ny;
-    let w = color.len();
     s.pixels.clear();
     let row = j as usize * ctx.settings.width as usize + x0 as usize;
     s.pixels
         .extend((0..w as u32).filter(|&p| ctx.active.is_none_or(|a| a[row + p as usize])));
     if s.pixels.is_empty() {
-        return;
+        return false;
     }
     let count = s.pixels.len() * spp;
     s.pos.clear();
@@ -381,6 +407,13 @@ fn reference_row(
     s.depth.resize(count, f32::INFINITY);
     s.winner.clear();
     s.winner.resize(count, u32::MAX);
+    true
+}
+
+/// For every sample of the row `j` pixels from `x0` (`w` wide), the nearest triangle of `bin`
+/// that covers it (by the edge functions in fixed point, the depth in `f32`).
+fn nearest_triangles(ctx: &Context, bin: &[u32], (x0, j): (u32, u32), w: usize, s: &mut Scratch) {
+    let spp = ctx.strata[0] as usize * ctx.strata[1] as usize;
     let x1 = x0 + w as u32 - 1;
     for &id in bin {
         let t = &ctx.setups[id as usize];
@@ -407,6 +440,13 @@ fn reference_row(
             }
         }
     }
+}
+
+/// Each pixel's mean over its samples: the nearest triangle's shaded colour, or the background
+/// (the environment along the sample's ray, where it is the background); the pixel's depth is its
+/// nearest sample's.
+fn shade_samples(ctx: &Context, color: &mut [[f32; 4]], depth: &mut [f32], s: &Scratch) {
+    let spp = ctx.strata[0] as usize * ctx.strata[1] as usize;
     let background = Vec4::from_array(ctx.settings.background);
     let inv_spp = 1.0 / spp as f32;
     for (q, &p) in s.pixels.iter().enumerate() {
