@@ -219,21 +219,39 @@ impl Stats {
     }
 
     /// The largest distance over R, G, B between the displayed mean and the displayed ends of the
-    /// 95 % interval.
+    /// 95 % interval ([`display_half_width`]).
     fn display_half_width(&self, srgb: bool) -> f64 {
         if self.n < 2 {
             return f64::INFINITY;
         }
-        let t = t_975(self.n - 1);
         let se = self.std_error();
-        (0..3)
-            .map(|c| {
-                let (m, h) = (self.mean[c], t * se[c]);
-                let d = display(m, srgb);
-                (display(m + h, srgb) - d).max(d - display(m - h, srgb))
-            })
-            .fold(0.0, f64::max)
+        display_half_width(
+            [self.mean[0], self.mean[1], self.mean[2]],
+            [se[0], se[1], se[2]],
+            self.n,
+            srgb,
+        )
     }
+}
+
+/// The largest distance over R, G, B between the displayed value of `mean` (linear) and the
+/// displayed ends of its 95 % interval, `mean +- t std_error` with Student's `t` for `n - 1`
+/// degrees of freedom ([`t_975`]), in display units (1 is full scale: half an 8-bit step is
+/// `0.5 / 255`). `n` is the number of independent passes the mean and its standard error come
+/// from; below two the width is infinite. A converging reference stops refining a pixel once
+/// this is within its tolerance; the viewer reports the share of pixels for which it is.
+pub fn display_half_width(mean: [f64; 3], std_error: [f64; 3], n: u32, srgb: bool) -> f64 {
+    if n < 2 {
+        return f64::INFINITY;
+    }
+    let t = t_975(n - 1);
+    (0..3)
+        .map(|c| {
+            let (m, h) = (mean[c], t * std_error[c]);
+            let d = display(m, srgb);
+            (display(m + h, srgb) - d).max(d - display(m - h, srgb))
+        })
+        .fold(0.0, f64::max)
 }
 
 /// `plan` checked against its ranges.

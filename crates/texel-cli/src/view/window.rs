@@ -322,6 +322,9 @@ impl App {
             if let Some(n) = p.samples {
                 s.push_str(&format!("  {n}/{MAX_REFERENCE_SAMPLES} samples/px"));
             }
+            if let Some(share) = p.within {
+                s.push_str(&format!("  {:.0}% within 0.5 step", 100.0 * share));
+            }
             match p.stats {
                 Some(st) => {
                     s.push_str(&format!("  {:.1} texels/px", st.texels_mean));

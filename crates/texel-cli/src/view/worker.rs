@@ -138,6 +138,10 @@ pub struct PartInfo {
     pub backend: &'static str,
     /// Reference samples per pixel accumulated so far.
     pub samples: Option<u32>,
+    /// For a still reference of at least two passes: the share of its pixels whose displayed
+    /// value's 95 % interval, from the spread of the passes, is within half an 8-bit step
+    /// ([`texel_raster::adaptive::display_half_width`]).
+    pub within: Option<f64>,
     /// Mean texels read per covered pixel and the lod range (min, max) over covered pixels,
     /// once measured for this image.
     pub stats: Option<Stats>,
@@ -197,6 +201,9 @@ struct Progress {
     image: Option<Request>,
     /// Reference sums (linear RGBA) and samples per pixel.
     sum: Vec<[f32; 4]>,
+    /// Per pixel, the sum of the squared pass means (linear RGB): with `sum`, the spread of the
+    /// passes, hence the reference's standard error.
+    squares: Vec<[f64; 3]>,
     samples: u32,
     passes: u64,
     stats: Option<Vec<Option<Stats>>>,
@@ -357,6 +364,30 @@ fn reference_spp(req: &Request) -> [u32; 2] {
     }
 }
 
+/// The share of the pixels of `rect` (in a frame `w` wide) whose accumulated reference, `passes`
+/// equal passes in `progress`, has a 95 % interval of its displayed value (sRGB when `srgb`)
+/// within half an 8-bit step: each pass mean is one independent estimate, so the standard error
+/// of their mean is the passes' sample deviation over `sqrt(passes)`.
+fn share_within(progress: &Progress, rect: [u32; 4], w: u32, passes: u32, srgb: bool) -> f64 {
+    let n = f64::from(passes);
+    let tolerance = crate::cli::DEFAULT_TOLERANCE_STEPS / 255.0;
+    let (mut inside, mut all) = (0u64, 0u64);
+    for_rect(rect, w, |k| {
+        let (sum, squares) = (progress.sum[k], progress.squares[k]);
+        // `sum` holds every sample; a pass mean's mean is the same mean.
+        let mean: [f64; 3] =
+            std::array::from_fn(|c| f64::from(sum[c]) / f64::from(progress.samples));
+        let se = std::array::from_fn(|c| {
+            let var = (squares[c] - n * mean[c] * mean[c]).max(0.0) / (n - 1.0);
+            (var / n).sqrt()
+        });
+        let half = texel_raster::adaptive::display_half_width(mean, se, passes, srgb);
+        inside += u64::from(half <= tolerance);
+        all += 1;
+    });
+    inside as f64 / all.max(1) as f64
+}
+
 /// The scene's settings for a `w x h` frame of `state`'s view, perspective and derivatives, on
 /// every thread, into linear floats (progressive passes accumulate them).
 fn view_settings(
@@ -436,6 +467,7 @@ impl FrameContext<'_, '_> {
         };
         if self.progress.sum.len() != frame.color.len() {
             self.progress.sum = vec![[0.0; 4]; frame.color.len()];
+            self.progress.squares = vec![[0.0; 3]; frame.color.len()];
         }
         let t0 = Instant::now();
         let mut parts = Vec::new();
@@ -459,6 +491,7 @@ impl FrameContext<'_, '_> {
                 mode,
                 backend: if gpu { "gpu" } else { "cpu" },
                 samples: None,
+                within: None,
                 stats: None,
             });
         }
@@ -595,10 +628,15 @@ impl FrameContext<'_, '_> {
                     let pass = render_reference_strata(&s, &draws, spp, seed, None)?;
                     // The pass holds means of spp[0] x spp[1] samples: add their sums.
                     let n = (spp[0] * spp[1]) as f32;
+                    let progress = &mut *self.progress;
                     for_rect(band, w, |k| {
-                        let (a, b) = (&mut self.progress.sum[k], pass.color[k]);
+                        let (a, b) = (&mut progress.sum[k], pass.color[k]);
                         for c in 0..4 {
                             a[c] += b[c] * n;
+                        }
+                        let q = &mut progress.squares[k];
+                        for c in 0..3 {
+                            q[c] += f64::from(b[c]) * f64::from(b[c]);
                         }
                     });
                 }
@@ -622,6 +660,9 @@ impl FrameContext<'_, '_> {
         }
         let samples = self.progress.samples;
         let w = frame.width;
+        let [a, b] = reference_spp(req);
+        let passes = samples / (a * b);
+        let srgb = req.state.color == texel::ColorHandling::Srgb;
         for (part, &rect) in parts.iter_mut().zip(rects) {
             if part.mode == Mode::Reference {
                 part.samples = Some(samples);
@@ -629,6 +670,9 @@ impl FrameContext<'_, '_> {
                 for_rect(rect, w, |k| {
                     frame.color[k] = self.progress.sum[k].map(|c| c * inv);
                 });
+                if !req.moving && passes >= 2 {
+                    part.within = Some(share_within(&*self.progress, rect, w, passes, srgb));
+                }
             }
         }
     }
@@ -1058,6 +1102,56 @@ mod tests {
         moved.camera.eye.y += 0.1;
         let r = h.render(&moved).unwrap();
         assert_eq!(r.parts[0].samples, Some(4));
+    }
+
+    /// The share of the reference's pixels within half a step equals one computed from the
+    /// passes themselves: each pixel's mean and standard error over its passes, in `f64`.
+    #[test]
+    fn the_reference_reports_the_share_within_half_a_step() {
+        let mut h = Harness::new(64, 36);
+        let req = h.request("0", false);
+        assert_eq!(h.render(&req).unwrap().parts[0].within, None, "one pass");
+        let passes = 4u32;
+        let mut got = None;
+        for _ in 1..passes {
+            got = h.render(&req).unwrap().parts[0].within;
+        }
+        let got = got.expect("a share after two passes");
+        let scene = h.worker.scenes[0].as_ref().unwrap();
+        let samplers = scene.samplers(Filter::Trilinear).unwrap();
+        let draws = scene.draws(&samplers);
+        let frames: Vec<_> = (1..=u64::from(passes))
+            .map(|seed| {
+                render_reference_strata(&scene.settings(), &draws, [2, 2], seed, None).unwrap()
+            })
+            .collect();
+        let n = f64::from(passes);
+        let within = (0..64 * 36)
+            .filter(|&k| {
+                let mean: [f64; 3] = std::array::from_fn(|c| {
+                    frames.iter().map(|f| f64::from(f.color[k][c])).sum::<f64>() / n
+                });
+                let se = std::array::from_fn(|c| {
+                    let ss: f64 = frames
+                        .iter()
+                        .map(|f| (f64::from(f.color[k][c]) - mean[c]).powi(2))
+                        .sum();
+                    (ss / (n - 1.0) / n).sqrt()
+                });
+                let half = texel_raster::adaptive::display_half_width(mean, se, passes, true);
+                half <= 0.5 / 255.0
+            })
+            .count();
+        let want = within as f64 / (64.0 * 36.0);
+        // The sums differ from the two-pass form in the last bits of a few pixels at most.
+        assert!(
+            (got - want).abs() <= 2.0 / (64.0 * 36.0),
+            "{got} against {want}"
+        );
+        assert!(
+            want > 0.0 && want < 1.0,
+            "the ground is neither converged nor all noise: {want}"
+        );
     }
 
     #[test]
