@@ -228,7 +228,8 @@ fn environment_maps(
         "the environment's prefiltered pyramid and irradiance",
         EnvironmentMaps::extra_bytes(spec.mapping, w, h),
     )?;
-    let maps = EnvironmentMaps::new(spec.mapping, faces, &Limits::default())?;
+    let maps = EnvironmentMaps::new(spec.mapping, faces, &Limits::default())
+        .map_err(texel_raster::RasterError::from)?;
     Ok((maps, replaced))
 }
 

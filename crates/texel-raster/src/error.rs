@@ -111,10 +111,9 @@ pub enum RasterError {
     /// The work was stopped before it had a result.
     #[error("interrupted before the first pass of the reference completed")]
     Interrupted,
-    /// An environment map's faces do not fit its mapping (six square faces of one size for a
-    /// cube, one square image for an octahedral map).
-    #[error("environment map: {0}")]
-    InvalidEnvironment(&'static str),
+    /// Building the shading inputs (an environment map's faces that do not fit its mapping).
+    #[error(transparent)]
+    Shade(#[from] texel_shade::ShadeError),
     /// A texture could not be created (the reference renderer builds its own sampler).
     #[error(transparent)]
     Texture(#[from] texel_texture::TextureError),

@@ -45,13 +45,9 @@ pub mod adaptive;
 pub mod camera;
 pub mod clip;
 mod draw;
-pub mod environment;
 mod error;
 mod frame;
-mod inputs;
 pub mod interp;
-pub mod layers;
-pub mod material;
 mod point;
 pub mod reference;
 mod relief;
@@ -65,19 +61,19 @@ pub mod warp;
 
 pub use adaptive::{render_reference_adaptive, ReferenceEstimate, ReferencePlan, ReferenceStatus};
 pub use draw::{DrawCall, UvEvaluation, UvMapping, Vertex};
-pub use environment::{Environment, EnvironmentMaps};
 pub use error::RasterError;
 pub use frame::Frame;
-pub use layers::{Layer, LayerBlend, Layers};
-pub use material::{
-    ChannelInput, Displacement, Light, Material, SpecularAa, TextureInput, MAX_LIGHTS,
-};
 pub use reference::{render_reference, render_reference_strata};
 pub use settings::{
     ColorTarget, Derivatives, Perspective, Precision, RenderSettings, View, MAX_DIMENSION,
     MAX_PIXELS,
 };
 pub use stream::{last_level_cache_bytes, set_streaming, streaming, Streaming};
+pub use texel_shade::{environment, inputs, layers, material};
+pub use texel_shade::{
+    ChannelInput, Displacement, Environment, EnvironmentMaps, Layer, LayerBlend, Layers, Light,
+    Material, SpecularAa, TextureInput, MAX_LIGHTS,
+};
 pub use texel_texture::engine::dispatch::{level as simd_level, limit_level, SimdLevel};
 
 /// Render `draws` (in order; equal depths keep the earlier fragment) into a new [`Frame`].

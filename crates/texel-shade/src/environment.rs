@@ -55,7 +55,7 @@
 //! grid's resolution, whatever its layout). Both are scaled by the environment's intensity and
 //! the surface's ambient occlusion.
 //!
-//! **The reference** ([`crate::reference`]) reads the plain map bilinearly at level 0 for the
+//! **The reference** (texel-raster's `reference`) reads the plain map bilinearly at level 0 for the
 //! background and mirrors, and the glossy pyramid trilinearly at exactly `lod_r` (the lobe is the
 //! material's, not a filter's): what it leaves out is every pixel footprint.
 
@@ -67,7 +67,7 @@ use rayon::prelude::*;
 pub use texel_texture::mapping::sphere::{equirect_direction, equirect_duv, equirect_uv, Mapping};
 use texel_texture::{AddressMode, Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
-use crate::error::RasterError;
+use crate::error::ShadeError;
 use crate::material::{ggx_d, smith_visibility, MIN_ROUGHNESS};
 
 /// Width of the irradiance map (its height is half).
@@ -315,19 +315,15 @@ impl EnvironmentMaps {
     /// the current rayon pool.
     ///
     /// # Errors
-    /// [`RasterError::Texture`] when a float pyramid does not fit `limits`;
-    /// [`RasterError::InvalidEnvironment`] for the wrong number of faces or faces of the wrong shape.
-    pub fn new(
-        mapping: Mapping,
-        faces: Vec<Texture>,
-        limits: &Limits,
-    ) -> Result<Self, RasterError> {
-        let first = faces.first().ok_or(RasterError::InvalidEnvironment(
+    /// [`ShadeError::Texture`] when a float pyramid does not fit `limits`;
+    /// [`ShadeError::InvalidEnvironment`] for the wrong number of faces or faces of the wrong shape.
+    pub fn new(mapping: Mapping, faces: Vec<Texture>, limits: &Limits) -> Result<Self, ShadeError> {
+        let first = faces.first().ok_or(ShadeError::InvalidEnvironment(
             "an environment map needs an image",
         ))?;
         let layout = MapLayout::new(mapping, first.width(), first.height());
         if faces.len() != layout.layers() {
-            return Err(RasterError::InvalidEnvironment(
+            return Err(ShadeError::InvalidEnvironment(
                 "a cube map has six faces, other environment maps one image",
             ));
         }
@@ -336,7 +332,7 @@ impl EnvironmentMaps {
                 .iter()
                 .any(|f| f.width() != f.height() || f.width() != layout.side)
         {
-            return Err(RasterError::InvalidEnvironment(
+            return Err(ShadeError::InvalidEnvironment(
                 "cube faces and octahedral maps must be square, cube faces all of one size",
             ));
         }
@@ -422,7 +418,7 @@ impl MapFaces<'_> {
         bordered: MapLayout,
         layer: usize,
         limits: &Limits,
-    ) -> Result<Texture, RasterError> {
+    ) -> Result<Texture, ShadeError> {
         let (w, h) = bordered.stored_size();
         let b = bordered.border;
         let face = &self.faces[layer];
@@ -444,7 +440,7 @@ impl MapFaces<'_> {
     }
 
     /// The GGX-prefiltered pyramid of layer `layer` (module docs).
-    fn prefilter_ggx(&self, layer: usize, limits: &Limits) -> Result<Texture, RasterError> {
+    fn prefilter_ggx(&self, layer: usize, limits: &Limits) -> Result<Texture, ShadeError> {
         let layout = self.layout;
         let radiance = &self.faces[layer];
         let (w, h) = (radiance.width(), radiance.height());
@@ -496,7 +492,7 @@ impl MapFaces<'_> {
 
     /// `E(n) / pi` over the map's directions (module docs), as an [`IRRADIANCE_WIDTH`]-wide
     /// equirect map.
-    fn irradiance_map(&self, limits: &Limits) -> Result<Texture, RasterError> {
+    fn irradiance_map(&self, limits: &Limits) -> Result<Texture, ShadeError> {
         let (sw, sh) = (IRRADIANCE_SOURCES, IRRADIANCE_SOURCES / 2);
         // The level whose texels match the grid's cells.
         let lod = ((2.0 * PI / f64::from(sw)) / self.layout.texel_angle())

@@ -50,7 +50,7 @@ pub struct Layer<'a> {
     pub roughness: f32,
     /// Roughness from a texture channel.
     pub roughness_map: Option<ChannelInput<'a>>,
-    /// Tangent-space normal map (glTF convention, as [`crate::Material::normal_map`]).
+    /// Tangent-space normal map (glTF convention, as [`crate::material::Material::normal_map`]).
     pub normal_map: Option<TextureInput<'a>>,
     /// Scales the normal map's x and y.
     pub normal_scale: f32,
@@ -342,7 +342,7 @@ impl<'a> Layers<'a> {
 /// One normal map's filtered tangent-space normal at `fp` with its x and y scaled by `scale`, and
 /// LEAN's moments read from `lean` (scaled likewise: `b` by `scale`, `b^2` by its square) where it
 /// is given.
-pub(crate) fn read_normal(
+pub fn read_normal(
     map: &TextureInput,
     scale: f32,
     lean: Option<&MomentMap>,

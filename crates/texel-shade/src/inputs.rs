@@ -64,7 +64,7 @@ impl MomentMap {
 
     /// The filtered moments `[m_x, m_y, m_x^2, m_y^2, m_x m_y]` at `fp` through `sampler`, adding
     /// the texels read to `texels` when `count`.
-    pub(crate) fn read(
+    pub fn read(
         &self,
         sampler: &Sampler,
         fp: &Footprint,
@@ -80,12 +80,7 @@ impl MomentMap {
 }
 
 /// Read `input` at `fp`, adding the texels read to `texels` when `count`.
-pub(crate) fn read(
-    input: &TextureInput,
-    fp: &Footprint,
-    count: bool,
-    texels: &mut u32,
-) -> [f32; 4] {
+pub fn read(input: &TextureInput, fp: &Footprint, count: bool, texels: &mut u32) -> [f32; 4] {
     if count {
         let (t, n) = input.sampler.sample_counted(input.texture, fp);
         *texels += n;
@@ -96,11 +91,6 @@ pub(crate) fn read(
 }
 
 /// One channel of `input` at `fp`, adding the texels read to `texels` when `count`.
-pub(crate) fn read_channel(
-    input: &ChannelInput,
-    fp: &Footprint,
-    count: bool,
-    texels: &mut u32,
-) -> f32 {
+pub fn read_channel(input: &ChannelInput, fp: &Footprint, count: bool, texels: &mut u32) -> f32 {
     read(&input.input, fp, count, texels)[input.channel]
 }
