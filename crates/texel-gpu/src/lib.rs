@@ -136,16 +136,23 @@ impl GpuFilter {
             .filter(|&f| GpuFilter::of(f).is_some())
     }
 
-    /// The shader's mode number and anisotropy clamp.
-    fn mode(self) -> (u32, u32) {
+    /// The shader's mode number and anisotropy clamp; `None` for a texel filter the shader
+    /// lacks (the ripmap and the summed-area table, which [`GpuFilter::of`] refuses and
+    /// [`Gpu::prepare`] rejects).
+    fn shader(self) -> Option<(u32, u32)> {
         match self {
             GpuFilter::Shader(f) => {
-                let d = f.descriptor(AddressMode::ClampToEdge, AddressMode::ClampToEdge);
-                shader_mode(&d).expect("GpuFilter::of checks the shader has the filter")
+                shader_mode(&f.descriptor(AddressMode::ClampToEdge, AddressMode::ClampToEdge))
             }
-            GpuFilter::HwTrilinear => (20, 1),
-            GpuFilter::HwAniso16 => (21, 16),
+            GpuFilter::HwTrilinear => Some((20, 1)),
+            GpuFilter::HwAniso16 => Some((21, 16)),
         }
+    }
+
+    /// [`GpuFilter::shader`] of a filter [`Gpu::prepare`] accepted.
+    fn mode(self) -> (u32, u32) {
+        self.shader()
+            .expect("Gpu::prepare rejects filters the shader lacks")
     }
 
     fn is_hardware(self) -> bool {
@@ -602,11 +609,17 @@ impl Gpu {
     /// Upload `draws` for rendering with `filter`.
     ///
     /// # Errors
-    /// [`GpuError::Unsupported`] for draws with a material or a per-pixel sphere mapping (the
+    /// [`GpuError::Unsupported`] for a filter the shader lacks ([`GpuFilter::of`] gives `None`),
+    /// and for draws with a material or a per-pixel sphere mapping (the
     /// shader interpolates the vertices' uv; `UvEvaluation::PerVertex` draws are accepted);
     /// [`GpuError::TooLarge`] for a texture over the device's limit; [`GpuError::Failed`] when
     /// the device reports an error.
     pub fn prepare(&self, draws: &[DrawCall], filter: GpuFilter) -> Result<GpuDraws<'_>, GpuError> {
+        if filter.shader().is_none() {
+            return Err(GpuError::Unsupported(
+                "the ripmap and the summed-area table (the shader has no such filter)",
+            ));
+        }
         if draws.iter().any(|d| d.material.is_some()) {
             return Err(GpuError::Unsupported("materials"));
         }
@@ -1145,6 +1158,9 @@ mod tests {
             assert_eq!(GpuFilter::of(f).unwrap().mode().0, u32::from(m));
         }
         assert_eq!(GpuFilter::HwAniso16.mode(), (21, 16));
+        // Built by hand, a filter the shader lacks has no mode (and `Gpu::prepare` refuses it).
+        assert_eq!(GpuFilter::Shader(Filter::Ripmap).shader(), None);
+        assert_eq!(GpuFilter::Shader(Filter::Sat).shader(), None);
         assert!(
             GpuFilter::HwTrilinear.is_hardware()
                 && !GpuFilter::of(Filter::Ewa).unwrap().is_hardware()

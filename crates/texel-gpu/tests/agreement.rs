@@ -235,3 +235,20 @@ fn a_moved_camera_and_a_scissor_match_fresh_draws() {
         }
     }
 }
+
+/// A texel filter the shader lacks, built by hand, is refused with an error, not a panic.
+#[test]
+fn filters_the_shader_lacks_are_refused() {
+    let Some(gpu) = gpu() else { return };
+    let prepared = small("builtin:ground");
+    let samplers = prepared.samplers(Filter::Trilinear).unwrap();
+    let draws = prepared.draws(&samplers);
+    for f in [Filter::Ripmap, Filter::Sat] {
+        assert_eq!(GpuFilter::of(f), None);
+        let e = gpu
+            .prepare(&draws, GpuFilter::Shader(f))
+            .err()
+            .expect("refused");
+        assert!(e.to_string().contains("summed-area table"), "{e}");
+    }
+}

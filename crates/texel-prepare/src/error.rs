@@ -1,4 +1,5 @@
-//! The one error type of the `texel` crate: the libraries' errors, plus what scene preparation adds.
+//! The one error type of texel-prepare (and of the `texel` facade, which re-exports it): the
+//! libraries' errors, plus what scene preparation adds.
 
 use thiserror::Error;
 

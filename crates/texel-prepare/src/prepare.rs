@@ -1,6 +1,7 @@
 //! A scene made ready to draw: textures decoded and their pyramids built once, meshes turned into
 //! the rasterizer's vertices, the camera into `clip_from_world`, and one sampler per mesh for a
-//! filter. The CLI, the examples and (later) the GPU path and the viewer all draw through this.
+//! filter. The CLI, the examples, the GPU path, the viewer and the Python package all draw
+//! through this.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::{Mutex, OnceLock};

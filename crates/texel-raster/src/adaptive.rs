@@ -294,7 +294,8 @@ fn estimate(
         width: settings.width,
         height: settings.height,
         target: crate::settings::ColorTarget::Float,
-        // Every pixel has at least one pass (an earlier stop is an error above).
+        // Every pixel has at least one pass: a stop before the first is an error
+        // (`render_reference_adaptive`).
         color: stats.iter().map(|s| s.mean.map(|m| m as f32)).collect(),
         color8: Vec::new(),
         texels_read: Vec::new(),

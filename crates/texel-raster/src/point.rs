@@ -1,6 +1,6 @@
 //! Where a fragment is shaded: [`ShadingPoint`], the one argument that tells the shading
-//! functions ([`crate::shade`], [`crate::relief`]) where they are, instead of a triangle's
-//! vertices, barycentrics, their derivatives and a footprint passed one by one.
+//! functions ([`crate::shade`], [`crate::relief`]) where they are: a triangle's vertices,
+//! barycentrics, their derivatives and a footprint, travelling together.
 
 use glam::{DVec3, Vec3};
 use texel_texture::Footprint;

@@ -323,7 +323,11 @@ impl App {
                 s.push_str(&format!("  {n}/{MAX_REFERENCE_SAMPLES} samples/px"));
             }
             if let Some(share) = p.within {
-                s.push_str(&format!("  {:.0}% within 0.5 step", 100.0 * share));
+                s.push_str(&format!(
+                    "  {:.0}% within {} step",
+                    100.0 * share,
+                    crate::cli::DEFAULT_TOLERANCE_STEPS
+                ));
             }
             match p.stats {
                 Some(st) => {
