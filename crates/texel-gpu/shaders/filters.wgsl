@@ -312,21 +312,15 @@ fn ewa_at(uv: vec2<f32>, s: vec4<f32>, k0: i32) -> vec4<f32> {
     return ewa_level(uv, k, in_level(s, k, true));
 }
 
-// EWA: the two levels around lod = log2(minor semi-axis) + bias, lerped by its fraction.
+// EWA in the one level floor(lod), lod = log2(minor semi-axis) + bias: there the minor semi-axis
+// spans 1 to 2 texels.
 fn ewa(uv: vec2<f32>, px: vec2<f32>, py: vec2<f32>, iso_lod: f32) -> vec4<f32> {
     if !(all(abs(px) < vec2<f32>(3.4e38)) && all(abs(py) < vec2<f32>(3.4e38))) {
         return trilinear(uv, iso_lod);
     }
     let s = ellipse(px, py, f32(params.mode.z));
-    let q = last_level();
-    let d = clamp(lod_of(s.w), 0.0, q);
-    let k = floor(d);
-    let t = d - k;
-    let a = ewa_at(uv, s, i32(k));
-    if t > 0.0 && k < q {
-        return mix(a, ewa_at(uv, s, i32(k) + 1), t);
-    }
-    return a;
+    let d = clamp(lod_of(s.w), 0.0, last_level());
+    return ewa_at(uv, s, i32(floor(d)));
 }
 
 // ---- The fragment shader -------------------------------------------------------------------------

@@ -9,8 +9,8 @@
 //!    grows to `r2 = r1 / A` (Heckbert / pbrt: grow the minor axis rather than shrink the major, so
 //!    the filter blurs instead of aliasing).
 //! 2. `lod = log2(r2) + lod_bias`, clamped to `[lod_min_clamp, lod_max_clamp]` and to the levels;
-//!    the levels `floor(lod)` and `floor(lod) + 1` are filtered and lerped by `fract(lod)` (the last
-//!    level holds).
+//!    the one level `k = floor(lod)` is filtered, where the minor semi-axis spans 1 to 2 texels
+//!    (pbrt-v4 also filters `k + 1` and lerps by `fract(lod)`; see the decisions below).
 //! 3. In level `k` (scale `s = (w_k / W, h_k / H)` per axis) the ellipse is `Q = D S D + I`,
 //!    `D = diag(s)`: the `+ I` convolves with a unit-variance reconstruction filter, so the ellipse
 //!    always covers at least one texel centre (Heckbert sec. 3.5.8; pbrt adds 1 to A and C).
@@ -20,6 +20,14 @@
 //!    [`weight_lut`]'s code, next to it). The result is `sum(w T) / sum(w)`: weights normalised.
 //!
 //! Decisions:
+//! - One level, the finer of the two around `lod`. pbrt-v4's blend with the coarser level adds
+//!   that level's blurrier kernel (in it the minor semi-axis spans half a texel to one, so the
+//!   `+ I` reconstruction dominates) for a quarter more texels and half as many lines again.
+//!   Reading only `floor(lod)` scores higher against the box-filtered reference on every
+//!   built-in scene, by up to 2.6 dB, and against the brute-force Gaussian below; the ground
+//!   frame takes about two thirds of the time. Figures: docs/decisions.md ("EWA reads one
+//!   level"). The cost is a seam where `lod` crosses an integer, which the blend hid; it is
+//!   within the filter's Gaussian, so no step shows on the ground plane's images.
 //! - Texels are visited row by row over the exact span where `r^2 < 1` (a quadratic in the column
 //!   offset per row), not over the bounding box, so the cost is proportional to the ellipse's area
 //!   (`pi sqrt(det Q)` texels) rather than its bounding box, which for a 16:1 ellipse at 45 degrees
@@ -47,17 +55,17 @@
 //! |---|---|---|
 //! | trilinear | 0.0252 | 8.0 |
 //! | anisotropic 16x | 0.0158 | 72.3 |
-//! | EWA | 0.0121 | 91.1 |
+//! | EWA | 0.0091 | 67.3 |
+//!
+//! (The blend of two levels, pbrt-v4's, scores 0.0121 with 91.1 texels.)
 //!
 //! Rotation invariance (`ewa_circular_footprint_is_rotation_invariant`, circular footprints of
 //! radius 1.5 to 5.5 texels on a radial cosine of period 64 texels, texture rotated 30 degrees):
-//! relative difference RMS 0.41 %, worst 1.5 % (trilinear: 0.32 %, 1.5 %). Known weakness: at the
-//! coarse level of the lerp the ellipse holds only about 4 to 15 texels, so the discrete kernel's
-//! centroid and effective blur vary with the sub-texel position; a level one finer would cost 4x the
-//! reads.
+//! relative difference RMS 0.31 %, worst 1.5 % (trilinear: 0.32 %, 1.5 %; the two-level blend
+//! 0.41 %, 1.5 %, its coarse level's ellipse holding only about 4 to 15 texels).
 //!
 //! The code path: `ewa` builds the [`Ellipse`] in `f64` (eigen-axes in closed form: no `atan2`,
-//! `sin`, `cos` or `hypot`), picks its levels with `crate::technique::mip::linear_levels`, and in each level
+//! `sin`, `cos` or `hypot`), picks its level with `crate::technique::mip::linear_levels`, and in it
 //! runs one scan ([`LevelEllipse::scan`]) and one weighted-sum loop over the scan's lines. The scan
 //! follows the ellipse's wider side (columns for a tall ellipse, rows otherwise): footprints near
 //! the ground's horizon are long in v, and rows would give many lines one to four texels long, each
@@ -88,8 +96,8 @@
 //! box's variance (`ALPHA = 6`, sigma^2 = 1/12 pixel^2) scores EWA 27.5 dB but leaves only about
 //! one texel per standard deviation at the chosen level: rotation invariance drops to 1.5 % RMS
 //! (worst 7 %) and the RMS error against its own brute-force Gaussian is 0.0196 against pbrt's
-//! falloff's 0.0119, behind aniso16 (both on another noise texture than the table's above).
-//! Keeping it would need a level one finer (4x the reads); pbrt's falloff stays.
+//! falloff's 0.0119, behind aniso16 (both on another noise texture than the table's above, with
+//! the two-level blend). pbrt's falloff stays.
 //!
 //! Cost: throughput and texels read per sample at anisotropy ratios 1 to 64 are in
 //! docs/benchmarks.md (the anisotropic filters' table, from `benches/aniso.rs`); frame
@@ -102,7 +110,6 @@ use glam::{DVec2, Vec2, Vec4};
 use crate::base::address::{Address, AddressMode};
 use crate::base::floor::{ceil_f64, floor_f64, floor_staged_f64};
 use crate::base::footprint::{lod_from_rho, Query};
-use crate::base::lerp::lerp;
 use crate::kernel::bilinear::{bilinear, texel_or_border, Bilinear};
 use crate::storage::fetch::Fetch;
 use crate::storage::view::Pyramid;
@@ -159,6 +166,7 @@ impl Ellipse {
     /// grown so that `major / minor <= max_anisotropy` (`>= 1`).
     ///
     /// `None` if an input is not finite. Zero axes give a zero ellipse (a point).
+    #[inline(always)]
     pub fn from_axes(px: Vec2, py: Vec2, max_anisotropy: f32) -> Option<Ellipse> {
         if !px.is_finite() || !py.is_finite() {
             return None;
@@ -673,8 +681,8 @@ fn scan_wrapped<F: Fetch>(
 }
 
 /// EWA filtering of query `q` (lod `> 0`), eccentricity clamped to `max`: the ellipse of the
-/// footprint's axes, its level `floor(lod)` and the next blended by `fract(lod)` ([`linear_levels`])
-/// with `lod = log2(minor semi-axis) + bias`; non-finite axes fall back to trilinear at `q.lod`.
+/// footprint's axes in the one level `floor(lod)` ([`linear_levels`]) with
+/// `lod = log2(minor semi-axis) + bias`; non-finite axes fall back to trilinear at `q.lod`.
 #[inline(always)]
 pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Params, q: &Query, max: f32) -> Vec4 {
     let addr = s.addr;
@@ -686,35 +694,27 @@ pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Params, q: &Query, max: f32) -> Vec4 {
     };
     let lod = lod_from_rho(e.minor as f32, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
     let last = p.level_count() - 1;
-    let (k, t) = linear_levels(lod, last);
+    let (k, _) = linear_levels(lod, last);
     let scale = |k: usize| {
         let (w, h) = p.level(k).size();
         DVec2::new(f64::from(w) / f64::from(w0), f64::from(h) / f64::from(h0))
     };
     // EWA at level `k`, moving to coarser levels while the ellipse exceeds MAX_ELLIPSE_AREA.
-    let at = |k: usize| {
-        let mut k = k.min(last);
-        while k < last && e.in_level(scale(k), false).area() > MAX_ELLIPSE_AREA {
-            k += 1;
-        }
-        let level = p.level(k);
-        // A 1x1 level maps every texel index to its one texel (all modes but ClampToBorder):
-        // the normalised average is that texel, however large the ellipse.
-        if level.size() == (1, 1)
-            && addr.u != AddressMode::ClampToBorder
-            && addr.v != AddressMode::ClampToBorder
-        {
-            return level.texel(0, 0);
-        }
-        let ql = e.in_level(scale(k), true);
-        ewa_level(&level, &addr, &ql, q.uv()).unwrap_or_else(|| bilinear(&level, &addr, q.uv()))
-    };
-    let a = at(k);
-    if t > 0.0 && k < last {
-        lerp(a, at(k + 1), t)
-    } else {
-        a
+    let mut k = k.min(last);
+    while k < last && e.in_level(scale(k), false).area() > MAX_ELLIPSE_AREA {
+        k += 1;
     }
+    let level = p.level(k);
+    // A 1x1 level maps every texel index to its one texel (all modes but ClampToBorder):
+    // the normalised average is that texel, however large the ellipse.
+    if level.size() == (1, 1)
+        && addr.u != AddressMode::ClampToBorder
+        && addr.v != AddressMode::ClampToBorder
+    {
+        return level.texel(0, 0);
+    }
+    let ql = e.in_level(scale(k), true);
+    ewa_level(&level, &addr, &ql, q.uv()).unwrap_or_else(|| bilinear(&level, &addr, q.uv()))
 }
 
 #[cfg(test)]
