@@ -23,8 +23,9 @@
 //! - One level, the finer of the two around `lod`. pbrt-v4's blend with the coarser level adds
 //!   that level's blurrier kernel (in it the minor semi-axis spans half a texel to one, so the
 //!   `+ I` reconstruction dominates) for a quarter more texels and half as many lines again.
-//!   Reading only `floor(lod)` scores higher against the box-filtered reference on every
-//!   built-in scene, by up to 2.6 dB, and against the brute-force Gaussian below; the ground
+//!   Reading only `floor(lod)` scores as high or higher against the box-filtered reference on
+//!   every built-in scene (up to 2.6 dB higher; terrain 0.01 dB lower), and higher against the
+//!   brute-force Gaussian below; the ground
 //!   frame takes about two thirds of the time. Figures: docs/decisions.md ("EWA reads one
 //!   level"). The cost is a seam where `lod` crosses an integer, which the blend hid: on
 //!   uniform noise the result jumps by 0.019 RMS there, half of mip-nearest's jump at its
