@@ -696,15 +696,17 @@ pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Params, q: &Query, max: f32) -> Vec4 {
     };
     let lod = lod_from_rho(e.minor as f32, d.lod_bias, d.lod_min_clamp, d.lod_max_clamp);
     let last = p.level_count() - 1;
-    let (k, _) = linear_levels(lod, last);
+    // `linear_levels` clamps to the levels: `k <= last`.
+    let (mut k, _) = linear_levels(lod, last);
     let scale = |k: usize| {
         let (w, h) = p.level(k).size();
         DVec2::new(f64::from(w) / f64::from(w0), f64::from(h) / f64::from(h0))
     };
     // EWA at level `k`, moving to coarser levels while the ellipse exceeds MAX_ELLIPSE_AREA.
-    let mut k = k.min(last);
-    while k < last && e.in_level(scale(k), false).area() > MAX_ELLIPSE_AREA {
+    let mut ql = e.in_level(scale(k), false);
+    while k < last && ql.area() > MAX_ELLIPSE_AREA {
         k += 1;
+        ql = e.in_level(scale(k), false);
     }
     let level = p.level(k);
     // A 1x1 level maps every texel index to its one texel (all modes but ClampToBorder):
@@ -715,7 +717,11 @@ pub(crate) fn ewa<P: Pyramid>(p: &P, s: &Params, q: &Query, max: f32) -> Vec4 {
     {
         return level.texel(0, 0);
     }
-    let ql = e.in_level(scale(k), true);
+    // Only the last level's ellipse can still exceed the area; shrinking leaves smaller ones as
+    // they are, so the unshrunk ellipse is reused.
+    if ql.area() > MAX_ELLIPSE_AREA {
+        ql = e.in_level(scale(k), true);
+    }
     ewa_level(&level, &addr, &ql, q.uv()).unwrap_or_else(|| bilinear(&level, &addr, q.uv()))
 }
 
