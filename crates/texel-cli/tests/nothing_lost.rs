@@ -172,10 +172,8 @@ fn under_ulimit(kib: u64, args: &[&str]) -> (Option<i32>, String) {
     (out.status.code(), stderr(&out))
 }
 
-#[test]
-fn the_default_budget_follows_ulimit() {
-    let d = Dir::new("ulimit");
-    // Four 8192 x 8192 procedural textures: 358 MiB each with their pyramids.
+/// A scene of four 8192 x 8192 procedural textures: 358 MiB each with their pyramids.
+fn four_big_textures(d: &Dir) -> String {
     let mut toml = String::from(HEAD);
     for k in 0..4 {
         toml.push_str(&format!(
@@ -185,14 +183,46 @@ fn the_default_budget_follows_ulimit() {
     for k in 0..4 {
         toml.push_str(&TRIANGLE.replace("texture = \"t\"", &format!("texture = \"t{k}\"")));
     }
-    let scene = d.write("big.toml", &toml);
-    let scene = scene.to_string_lossy();
+    d.write("big.toml", &toml).to_string_lossy().into_owned()
+}
+
+#[test]
+fn the_default_budget_follows_ulimit() {
+    let d = Dir::new("ulimit");
+    let scene = four_big_textures(&d);
     let (code, err) = under_ulimit(
         1_000_000,
         &["render", &scene, "--size", "16x9", "-o", &d.arg("x.png")],
     );
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("ulimit -v"), "{err}");
+    assert!(!d.join("x.png").exists());
+}
+
+#[test]
+fn an_explicit_budget_is_held_to_the_process_limits() {
+    // Asking for more than the process may map (64 GiB under about 1 GiB of address space) is
+    // held to what it may: the same refusal as the default's, naming the request and the cap,
+    // rather than an allocation that aborts.
+    let d = Dir::new("ulimit-explicit");
+    let scene = four_big_textures(&d);
+    let out = d.arg("x.png");
+    let args = [
+        "render",
+        &scene,
+        "--size",
+        "16x9",
+        "--max-memory",
+        "64G",
+        "-o",
+        &out,
+    ];
+    let (code, err) = under_ulimit(1_000_000, &args);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--max-memory 65536.0 MiB, capped at") && err.contains("ulimit -v"),
+        "{err}"
+    );
     assert!(!d.join("x.png").exists());
 }
 

@@ -195,6 +195,32 @@ const PROCESS_LIMIT_SHARE: u64 = 2;
 /// data (`ulimit -d`, `RLIMIT_DATA`) limits leave above what the process already maps. Where none
 /// can be read, [`FALLBACK_BYTES`].
 pub fn default_limit() -> (u64, String) {
+    process_limit(2).unwrap_or((FALLBACK_BYTES, "texel's fallback limit".into()))
+}
+
+/// The most an explicit limit may grant, and what sets it: [`default_limit`]'s figures with the
+/// whole of the machine's memory rather than half (the cgroup's limit and half of what the
+/// process limits leave stay as they are: past them an allocation fails, and the process aborts,
+/// whatever the account allows). `None` where none can be read.
+pub fn hard_limit() -> Option<(u64, String)> {
+    process_limit(1)
+}
+
+/// An explicit limit of `requested` bytes held to [`hard_limit`]: the bytes a budget may grant
+/// and its name for errors, `name` itself or, when capped, `name` followed by the cap and what
+/// set it (`--max-memory 1048576.0 MiB, capped at 23984.1 MiB (this machine's memory)`).
+pub fn capped_limit(requested: u64, name: &str) -> (u64, String) {
+    match hard_limit() {
+        Some((hard, why)) if hard < requested => {
+            (hard, format!("{name}, capped at {} ({why})", mib(hard)))
+        }
+        _ => (requested, name.to_string()),
+    }
+}
+
+/// The smallest of `MemTotal / machine_share`, the cgroup limits and half of what the process
+/// limits leave, with what set it (see [`default_limit`]).
+fn process_limit(machine_share: u64) -> Option<(u64, String)> {
     let read = |p: &str| std::fs::read_to_string(p).ok();
     let mut best: Option<(u64, String)> = None;
     let mut offer = |bytes: u64, why: String| {
@@ -203,7 +229,11 @@ pub fn default_limit() -> (u64, String) {
         }
     };
     if let Some(kb) = read("/proc/meminfo").and_then(|s| proc_field(&s, "MemTotal:")) {
-        offer(kb * 1024 / 2, "half of this machine's memory".into());
+        let share = if machine_share == 1 { "" } else { "half of " };
+        offer(
+            kb * 1024 / machine_share.max(1),
+            format!("{share}this machine's memory"),
+        );
     }
     for (p, b) in cgroup_limits(&read("/proc/self/cgroup").unwrap_or_default()) {
         offer(b, format!("the cgroup's memory limit ({p})"));
@@ -236,7 +266,7 @@ pub fn default_limit() -> (u64, String) {
             }
         }
     }
-    best.unwrap_or((FALLBACK_BYTES, "texel's fallback limit".into()))
+    best
 }
 
 /// The running account of one piece of work against a limit.
@@ -257,11 +287,14 @@ impl MemoryBudget {
         }
     }
 
-    /// A budget of `limit` bytes when given (named "the memory limit of N MiB"), else
-    /// [`MemoryBudget::process_default`].
+    /// A budget of `limit` bytes when given (named "the memory limit of N MiB"), held to
+    /// [`hard_limit`] ([`capped_limit`]), else [`MemoryBudget::process_default`].
     pub fn limit_or_default(limit: Option<u64>) -> Self {
         match limit {
-            Some(b) => Self::new(b, format!("the memory limit of {}", mib(b))),
+            Some(b) => {
+                let (limit, name) = capped_limit(b, &format!("the memory limit of {}", mib(b)));
+                Self::new(limit, name)
+            }
             None => Self::process_default(),
         }
     }
@@ -325,6 +358,33 @@ impl MemoryBudget {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn explicit_limits_are_capped_by_the_hard_limit() {
+        let Some((hard, why)) = hard_limit() else {
+            println!("skipped: neither /proc/meminfo nor a cgroup or process limit can be read");
+            return;
+        };
+        // Never more than the machine: MemTotal itself is one of the figures.
+        let total = std::fs::read_to_string("/proc/meminfo")
+            .ok()
+            .and_then(|s| proc_field(&s, "MemTotal:"));
+        assert!(
+            hard <= total.map_or(u64::MAX, |kb| kb * 1024),
+            "{hard} {why}"
+        );
+        assert!(default_limit().0 <= hard);
+        let (b, name) = capped_limit(u64::MAX, "--max-memory huge");
+        assert_eq!(b, hard);
+        assert_eq!(
+            name,
+            format!("--max-memory huge, capped at {} ({why})", mib(hard))
+        );
+        let (b, name) = capped_limit(1 << 20, "--max-memory 1.0 MiB");
+        assert_eq!((b, name.as_str()), (1 << 20, "--max-memory 1.0 MiB"));
+        let budget = MemoryBudget::limit_or_default(Some(u64::MAX));
+        assert!(budget.name().contains("capped at"), "{}", budget.name());
+    }
+
     use super::*;
 
     #[test]
