@@ -41,6 +41,10 @@ def test_nan_values_are_value_errors():
     bad[0, 0, 0] = np.nan
     with pytest.raises(ValueError, match="finite|NaN"):
         texel.Texture(bad)
+    # Finite but beyond the range whose filtered sums stay finite in float32.
+    bad[0, 0, 0] = 3e38
+    with pytest.raises(ValueError, match=r"texel \(0, 0\) channel R is 3e38: .*within"):
+        texel.Texture(bad)
     with pytest.raises(ValueError, match="lod_bias"):
         t.sample(np.zeros((1, 2)), filter="bilinear", lod_bias=float("nan"))
 

@@ -42,8 +42,10 @@ impl Input {
     pub fn warn_replaced(&self, name: &str, replaced: u64) {
         if replaced > 0 {
             eprintln!(
-                "texel: warning: texture {name:?}: replaced {replaced} NaN or infinite channel values (NaN -> 0, +-inf -> +-{})",
-                texel_texture::NON_FINITE_CLAMP
+                "texel: warning: texture {name:?}: replaced {replaced} NaN, infinite or out-of-range channel values (NaN -> 0, +-inf -> +-{}, beyond +-{:e} -> +-{:e})",
+                texel_texture::NON_FINITE_CLAMP,
+                texel_texture::MAX_TEXEL,
+                texel_texture::MAX_TEXEL
             );
         }
     }

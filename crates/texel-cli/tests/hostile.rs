@@ -546,7 +546,7 @@ fn non_finite_texels_are_named_or_replaced() {
         &d.arg("m"),
     ]);
     assert!(
-        stderr(&out).contains("replaced 2 NaN or infinite"),
+        stderr(&out).contains("replaced 2 NaN, infinite or out-of-range"),
         "{}",
         stderr(&out)
     );

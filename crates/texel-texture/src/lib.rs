@@ -49,5 +49,5 @@ pub use storage::lanes::Lanes;
 pub use storage::tables::{Ripmap, SummedAreaTable};
 pub use storage::texture::{
     replace_non_finite, ColorSpace, Format, LevelInfo, LevelTexels, Limits, LoadOptions, Loaded,
-    Texture, NON_FINITE_CLAMP,
+    Texture, MAX_TEXEL, NON_FINITE_CLAMP,
 };

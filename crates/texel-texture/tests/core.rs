@@ -1593,3 +1593,104 @@ fn lanes_longer_than_out_panic() {
     let mut out = [[0.0f32; 4]; 4];
     s.sample_batch(&tex, FootprintLanes::points(&u, &v), &mut out);
 }
+
+/// Float texels at the edge of their range (`±MAX_TEXEL`) filter to finite values within it, for
+/// every filter and aniso64, on footprints from magnified to anisotropy 64 (EWA's and the probes'
+/// sums of many such texels stay finite); beyond the range a texture is refused, naming the
+/// texel, and `replace_non_finite` clamps to the range.
+#[test]
+fn float_texels_at_the_range_edge_filter_to_finite_values() {
+    use texel_texture::{replace_non_finite, Filter, MAX_TEXEL};
+    let m = MAX_TEXEL;
+    // Constant, and noise of the two extremes (every filter's sum sees both signs).
+    let constant = vec![[m; 4]; 64 * 64];
+    let extremes: Vec<[f32; 4]> = (0..64 * 64u64)
+        .map(|k| {
+            let c = |s| if noise(4 * k + s) < 0.5 { -m } else { m };
+            [c(0), c(1), c(2), m]
+        })
+        .collect();
+    let mut descriptors: Vec<(String, SamplerDescriptor)> = Filter::ALL
+        .iter()
+        .map(|f| {
+            let d = f.descriptor(AddressMode::Repeat, AddressMode::Repeat);
+            (f.name().to_string(), d)
+        })
+        .collect();
+    descriptors.push((
+        "aniso64".into(),
+        SamplerDescriptor {
+            anisotropy_clamp: 64,
+            ..Filter::Trilinear.descriptor(AddressMode::Repeat, AddressMode::Repeat)
+        },
+    ));
+    let footprints: Vec<Footprint> = [
+        (0.1f32, 0.1f32),
+        (1.0, 1.0),
+        (8.0, 1.0),
+        (64.0, 1.0),
+        (64.0, 0.25),
+    ]
+    .iter()
+    .enumerate()
+    .flat_map(|(k, &(major, minor))| {
+        (0..16).map(move |j| {
+            let (u, v) = spread(k * 16 + j);
+            let a = j as f32 * 0.4;
+            let (c, s) = (a.cos() / 64.0, a.sin() / 64.0);
+            Footprint {
+                u,
+                v,
+                dudx: major * c,
+                dvdx: major * s,
+                dudy: -minor * s,
+                dvdy: minor * c,
+            }
+        })
+    })
+    .collect();
+    for (texels, name) in [(constant, "constant"), (extremes, "extremes")] {
+        let tex = Texture::from_rgba32f(64, 64, texels, &Limits::default()).unwrap();
+        for (filter, d) in &descriptors {
+            let s = Sampler::new(*d).unwrap();
+            let mut batch = vec![[0.0; 4]; footprints.len()];
+            s.sample_batch(&tex, &footprints, &mut batch);
+            // Catmull-Rom overshoots by at most a quarter of the range on each side.
+            let bound = if filter == "bicubic" {
+                1.5 * m
+            } else {
+                m * (1.0 + 1e-5)
+            };
+            for (fp, b) in footprints.iter().zip(&batch) {
+                let one = s.sample(&tex, fp);
+                for c in one.iter().chain(b) {
+                    assert!(
+                        c.is_finite() && c.abs() <= bound,
+                        "{name} {filter} {fp:?}: {c}"
+                    );
+                }
+                if name == "constant" && filter != "bicubic" {
+                    assert!(((one[0] - m) / m).abs() <= 1e-5, "{filter} {fp:?}: {one:?}");
+                }
+            }
+        }
+    }
+    // Beyond the range: refused, naming the texel; replaced by the range's edge when asked.
+    let mut texels = vec![[1.0f32; 4]; 16];
+    texels[5][2] = 3e38;
+    match Texture::from_rgba32f(4, 4, texels.clone(), &Limits::default()) {
+        Err(e @ TextureError::TexelOutOfRange { x: 1, y: 1, .. }) => {
+            let msg = e.to_string();
+            assert!(
+                msg.contains("channel B is 3e38") && msg.contains("--sanitize"),
+                "{msg}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    texels[6][0] = f32::NAN;
+    texels[7][1] = -f32::MAX;
+    assert_eq!(replace_non_finite(&mut texels), 3);
+    assert_eq!((texels[5][2], texels[6][0], texels[7][1]), (m, 0.0, -m));
+    assert!(Texture::from_rgba32f(4, 4, texels, &Limits::default()).is_ok());
+}

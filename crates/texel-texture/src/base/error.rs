@@ -123,6 +123,21 @@ pub enum TextureError {
         /// The value found.
         value: f32,
     },
+    /// A float texel (as for [`TextureError::NonFiniteTexel`]) is finite but larger in magnitude
+    /// than [`crate::MAX_TEXEL`]: a filter's weighted sums of such values overflow `f32`.
+    #[error("texel ({x}, {y}) channel {channel} is {value:e}: float textures hold values within +-{max:e}, so that a filter's weighted sums stay finite (the texel CLI's --sanitize, or LoadOptions::replace_non_finite, clamps them to that)")]
+    TexelOutOfRange {
+        /// Column of the texel.
+        x: u32,
+        /// Row of the texel (0 is the top).
+        y: u32,
+        /// `"R"`, `"G"`, `"B"` or `"A"`.
+        channel: &'static str,
+        /// The value found.
+        value: f32,
+        /// [`crate::MAX_TEXEL`].
+        max: f32,
+    },
     /// The image decoder crashed on the file (a panic caught by [`texel_io::guarded`]): the
     /// file is corrupt, or uses a feature the decoder mishandles.
     #[error("cannot decode image: the decoder failed on this file (corrupt, or a feature it mishandles): {0}")]

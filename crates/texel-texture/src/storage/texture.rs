@@ -131,8 +131,8 @@ pub struct LoadOptions {
     pub color: ColorSpace,
     /// Size and memory limits.
     pub limits: Limits,
-    /// Replace NaN and infinite float texels ([`replace_non_finite`]) instead of refusing the
-    /// image; [`Loaded::replaced`] says how many values were replaced.
+    /// Replace NaN, infinite and out-of-range float texels ([`replace_non_finite`]) instead of
+    /// refusing the image; [`Loaded::replaced`] says how many values were replaced.
     pub replace_non_finite: bool,
 }
 
@@ -160,8 +160,14 @@ pub struct Loaded {
 /// floats, so this is the brightest value such a file can hold.
 pub const NON_FINITE_CLAMP: f32 = 65504.0;
 
-/// Replace every NaN channel value with 0 and every infinity with `±`[`NON_FINITE_CLAMP`];
-/// returns how many values changed.
+/// The largest magnitude a float texel may have, `2^40` (about `1.1e12`). A filter sums up to
+/// 16384 weighted texels (EWA) or 64 probes (anisotropic) in `f32` and interpolates differences
+/// of neighbours, so values near `f32::MAX` would overflow to infinity where the average itself
+/// is finite; below `2^40` every such sum stays below `2^60`.
+pub const MAX_TEXEL: f32 = 1_099_511_627_776.0;
+
+/// Replace every NaN channel value with 0, every infinity with `±`[`NON_FINITE_CLAMP`] and every
+/// finite value beyond `±`[`MAX_TEXEL`] with `±MAX_TEXEL`; returns how many values changed.
 pub fn replace_non_finite(texels: &mut [[f32; 4]]) -> u64 {
     let mut n = 0;
     for c in texels.iter_mut().flatten() {
@@ -171,6 +177,9 @@ pub fn replace_non_finite(texels: &mut [[f32; 4]]) -> u64 {
             } else {
                 NON_FINITE_CLAMP.copysign(*c)
             };
+            n += 1;
+        } else if c.abs() > MAX_TEXEL {
+            *c = MAX_TEXEL.copysign(*c);
             n += 1;
         }
     }
@@ -249,11 +258,13 @@ impl Texture {
     /// A texture from row-major linear `f32` RGBA texels, building its pyramid.
     ///
     /// Every value must be finite: one NaN would spread through every coarser level (and an
-    /// infinity makes its averages NaN). [`replace_non_finite`] cleans data that has them.
+    /// infinity makes its averages NaN); and within `±`[`MAX_TEXEL`], so that the filters' sums
+    /// stay finite. [`replace_non_finite`] cleans data that breaks either rule.
     ///
     /// # Errors
-    /// Size or memory limits ([`Limits::check`]), [`TextureError::DataLength`] and
-    /// [`TextureError::NonFiniteTexel`] naming the first non-finite value in row-major order.
+    /// Size or memory limits ([`Limits::check`]), [`TextureError::DataLength`], and
+    /// [`TextureError::NonFiniteTexel`] or [`TextureError::TexelOutOfRange`] naming the first
+    /// value that breaks the rules in row-major order.
     pub fn from_rgba32f(
         width: u32,
         height: u32,
@@ -400,12 +411,14 @@ impl Texture {
     /// ([`Limits::check_load`] counts the encoded bytes, the decoded image, its conversion to
     /// texels and the pyramid with its build scratch, all held at once); a JPEG must end in its
     /// end-of-image marker and be large enough to hold one coded bit per 8x8 block (a truncated
-    /// file is an error, not an image filled with grey). After decoding, a float texel that is NaN
-    /// or infinite is an error naming it ([`LoadOptions::replace_non_finite`] replaces them).
+    /// file is an error, not an image filled with grey). After decoding, a float texel that is NaN,
+    /// infinite or beyond `±`[`MAX_TEXEL`] is an error naming it
+    /// ([`LoadOptions::replace_non_finite`] replaces them).
     ///
     /// # Errors
     /// [`TextureError::Decode`] (corrupt, unsupported), [`TextureError::Truncated`],
-    /// [`TextureError::NonFiniteTexel`], [`TextureError::UnsupportedFormat`] and the size errors.
+    /// [`TextureError::NonFiniteTexel`], [`TextureError::TexelOutOfRange`],
+    /// [`TextureError::UnsupportedFormat`] and the size errors.
     pub fn decode(bytes: &[u8], color: ColorSpace, limits: &Limits) -> Result<Self, TextureError> {
         Self::decode_with(bytes, &LoadOptions::new(color, *limits)).map(|l| l.texture)
     }
@@ -611,16 +624,30 @@ impl Texture {
     }
 }
 
-/// [`TextureError::NonFiniteTexel`] for the first non-finite value of row-major `texels` (rows
-/// of `width`; past level 0, the index counts on as if the level continued).
+/// [`TextureError::NonFiniteTexel`] or [`TextureError::TexelOutOfRange`] for the first value
+/// of row-major `texels` that is not finite or lies beyond `±`[`MAX_TEXEL`] (rows of `width`;
+/// past level 0, the index counts on as if the level continued).
 fn check_finite(width: u32, texels: &[[f32; 4]]) -> Result<(), TextureError> {
-    if let Some(k) = texels.iter().position(|t| !t.iter().all(|c| c.is_finite())) {
-        let channel = texels[k].iter().position(|c| !c.is_finite()).unwrap_or(0);
-        return Err(TextureError::NonFiniteTexel {
-            x: (k % width as usize) as u32,
-            y: (k / width as usize) as u32,
-            channel: ["R", "G", "B", "A"][channel],
-            value: texels[k][channel],
+    let bad = |c: &f32| !c.is_finite() || c.abs() > MAX_TEXEL;
+    if let Some(k) = texels.iter().position(|t| t.iter().any(bad)) {
+        let channel = texels[k].iter().position(bad).unwrap_or(0);
+        let (x, y) = ((k % width as usize) as u32, (k / width as usize) as u32);
+        let (channel, value) = (["R", "G", "B", "A"][channel], texels[k][channel]);
+        return Err(if value.is_finite() {
+            TextureError::TexelOutOfRange {
+                x,
+                y,
+                channel,
+                value,
+                max: MAX_TEXEL,
+            }
+        } else {
+            TextureError::NonFiniteTexel {
+                x,
+                y,
+                channel,
+                value,
+            }
         });
     }
     Ok(())
