@@ -20,12 +20,13 @@ pub struct Cli {
     pub command: Command,
     /// Most memory the command may hold at once, e.g. 512M or 4G (K, M, G, T: powers of 1024;
     /// at least 1M). Work that would need more is refused before it starts, with the figures.
-    /// Default: half of this machine's memory; a larger request is held to the machine's memory
-    /// and the process's limits.
+    /// Default: the smallest of half of this machine's memory, the cgroup's limit and half of what
+    /// `ulimit -v`/`-d` leave; an explicit SIZE is held to the same figures with all of the
+    /// machine's memory.
     #[arg(long, global = true, value_name = "SIZE")]
     pub max_memory: Option<ByteSize>,
     /// Replace NaN and infinite texels of float images (EXR) with 0 and +-65504, and finite ones
-    /// beyond +-2^40 with +-2^40, with a warning, instead of refusing the image.
+    /// beyond +-2^64 with +-2^64, with a warning, instead of refusing the image.
     #[arg(long, global = true)]
     pub sanitize: bool,
 }

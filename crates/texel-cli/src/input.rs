@@ -10,11 +10,12 @@ use texel_raster::SpecularAa;
 
 use crate::cli::{SceneArgs, Size};
 
-/// How a command reads its inputs: the memory account and the non-finite-texel policy.
+/// How a command reads its inputs: the memory account and the policy for non-finite and
+/// out-of-range texels.
 pub struct Input {
     /// The `--max-memory` account.
     pub budget: MemoryBudget,
-    /// `--sanitize`: replace NaN/Inf texels instead of refusing them.
+    /// `--sanitize`: replace NaN, infinite and out-of-range texels instead of refusing them.
     pub sanitize: bool,
 }
 

@@ -358,34 +358,31 @@ impl MemoryBudget {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     #[test]
     fn explicit_limits_are_capped_by_the_hard_limit() {
-        let Some((hard, why)) = hard_limit() else {
+        // Where `ulimit -v`/`-d` binds, the figure moves with what the process maps (other tests'
+        // threads), so no two reads are compared for equality.
+        let Some((hard, _)) = hard_limit() else {
             println!("skipped: neither /proc/meminfo nor a cgroup or process limit can be read");
             return;
         };
         // Never more than the machine: MemTotal itself is one of the figures.
         let total = std::fs::read_to_string("/proc/meminfo")
             .ok()
-            .and_then(|s| proc_field(&s, "MemTotal:"));
-        assert!(
-            hard <= total.map_or(u64::MAX, |kb| kb * 1024),
-            "{hard} {why}"
-        );
-        assert!(default_limit().0 <= hard);
+            .and_then(|s| proc_field(&s, "MemTotal:"))
+            .map_or(u64::MAX, |kb| kb * 1024);
+        assert!(hard <= total, "{hard}");
         let (b, name) = capped_limit(u64::MAX, "--max-memory huge");
-        assert_eq!(b, hard);
-        assert_eq!(
-            name,
-            format!("--max-memory huge, capped at {} ({why})", mib(hard))
-        );
+        assert!(b <= total, "{b}");
+        assert!(name.starts_with("--max-memory huge, capped at "), "{name}");
+        assert!(name.ends_with(')') && name.contains(" MiB ("), "{name}");
         let (b, name) = capped_limit(1 << 20, "--max-memory 1.0 MiB");
         assert_eq!((b, name.as_str()), (1 << 20, "--max-memory 1.0 MiB"));
         let budget = MemoryBudget::limit_or_default(Some(u64::MAX));
         assert!(budget.name().contains("capped at"), "{}", budget.name());
     }
-
-    use super::*;
 
     #[test]
     fn account_refuses_with_figures() {

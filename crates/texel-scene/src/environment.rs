@@ -296,7 +296,7 @@ impl EnvironmentSpec {
         self.load_with(limits, false).map(|(faces, _)| faces)
     }
 
-    /// As [`EnvironmentSpec::load`]; with `replace_non_finite`, NaN and infinite texels of the
+    /// As [`EnvironmentSpec::load`]; with `replace_non_finite`, NaN, infinite and out-of-range texels of the
     /// map's files are replaced ([`texel_texture::replace_non_finite`]) instead of refused, and
     /// their count is returned beside the layers.
     ///

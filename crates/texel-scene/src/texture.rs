@@ -29,7 +29,7 @@ impl TextureSpec {
             .map(|l| l.texture)
     }
 
-    /// As [`TextureSpec::load`]; with `replace_non_finite`, NaN and infinite float texels are
+    /// As [`TextureSpec::load`]; with `replace_non_finite`, NaN, infinite and out-of-range float texels are
     /// replaced ([`texel_texture::replace_non_finite`]) rather than refused, and counted.
     ///
     /// # Errors

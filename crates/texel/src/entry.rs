@@ -38,7 +38,7 @@ pub struct RenderOptions {
 }
 
 /// `scene` prepared as a command prepares it: at `size` (or its own), with `color` handling,
-/// non-finite texels refused, every other option at its default.
+/// non-finite and out-of-range texels refused, every other option at its default.
 fn prepare(
     scene: &Scene,
     size: Option<(u32, u32)>,

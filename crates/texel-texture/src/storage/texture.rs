@@ -137,7 +137,7 @@ pub struct LoadOptions {
 }
 
 impl LoadOptions {
-    /// `color` and `limits`, refusing non-finite texels.
+    /// `color` and `limits`, refusing non-finite and out-of-range texels.
     pub fn new(color: ColorSpace, limits: Limits) -> Self {
         LoadOptions {
             color,
@@ -147,7 +147,8 @@ impl LoadOptions {
     }
 }
 
-/// A texture read from a file, and how many non-finite channel values were replaced.
+/// A texture read from a file, and how many non-finite or out-of-range channel values were
+/// replaced.
 #[derive(Debug)]
 pub struct Loaded {
     /// The texture.
@@ -160,11 +161,13 @@ pub struct Loaded {
 /// floats, so this is the brightest value such a file can hold.
 pub const NON_FINITE_CLAMP: f32 = 65504.0;
 
-/// The largest magnitude a float texel may have, `2^40` (about `1.1e12`). A filter sums up to
-/// 16384 weighted texels (EWA) or 64 probes (anisotropic) in `f32` and interpolates differences
-/// of neighbours, so values near `f32::MAX` would overflow to infinity where the average itself
-/// is finite; below `2^40` every such sum stays below `2^60`.
-pub const MAX_TEXEL: f32 = 1_099_511_627_776.0;
+/// The largest magnitude a float texel read from outside may have ([`Texture::from_rgba32f`],
+/// image files), `2^64` (about `1.8e19`). A filter sums up to 16384 weighted texels (EWA) or 64
+/// probes (anisotropic) in `f32`, the pyramid sums each level's texels in fours, and interpolation
+/// takes differences of neighbours, so values near `f32::MAX` would overflow to infinity where the
+/// average itself is finite; from inputs below `2^64` every such sum, and those of the maps
+/// derived from them, stays far below `f32::MAX` (`2^128`).
+pub const MAX_TEXEL: f32 = 18_446_744_073_709_551_616.0;
 
 /// Replace every NaN channel value with 0, every infinity with `±`[`NON_FINITE_CLAMP`] and every
 /// finite value beyond `±`[`MAX_TEXEL`] with `±MAX_TEXEL`; returns how many values changed.
@@ -259,7 +262,7 @@ impl Texture {
     ///
     /// Every value must be finite: one NaN would spread through every coarser level (and an
     /// infinity makes its averages NaN); and within `±`[`MAX_TEXEL`], so that the filters' sums
-    /// stay finite. [`replace_non_finite`] cleans data that breaks either rule.
+    /// stay far from overflow. [`replace_non_finite`] cleans data that breaks either rule.
     ///
     /// # Errors
     /// Size or memory limits ([`Limits::check`]), [`TextureError::DataLength`], and
@@ -271,9 +274,20 @@ impl Texture {
         texels: Vec<[f32; 4]>,
         limits: &Limits,
     ) -> Result<Self, TextureError> {
+        Self::from_rgba32f_checked(width, height, texels, limits, true)
+    }
+
+    /// [`Texture::from_rgba32f`], checking the range only when `range` is set (finiteness always).
+    fn from_rgba32f_checked(
+        width: u32,
+        height: u32,
+        texels: Vec<[f32; 4]>,
+        limits: &Limits,
+        range: bool,
+    ) -> Result<Self, TextureError> {
         limits.check(width, height, Format::Rgba32Float)?;
         check_len(width, height, texels.len())?;
-        check_finite(width, &texels)?;
+        check_texels(width, &texels, range)?;
         let level0 = Level {
             width,
             height,
@@ -298,9 +312,12 @@ impl Texture {
     /// GGX-prefiltered levels (each convolved with a wider specular lobe). Ripmaps and
     /// summed-area tables, built from level 0, know nothing of the other levels.
     ///
+    /// The levels are maps code derives (from inputs within [`MAX_TEXEL`], by bounded factors),
+    /// so only finiteness is checked, not the range.
+    ///
     /// # Errors
-    /// As [`Texture::from_rgba32f`], with [`TextureError::DataLength`] against the whole chain
-    /// (reported as level 0's size).
+    /// As [`Texture::from_rgba32f`] less [`TextureError::TexelOutOfRange`], with
+    /// [`TextureError::DataLength`] against the whole chain (reported as level 0's size).
     pub fn from_rgba32f_levels(
         width: u32,
         height: u32,
@@ -317,7 +334,7 @@ impl Texture {
                 got: texels.len(),
             });
         }
-        check_finite(width, &texels)?;
+        check_texels(width, &texels, false)?;
         let mut offset = 0;
         let levels = (0..pyramid::level_count(width, height))
             .map(|k| {
@@ -340,10 +357,15 @@ impl Texture {
     }
 
     /// A texture whose texel `(i, j)` is `f(i, j)` (linear RGBA in `[0, 1]` for 8-bit formats),
-    /// stored in `format`. Handy for procedural textures and tests.
+    /// stored in `format`. Handy for procedural textures, tests and the maps code derives from
+    /// other maps (slope moments, baked layers, irradiance): float values must be finite but, unlike
+    /// [`Texture::from_rgba32f`]'s, are not held to [`MAX_TEXEL`], since a derived map may exceed
+    /// its inputs' range by the derivation's factor (a squared slope, a quadrature's rounding).
+    /// The filters' sums stay finite for values up to `2^110`.
     ///
     /// # Errors
-    /// As [`Texture::from_rgba8`] / [`Texture::from_rgba32f`].
+    /// As [`Texture::from_rgba8`] / [`Texture::from_rgba32f`], less
+    /// [`TextureError::TexelOutOfRange`].
     pub fn from_fn(
         width: u32,
         height: u32,
@@ -356,7 +378,7 @@ impl Texture {
         match format {
             Format::Rgba32Float => {
                 let texels = coords.map(|(i, j)| f(i, j)).collect();
-                Self::from_rgba32f(width, height, texels, limits)
+                Self::from_rgba32f_checked(width, height, texels, limits, false)
             }
             Format::Rgba8Srgb | Format::Rgba8Unorm => {
                 let srgb = format == Format::Rgba8Srgb;
@@ -624,11 +646,11 @@ impl Texture {
     }
 }
 
-/// [`TextureError::NonFiniteTexel`] or [`TextureError::TexelOutOfRange`] for the first value
-/// of row-major `texels` that is not finite or lies beyond `±`[`MAX_TEXEL`] (rows of `width`;
-/// past level 0, the index counts on as if the level continued).
-fn check_finite(width: u32, texels: &[[f32; 4]]) -> Result<(), TextureError> {
-    let bad = |c: &f32| !c.is_finite() || c.abs() > MAX_TEXEL;
+/// [`TextureError::NonFiniteTexel`] for the first value of row-major `texels` that is not finite
+/// or, with `range`, [`TextureError::TexelOutOfRange`] for the first beyond `±`[`MAX_TEXEL`]
+/// (rows of `width`; past level 0, the index counts on as if the level continued).
+fn check_texels(width: u32, texels: &[[f32; 4]], range: bool) -> Result<(), TextureError> {
+    let bad = |c: &f32| !c.is_finite() || (range && c.abs() > MAX_TEXEL);
     if let Some(k) = texels.iter().position(|t| t.iter().any(bad)) {
         let channel = texels[k].iter().position(bad).unwrap_or(0);
         let (x, y) = ((k % width as usize) as u32, (k / width as usize) as u32);
