@@ -93,8 +93,8 @@ fn texture_of(image: ImageIn, srgb: bool) -> PyResult<texel::Texture> {
 /// `array` is an `H x W x C` numpy array, `uint8` or `float32`, C in 1-4 (grey, grey and alpha,
 /// RGB, RGBA; `H x W` is grey). Row 0 is the top of the image, where `v = 0`. 8-bit RGB is
 /// decoded as `color` says (`"srgb"`, or `"linear"` for data such as normal maps); float values
-/// are linear already and must be finite and within +-2^64. `address` sets both axes (`address_u`/`address_v`
-/// override one): `"repeat"`, `"clamp"`, `"mirror"`, `"clamp-to-border"` or
+/// are linear already and must be finite and within +-2^64. `address` sets both axes
+/// (`address_u`/`address_v` override one): `"repeat"`, `"clamp"`, `"mirror"`, `"clamp-to-border"` or
 /// `"mirror-clamp-to-edge"`; `border` is the colour outside the texture under `clamp-to-border`.
 #[pyclass(frozen, module = "texel")]
 pub struct Texture {

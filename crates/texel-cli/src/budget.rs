@@ -37,16 +37,13 @@ impl std::str::FromStr for ByteSize {
 }
 
 /// The account for `--max-memory` if given, held to what the machine and the process's limits
-/// allow ([`texel::memory::capped_limit`]: a request beyond them would end in an aborted
+/// allow ([`MemoryBudget::explicit`]: a request beyond them would end in an aborted
 /// allocation, not an error), else for the process's default ([`texel::memory::default_limit`]:
 /// the smallest of half the machine's memory, the cgroup's limit and what `ulimit -v`/`-d`
 /// leave); errors name the flag.
 pub fn budget(max_memory: Option<ByteSize>) -> MemoryBudget {
     match max_memory {
-        Some(ByteSize(b)) => {
-            let (limit, name) = texel::memory::capped_limit(b, &format!("--max-memory {}", mib(b)));
-            MemoryBudget::new(limit, name)
-        }
+        Some(ByteSize(b)) => MemoryBudget::explicit(b, &format!("--max-memory {}", mib(b))),
         None => {
             let (limit, why) = texel::memory::default_limit();
             MemoryBudget::new(

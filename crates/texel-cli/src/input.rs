@@ -43,10 +43,9 @@ impl Input {
     pub fn warn_replaced(&self, name: &str, replaced: u64) {
         if replaced > 0 {
             eprintln!(
-                "texel: warning: texture {name:?}: replaced {replaced} NaN, infinite or out-of-range channel values (NaN -> 0, +-inf -> +-{}, beyond +-{:e} -> +-{:e})",
-                texel_texture::NON_FINITE_CLAMP,
-                texel_texture::MAX_TEXEL,
-                texel_texture::MAX_TEXEL
+                "texel: warning: texture {name:?}: replaced {replaced} NaN, infinite or out-of-range channel values (NaN -> 0, +-inf -> +-{inf}, beyond +-{max:e} -> +-{max:e})",
+                inf = texel_texture::NON_FINITE_CLAMP,
+                max = texel_texture::MAX_TEXEL
             );
         }
     }

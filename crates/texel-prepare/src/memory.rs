@@ -195,7 +195,7 @@ const PROCESS_LIMIT_SHARE: u64 = 2;
 /// data (`ulimit -d`, `RLIMIT_DATA`) limits leave above what the process already maps. Where none
 /// can be read, [`FALLBACK_BYTES`].
 pub fn default_limit() -> (u64, String) {
-    process_limit(2).unwrap_or((FALLBACK_BYTES, "texel's fallback limit".into()))
+    process_limit(true).unwrap_or((FALLBACK_BYTES, "texel's fallback limit".into()))
 }
 
 /// The most an explicit limit may grant, and what sets it: [`default_limit`]'s figures with the
@@ -203,7 +203,7 @@ pub fn default_limit() -> (u64, String) {
 /// process limits leave stay as they are: past them an allocation fails, and the process aborts,
 /// whatever the account allows). `None` where none can be read.
 pub fn hard_limit() -> Option<(u64, String)> {
-    process_limit(1)
+    process_limit(false)
 }
 
 /// An explicit limit of `requested` bytes held to [`hard_limit`]: the bytes a budget may grant
@@ -218,9 +218,9 @@ pub fn capped_limit(requested: u64, name: &str) -> (u64, String) {
     }
 }
 
-/// The smallest of `MemTotal / machine_share`, the cgroup limits and half of what the process
-/// limits leave, with what set it (see [`default_limit`]).
-fn process_limit(machine_share: u64) -> Option<(u64, String)> {
+/// The smallest of `MemTotal` (half of it with `half_of_machine`), the cgroup limits and half of
+/// what the process limits leave, with what set it (see [`default_limit`]).
+fn process_limit(half_of_machine: bool) -> Option<(u64, String)> {
     let read = |p: &str| std::fs::read_to_string(p).ok();
     let mut best: Option<(u64, String)> = None;
     let mut offer = |bytes: u64, why: String| {
@@ -229,11 +229,11 @@ fn process_limit(machine_share: u64) -> Option<(u64, String)> {
         }
     };
     if let Some(kb) = read("/proc/meminfo").and_then(|s| proc_field(&s, "MemTotal:")) {
-        let share = if machine_share == 1 { "" } else { "half of " };
-        offer(
-            kb * 1024 / machine_share.max(1),
-            format!("{share}this machine's memory"),
-        );
+        if half_of_machine {
+            offer(kb * 1024 / 2, "half of this machine's memory".into());
+        } else {
+            offer(kb * 1024, "this machine's memory".into());
+        }
     }
     for (p, b) in cgroup_limits(&read("/proc/self/cgroup").unwrap_or_default()) {
         offer(b, format!("the cgroup's memory limit ({p})"));
@@ -291,12 +291,16 @@ impl MemoryBudget {
     /// [`hard_limit`] ([`capped_limit`]), else [`MemoryBudget::process_default`].
     pub fn limit_or_default(limit: Option<u64>) -> Self {
         match limit {
-            Some(b) => {
-                let (limit, name) = capped_limit(b, &format!("the memory limit of {}", mib(b)));
-                Self::new(limit, name)
-            }
+            Some(b) => Self::explicit(b, &format!("the memory limit of {}", mib(b))),
             None => Self::process_default(),
         }
+    }
+
+    /// A budget of the `requested` bytes a user asked for, named `name`, held to [`hard_limit`]
+    /// ([`capped_limit`]).
+    pub fn explicit(requested: u64, name: &str) -> Self {
+        let (limit, name) = capped_limit(requested, name);
+        Self::new(limit, name)
     }
 
     /// The default budget: [`default_limit`], named after the limit that set it.

@@ -59,8 +59,9 @@ pub struct SceneOptions {
     pub size: Option<(u32, u32)>,
     /// Colour handling.
     pub color: ColorHandling,
-    /// Replace NaN, infinite and out-of-range float texels ([`texel_texture::replace_non_finite`]) instead of
-    /// refusing the texture; [`PreparedScene::replaced`] reports how many.
+    /// Replace NaN, infinite and out-of-range float texels
+    /// ([`texel_texture::replace_non_finite`]) instead of refusing the texture;
+    /// [`PreparedScene::replaced`] reports how many.
     pub replace_non_finite: bool,
     /// Specular antialiasing for every material, overriding each one's `specular_aa` (the
     /// CLI's `--specular-aa`).
@@ -189,8 +190,8 @@ pub struct PreparedScene {
 }
 
 /// Load the environment map of `spec` within what `budget` has left and prefilter it (its
-/// glossy pyramid and irradiance), charging both; with `replace_non_finite`, NaN, infinite and out-of-range
-/// texels of its files are replaced (their count is returned) instead of refused.
+/// glossy pyramid and irradiance), charging both; with `replace_non_finite`, NaN, infinite and
+/// out-of-range texels of its files are replaced (their count is returned) instead of refused.
 fn environment_maps(
     spec: &texel_scene::EnvironmentSpec,
     budget: &mut MemoryBudget,
