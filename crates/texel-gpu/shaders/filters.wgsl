@@ -298,18 +298,23 @@ fn ewa_level(uv: vec2<f32>, level: i32, q: vec4<f32>) -> vec4<f32> {
 fn ewa_at(uv: vec2<f32>, s: vec4<f32>, k0: i32) -> vec4<f32> {
     let last = i32(last_level());
     var k = min(k0, last);
+    var q = in_level(s, k, false);
     loop {
-        let q = in_level(s, k, false);
         if k >= last || PI * sqrt(max(q.w, 0.0)) <= MAX_ELLIPSE_AREA {
             break;
         }
         k++;
+        q = in_level(s, k, false);
     }
     // A 1x1 level is its one texel under every address mode but clamp-to-border.
     if all(level_size(k) == vec2<i32>(1)) && params.address.x != 3u && params.address.y != 3u {
         return fetch(0, 0, k);
     }
-    return ewa_level(uv, k, in_level(s, k, true));
+    // Only the last level's ellipse can still exceed the area; it is shrunk to it.
+    if PI * sqrt(max(q.w, 0.0)) > MAX_ELLIPSE_AREA {
+        q = in_level(s, k, true);
+    }
+    return ewa_level(uv, k, q);
 }
 
 // EWA in the one level floor(lod), lod = log2(minor semi-axis) + bias: there the minor semi-axis
