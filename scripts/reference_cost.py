@@ -7,9 +7,10 @@ For each scene (default: the unlit built-ins) it renders, timed, the reference w
 plan (at least 256 samples a pixel, more until the 95 % interval of the displayed value is within
 half an 8-bit step, at most 65536) and a fixed 256-sample one, both with the default seed, and a
 fixed 4096-sample one with another seed (independent). It prints each one's time and mean samples
-a pixel, and the share of pixels whose displayed value (clipped, sRGB, 8-bit units) lies
-within half a step of the 4096-sample reference's in every channel: the unlit goal of the
-reference's error bars (docs/guide/measuring.md). Needs the Python package (python/).
+a pixel and, for the first two, the share of pixels whose displayed value (clipped, sRGB, 8-bit
+units, not rounded) lies within half a step of the 4096-sample reference's in every channel: the
+unlit goal of the reference's error bars (docs/guide/measuring.md). Needs the Python package
+(python/).
 """
 import argparse
 import time
@@ -47,10 +48,13 @@ def main():
         truth = runs["fixed 4096"][0]
         shown = display(truth["linear"][..., :3])
         for name, (r, secs) in runs.items():
-            d = np.abs(display(r["linear"][..., :3]) - shown).max(-1)
-            within = (d <= 0.5).mean() * 100
-            print(f"| {scene} | {name} | {secs:.1f} | {r['spp'].mean():.0f} | "
-                  f"{within:.1f} % |", flush=True)
+            if r is truth:
+                within = "-"
+            else:
+                d = np.abs(display(r["linear"][..., :3]) - shown).max(-1)
+                within = f"{(d <= 0.5).mean() * 100:.1f} %"
+            print(f"| {scene} | {name} | {secs:.1f} | {r['spp'].mean():.0f} | {within} |",
+                  flush=True)
 
 
 if __name__ == "__main__":

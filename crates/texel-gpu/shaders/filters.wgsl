@@ -249,6 +249,11 @@ fn ellipse(px: vec2<f32>, py: vec2<f32>, max_ecc: f32) -> vec4<f32> {
 const MAX_ELLIPSE_AREA: f32 = 4096.0;
 const PI: f32 = 3.14159265;
 
+// The area in texels, pi sqrt(det Q), of an ellipse (q00, q01, q11, det Q).
+fn ellipse_area(q: vec4<f32>) -> f32 {
+    return PI * sqrt(max(q.w, 0.0));
+}
+
 // The ellipse in level `level` convolved with the unit reconstruction filter: Q = D S D + I,
 // D = diag(level size / level-0 size); shrunk to MAX_ELLIPSE_AREA texels when `shrink`.
 // Returns (q00, q01, q11, det Q).
@@ -256,7 +261,7 @@ fn in_level(s: vec4<f32>, level: i32, shrink: bool) -> vec4<f32> {
     let d = size_of(level) / size_of(0);
     var q = vec3<f32>(d.x * d.x * s.x + 1.0, d.x * d.y * s.y, d.y * d.y * s.z + 1.0);
     var det = q.x * q.z - q.y * q.y;
-    let area = PI * sqrt(max(det, 0.0));
+    let area = ellipse_area(vec4<f32>(q, det));
     if shrink && area > MAX_ELLIPSE_AREA {
         let f = MAX_ELLIPSE_AREA / area;
         q *= f;
@@ -300,7 +305,7 @@ fn ewa_at(uv: vec2<f32>, s: vec4<f32>, k0: i32) -> vec4<f32> {
     var k = min(k0, last);
     var q = in_level(s, k, false);
     loop {
-        if k >= last || PI * sqrt(max(q.w, 0.0)) <= MAX_ELLIPSE_AREA {
+        if k >= last || ellipse_area(q) <= MAX_ELLIPSE_AREA {
             break;
         }
         k++;
@@ -311,7 +316,7 @@ fn ewa_at(uv: vec2<f32>, s: vec4<f32>, k0: i32) -> vec4<f32> {
         return fetch(0, 0, k);
     }
     // Only the last level's ellipse can still exceed the area; it is shrunk to it.
-    if PI * sqrt(max(q.w, 0.0)) > MAX_ELLIPSE_AREA {
+    if ellipse_area(q) > MAX_ELLIPSE_AREA {
         q = in_level(s, k, true);
     }
     return ewa_level(uv, k, q);

@@ -209,7 +209,7 @@ pub fn hard_limit() -> Option<(u64, String)> {
 /// An explicit limit of `requested` bytes held to [`hard_limit`]: the bytes a budget may grant
 /// and its name for errors, `name` itself or, when capped, `name` followed by the cap and what
 /// set it (`--max-memory 1048576.0 MiB, capped at 23984.1 MiB (this machine's memory)`).
-pub fn capped_limit(requested: u64, name: &str) -> (u64, String) {
+fn capped_limit(requested: u64, name: &str) -> (u64, String) {
     match hard_limit() {
         Some((hard, why)) if hard < requested => {
             (hard, format!("{name}, capped at {} ({why})", mib(hard)))
@@ -288,7 +288,7 @@ impl MemoryBudget {
     }
 
     /// A budget of `limit` bytes when given (named "the memory limit of N MiB"), held to
-    /// [`hard_limit`] ([`capped_limit`]), else [`MemoryBudget::process_default`].
+    /// [`hard_limit`] ([`MemoryBudget::explicit`]), else [`MemoryBudget::process_default`].
     pub fn limit_or_default(limit: Option<u64>) -> Self {
         match limit {
             Some(b) => Self::explicit(b, &format!("the memory limit of {}", mib(b))),
@@ -296,8 +296,9 @@ impl MemoryBudget {
         }
     }
 
-    /// A budget of the `requested` bytes a user asked for, named `name`, held to [`hard_limit`]
-    /// ([`capped_limit`]).
+    /// A budget of the `requested` bytes a user asked for, held to [`hard_limit`], and named
+    /// `name` or, when capped, `name` followed by the cap and what set it (`--max-memory
+    /// 1048576.0 MiB, capped at 23984.1 MiB (this machine's memory)`).
     pub fn explicit(requested: u64, name: &str) -> Self {
         let (limit, name) = capped_limit(requested, name);
         Self::new(limit, name)
