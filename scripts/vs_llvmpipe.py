@@ -14,7 +14,9 @@ texel runs with `--color raw` (texture bytes are linear, as a GPU samples a plai
 which is what llvmpipe does with the scene's textures. llvmpipe's 16x anisotropic filter (an EWA
 port in Mesa 22.3) takes seconds per frame; `--llvmpipe-aniso` times one frame of it once.
 `--gpu-precision` also times texel's four core filters with `--precision gpu` (8-bit fixed-point
-weights, as llvmpipe blends) in every round and adds its columns.
+weights, as llvmpipe blends) in every round and adds its columns; `--float-storage` does the same
+with `--texture-storage float` (textures decoded once to `f32`: the same images, four times the
+texture memory).
 """
 
 import argparse
@@ -44,9 +46,11 @@ def main():
                     help="also time one llvmpipe aniso16 frame (tens of seconds)")
     ap.add_argument("--gpu-precision", action="store_true",
                     help="also time texel's core filters with --precision gpu")
+    ap.add_argument("--float-storage", action="store_true",
+                    help="also time texel's core filters with --texture-storage float")
     a = ap.parse_args()
 
-    texel, peer, fixed = [], [], []
+    texel, peer, fixed, floats = [], [], [], []
     renderer = "llvmpipe"
     for r in range(a.rounds):
         print(f"round {r + 1}/{a.rounds}", file=sys.stderr)
@@ -57,6 +61,11 @@ def main():
             fixed.append(run_json([a.texel, "bench", a.scene, "--color", "raw", "--frames",
                                    str(a.frames), "--threads", str(a.threads), "--filters",
                                    ",".join(CORE), "--precision", "gpu", "--json"])["median_ms"])
+        if a.float_storage:
+            floats.append(run_json([a.texel, "bench", a.scene, "--color", "raw", "--frames",
+                                    str(a.frames), "--threads", str(a.threads), "--filters",
+                                    ",".join(CORE + TEXEL_ONLY), "--texture-storage", "float",
+                                    "--json"])["median_ms"])
         p = run_json([sys.executable, a.peer, a.scene, "--frames", str(a.frames), "--threads",
                       str(a.threads), "--filters", ",".join(CORE)])
         renderer = f"{p.get('renderer', 'llvmpipe')}, {p.get('version', '')}"
@@ -68,9 +77,11 @@ def main():
 
     print(f"{renderer}; {a.rounds} alternating rounds, {a.frames} frames each, "
           f"{a.threads} threads; ms per frame (median of the rounds' medians)\n")
-    extra_head = " texel gpu precision | gpu precision / llvmpipe (per round) |" if fixed else ""
+    extras = [(name, runs) for name, runs in [("gpu precision", fixed), ("float storage", floats)]
+              if runs]
+    extra_head = "".join(f" texel {n} | {n} / llvmpipe (per round) |" for n, _ in extras)
     print(f"| filter | texel | llvmpipe | texel / llvmpipe (per round) |{extra_head}")
-    print("|---|--:|--:|--:|" + ("--:|--:|" if fixed else ""))
+    print("|---|--:|--:|--:|" + "--:|--:|" * len(extras))
 
     def ratio_cells(t, p):
         ratios = [x / y for x, y in zip(t, p)]
@@ -81,18 +92,23 @@ def main():
         p = [x[f] for x in peer]
         t, r = ratio_cells([x[f] for x in texel], p)
         extra = ""
-        if fixed:
-            g, gr = ratio_cells([x[f] for x in fixed], p)
-            extra = f" {g}{gr}"
+        for _, runs in extras:
+            g, gr = ratio_cells([x[f] for x in runs], p)
+            extra += f" {g}{gr}"
         print(f"| {f} | {t}{statistics.median(p):.2f} | {r}{extra}")
     for f in TEXEL_ONLY:
         t = statistics.median(x[f] for x in texel)
         other = f"{aniso_peer:.0f} (one frame)" if f == "aniso16" and aniso_peer else "-"
         ratio = f"{t / aniso_peer:.4f}" if f == "aniso16" and aniso_peer else "-"
-        print(f"| {f} | {t:.2f} | {other} | {ratio} |" + (" | |" if fixed else ""))
+        cells = "".join(f" {statistics.median(x[f] for x in runs):.2f} | - |" if f in runs[0]
+                        else " | |" for _, runs in extras)
+        print(f"| {f} | {t:.2f} | {other} | {ratio} |" + cells)
     for f in TEXEL_ONLY:
         per_round = ", ".join(f"{x[f] / x['trilinear']:.1f}" for x in texel)
         print(f"\ntexel {f} / texel trilinear per round: {per_round}")
+        if floats:
+            per_round = ", ".join(f"{x[f] / x['trilinear']:.1f}" for x in floats)
+            print(f"texel {f} / texel trilinear per round, float storage: {per_round}")
 
 
 if __name__ == "__main__":

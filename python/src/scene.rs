@@ -15,7 +15,7 @@ use texel::quality::{
 use texel::raster::{draw_into, ReferencePlan, View};
 use texel::{
     ColorHandling, Error, Filter, Frame, MemoryBudget, PreparedScene, ReferenceOptions,
-    ReferenceRun, RenderOptions, Scene, SceneOptions,
+    ReferenceRun, RenderOptions, Scene, SceneOptions, TextureStorage,
 };
 
 use crate::arrays::{array_out, rgba_out};
@@ -117,6 +117,15 @@ fn view_named(name: &str) -> PyResult<View> {
     })
 }
 
+/// How 8-bit textures are kept, by its command-line name (`--texture-storage`).
+fn storage_named(name: &str) -> PyResult<TextureStorage> {
+    TextureStorage::from_str(name, false).map_err(|_| {
+        PyValueError::new_err(format!(
+            "unknown texture_storage {name:?}: valid values are stored, float"
+        ))
+    })
+}
+
 /// Output size from Python, checked for zero sides.
 fn size_of(size: Option<(u32, u32)>) -> PyResult<Option<(u32, u32)>> {
     if let Some((w, h)) = size {
@@ -140,7 +149,7 @@ pub fn scene_size(scene: PathBuf, size: Option<(u32, u32)>) -> PyResult<(u32, u3
 /// Render `scene` with `filter` (`None`: a glTF mesh's own sampler, else trilinear) and return the
 /// `H x W x 4` `uint8` image `texel render SCENE -o FILE.png` writes, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (scene, filter = Some("trilinear"), size = None, color = "srgb", view = "color", threads = None, max_memory = None))]
+#[pyo3(signature = (scene, filter = Some("trilinear"), size = None, color = "srgb", view = "color", threads = None, max_memory = None, texture_storage = "stored"))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -151,6 +160,7 @@ pub fn render<'py>(
     view: &str,
     threads: Option<usize>,
     max_memory: Option<u64>,
+    texture_storage: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     let options = RenderOptions {
         filter: filter.map(filter_named).transpose()?,
@@ -159,6 +169,7 @@ pub fn render<'py>(
         view: view_named(view)?,
         max_memory,
         threads: threads_of(threads)?,
+        texture_storage: storage_named(texture_storage)?,
     };
     let loaded = load_scene(&scene)?;
     let image = run_released(py, move |_| {

@@ -23,6 +23,15 @@ def test_render_equals_the_cli_png(cli, tmp_path, filter, color, view):
     np.testing.assert_array_equal(got, read_png(out))
 
 
+@pytest.mark.parametrize("filter", ["aniso16", "ewa", "ripmap"])
+def test_float_texture_storage_renders_the_same_image(filter):
+    stored = texel.render("builtin:ground", filter=filter, size=(96, 54))
+    float_ = texel.render("builtin:ground", filter=filter, size=(96, 54), texture_storage="float")
+    np.testing.assert_array_equal(float_, stored)
+    with pytest.raises(ValueError, match="texture_storage"):
+        texel.render("builtin:ground", size=(8, 8), texture_storage="half")
+
+
 def test_scene_text_renders_as_its_file():
     text = (ROOT / "scenes" / "ground.toml").read_text()
     a = texel.render(text, size=(48, 27))

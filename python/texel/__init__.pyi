@@ -49,6 +49,7 @@ def render(
     view: str = "color",
     threads: Optional[int] = None,
     max_memory: Optional[int] = None,
+    texture_storage: str = "stored",
 ) -> npt.NDArray[np.uint8]: ...
 def reference(
     scene: _Scene,

@@ -142,6 +142,12 @@ pub struct SceneArgs {
     /// the reference stay exact.
     #[arg(long, value_enum, default_value_t)]
     pub precision: texel::raster::Precision,
+    /// How 8-bit textures are kept for the CPU's filters: as stored (4 bytes a texel, decoded at
+    /// each read), or decoded once to float (16 bytes a texel; the same images, anisotropic and
+    /// EWA frames faster: docs/decisions.md). Default: float for `view`, stored elsewhere; with
+    /// --gpu, stored. A texture whose float copy does not fit the memory budget stays stored.
+    #[arg(long, value_enum, value_name = "STORAGE")]
+    pub texture_storage: Option<texel::TextureStorage>,
 }
 
 /// A finite number in `[lo, hi]` of `unit` (the error names both).

@@ -22,7 +22,7 @@ use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
 
 use crate::cli::{BenchArgs, TargetArg};
 use crate::filters::{parse_gpu_list, parse_list, GpuJob};
-use crate::input::{load_scene, Input};
+use crate::input::{check_storage, load_scene, Input};
 use crate::threads::{thread_count, with_threads};
 
 /// One filter's timings in milliseconds.
@@ -200,6 +200,7 @@ fn time_gpu(
 
 /// Run `texel bench`.
 pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
+    check_storage(&args.scene, args.gpu)?;
     let scene = load_scene(&args.scene, input)?;
     // The GPU's rows are checked before the (slower) adapter start; the CPU's list as before.
     let (filters, jobs) = if args.gpu {

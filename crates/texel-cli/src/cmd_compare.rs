@@ -21,7 +21,7 @@ use crate::cli::CompareArgs;
 use crate::cmd_bench::{median, time_frames};
 use crate::cmd_reference::{self as reference, reference_estimate};
 use crate::filters::{parse_list, Filter};
-use crate::input::{load_scene, Input};
+use crate::input::{check_storage, load_scene, Input};
 use crate::output::encoding;
 use crate::progress;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
@@ -506,6 +506,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         args.scene.color == texel::ColorHandling::Srgb,
         texel_raster::adaptive::DEFAULT_SEED,
     )?;
+    check_storage(&args.scene, args.gpu)?;
     let scene = load_scene(&args.scene, input)?;
     let frames = if args.gpu {
         gpu_rows(&scene, &filters, args.adapter.as_deref(), &mut input.budget)?

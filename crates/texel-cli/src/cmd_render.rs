@@ -6,7 +6,7 @@ use texel_raster::{render, ColorTarget, Derivatives, UvEvaluation, View};
 
 use crate::cli::RenderArgs;
 use crate::filters::Filter;
-use crate::input::{load_scene, Input};
+use crate::input::{check_storage, load_scene, Input};
 use crate::output::{encoding, is_exr, write_frame};
 use crate::threads::with_threads;
 
@@ -16,6 +16,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         Some(m) => Some(Filter::from_lab_mode(m)?),
         None => args.filter,
     };
+    check_storage(&args.scene, args.gpu)?;
     let mut scene = load_scene(&args.scene, input)?;
     if args.gpu && args.scene.surface_uv.is_none() && scene.maps_uv_per_pixel() {
         // The shader interpolates the vertices' uv: say so rather than refuse the scene.

@@ -122,6 +122,8 @@ pub struct MaterialOverrides {
     pub surface_uv: Option<texel::raster::UvEvaluation>,
     /// `--precision`.
     pub precision: texel::raster::Precision,
+    /// `--texture-storage`, or the command's default.
+    pub texture_storage: texel::TextureStorage,
 }
 
 impl MaterialOverrides {
@@ -136,8 +138,20 @@ impl MaterialOverrides {
             environment_mapping: args.environment_mapping,
             surface_uv: args.surface_uv,
             precision: args.precision,
+            texture_storage: args.texture_storage.unwrap_or_default(),
         }
     }
+}
+
+/// `--texture-storage` against a command's `--gpu`: the GPU path uploads the texels as stored,
+/// so `float` with `--gpu` is refused rather than ignored.
+pub fn check_storage(args: &SceneArgs, gpu: bool) -> Result<()> {
+    if gpu && args.texture_storage == Some(texel::TextureStorage::Float) {
+        anyhow::bail!(
+            "--texture-storage float is for the CPU's filters; --gpu uploads the texels as stored"
+        );
+    }
+    Ok(())
 }
 
 /// Load `scene` (a path or `builtin:NAME`) and its textures within `input`'s account, with
@@ -187,11 +201,19 @@ pub fn load_scene_with(
         environment_mapping: overrides.environment_mapping,
         surface_uv: overrides.surface_uv.unwrap_or_default(),
         precision: overrides.precision,
+        texture_storage: overrides.texture_storage,
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;
     for (name, n) in &prepared.replaced {
         input.warn_replaced(name, *n);
+    }
+    for (name, bytes) in &prepared.kept_stored {
+        eprintln!(
+            "texel: note: texture {name:?} stays 8-bit: its float copy ({}) does not fit {}",
+            texel::memory::mib(*bytes),
+            input.budget.name()
+        );
     }
     Ok(prepared)
 }

@@ -208,3 +208,55 @@ fn precision_gpu_changes_raw_frames_by_at_most_three_codes() {
     }
     fails(&["render", "--precision", "half"], 2, &["half"]);
 }
+
+/// `--texture-storage float` decodes 8-bit textures once to `f32`: the bytes are the stored
+/// textures' for every kind of filter, sRGB and raw, lit and unlit; a texture whose float copy
+/// does not fit `--max-memory` stays 8-bit with a note (same bytes again); `float` with `--gpu`
+/// is refused rather than ignored.
+#[test]
+fn float_texture_storage_renders_the_same_bytes() {
+    let d = Dir::new("render-storage");
+    let cases = [
+        ("builtin:ground", "mip-nearest"),
+        ("builtin:ground", "aniso16"),
+        ("builtin:ground", "ewa"),
+        ("builtin:ground", "ripmap"),
+        ("builtin:glossy", "trilinear"),
+        ("builtin:terrain", "aniso4"),
+    ];
+    for (scene, filter) in cases {
+        for color in ["srgb", "raw"] {
+            let render = |storage: &str, more: &[&str]| {
+                let out = d.arg(&format!("{filter}-{color}-{storage}.png"));
+                let args = ["render", scene, "--size", "96x54", "--filter", filter];
+                let rest = ["--color", color, "--texture-storage", storage, "-o", &out];
+                let o = texel(&[&args[..], more, &rest[..]].concat());
+                assert!(o.status.success(), "{}", stderr(&o));
+                (load(&out), stderr(&o))
+            };
+            let (stored, _) = render("stored", &[]);
+            let (float, note) = render("float", &[]);
+            assert!(stored == float, "{scene} {filter} {color}: images differ");
+            assert!(!note.contains("stays 8-bit"), "{note}");
+            if scene == "builtin:ground" && filter == "aniso16" {
+                // The checker's pyramid: 5.3 MiB stored, 21.3 MiB as float.
+                let (kept, note) = render("float", &["--max-memory", "16M"]);
+                assert!(kept == stored, "{color}: kept-stored image differs");
+                assert!(note.contains("\"checker\" stays 8-bit"), "{note}");
+            }
+        }
+    }
+    fails(
+        &[
+            "render",
+            "--gpu",
+            "--texture-storage",
+            "float",
+            "-o",
+            &d.arg("g.png"),
+        ],
+        1,
+        &["--texture-storage float", "--gpu"],
+    );
+    fails(&["render", "--texture-storage", "half"], 2, &["half"]);
+}

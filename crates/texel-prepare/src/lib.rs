@@ -20,7 +20,7 @@ pub mod tessellate;
 pub use error::Error;
 pub use memory::MemoryBudget;
 pub use plan::FramePlan;
-pub use prepare::{ColorHandling, PreparedScene, SceneOptions};
+pub use prepare::{ColorHandling, PreparedScene, SceneOptions, TextureStorage};
 pub use reference::ReferenceRun;
 
 use texel_texture::Filter;

@@ -18,7 +18,7 @@ use texel_scene::{
     SpecularAaSpec, TextureSampler,
 };
 use texel_texture::base::color::srgb_to_linear;
-use texel_texture::{AddressMode, ColorSpace, Limits, Sampler, Texture};
+use texel_texture::{AddressMode, ColorSpace, Format, Limits, Sampler, Texture};
 
 use crate::bake::{self, Composite};
 use crate::memory::{raster_bytes, FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_BYTES};
@@ -50,6 +50,32 @@ pub enum ColorHandling {
         )
     )]
     Raw,
+}
+
+/// How the scene's 8-bit textures are kept for the CPU's filters (the CLI's
+/// `--texture-storage`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum TextureStorage {
+    /// As they are stored: 4 bytes a texel, decoded at each read (a GPU's way).
+    #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "8-bit texels, decoded at each read: 4 bytes a texel (a GPU's way)")
+    )]
+    Stored,
+    /// Decoded once to linear `f32` ([`Texture::to_float`]): 16 bytes a texel, the same images,
+    /// and faster anisotropic and EWA filtering on CPUs whose caches hold the larger pyramids
+    /// (docs/decisions.md, "Decoded float storage"). A texture whose float pyramid does not fit
+    /// what the memory budget has left stays stored ([`PreparedScene::kept_stored`]); under
+    /// [`Precision::Gpu`] unorm8 textures stay stored, since the fixed-point path reads codes.
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Decoded once to linear f32: 16 bytes a texel, the same images, faster anisotropic and EWA filtering"
+        )
+    )]
+    Float,
 }
 
 /// How a scene is prepared.
@@ -89,6 +115,8 @@ pub struct SceneOptions {
     /// The filtering arithmetic for unorm8 textures in [`PreparedScene::settings`] (the CLI's
     /// `--precision`; the reference ignores it).
     pub precision: Precision,
+    /// How 8-bit textures are kept (the CLI's `--texture-storage`): images do not depend on it.
+    pub texture_storage: TextureStorage,
 }
 
 /// `spec` with its procedural sky laid out in `mapping` at about the same texel angle: an
@@ -147,6 +175,9 @@ pub struct PreparedScene {
     /// Per texture, the non-finite channel values replaced (only with
     /// [`SceneOptions::replace_non_finite`]; textures with none are not listed).
     pub replaced: Vec<(String, u64)>,
+    /// Textures that [`TextureStorage::Float`] left stored because their float pyramid did not
+    /// fit what the memory budget had left, with the bytes it would have taken.
+    pub kept_stored: Vec<(String, u64)>,
     /// The (texture, structure) pairs [`PreparedScene::build_structures_within`] has charged.
     charged: Mutex<BTreeSet<(String, &'static str)>>,
     /// [`SceneOptions::precision`].
@@ -252,7 +283,8 @@ impl PreparedScene {
             .size
             .unwrap_or((scene.output.width, scene.output.height));
         charge_geometry(&scene, (width, height), budget)?;
-        let (textures, mut replaced) = load_textures(&scene, options, budget)?;
+        let (mut textures, mut replaced) = load_textures(&scene, options, budget)?;
+        let kept_stored = store_textures(&mut textures, options, budget)?;
         if let Some(spec) = &scene.environment {
             scene.environment = Some(relay_sky(spec, options.environment_mapping)?);
         }
@@ -291,6 +323,7 @@ impl PreparedScene {
             height,
             color: options.color,
             replaced,
+            kept_stored,
             charged: Mutex::new(BTreeSet::new()),
             precision: options.precision,
             specular_aa: options.specular_aa,
@@ -812,6 +845,47 @@ fn load_textures(
         textures.insert(u.name.to_string(), loaded.texture);
     }
     Ok((textures, replaced))
+}
+
+/// Keep `textures` as `options.texture_storage` asks: with [`TextureStorage::Float`] each 8-bit
+/// texture is replaced by its float copy where the copy fits what `budget` has left (charged
+/// while both exist, the 8-bit pyramid released after); the names and float bytes of those that
+/// did not fit.
+fn store_textures(
+    textures: &mut BTreeMap<String, Texture>,
+    options: &SceneOptions,
+    budget: &mut MemoryBudget,
+) -> Result<Vec<(String, u64)>, Error> {
+    let mut kept = Vec::new();
+    if options.texture_storage == TextureStorage::Stored {
+        return Ok(kept);
+    }
+    for (name, texture) in textures.iter_mut() {
+        let format = texture.format();
+        let codes_read = options.precision == Precision::Gpu && format == Format::Rgba8Unorm;
+        if format == Format::Rgba32Float || codes_read {
+            continue;
+        }
+        let stored = texture.pyramid_bytes();
+        let float = stored.saturating_mul(4);
+        if float > budget.remaining() {
+            kept.push((name.clone(), float));
+            continue;
+        }
+        budget.take(&format!("texture {name:?} as float"), float)?;
+        match texture.to_float() {
+            Ok(copy) => {
+                *texture = copy;
+                budget.release(stored);
+            }
+            // Over the texture's own limits (those it was loaded within).
+            Err(_) => {
+                budget.release(float);
+                kept.push((name.clone(), float));
+            }
+        }
+    }
+    Ok(kept)
 }
 
 /// The distinct samplers textures bring of their own (glTF textures' `wrapS`/`wrapT`), and

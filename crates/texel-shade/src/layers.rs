@@ -361,7 +361,7 @@ pub fn read_normal(
         raw,
         mean: raw * Vec3::new(scale, scale, 1.0),
         moments,
-        slack: if map.texture.format() == Format::Rgba32Float {
+        slack: if map.texture.source_format() == Format::Rgba32Float {
             0.0
         } else {
             UNORM8_NORMAL_SLACK

@@ -1691,3 +1691,78 @@ fn float_texels_at_the_range_edge_filter_to_finite_values() {
     assert_eq!((texels[5][2], texels[6][0], texels[7][1]), (m, 0.0, -m));
     assert!(Texture::from_rgba32f(4, 4, texels, &Limits::default()).is_ok());
 }
+
+/// A decoded float copy ([`Texture::to_float`]) samples bit for bit as its 8-bit original: every
+/// named filter (ripmap and summed-area table included, built on each texture), every address
+/// mode, sRGB and unorm codes, a power-of-two and an odd size, footprints from magnified to
+/// 64:1, through the one-sample and the batched paths.
+#[test]
+fn float_copies_sample_as_their_8bit_originals() {
+    let footprints: Vec<Footprint> = [
+        (0.3f32, 0.3f32),
+        (1.5, 1.0),
+        (6.0, 2.0),
+        (16.0, 1.0),
+        (64.0, 1.0),
+        (40.0, 13.0),
+    ]
+    .iter()
+    .enumerate()
+    .flat_map(|(k, &(major, minor))| {
+        (0..24).map(move |j| {
+            let (u, v) = spread(k * 24 + j);
+            let a = j as f32 * 0.37;
+            let (c, s) = (a.cos() / 64.0, a.sin() / 64.0);
+            Footprint {
+                // Some centres outside [0, 1) so that the address modes matter.
+                u: u * 1.6 - 0.3,
+                v: v * 1.6 - 0.3,
+                dudx: major * c,
+                dvdx: major * s,
+                dudy: -minor * s,
+                dvdy: minor * c,
+            }
+        })
+    })
+    .collect();
+    for format in [Format::Rgba8Srgb, Format::Rgba8Unorm] {
+        for (w, h) in [(64, 64), (37, 53)] {
+            let stored = noise_texture(w, h, format);
+            let float = stored.to_float().unwrap();
+            assert_eq!(float.format(), Format::Rgba32Float);
+            assert_eq!(float.source_format(), format);
+            assert_eq!(float.pyramid_bytes(), 4 * stored.pyramid_bytes());
+            for mode in ADDRESS_MODES {
+                for filter in texel_texture::Filter::ALL {
+                    let s = Sampler::new(filter.descriptor(mode, mode)).unwrap();
+                    let (mut a, mut b) = (
+                        vec![[0.0; 4]; footprints.len()],
+                        vec![[0.0; 4]; footprints.len()],
+                    );
+                    s.sample_batch(&stored, &footprints, &mut a);
+                    s.sample_batch(&float, &footprints, &mut b);
+                    for ((fp, x), y) in footprints.iter().zip(&a).zip(&b) {
+                        let what = format!("{format:?} {w}x{h} {mode:?} {}", filter.name());
+                        assert_eq!(x.map(f32::to_bits), y.map(f32::to_bits), "{what} {fp:?}");
+                        let (p, q) = (s.sample(&stored, fp), s.sample(&float, fp));
+                        assert_eq!(p.map(f32::to_bits), q.map(f32::to_bits), "{what} {fp:?}");
+                    }
+                }
+            }
+        }
+    }
+    // Past the limits the copy is refused, not allocated: 4 bytes a texel fit, 16 do not.
+    let limits = Limits {
+        max_bytes: 50_000,
+        ..Limits::default()
+    };
+    let small = Texture::from_fn(64, 64, Format::Rgba8Unorm, &limits, |_, _| [0.5; 4]).unwrap();
+    assert!(small.to_float().is_err());
+    // A float texture is copied as it is.
+    let f = noise_texture(9, 7, Format::Rgba32Float);
+    let g = f.to_float().unwrap();
+    assert_eq!(g.source_format(), Format::Rgba32Float);
+    for k in 0..f.levels().len() {
+        assert_eq!(f.level_mean(k), g.level_mean(k));
+    }
+}

@@ -5,7 +5,7 @@
 use std::sync::atomic::AtomicBool;
 
 use texel_prepare::{
-    ColorHandling, Error, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
+    ColorHandling, Error, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions, TextureStorage,
 };
 use texel_raster::{
     render, ColorTarget, Frame, RasterError, ReferenceEstimate, ReferencePlan, View,
@@ -35,20 +35,26 @@ pub struct RenderOptions {
     pub max_memory: Option<u64>,
     /// Worker threads; `None`: all cores.
     pub threads: Option<usize>,
+    /// How 8-bit textures are kept: as stored, or decoded to float (the same image; faster
+    /// anisotropic and EWA filtering, four times the texture memory).
+    pub texture_storage: TextureStorage,
 }
 
 /// `scene` prepared as a command prepares it: at `size` (or its own), with `color` handling,
-/// non-finite and out-of-range texels refused, every other option at its default.
+/// 8-bit textures kept as `texture_storage` says, non-finite and out-of-range texels refused,
+/// every other option at its default.
 fn prepare(
     scene: &Scene,
     size: Option<(u32, u32)>,
     color: ColorHandling,
+    texture_storage: TextureStorage,
     budget: &mut MemoryBudget,
 ) -> Result<PreparedScene, Error> {
     let options = SceneOptions {
         size,
         color,
         replace_non_finite: false,
+        texture_storage,
         ..SceneOptions::default()
     };
     PreparedScene::new(scene.clone(), &options, budget)
@@ -89,7 +95,13 @@ pub fn encoding(color: ColorHandling) -> quality::Encoding {
 /// [`Error::Raster`] (an invalid size).
 pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Error> {
     let mut budget = MemoryBudget::limit_or_default(options.max_memory);
-    let prepared = prepare(scene, options.size, options.color, &mut budget)?;
+    let prepared = prepare(
+        scene,
+        options.size,
+        options.color,
+        options.texture_storage,
+        &mut budget,
+    )?;
     let plan = prepared.plan(options.filter, &mut budget)?;
     let mut settings = plan.settings();
     settings.view = options.view;
@@ -144,7 +156,13 @@ pub fn reference_scene(
     stop: Option<&AtomicBool>,
 ) -> Result<ReferenceEstimate, Error> {
     let mut budget = MemoryBudget::limit_or_default(options.max_memory);
-    let prepared = prepare(scene, options.size, options.color, &mut budget)?;
+    let prepared = prepare(
+        scene,
+        options.size,
+        options.color,
+        TextureStorage::Stored,
+        &mut budget,
+    )?;
     budget.take(
         "the reference's per-pixel statistics",
         u64::from(prepared.width) * u64::from(prepared.height) * REFERENCE_BYTES_PER_PIXEL,

@@ -41,6 +41,7 @@ pub use texel_prepare as prepare;
 pub use texel_prepare::{ao, bake, bvh, memory, tessellate};
 pub use texel_prepare::{
     ColorHandling, Error, FramePlan, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
+    TextureStorage,
 };
 pub use texel_raster::{render, ColorTarget, DrawCall, Frame, RenderSettings, View};
 pub use texel_scene::{Scene, SceneLimits};

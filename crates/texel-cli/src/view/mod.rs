@@ -20,8 +20,9 @@ use winit::event_loop::EventLoop;
 
 use crate::cli::ViewArgs;
 use crate::controls::{parse_keys, Mode, ViewState};
-use crate::input::{load_scene, Input};
+use crate::input::{check_storage, load_scene_with, Input, MaterialOverrides};
 use fly::Fly;
+use texel::TextureStorage;
 use window::{App, Options};
 use worker::{Rendered, Shared, Worker};
 
@@ -30,7 +31,19 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     let presses =
         parse_keys(args.keys.as_deref().unwrap_or("")).map_err(|e| anyhow!("--keys: {e}"))?;
     let mut input = input;
-    let scene = load_scene(&args.scene, &mut input)?;
+    check_storage(&args.scene, args.gpu)?;
+    // The window filters on the CPU unless --gpu: its textures are decoded to float by default
+    // (the same images, anisotropic frames faster; docs/decisions.md).
+    let overrides = MaterialOverrides {
+        texture_storage: args.scene.texture_storage.unwrap_or(if args.gpu {
+            TextureStorage::Stored
+        } else {
+            TextureStorage::Float
+        }),
+        ..MaterialOverrides::of(&args.scene)
+    };
+    let a = &args.scene;
+    let scene = load_scene_with(&a.scene, a.color, a.size, overrides, &mut input)?;
     let gpu = if args.gpu {
         Some(Gpu::new(args.adapter.as_deref())?)
     } else {
@@ -54,7 +67,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     let worker = Worker {
         scene_spec: args.scene.scene.clone(),
         size: args.scene.size,
-        overrides: crate::input::MaterialOverrides::of(&args.scene),
+        overrides,
         scenes,
         input,
         threads: args.threads,

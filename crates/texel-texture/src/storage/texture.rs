@@ -204,6 +204,9 @@ fn check_jpeg_complete(bytes: &[u8], width: u32, height: u32) -> Result<(), Text
 #[derive(Debug)]
 pub struct Texture {
     format: Format,
+    /// The format the texels came in: [`Texture::format`], except for a decoded copy
+    /// ([`Texture::to_float`]) of 8-bit texels.
+    source: Format,
     levels: Vec<LevelInfo>,
     storage: Storage,
     limits: Limits,
@@ -520,6 +523,7 @@ impl Texture {
     fn assemble(format: Format, levels: Vec<LevelInfo>, storage: Storage, limits: &Limits) -> Self {
         Texture {
             format,
+            source: format,
             levels,
             storage,
             limits: *limits,
@@ -589,6 +593,48 @@ impl Texture {
     /// The storage format.
     pub fn format(&self) -> Format {
         self.format
+    }
+
+    /// The format the texels came in: the storage format, or for a copy decoded by
+    /// [`Texture::to_float`] the 8-bit format of its original, whose codes its values are (what
+    /// a consumer asks when it allows for 8-bit quantisation, such as a normal map's slack).
+    pub fn source_format(&self) -> Format {
+        self.source
+    }
+
+    /// The same texture stored as linear `f32` ([`Format::Rgba32Float`]): every level's texels
+    /// decoded once, to exactly the values the sampler decodes them to, so every filter samples
+    /// it bit for bit as it samples `self` (its ripmap, built on first use, rounds its images to
+    /// the original's 8-bit codes as the original's own ripmap does). It costs 16 bytes a texel
+    /// instead of 4 and spares the filters a decode per texel read: on CPUs whose caches hold
+    /// the larger pyramid, the anisotropic and EWA filters run faster on it (figures in
+    /// docs/decisions.md, "Decoded float storage"). A float texture is copied as it is. The
+    /// copy has `self`'s limits and starts without built structures.
+    ///
+    /// # Errors
+    /// [`TextureError::OverMemoryLimit`] when the float pyramid exceeds the texture's
+    /// [`Limits::max_bytes`] (nothing is allocated then).
+    pub fn to_float(&self) -> Result<Texture, TextureError> {
+        let bytes = self
+            .pyramid_bytes()
+            .saturating_mul(Format::Rgba32Float.texel_bytes() / self.format.texel_bytes());
+        self.limits
+            .check_bytes(self.width(), self.height(), bytes)?;
+        let texels: Vec<[f32; 4]> = match &self.storage {
+            Storage::F32(v) => v.clone(),
+            Storage::U8(v) => {
+                let srgb = self.format == Format::Rgba8Srgb;
+                v.iter().map(|&t| decode_rgba8(t, srgb)).collect()
+            }
+        };
+        let mut t = Texture::assemble(
+            Format::Rgba32Float,
+            self.levels.clone(),
+            Storage::F32(texels),
+            &self.limits,
+        );
+        t.source = self.source;
+        Ok(t)
     }
 
     /// Width of level 0 in texels.

@@ -45,6 +45,7 @@ use crate::kernel::bilinear::bilinear;
 use crate::storage::fetch::Fetch;
 use crate::storage::pyramid::{axis_taps, level_count};
 use crate::storage::tables::Ripmap;
+use crate::storage::texture::decode_rgba8;
 use crate::storage::texture::{Format, LevelInfo, Storage, Texture};
 use crate::storage::view::{with_pyramid, Pyramid};
 use crate::technique::mip::linear_levels;
@@ -127,7 +128,7 @@ impl Ripmap {
         let idx = info.offset + j as usize * w as usize + i as usize;
         Some(match &self.storage {
             // Decode as the pyramid does.
-            Storage::U8(v) => crate::storage::texture::decode_rgba8(v[idx], self.srgb),
+            Storage::U8(v) => decode_rgba8(v[idx], self.srgb),
             Storage::F32(v) => v[idx],
         })
     }
@@ -199,11 +200,22 @@ fn build_from<F: Fetch + Sync>(texture: &Texture, level0: &F) -> Ripmap {
         _ => out_u8.reserve_exact(total),
     }
     let srgb = format == Format::Rgba8Srgb;
+    // A float copy of 8-bit texels ([`Texture::to_float`]) rounds its images to the original's
+    // codes, as the original's own ripmap stores them, so both sample the same values.
+    let codes = match texture.source_format() {
+        Format::Rgba32Float => None,
+        source => Some(source == Format::Rgba8Srgb),
+    };
     let mut push = |img: &[Vec4]| -> usize {
-        match format {
-            Format::Rgba32Float => {
+        match (format, codes) {
+            (Format::Rgba32Float, None) => {
                 let off = out_f32.len();
                 out_f32.extend(img.iter().map(|c| c.to_array()));
+                off
+            }
+            (Format::Rgba32Float, Some(srgb)) => {
+                let off = out_f32.len();
+                out_f32.extend(img.iter().map(|c| decode_rgba8(encode_u8(*c, srgb), srgb)));
                 off
             }
             _ => {
