@@ -143,9 +143,10 @@ pub struct SceneArgs {
     #[arg(long, value_enum, default_value_t)]
     pub precision: texel::raster::Precision,
     /// How 8-bit textures are kept for the CPU's filters: as stored (4 bytes a texel, decoded at
-    /// each read), or decoded once to float (16 bytes a texel; the same images, anisotropic and
-    /// EWA frames faster: docs/decisions.md). Default: float for `view`, stored elsewhere; with
-    /// --gpu, stored. A texture whose float copy does not fit the memory budget stays stored.
+    /// each read), or decoded once to float (16 bytes a texel; the same images, mip and
+    /// anisotropic frames faster: docs/decisions.md). Default: float for `view`, stored
+    /// elsewhere and with --gpu or --precision gpu. A texture whose float copy does not fit the
+    /// memory budget stays stored.
     #[arg(long, value_enum, value_name = "STORAGE")]
     pub texture_storage: Option<texel::TextureStorage>,
 }

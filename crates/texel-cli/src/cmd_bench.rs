@@ -270,11 +270,12 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         };
         writeln!(
             stdout,
-            "{{\n \"renderer\": \"{renderer}\",{adapter}\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"streaming\": \"{}\",\n \"streamed\": {},\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
+            "{{\n \"renderer\": \"{renderer}\",{adapter}\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"texture_storage\": \"{}\",\n \"streaming\": \"{}\",\n \"streamed\": {},\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
             serde_json::Value::from(cpu_model()),
             simd_level(),
             target_name(args.target),
             precision_name(args.scene.precision),
+            storage_name(&scene),
             args.streaming.name(),
             streamed,
             scene.width,
@@ -297,10 +298,11 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         )?;
         writeln!(
             stdout,
-            "cpu: {}; simd: {}; precision: {}; streaming: {} ({})",
+            "cpu: {}; simd: {}; precision: {}; textures: {}; streaming: {} ({})",
             cpu_model(),
             simd_level(),
             precision_name(args.scene.precision),
+            storage_name(&scene),
             args.streaming.name(),
             if streamed { "streamed" } else { "in place" }
         )?;
@@ -353,6 +355,20 @@ fn cpu_model() -> String {
 /// `texel_raster::simd_level`).
 fn simd_level() -> String {
     format!("{}, run-time dispatch", texel_raster::simd_level().name())
+}
+
+/// How the scene's textures are kept, as the bench prints it: `stored`, `float` (8-bit textures
+/// decoded to float), or `float, N stored` when N of them did not fit the budget as float.
+fn storage_name(scene: &texel::PreparedScene) -> String {
+    let decoded = scene
+        .textures
+        .values()
+        .any(|t| t.format() != t.source_format());
+    match (decoded, scene.kept_stored.len()) {
+        (false, 0) => "stored".into(),
+        (true, 0) => "float".into(),
+        (_, n) => format!("float, {n} stored"),
+    }
 }
 
 /// `--precision`'s value as the bench prints it.

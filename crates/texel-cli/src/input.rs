@@ -143,12 +143,21 @@ impl MaterialOverrides {
     }
 }
 
-/// `--texture-storage` against a command's `--gpu`: the GPU path uploads the texels as stored,
-/// so `float` with `--gpu` is refused rather than ignored.
+/// `--texture-storage` against a command's `--gpu` and `--precision`: the GPU path uploads the
+/// texels as stored and the fixed-point path reads 8-bit codes, so `float` with either is
+/// refused rather than ignored.
 pub fn check_storage(args: &SceneArgs, gpu: bool) -> Result<()> {
-    if gpu && args.texture_storage == Some(texel::TextureStorage::Float) {
+    if args.texture_storage != Some(texel::TextureStorage::Float) {
+        return Ok(());
+    }
+    if gpu {
         anyhow::bail!(
             "--texture-storage float is for the CPU's filters; --gpu uploads the texels as stored"
+        );
+    }
+    if args.precision == texel::raster::Precision::Gpu {
+        anyhow::bail!(
+            "--texture-storage float and --precision gpu: the fixed-point filters read 8-bit codes"
         );
     }
     Ok(())

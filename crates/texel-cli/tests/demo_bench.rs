@@ -104,11 +104,13 @@ fn bench_json_has_the_llvmpipe_shape() {
             "streamed",
             "streaming",
             "target",
+            "texture_storage",
             "threads",
             "width"
         ]
     );
     assert_eq!(v["renderer"], "texel");
+    assert_eq!(v["texture_storage"], "stored");
     assert_eq!(v["target"], "rgba8");
     assert_eq!(v["precision"], "exact");
     assert_eq!(v["streaming"], "auto");
@@ -184,4 +186,33 @@ fn bench_streaming_is_reported() {
     }
     let text = bench("nearest", "always", false);
     assert!(text.contains("streaming: always (streamed)"), "{text}");
+}
+
+/// The report names how the textures were kept: `--texture-storage float` says `float`, and a
+/// budget too small for the float copy keeps the texture stored and says so.
+#[test]
+fn bench_reports_texture_storage() {
+    let bench = |more: &[&str]| {
+        let args = [
+            "bench",
+            "--size",
+            "64x36",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+            "--filters",
+            "aniso16",
+        ];
+        let o = texel(&[&args[..], more].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        (stdout(&o), stderr(&o))
+    };
+    let (json, _) = bench(&["--texture-storage", "float", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["texture_storage"], "float");
+    // The ground's checker: 5.3 MiB stored, 21.3 MiB as float.
+    let (text, note) = bench(&["--texture-storage", "float", "--max-memory", "16M"]);
+    assert!(text.contains("textures: float, 1 stored"), "{text}");
+    assert!(note.contains("stays 8-bit"), "{note}");
 }

@@ -258,5 +258,18 @@ fn float_texture_storage_renders_the_same_bytes() {
         1,
         &["--texture-storage float", "--gpu"],
     );
+    fails(
+        &[
+            "render",
+            "--texture-storage",
+            "float",
+            "--precision",
+            "gpu",
+            "-o",
+            &d.arg("p.png"),
+        ],
+        1,
+        &["--texture-storage float", "--precision gpu"],
+    );
     fails(&["render", "--texture-storage", "half"], 2, &["half"]);
 }

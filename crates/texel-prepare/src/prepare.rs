@@ -65,14 +65,14 @@ pub enum TextureStorage {
     )]
     Stored,
     /// Decoded once to linear `f32` ([`Texture::to_float`]): 16 bytes a texel, the same images,
-    /// and faster anisotropic and EWA filtering on CPUs whose caches hold the larger pyramids
+    /// and faster mip and anisotropic filtering on CPUs whose caches hold the larger pyramids
     /// (docs/decisions.md, "Decoded float storage"). A texture whose float pyramid does not fit
     /// what the memory budget has left stays stored ([`PreparedScene::kept_stored`]); under
     /// [`Precision::Gpu`] unorm8 textures stay stored, since the fixed-point path reads codes.
     #[cfg_attr(
         feature = "clap",
         value(
-            help = "Decoded once to linear f32: 16 bytes a texel, the same images, faster anisotropic and EWA filtering"
+            help = "Decoded once to linear f32: 16 bytes a texel, the same images, faster mip and anisotropic filtering"
         )
     )]
     Float,
@@ -866,8 +866,7 @@ fn store_textures(
         if format == Format::Rgba32Float || codes_read {
             continue;
         }
-        let stored = texture.pyramid_bytes();
-        let float = stored.saturating_mul(4);
+        let (stored, float) = (texture.pyramid_bytes(), texture.float_pyramid_bytes());
         if float > budget.remaining() {
             kept.push((name.clone(), float));
             continue;

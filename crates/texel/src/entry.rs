@@ -35,8 +35,9 @@ pub struct RenderOptions {
     pub max_memory: Option<u64>,
     /// Worker threads; `None`: all cores.
     pub threads: Option<usize>,
-    /// How 8-bit textures are kept: as stored, or decoded to float (the same image; faster
-    /// anisotropic and EWA filtering, four times the texture memory).
+    /// How 8-bit textures are kept: as stored, or decoded to float (the same image; faster mip
+    /// and anisotropic filtering, four times the texture memory; a texture whose float copy does
+    /// not fit `max_memory` stays stored).
     pub texture_storage: TextureStorage,
 }
 

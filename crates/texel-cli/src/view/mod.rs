@@ -35,11 +35,13 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     // The window filters on the CPU unless --gpu: its textures are decoded to float by default
     // (the same images, anisotropic frames faster; docs/decisions.md).
     let overrides = MaterialOverrides {
-        texture_storage: args.scene.texture_storage.unwrap_or(if args.gpu {
-            TextureStorage::Stored
-        } else {
-            TextureStorage::Float
-        }),
+        texture_storage: args.scene.texture_storage.unwrap_or(
+            if args.gpu || args.scene.precision == texel::raster::Precision::Gpu {
+                TextureStorage::Stored
+            } else {
+                TextureStorage::Float
+            },
+        ),
         ..MaterialOverrides::of(&args.scene)
     };
     let a = &args.scene;

@@ -607,17 +607,19 @@ impl Texture {
     /// it bit for bit as it samples `self` (its ripmap, built on first use, rounds its images to
     /// the original's 8-bit codes as the original's own ripmap does). It costs 16 bytes a texel
     /// instead of 4 and spares the filters a decode per texel read: on CPUs whose caches hold
-    /// the larger pyramid, the anisotropic and EWA filters run faster on it (figures in
+    /// the larger pyramid, the mip and anisotropic filters (and EWA of sRGB texels) run faster
+    /// on it (figures in
     /// docs/decisions.md, "Decoded float storage"). A float texture is copied as it is. The
-    /// copy has `self`'s limits and starts without built structures.
+    /// copy starts without built structures (its ripmap, built in float, takes four times the
+    /// 8-bit one's bytes); its limits are `self`'s with [`Limits::max_bytes`] raised by the
+    /// pyramid's growth, so that what fitted next to the 8-bit pyramid is measured against the
+    /// same room.
     ///
     /// # Errors
-    /// [`TextureError::OverMemoryLimit`] when the float pyramid exceeds the texture's
-    /// [`Limits::max_bytes`] (nothing is allocated then).
+    /// [`TextureError::OverMemoryLimit`] when [`Texture::float_pyramid_bytes`] exceeds the
+    /// texture's [`Limits::max_bytes`] (nothing is allocated then).
     pub fn to_float(&self) -> Result<Texture, TextureError> {
-        let bytes = self
-            .pyramid_bytes()
-            .saturating_mul(Format::Rgba32Float.texel_bytes() / self.format.texel_bytes());
+        let bytes = self.float_pyramid_bytes();
         self.limits
             .check_bytes(self.width(), self.height(), bytes)?;
         let texels: Vec<[f32; 4]> = match &self.storage {
@@ -627,14 +629,25 @@ impl Texture {
                 v.iter().map(|&t| decode_rgba8(t, srgb)).collect()
             }
         };
+        let growth = bytes - self.pyramid_bytes();
+        let limits = Limits {
+            max_bytes: self.limits.max_bytes.saturating_add(growth),
+            ..self.limits
+        };
         let mut t = Texture::assemble(
             Format::Rgba32Float,
             self.levels.clone(),
             Storage::F32(texels),
-            &self.limits,
+            &limits,
         );
         t.source = self.source;
         Ok(t)
+    }
+
+    /// Bytes of the pyramid as [`Texture::to_float`] stores it (16 a texel).
+    pub fn float_pyramid_bytes(&self) -> u64 {
+        self.pyramid_bytes()
+            .saturating_mul(Format::Rgba32Float.texel_bytes() / self.format.texel_bytes())
     }
 
     /// Width of level 0 in texels.
