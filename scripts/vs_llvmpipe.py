@@ -50,22 +50,21 @@ def main():
                     help="also time texel's core filters with --texture-storage float")
     a = ap.parse_args()
 
+    def bench(filters, *extra):
+        """One `texel bench --json` of `filters` with `extra` options: ms per frame by filter."""
+        return run_json([a.texel, "bench", a.scene, "--color", "raw", "--frames", str(a.frames),
+                         "--threads", str(a.threads), "--filters", ",".join(filters), *extra,
+                         "--json"])["median_ms"]
+
     texel, peer, fixed, floats = [], [], [], []
     renderer = "llvmpipe"
     for r in range(a.rounds):
         print(f"round {r + 1}/{a.rounds}", file=sys.stderr)
-        texel.append(run_json([a.texel, "bench", a.scene, "--color", "raw", "--frames",
-                               str(a.frames), "--threads", str(a.threads), "--filters",
-                               ",".join(CORE + TEXEL_ONLY), "--json"])["median_ms"])
+        texel.append(bench(CORE + TEXEL_ONLY))
         if a.gpu_precision:
-            fixed.append(run_json([a.texel, "bench", a.scene, "--color", "raw", "--frames",
-                                   str(a.frames), "--threads", str(a.threads), "--filters",
-                                   ",".join(CORE), "--precision", "gpu", "--json"])["median_ms"])
+            fixed.append(bench(CORE, "--precision", "gpu"))
         if a.float_storage:
-            floats.append(run_json([a.texel, "bench", a.scene, "--color", "raw", "--frames",
-                                    str(a.frames), "--threads", str(a.threads), "--filters",
-                                    ",".join(CORE + TEXEL_ONLY), "--texture-storage", "float",
-                                    "--json"])["median_ms"])
+            floats.append(bench(CORE + TEXEL_ONLY, "--texture-storage", "float"))
         p = run_json([sys.executable, a.peer, a.scene, "--frames", str(a.frames), "--threads",
                       str(a.threads), "--filters", ",".join(CORE)])
         renderer = f"{p.get('renderer', 'llvmpipe')}, {p.get('version', '')}"

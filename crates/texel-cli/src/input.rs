@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use texel::memory::{MESH_BYTES, TRIANGLE_BYTES, VERTEX_BYTES};
-use texel::{MemoryBudget, PreparedScene, Scene, SceneLimits, SceneOptions};
+use texel::{MemoryBudget, PreparedScene, Scene, SceneLimits, SceneOptions, TextureStorage};
 use texel_texture::{ColorSpace, Limits, LoadOptions, TextureError};
 
 use texel_raster::SpecularAa;
@@ -123,7 +123,7 @@ pub struct MaterialOverrides {
     /// `--precision`.
     pub precision: texel::raster::Precision,
     /// `--texture-storage`, or the command's default.
-    pub texture_storage: texel::TextureStorage,
+    pub texture_storage: TextureStorage,
 }
 
 impl MaterialOverrides {
@@ -143,24 +143,35 @@ impl MaterialOverrides {
     }
 }
 
-/// `--texture-storage` against a command's `--gpu` and `--precision`: the GPU path uploads the
-/// texels as stored and the fixed-point path reads 8-bit codes, so `float` with either is
-/// refused rather than ignored.
+/// The texture storage a command with `args` and `gpu` (its `--gpu`) runs with:
+/// `--texture-storage` when given, else `preferred`. The GPU path uploads the texels as stored
+/// and the fixed-point path (`--precision gpu`) reads 8-bit codes, so with either `float` is
+/// refused when asked for and not chosen by default.
+pub fn texture_storage(
+    args: &SceneArgs,
+    gpu: bool,
+    preferred: TextureStorage,
+) -> Result<TextureStorage> {
+    let stored_only = if gpu {
+        Some("--texture-storage float is for the CPU's filters; --gpu uploads the texels as stored")
+    } else if args.precision == texel::raster::Precision::Gpu {
+        Some(
+            "--texture-storage float and --precision gpu: the fixed-point filters read 8-bit codes",
+        )
+    } else {
+        None
+    };
+    Ok(match (args.texture_storage, stored_only) {
+        (Some(TextureStorage::Float), Some(why)) => anyhow::bail!("{why}"),
+        (Some(asked), _) => asked,
+        (None, Some(_)) => TextureStorage::Stored,
+        (None, None) => preferred,
+    })
+}
+
+/// [`texture_storage`]'s refusals for a command whose default is stored.
 pub fn check_storage(args: &SceneArgs, gpu: bool) -> Result<()> {
-    if args.texture_storage != Some(texel::TextureStorage::Float) {
-        return Ok(());
-    }
-    if gpu {
-        anyhow::bail!(
-            "--texture-storage float is for the CPU's filters; --gpu uploads the texels as stored"
-        );
-    }
-    if args.precision == texel::raster::Precision::Gpu {
-        anyhow::bail!(
-            "--texture-storage float and --precision gpu: the fixed-point filters read 8-bit codes"
-        );
-    }
-    Ok(())
+    texture_storage(args, gpu, TextureStorage::Stored).map(drop)
 }
 
 /// Load `scene` (a path or `builtin:NAME`) and its textures within `input`'s account, with

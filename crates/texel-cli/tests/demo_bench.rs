@@ -161,23 +161,11 @@ fn bench_json_has_the_llvmpipe_shape() {
 #[test]
 fn bench_streaming_is_reported() {
     let bench = |filter: &str, policy: &str, json: bool| {
-        let mut args = vec![
-            "bench",
-            "--size",
-            "64x36",
-            "--frames",
-            "1",
-            "--warmup",
-            "0",
-            "--filters",
+        let json: &[&str] = if json { &["--json"] } else { &[] };
+        stdout(&ok(&one_frame_bench(
             filter,
-            "--streaming",
-            policy,
-        ];
-        if json {
-            args.push("--json");
-        }
-        stdout(&ok(&args))
+            &[&["--streaming", policy], json].concat(),
+        )))
     };
     for (policy, streamed) in [("always", true), ("never", false)] {
         let v: serde_json::Value = serde_json::from_str(&bench("bilinear", policy, true)).unwrap();
@@ -193,18 +181,7 @@ fn bench_streaming_is_reported() {
 #[test]
 fn bench_reports_texture_storage() {
     let bench = |more: &[&str]| {
-        let args = [
-            "bench",
-            "--size",
-            "64x36",
-            "--frames",
-            "1",
-            "--warmup",
-            "0",
-            "--filters",
-            "aniso16",
-        ];
-        let o = texel(&[&args[..], more].concat());
+        let o = texel(&one_frame_bench("aniso16", more));
         assert!(o.status.success(), "{}", stderr(&o));
         (stdout(&o), stderr(&o))
     };
@@ -215,4 +192,20 @@ fn bench_reports_texture_storage() {
     let (text, note) = bench(&["--texture-storage", "float", "--max-memory", "16M"]);
     assert!(text.contains("textures: float, 1 stored"), "{text}");
     assert!(note.contains("stays 8-bit"), "{note}");
+}
+
+/// `texel bench` of one 64 x 36 frame of `filter` without warm-up, then `more`.
+fn one_frame_bench<'a>(filter: &'a str, more: &[&'a str]) -> Vec<&'a str> {
+    let args = [
+        "bench",
+        "--size",
+        "64x36",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--filters",
+        filter,
+    ];
+    [&args[..], more].concat()
 }

@@ -850,7 +850,8 @@ fn load_textures(
 /// Keep `textures` as `options.texture_storage` asks: with [`TextureStorage::Float`] each 8-bit
 /// texture is replaced by its float copy where the copy fits what `budget` has left (charged
 /// while both exist, the 8-bit pyramid released after); the names and float bytes of those that
-/// did not fit.
+/// did not fit. A copy that fits the budget fits its texture's own limits too: those were what
+/// the budget had left when the texture was loaded, before its own pyramid was charged.
 fn store_textures(
     textures: &mut BTreeMap<String, Texture>,
     options: &SceneOptions,
@@ -872,17 +873,8 @@ fn store_textures(
             continue;
         }
         budget.take(&format!("texture {name:?} as float"), float)?;
-        match texture.to_float() {
-            Ok(copy) => {
-                *texture = copy;
-                budget.release(stored);
-            }
-            // Over the texture's own limits (those it was loaded within).
-            Err(_) => {
-                budget.release(float);
-                kept.push((name.clone(), float));
-            }
-        }
+        *texture = texture.to_float()?;
+        budget.release(stored);
     }
     Ok(kept)
 }

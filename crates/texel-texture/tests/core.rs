@@ -82,6 +82,35 @@ fn spread(k: usize) -> (f32, f32) {
     (t.fract(), (t * 0.37).fract())
 }
 
+/// `per` footprints for each `(major, minor)` pair of axis lengths (texels of a 64-texel side):
+/// footprint `j` of a pair turned by `j * turn` radians, centred at `centre` of the `k`-th
+/// [`spread`] position (per coordinate).
+fn rotated_footprints(
+    axes: &[(f32, f32)],
+    per: usize,
+    turn: f32,
+    centre: impl Fn(f32) -> f32 + Copy,
+) -> Vec<Footprint> {
+    axes.iter()
+        .enumerate()
+        .flat_map(|(k, &(major, minor))| {
+            (0..per).map(move |j| {
+                let (u, v) = spread(k * per + j);
+                let a = j as f32 * turn;
+                let (c, s) = (a.cos() / 64.0, a.sin() / 64.0);
+                Footprint {
+                    u: centre(u),
+                    v: centre(v),
+                    dudx: major * c,
+                    dvdx: major * s,
+                    dudy: -minor * s,
+                    dvdy: minor * c,
+                }
+            })
+        })
+        .collect()
+}
+
 /// `fps` as lanes: `u`, `v` and `[dudx, dudy, dvdx, dvdy]` (for [`FootprintLanes::new`]).
 fn lanes_of(fps: &[Footprint]) -> (Vec<f32>, Vec<f32>, [Vec<f32>; 4]) {
     let field = |f: fn(&Footprint) -> f32| fps.iter().map(f).collect::<Vec<_>>();
@@ -1625,31 +1654,14 @@ fn float_texels_at_the_range_edge_filter_to_finite_values() {
             ..Filter::Trilinear.descriptor(AddressMode::Repeat, AddressMode::Repeat)
         },
     ));
-    let footprints: Vec<Footprint> = [
+    let axes = [
         (0.1f32, 0.1f32),
         (1.0, 1.0),
         (8.0, 1.0),
         (64.0, 1.0),
         (64.0, 0.25),
-    ]
-    .iter()
-    .enumerate()
-    .flat_map(|(k, &(major, minor))| {
-        (0..16).map(move |j| {
-            let (u, v) = spread(k * 16 + j);
-            let a = j as f32 * 0.4;
-            let (c, s) = (a.cos() / 64.0, a.sin() / 64.0);
-            Footprint {
-                u,
-                v,
-                dudx: major * c,
-                dvdx: major * s,
-                dudy: -minor * s,
-                dvdy: minor * c,
-            }
-        })
-    })
-    .collect();
+    ];
+    let footprints = rotated_footprints(&axes, 16, 0.4, |x| x);
     for (texels, name) in [(constant, "constant"), (extremes, "extremes")] {
         let tex = Texture::from_rgba32f(64, 64, texels, &Limits::default()).unwrap();
         for (filter, d) in &descriptors {
@@ -1698,33 +1710,16 @@ fn float_texels_at_the_range_edge_filter_to_finite_values() {
 /// 64:1, through the one-sample and the batched paths.
 #[test]
 fn float_copies_sample_as_their_8bit_originals() {
-    let footprints: Vec<Footprint> = [
+    let axes = [
         (0.3f32, 0.3f32),
         (1.5, 1.0),
         (6.0, 2.0),
         (16.0, 1.0),
         (64.0, 1.0),
         (40.0, 13.0),
-    ]
-    .iter()
-    .enumerate()
-    .flat_map(|(k, &(major, minor))| {
-        (0..24).map(move |j| {
-            let (u, v) = spread(k * 24 + j);
-            let a = j as f32 * 0.37;
-            let (c, s) = (a.cos() / 64.0, a.sin() / 64.0);
-            Footprint {
-                // Some centres outside [0, 1) so that the address modes matter.
-                u: u * 1.6 - 0.3,
-                v: v * 1.6 - 0.3,
-                dudx: major * c,
-                dvdx: major * s,
-                dudy: -minor * s,
-                dvdy: minor * c,
-            }
-        })
-    })
-    .collect();
+    ];
+    // Some centres outside [0, 1) so that the address modes matter.
+    let footprints = rotated_footprints(&axes, 24, 0.37, |x| x * 1.6 - 0.3);
     for format in [Format::Rgba8Srgb, Format::Rgba8Unorm] {
         for (w, h) in [(64, 64), (37, 53)] {
             let stored = noise_texture(w, h, format);

@@ -20,7 +20,7 @@ use winit::event_loop::EventLoop;
 
 use crate::cli::ViewArgs;
 use crate::controls::{parse_keys, Mode, ViewState};
-use crate::input::{check_storage, load_scene_with, Input, MaterialOverrides};
+use crate::input::{load_scene_with, texture_storage, Input, MaterialOverrides};
 use fly::Fly;
 use texel::TextureStorage;
 use window::{App, Options};
@@ -31,17 +31,10 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     let presses =
         parse_keys(args.keys.as_deref().unwrap_or("")).map_err(|e| anyhow!("--keys: {e}"))?;
     let mut input = input;
-    check_storage(&args.scene, args.gpu)?;
-    // The window filters on the CPU unless --gpu: its textures are decoded to float by default
+    // The window's textures are decoded to float by default where its filters run on the CPU
     // (the same images, anisotropic frames faster; docs/decisions.md).
     let overrides = MaterialOverrides {
-        texture_storage: args.scene.texture_storage.unwrap_or(
-            if args.gpu || args.scene.precision == texel::raster::Precision::Gpu {
-                TextureStorage::Stored
-            } else {
-                TextureStorage::Float
-            },
-        ),
+        texture_storage: texture_storage(&args.scene, args.gpu, TextureStorage::Float)?,
         ..MaterialOverrides::of(&args.scene)
     };
     let a = &args.scene;

@@ -206,16 +206,15 @@ fn build_from<F: Fetch + Sync>(texture: &Texture, level0: &F) -> Ripmap {
         Format::Rgba32Float => None,
         source => Some(source == Format::Rgba8Srgb),
     };
+    let texel = |c: &Vec4| match codes {
+        Some(srgb) => decode_rgba8(encode_u8(*c, srgb), srgb),
+        None => c.to_array(),
+    };
     let mut push = |img: &[Vec4]| -> usize {
-        match (format, codes) {
-            (Format::Rgba32Float, None) => {
+        match format {
+            Format::Rgba32Float => {
                 let off = out_f32.len();
-                out_f32.extend(img.iter().map(|c| c.to_array()));
-                off
-            }
-            (Format::Rgba32Float, Some(srgb)) => {
-                let off = out_f32.len();
-                out_f32.extend(img.iter().map(|c| decode_rgba8(encode_u8(*c, srgb), srgb)));
+                out_f32.extend(img.iter().map(texel));
                 off
             }
             _ => {
