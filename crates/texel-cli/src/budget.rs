@@ -4,8 +4,8 @@
 use texel::memory::mib;
 use texel::MemoryBudget;
 
-/// A byte count from the command line: a whole number with an optional unit K, M, G, T (powers
-/// of 1024; `KiB`, `MB`, ... are read the same way), at least 1 MiB.
+/// A byte count from the command line: a number (decimals allowed, `170.8M`) with an optional
+/// unit K, M, G, T (powers of 1024; `KiB`, `MB`, ... are read the same way), at least 1 MiB.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ByteSize(pub u64);
 
@@ -13,11 +13,15 @@ impl std::str::FromStr for ByteSize {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         let t = s.trim();
-        let split = t.find(|c: char| !c.is_ascii_digit()).unwrap_or(t.len());
+        let split = t
+            .find(|c: char| !c.is_ascii_digit() && c != '.')
+            .unwrap_or(t.len());
         let (num, unit) = t.split_at(split);
-        let n: u64 = num
-            .parse()
-            .map_err(|_| format!("{s:?} is not a size (e.g. 512M, 4G or a number of bytes)"))?;
+        let not_a_size = || format!("{s:?} is not a size (e.g. 512M, 1.5G or a number of bytes)");
+        let (whole, fraction) = num.split_once('.').unwrap_or((num, ""));
+        if whole.is_empty() && fraction.is_empty() || fraction.contains('.') {
+            return Err(not_a_size());
+        }
         let shift = match unit.trim().to_ascii_uppercase().as_str() {
             "" | "B" => 0,
             "K" | "KB" | "KIB" => 10,
@@ -26,9 +30,26 @@ impl std::str::FromStr for ByteSize {
             "T" | "TB" | "TIB" => 40,
             other => return Err(format!("{s:?}: unknown unit {other:?} (use K, M, G or T)")),
         };
-        let bytes = n
-            .checked_mul(1u64 << shift)
-            .ok_or_else(|| format!("{s:?} is too large"))?;
+        let too_large = || format!("{s:?} is too large");
+        let whole: u64 = if whole.is_empty() {
+            0
+        } else {
+            whole.parse().map_err(|_| not_a_size())?
+        };
+        let mut bytes = whole.checked_mul(1u64 << shift).ok_or_else(too_large)?;
+        if !fraction.is_empty() {
+            // The decimals as a fraction of the unit, rounded up to a whole byte: a figure texel
+            // prints ("170.8 MiB") given back as a limit is never below it.
+            let digits = fraction.len().min(18) as u32;
+            let f: u128 = fraction[..digits as usize]
+                .parse()
+                .map_err(|_| not_a_size())?;
+            let scale = 10u128.pow(digits);
+            let part = (f * (1u128 << shift)).div_ceil(scale);
+            bytes = bytes
+                .checked_add(u64::try_from(part).map_err(|_| too_large())?)
+                .ok_or_else(too_large)?;
+        }
         if bytes < 1 << 20 {
             return Err(format!("{s:?} is below the minimum of 1M"));
         }
@@ -68,6 +89,13 @@ mod tests {
         assert!("4X".parse::<ByteSize>().is_err());
         assert!("99999999999T".parse::<ByteSize>().is_err());
         assert!("".parse::<ByteSize>().is_err());
+        // Decimals, as texel prints its figures, rounded up to a whole byte.
+        assert_eq!("170.8M".parse::<ByteSize>(), Ok(ByteSize(179_096_781)));
+        assert_eq!("1.5G".parse::<ByteSize>(), Ok(ByteSize(3 << 29)));
+        assert_eq!(".5G".parse::<ByteSize>(), Ok(ByteSize(1 << 29)));
+        for bad in [".", "1.5.2M", "1..5M", "-1M", "1,5M"] {
+            assert!(bad.parse::<ByteSize>().is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -268,6 +268,12 @@ pub struct ReferenceArgs {
     /// (viridis, 0 to 4 8-bit steps; red where a pixel did not converge).
     #[arg(long, value_name = "PATH", value_parser = image_output())]
     pub error_map: Option<PathBuf>,
+    /// On an interrupt (Ctrl-C, SIGTERM, SIGHUP), write the partial reference over existing
+    /// files too. Without it a partial result goes only to outputs that do not exist yet; either
+    /// way it carries a `texel:partial` entry (PNG text chunk, OpenEXR attribute) with the
+    /// samples it reached.
+    #[arg(long)]
+    pub keep_partial: bool,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
     #[arg(short, long, value_parser = image_output())]

@@ -18,6 +18,7 @@ use crate::threads::{thread_count, with_threads};
 
 /// Run `texel bake-ao`.
 pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
+    crate::output::check_outputs(&[("-o", &args.output)])?;
     let meshes = load_meshes(&args.mesh, input)?;
     let mesh = AoMesh::from_meshes(&meshes);
     drop(meshes);
@@ -63,7 +64,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
             i64::from(protected_levels(m)) - 1
         ),
     };
-    eprintln!(
+    texel_io::stderr_line(format_args!(
         "texel bake-ao: {} triangles, {size}x{size}: {} texels sampled ({:.1} %), {} filled by the margin, {:.1} M rays in {seconds:.1} s on {} threads ({:.2} M rays/s); margin: {margin}",
         mesh.triangles.len(),
         map.sampled,
@@ -73,12 +74,12 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
         thread_count(args.threads),
         map.rays as f64 / 1e6 / seconds.max(1e-9),
         size = map.size,
-    );
+    ));
     if map.skipped_triangles > 0 {
-        eprintln!(
+        texel_io::stderr_line(format_args!(
             "texel bake-ao: warning: {} triangles not baked (zero area in uv or in space, or outside the map's [0, 1] uv square); they still occlude",
             map.skipped_triangles
-        );
+        ));
     }
     Ok(())
 }

@@ -120,9 +120,18 @@ pub const EXTRA_BYTES_PER_PIXEL: u64 = 16;
 
 /// Check `--extra` entries against each other and the filters: every label names one row and one
 /// file, so two labels that are equal, or whose file names would be equal, or a label equal to a
-/// compared filter's name, are refused.
+/// compared filter's name, are refused, and so is a label holding control or bidirectional
+/// characters (it is a row of the report).
 pub fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<()> {
     for (i, (label, _)) in extras.iter().enumerate() {
+        // A label is a row of the report (Markdown, HTML, JSON) that a terminal may show.
+        if label.chars().any(texel_io::term::needs_escape) {
+            bail!(
+                "--extra label {} holds control or bidirectional characters: give a label of \
+                 printable characters",
+                texel_io::escape(label)
+            );
+        }
         if let Some(f) = filters.iter().find(|f| f.name() == label) {
             bail!(
                 "--extra label {label:?} is also the name of a compared filter ({}): give the extra image another label",
@@ -169,7 +178,7 @@ fn gpu_rows(
     budget: &mut MemoryBudget,
 ) -> Result<Vec<(String, Frame, f64)>> {
     let gpu = texel_gpu::Gpu::new(adapter)?;
-    eprintln!("gpu: {}", gpu.info());
+    texel_io::stderr_line(format_args!("gpu: {}", gpu.info()));
     let mut settings = scene.settings();
     settings.derivatives = texel_raster::Derivatives::Quad;
     let mut jobs: Vec<(String, Filter, GpuFilter)> = filters
@@ -451,7 +460,7 @@ fn orbit_scores(
     let mut change = vec![0.0; filters.len()];
     let mut psnr_sum: Vec<f64> = rows.iter().map(|r| r.psnr_all).collect();
     for k in 1..spec.frames {
-        eprintln!("orbit frame {k} of {}", spec.frames - 1);
+        texel_io::stderr_line(format_args!("orbit frame {k} of {}", spec.frames - 1));
         let camera = scene.scene.camera.orbited(spec.step_deg * k as f32);
         let bar = progress::bar(1, "reference");
         let estimate = reference_estimate(scene, plan, &camera, None, &bar, None)?;
@@ -490,6 +499,28 @@ fn orbit_scores(
     })
 }
 
+/// What `compare` can tell before its first pixel: the frame holds SSIM's window, and every
+/// `--extra` image (its header read, not decoded) has the comparison's size.
+fn check_before_work(scene: &PreparedScene, extras: &[(String, PathBuf)]) -> Result<()> {
+    let (w, h) = (scene.width, scene.height);
+    let side = texel_quality::ssim::WINDOW as u32;
+    anyhow::ensure!(
+        w >= side && h >= side,
+        "invalid --size {w}x{h}: compare scores SSIM over {side}x{side} windows, so each side must \
+         be at least {side} pixels"
+    );
+    for (label, path) in extras {
+        let (iw, ih) = Image8::dimensions(path)
+            .with_context(|| format!("cannot load --extra image {label}={}", path.display()))?;
+        anyhow::ensure!(
+            (iw, ih) == (w, h),
+            "--extra image {} is {iw}x{ih} but the comparison is {w}x{h} (pass --size to match)",
+            path.display(),
+        );
+    }
+    Ok(())
+}
+
 /// Run `texel compare`.
 pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     let filters = parse_list(&args.filters)?;
@@ -508,6 +539,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     )?;
     check_storage(&args.scene, args.gpu)?;
     let scene = load_scene(&args.scene, input)?;
+    check_before_work(&scene, &extras)?;
     let frames = if args.gpu {
         gpu_rows(&scene, &filters, args.adapter.as_deref(), &mut input.budget)?
     } else {
@@ -543,8 +575,10 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     let mut inputs: Vec<&Path> = vec![Path::new(&args.scene.scene)];
     inputs.extend(extras.files.iter().map(|(_, p)| p.as_path()));
     let report = publish_dir(&args.out, &inputs, |dir| {
+        // The scene's name as the report shows it: control and bidirectional characters escaped.
+        let label = texel_io::escape(&args.scene.scene);
         let job = Comparison {
-            label: &args.scene.scene,
+            label: &label,
             filters: &filters,
             plan: &plan,
             orbit,
@@ -552,8 +586,11 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         compare(&scene, &job, &extras, dir, &mut input.budget)
     })
     .with_context(|| format!("cannot write the report to {}", args.out.display()))?;
-    print!("{}", report.to_markdown());
-    eprintln!("report: {}", args.out.join("index.html").display());
+    texel_io::stdout_text(&report.to_markdown()).context(crate::cmd_render::STDOUT)?;
+    texel_io::stderr_line(format_args!(
+        "report: {}",
+        args.out.join("index.html").display()
+    ));
     Ok(())
 }
 

@@ -38,7 +38,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let steps =
         scenes.len() * (Filter::ALL.len() + 1) + GLOBES.len() * (MAPPING_FILTERS.len() + 1) + 1;
     let pb = progress::bar(steps as u64, "demo");
-    let note = |pb: &ProgressBar, line: String| pb.suspend(|| eprintln!("{line}"));
+    let note = |pb: &ProgressBar, line: String| pb.suspend(|| texel_io::stderr_line(line));
     let reports = publish_dir(&args.out, &[], |dir| -> Result<Vec<(String, Report)>> {
         let mut reports: Vec<(String, Report)> = Vec::new();
         for name in &scenes {
@@ -92,12 +92,14 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     .with_context(|| format!("cannot write the demo to {}", args.out.display()))?;
     pb.finish_and_clear();
     let index = args.out.join("index.html");
-    println!(
+    texel_io::stdout_line(format_args!(
         "texel demo: {} scenes in {:.0} s",
         reports.len(),
         started.elapsed().as_secs_f64()
-    );
-    println!("open {}", index.display());
+    ))
+    .context(crate::cmd_render::STDOUT)?;
+    texel_io::stdout_line(format_args!("open {}", index.display()))
+        .context(crate::cmd_render::STDOUT)?;
     Ok(())
 }
 

@@ -80,16 +80,16 @@ pub fn run(args: &MipsArgs, input: &mut Input) -> Result<()> {
     })
     .with_context(|| format!("cannot write the levels to {}", args.out.display()))?;
     if !chain_fits {
-        eprintln!(
+        texel_io::stderr_line(format_args!(
             "texel mips: chain.png skipped: the chain would be {cw}x{ch}, over {MAX_SIDE} pixels per side"
-        );
+        ));
     }
-    eprintln!(
+    texel_io::stderr_line(format_args!(
         "wrote {} levels ({} bytes of pyramid){} to {}",
         levels.len(),
         tex.pyramid_bytes(),
         if chain_fits { " and chain.png" } else { "" },
         args.out.display()
-    );
+    ));
     Ok(())
 }

@@ -3,14 +3,14 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use texel_quality::{viridis, Image8};
 use texel_raster::{ReferenceEstimate, ReferencePlan, ReferenceStatus};
 
 use crate::cli::ReferenceArgs;
 use crate::input::{load_scene, Input};
 use crate::interrupt;
-use crate::output::{encoding, write_frame, write_image};
+use crate::output::{check_outputs, encoding, write_frame, write_image};
 use crate::progress;
 use texel::PreparedScene;
 
@@ -88,14 +88,9 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
         args.scene.color == texel::ColorHandling::Srgb,
         args.seed,
     )?;
-    if let Some(map) = &args.error_map {
-        anyhow::ensure!(
-            !same_destination(map, &args.output),
-            "--error-map {} and -o {} name the same file: give the error map a path of its own",
-            map.display(),
-            args.output.display()
-        );
-    }
+    let mut outputs = vec![("-o", args.output.as_path())];
+    outputs.extend(args.error_map.as_deref().map(|m| ("--error-map", m)));
+    check_outputs(&outputs)?;
     let scene = load_scene(&args.scene, input)?;
     input.budget.take(
         "the reference's per-pixel statistics",
@@ -115,41 +110,86 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     drop(graceful);
     pb.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
+    if estimate.interrupted {
+        return write_partial(args, &estimate, seconds);
+    }
     write_frame(&args.output, &estimate.frame, encoding(args.scene.color))?;
     if let Some(path) = &args.error_map {
-        write_error_map(path, &estimate)?;
+        write_error_map(path, &estimate, &[])?;
     }
-    eprintln!("{}", summary(&estimate, args.tolerance, seconds));
-    if estimate.interrupted {
-        return Err(interrupt::Interrupted(format!(
-            "interrupted: {} holds the passes completed so far, not a converged reference (the share converged is above)",
-            args.output.display()
-        ))
-        .into());
-    }
+    texel_io::stderr_line(summary(&estimate, args.tolerance, seconds));
     Ok(())
 }
 
-/// Whether two output paths name one destination: both standard output, or one file, resolved
-/// through links (a file that does not exist yet through its directory).
-fn same_destination(a: &std::path::Path, b: &std::path::Path) -> bool {
-    use std::path::Path;
-    if a.as_os_str() == "-" || b.as_os_str() == "-" {
-        return a == b;
-    }
-    let resolve = |p: &Path| {
-        std::fs::canonicalize(p).ok().or_else(|| {
-            let parent = p
-                .parent()
-                .filter(|d| !d.as_os_str().is_empty())
-                .unwrap_or(Path::new("."));
-            Some(std::fs::canonicalize(parent).ok()?.join(p.file_name()?))
-        })
+/// The keyword of the text entry (PNG `tEXt` chunk, OpenEXR attribute) that marks an interrupted
+/// reference.
+pub const PARTIAL_KEYWORD: &str = "texel:partial";
+
+/// The outputs of an interrupted reference: each one that does not exist yet (or, with
+/// `--keep-partial`, every one) gets the estimate so far, marked [`PARTIAL_KEYWORD`] with the
+/// samples it reached; an existing file is otherwise left as it is. Always an
+/// [`interrupt::Interrupted`] error, which says what was written.
+fn write_partial(args: &ReferenceArgs, e: &ReferenceEstimate, seconds: f64) -> Result<()> {
+    let min = e.spp.iter().copied().min().unwrap_or(0);
+    let max = e.spp.iter().copied().max().unwrap_or(0);
+    let note = format!(
+        "interrupted: {min}-{max} samples per pixel (mean {:.1}) of --spp {} to --max-spp {}; \
+         {:.2} % of pixels converged; seed {}",
+        e.mean_spp(None),
+        e.plan.min_spp,
+        e.plan.max_spp,
+        100.0 * e.converged_share(None),
+        e.plan.seed
+    );
+    let text = [(PARTIAL_KEYWORD, note.as_str())];
+    let exists = |p: &std::path::Path| {
+        p.as_os_str() != "-" && std::fs::metadata(p).is_ok_and(|m| m.is_file())
     };
-    match (resolve(a), resolve(b)) {
-        (Some(x), Some(y)) => x == y,
-        _ => std::path::absolute(a).ok() == std::path::absolute(b).ok(),
+    let mut written = Vec::new();
+    let mut kept = Vec::new();
+    let outputs =
+        std::iter::once((&args.output, false)).chain(args.error_map.iter().map(|m| (m, true)));
+    for (path, is_map) in outputs {
+        if exists(path) && !args.keep_partial {
+            kept.push(path.display().to_string());
+            continue;
+        }
+        if is_map {
+            write_error_map(path, e, &text)?;
+        } else {
+            crate::output::write_frame_with_text(
+                path,
+                &e.frame,
+                encoding(args.scene.color),
+                &text,
+            )?;
+        }
+        written.push(path.display().to_string());
     }
+    texel_io::stderr_line(summary(e, args.tolerance, seconds));
+    let mut message = String::from("interrupted");
+    if !written.is_empty() {
+        let _ = write!(
+            message,
+            "; {} {} the passes completed so far, marked {PARTIAL_KEYWORD} (not a converged \
+             reference; the share converged is above)",
+            written.join(" and "),
+            if written.len() == 1 { "holds" } else { "hold" }
+        );
+    }
+    if !kept.is_empty() {
+        let _ = write!(
+            message,
+            "; {} left as {} (--keep-partial writes a partial result over existing files)",
+            kept.join(" and "),
+            if kept.len() == 1 {
+                "it was"
+            } else {
+                "they were"
+            }
+        );
+    }
+    Err(interrupt::Interrupted(message).into())
 }
 
 /// One line: the share converged, the samples taken and the time.
@@ -179,7 +219,11 @@ pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> Str
 pub const ERROR_MAP_MAX_STEPS: f32 = 4.0;
 
 /// Write `--error-map`: the standard errors as OpenEXR, or their picture as PNG.
-fn write_error_map(path: &std::path::Path, e: &ReferenceEstimate) -> Result<()> {
+fn write_error_map(
+    path: &std::path::Path,
+    e: &ReferenceEstimate,
+    text: &[(&str, &str)],
+) -> Result<()> {
     let (w, h) = (e.frame.width, e.frame.height);
     if crate::output::is_exr(path) {
         let finite: Vec<[f32; 4]> = e
@@ -187,8 +231,8 @@ fn write_error_map(path: &std::path::Path, e: &ReferenceEstimate) -> Result<()> 
             .iter()
             .map(|s| s.map(|x| if x.is_finite() { x } else { f32::MAX }))
             .collect();
-        return texel_quality::write_exr_atomic(path, w, h, &finite)
-            .with_context(|| format!("cannot write {}", path.display()));
+        let bytes = texel_quality::encode_exr_with_text(w, h, &finite, text)?;
+        return crate::output::publish(path, &bytes);
     }
     let pixels: Vec<[u8; 4]> = e
         .display_half_width
@@ -203,5 +247,9 @@ fn write_error_map(path: &std::path::Path, e: &ReferenceEstimate) -> Result<()> 
             }
         })
         .collect();
-    write_image(path, &Image8::new(w, h, pixels)?)
+    let image = Image8::new(w, h, pixels)?;
+    if text.is_empty() {
+        return write_image(path, &image);
+    }
+    crate::output::publish(path, &crate::output::with_text(image.to_png()?, text))
 }

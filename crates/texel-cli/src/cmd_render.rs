@@ -1,6 +1,6 @@
 //! `texel render`: one filter (or a debug view), one PNG.
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use texel_gpu::{Gpu, GpuFilter};
 use texel_raster::{render, ColorTarget, Derivatives, UvEvaluation, View};
 
@@ -16,12 +16,13 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         Some(m) => Some(Filter::from_lab_mode(m)?),
         None => args.filter,
     };
+    crate::output::check_outputs(&[("-o", &args.output)])?;
     check_storage(&args.scene, args.gpu)?;
     let mut scene = load_scene(&args.scene, input)?;
     if args.gpu && args.scene.surface_uv.is_none() && scene.maps_uv_per_pixel() {
         // The shader interpolates the vertices' uv: say so rather than refuse the scene.
-        eprintln!(
-            "texel: --gpu interpolates sphere mappings from the vertices (--surface-uv vertex)"
+        texel_io::stderr_line(
+            "texel: --gpu interpolates sphere mappings from the vertices (--surface-uv vertex)",
         );
         scene.set_surface_uv(UvEvaluation::PerVertex);
     }
@@ -70,6 +71,9 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     write_frame(&args.output, &frame, encoding(color))
 }
 
+/// The context of a failed write of a result to standard output.
+pub const STDOUT: &str = "cannot write to standard output";
+
 /// Run `texel gpu-info`: every adapter, and which one `--gpu` would pick.
 pub fn gpu_info() -> Result<()> {
     let all = texel_gpu::adapters();
@@ -77,9 +81,9 @@ pub fn gpu_info() -> Result<()> {
         bail!(texel_gpu::GpuError::NoAdapter);
     }
     for a in &all {
-        println!("{a}");
+        texel_io::stdout_line(a).context(STDOUT)?;
     }
     let gpu = Gpu::new(None)?;
-    println!("--gpu uses: {}", gpu.info().name);
+    texel_io::stdout_line(format_args!("--gpu uses: {}", gpu.info().name)).context(STDOUT)?;
     Ok(())
 }

@@ -26,6 +26,7 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
             );
         }
     }
+    crate::output::check_outputs(&[("-o", &args.output)])?;
     let cannot = || format!("cannot load image {}", args.input.display());
     let bytes =
         texel_io::read_regular(&args.input, input.budget.remaining()).with_context(cannot)?;

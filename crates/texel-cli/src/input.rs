@@ -42,11 +42,11 @@ impl Input {
     /// Print a warning when `--sanitize` replaced values of texture `name`.
     pub fn warn_replaced(&self, name: &str, replaced: u64) {
         if replaced > 0 {
-            eprintln!(
+            texel_io::stderr_line(format_args!(
                 "texel: warning: texture {name:?}: replaced {replaced} NaN, infinite or out-of-range channel values (NaN -> 0, +-inf -> +-{inf}, beyond +-{max:e} -> +-{max:e})",
                 inf = texel_texture::NON_FINITE_CLAMP,
                 max = texel_texture::MAX_TEXEL
-            );
+            ));
         }
     }
 
@@ -229,11 +229,11 @@ pub fn load_scene_with(
         input.warn_replaced(name, *n);
     }
     for (name, bytes) in &prepared.kept_stored {
-        eprintln!(
+        texel_io::stderr_line(format_args!(
             "texel: note: texture {name:?} stays 8-bit: its float copy ({}) does not fit {}",
             texel::memory::mib(*bytes),
             input.budget.name()
-        );
+        ));
     }
     Ok(prepared)
 }

@@ -1,5 +1,5 @@
 //! Ctrl-C (SIGINT, SIGTERM, SIGHUP): by default texel deletes its unpublished temporary files
-//! and exits with status 130. Work that can stop cleanly between steps (the reference's passes)
+//! and exits with status 130. Work that can stop cleanly between steps (the reference, between pixel rows)
 //! holds a [`Graceful`] guard: while it does, the first signal only raises a flag the work
 //! reads, and a second one exits as usual.
 
@@ -17,7 +17,7 @@ static STOP: AtomicBool = AtomicBool::new(false);
 /// The signal handler.
 pub fn on_signal() {
     if GRACEFUL.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
-        eprintln!("\ntexel: stopping after the current pass (a second signal aborts)");
+        texel_io::stderr_text("\ntexel: stopping at the next pixel row (a second signal aborts)\n");
         return;
     }
     texel_io::remove_pending_and_exit(INTERRUPTED)

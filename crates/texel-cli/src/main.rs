@@ -30,7 +30,10 @@ use clap::Parser;
 use cli::{Cli, Command};
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(&e),
+    };
     // A decoder panic that texel_io::guarded turns into an error is not reported as a
     // panic; every other panic is.
     let default_hook = std::panic::take_hook();
@@ -41,7 +44,7 @@ fn main() -> ExitCode {
     }));
     // An interrupted run deletes its unpublished temporary files and staging directories.
     if let Err(e) = ctrlc::set_handler(interrupt::on_signal) {
-        eprintln!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files");
+        texel_io::stderr_line(format_args!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files"));
     }
     let mut input = input::Input {
         budget: budget::budget(cli.max_memory),
@@ -69,13 +72,51 @@ fn main() -> ExitCode {
             }) {
                 return ExitCode::SUCCESS;
             }
-            eprintln!("texel: error: {}", chain_line(&err));
+            // One line whatever the paths and names in it hold.
+            texel_io::stderr_line(format_args!("texel: error: {}", chain_line(&err)));
             if err.downcast_ref::<interrupt::Interrupted>().is_some() {
                 return ExitCode::from(interrupt::INTERRUPTED as u8);
             }
             ExitCode::FAILURE
         }
     }
+}
+
+/// Print clap's message (help, version or a usage error) and return the status it asks for. Help
+/// or a version that cannot be written to standard output is an error. A usage error shows the
+/// arguments it quotes that hold control or bidirectional characters escaped (and then without
+/// colour), so that they can neither drive the terminal nor fake a line.
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    let hostile: Vec<String> = std::env::args_os()
+        .skip(1)
+        .map(|a| a.to_string_lossy().into_owned())
+        .filter(|a| a.chars().any(texel_io::term::needs_escape))
+        .collect();
+    if !e.use_stderr() {
+        if let Err(err) = e.print() {
+            if err.kind() != std::io::ErrorKind::BrokenPipe {
+                texel_io::stderr_line(format_args!(
+                    "texel: error: cannot write to standard output: {err}"
+                ));
+                return ExitCode::FAILURE;
+            }
+        }
+    } else if hostile.is_empty() {
+        let _ = e.print();
+    } else {
+        // The message with clap's styles, where the arguments appear as given.
+        let mut text = e.render().ansi().to_string();
+        for a in &hostile {
+            // The whole argument, and the value after its `=` that clap may quote alone.
+            for part in std::iter::once(a.as_str()).chain(a.split_once('=').map(|(_, v)| v)) {
+                text = text.replace(part, &texel_io::escape(part));
+            }
+        }
+        // Without the styles (plain text, as clap prints when colour is off).
+        let plain = clap::builder::StyledStr::from(text).to_string();
+        texel_io::stderr_text(&plain);
+    }
+    ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
 }
 
 /// The error and its causes on one line: `outer: cause: root cause`.

@@ -65,13 +65,69 @@ pub fn png_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
     Ok(path)
 }
 
+/// Check a command's outputs (each flag with its path) before any work: no two of them can reach
+/// one file or stream, however they are spelled ([`texel_io::same_output`]: `-` and
+/// `/dev/stdout`, a link and its target), and each can be written ([`texel_io::check_output`]).
+///
+/// # Errors
+/// The two flags that name one output, or the first output that cannot be written.
+pub fn check_outputs(outputs: &[(&str, &Path)]) -> Result<()> {
+    for (i, &(flag, path)) in outputs.iter().enumerate() {
+        for &(other_flag, other) in &outputs[..i] {
+            anyhow::ensure!(
+                !texel_io::same_output(path, other),
+                "{other_flag} {} and {flag} {} name the same file or stream: give each output a \
+                 path of its own",
+                other.display(),
+                path.display()
+            );
+        }
+        texel_io::check_output(path).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
 /// Publish `frame` at `path`: OpenEXR of its linear colour ([`is_exr`]; a float frame is
 /// written as it is, an 8-bit one decoded), else PNG encoded as `encoding` ([`write_image`]).
 pub fn write_frame(path: &Path, frame: &Frame, encoding: Encoding) -> Result<()> {
+    write_frame_with_text(path, frame, encoding, &[])
+}
+
+/// [`write_frame`] with text entries (`keyword`, `text`): a PNG `tEXt` chunk or an OpenEXR
+/// header attribute each.
+pub fn write_frame_with_text(
+    path: &Path,
+    frame: &Frame,
+    encoding: Encoding,
+    text: &[(&str, &str)],
+) -> Result<()> {
     if is_exr(path) {
-        return write_exr(path, frame.width, frame.height, &frame.linear());
+        let bytes =
+            texel_quality::encode_exr_with_text(frame.width, frame.height, &frame.linear(), text)?;
+        return publish(path, &bytes);
     }
-    write_image(path, &texel::frame_image(frame, encoding)?)
+    let image = texel::frame_image(frame, encoding)?;
+    publish(path, &with_text(image.to_png()?, text))
+}
+
+/// `png` with a `tEXt` chunk for each text entry.
+pub fn with_text(png: Vec<u8>, text: &[(&str, &str)]) -> Vec<u8> {
+    text.iter().fold(png, |png, (keyword, value)| {
+        texel_quality::png_with_text(&png, keyword, value)
+    })
+}
+
+/// Publish encoded image bytes at `path` ([`texel_io::write_atomic`]), or on standard output for
+/// `-`.
+pub fn publish(path: &Path, bytes: &[u8]) -> Result<()> {
+    if path.as_os_str() == "-" {
+        let mut out = std::io::stdout().lock();
+        return out
+            .write_all(bytes)
+            .and_then(|()| out.flush())
+            .context("cannot write the PNG to standard output");
+    }
+    texel_io::write_atomic(path, bytes).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Publish linear RGBA pixels at `path`: OpenEXR for a `.exr` path ([`is_exr`]), else PNG

@@ -282,7 +282,7 @@ fn report_directories_are_replaced_only_when_texel_wrote_them() {
         &[
             "compare",
             "--size",
-            "16x9",
+            "16x12",
             "--spp",
             "1",
             "--filters",

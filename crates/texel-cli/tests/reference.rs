@@ -331,14 +331,11 @@ fn the_converging_reference_is_not_biased_dark_on_glints() {
     );
 }
 
-/// Ctrl-C while a reference converges: it stops after the current pass, writes the passes done
-/// (a whole image, the first passes' estimate), says so and exits with status 130.
+/// A reference that never converges (tolerance 0), sent `signal` after three seconds, writing to
+/// `out` (`extra` arguments added); returns its exit status and stderr.
 #[cfg(unix)]
-#[test]
-fn an_interrupted_reference_writes_what_it_has() {
+fn interrupted_reference(out: &str, signal: &str, extra: &[&str]) -> (Option<i32>, String) {
     use std::process::{Command, Stdio};
-    let d = Dir::new("reference-interrupted");
-    let out = d.arg("partial.png");
     let child = Command::new(env!("CARGO_BIN_EXE_texel"))
         .args([
             "reference",
@@ -351,27 +348,63 @@ fn an_interrupted_reference_writes_what_it_has() {
             "--tolerance",
             "0",
             "-o",
-            &out,
+            out,
         ])
+        .args(extra)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // Tolerance 0 never converges: without the signal it would run for a long time.
     std::thread::sleep(std::time::Duration::from_millis(3000));
     assert!(Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status()
         .unwrap()
         .success());
     let result = child.wait_with_output().unwrap();
-    let err = stderr(&result);
-    assert_eq!(result.status.code(), Some(130), "{err}");
+    (result.status.code(), stderr(&result))
+}
+
+/// Whether a PNG file carries the `texel:partial` text chunk.
+fn marked_partial(path: &str) -> bool {
+    let bytes = file_bytes(path);
+    let needle = b"tEXttexel:partial\0interrupted: ";
+    bytes.windows(needle.len()).any(|w| w == needle)
+}
+
+/// Ctrl-C while a reference converges: it stops at the next pixel row, writes the passes done
+/// (each pixel the mean of its whole passes) marked as partial in the file, says so and exits
+/// with status 130. An existing file is left as it was unless --keep-partial asks.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_reference_writes_what_it_has() {
+    let d = Dir::new("reference-interrupted");
+    let out = d.arg("partial.png");
+    let map = d.arg("partial-error.exr");
+    let (code, err) = interrupted_reference(&out, "-INT", &["--error-map", &map]);
+    assert_eq!(code, Some(130), "{err}");
     assert!(
-        err.contains("stopping after the current pass") && err.contains("interrupted"),
+        err.contains("stopping at the next pixel row") && err.contains("marked texel:partial"),
         "{err}"
     );
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(load(&out).size(), (160, 90));
+    assert!(marked_partial(&out));
+    let exr = file_bytes(&map);
+    assert!(exr.windows(13).any(|w| w == b"texel:partial"));
+    assert!(temp_files(d.path()).is_empty());
+    // SIGTERM over an existing image: left as it was.
+    let old = d.write("old.png", "the converged image");
+    let (code, err) = interrupted_reference(old.to_str().unwrap(), "-TERM", &[]);
+    assert_eq!(code, Some(130), "{err}");
+    assert!(
+        err.contains("left as it was") && err.contains("--keep-partial"),
+        "{err}"
+    );
+    assert_eq!(file_bytes(&old), b"the converged image");
+    // Asked, it is replaced, and marked.
+    let (code, err) = interrupted_reference(old.to_str().unwrap(), "-TERM", &["--keep-partial"]);
+    assert_eq!(code, Some(130), "{err}");
+    assert!(marked_partial(old.to_str().unwrap()), "{err}");
     assert!(temp_files(d.path()).is_empty());
 }

@@ -2,6 +2,7 @@
 //! [`util`] holds the shared helpers and fixtures, each other module one command or concern.
 
 mod bake_ao;
+mod budget_messages;
 mod compare;
 mod demo_bench;
 mod docs_commands;
@@ -13,10 +14,12 @@ mod meshes;
 mod mips;
 mod nothing_lost;
 mod outputs;
+mod published;
 mod python;
 mod reference;
 mod render;
 mod shading;
+mod terminal;
 mod util;
 mod view;
 mod warp;

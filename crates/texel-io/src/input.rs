@@ -7,10 +7,65 @@
 //! and every third-party image decoder runs inside [`guarded`].
 
 use std::cell::Cell;
+use std::collections::BTreeSet;
 use std::fs::File;
 use std::io::{self, Read};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Every file [`open_regular`] has opened in this process, as canonical paths: the inputs an
+/// output directory must never replace or delete ([`crate::publish_dir`] refuses to publish over
+/// a directory that holds one).
+static OPENED: Mutex<BTreeSet<PathBuf>> = Mutex::new(BTreeSet::new());
+
+/// The canonical paths of every input this process has opened through [`open_regular`] (and so
+/// [`read_regular`]): scene files, meshes, glTF buffers, textures, environment maps, images.
+pub fn files_opened() -> Vec<PathBuf> {
+    let set = OPENED.lock().unwrap_or_else(|e| e.into_inner());
+    set.iter().cloned().collect()
+}
+
+/// The recorders [`record_opened`] has running: each collects the paths opened while it runs.
+static RECORDERS: Mutex<Vec<(u64, Vec<PathBuf>)>> = Mutex::new(Vec::new());
+
+/// Numbers the recorders.
+static NEXT_RECORDER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Run `work` and return, beside its result, every file [`open_regular`] opened while it ran, as
+/// the paths it was given, in order, each once: the files a job reads, found by the code that
+/// reads them (a scene's meshes, glTF buffers and images, textures, environment faces). Files
+/// opened meanwhile by other threads are included too, so the list may hold more than `work`'s
+/// own, never less.
+pub fn record_opened<T>(work: impl FnOnce() -> T) -> (T, Vec<PathBuf>) {
+    /// A running recorder; dropped (even when `work` panics), it takes its list out.
+    struct Recorder(u64);
+    impl Recorder {
+        fn take(&self) -> Vec<PathBuf> {
+            let mut all = RECORDERS.lock().unwrap_or_else(|e| e.into_inner());
+            match all.iter().position(|(id, _)| *id == self.0) {
+                Some(k) => all.swap_remove(k).1,
+                None => Vec::new(),
+            }
+        }
+    }
+    impl Drop for Recorder {
+        fn drop(&mut self) {
+            self.take();
+        }
+    }
+    let id = NEXT_RECORDER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    RECORDERS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push((id, Vec::new()));
+    let recorder = Recorder(id);
+    let value = work();
+    let mut files = recorder.take();
+    let mut seen = BTreeSet::new();
+    files.retain(|p| seen.insert(p.clone()));
+    (value, files)
+}
 
 thread_local! {
     /// Set while [`guarded`] runs a decoder on this thread.
@@ -68,6 +123,18 @@ pub fn open_regular(path: &Path) -> io::Result<File> {
             io::ErrorKind::InvalidInput,
             "is not a regular file: texel reads inputs from regular files only",
         ));
+    }
+    {
+        let mut recorders = RECORDERS.lock().unwrap_or_else(|e| e.into_inner());
+        for (_, files) in recorders.iter_mut() {
+            files.push(path.to_path_buf());
+        }
+    }
+    if let Ok(canonical) = std::fs::canonicalize(path) {
+        OPENED
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(canonical);
     }
     Ok(file)
 }
@@ -243,6 +310,30 @@ pub fn check_jpeg_complete(bytes: &[u8], width: u32, height: u32) -> Result<(), 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn record_opened_lists_each_file_once_in_order() {
+        let d = std::env::temp_dir().join(format!("texel-io-record-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let (a, b) = (d.join("a.txt"), d.join("b.txt"));
+        std::fs::write(&a, b"a").unwrap();
+        std::fs::write(&b, b"b").unwrap();
+        let (n, files) = record_opened(|| {
+            read_regular(&b, 16).unwrap();
+            read_regular(&a, 16).unwrap();
+            read_regular(&b, 16).unwrap();
+            // A refused input is not a file the job read.
+            assert!(read_regular(&d, 16).is_err());
+            3
+        });
+        assert_eq!(n, 3);
+        assert_eq!(files, vec![b.clone(), a.clone()]);
+        // Nothing is recorded once the recorder is done.
+        let ((), inner) = record_opened(|| ());
+        assert!(inner.is_empty());
+        assert!(files_opened().contains(&std::fs::canonicalize(&a).unwrap()));
+        std::fs::remove_dir_all(&d).unwrap();
+    }
 
     #[test]
     fn regular_files_only() {

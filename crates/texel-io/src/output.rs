@@ -15,9 +15,15 @@
 //! The temporary name is `.texel-HHHHHHHHHHHHHHHH.PID.N.tmp` (`H`: FNV-1a of the destination's
 //! file name), 40-odd bytes whatever the destination is called, so every name the file system
 //! accepts as an output also has a valid temporary. Temporaries in progress are registered:
-//! [`remove_pending_and_exit`] (the CLI calls it on SIGINT/SIGTERM/SIGHUP) deletes them, and a
-//! temporary left by a killed process (SIGKILL) is deleted by the next write to the same path once
-//! its process is gone.
+//! [`remove_pending_and_exit`] (the CLI calls it on SIGINT/SIGTERM/SIGHUP) deletes them. Each is
+//! locked (`flock`) by its owner while it is in use, so a temporary left by a killed process
+//! (SIGKILL) is deleted by the next write to the same path once nobody holds its lock: a texel in
+//! another PID namespace or on another host sharing the directory keeps its lock and its files.
+//!
+//! Links are followed by hand under the rule the kernel's `fs.protected_symlinks` enforces: in a
+//! sticky, world-writable directory (`/tmp`) a link is followed only when it belongs to the
+//! directory's owner or to the user texel runs as. [`same_output`] tells whether two output paths
+//! can reach one file or stream, and [`check_output`] checks a destination before any work.
 //!
 //! [`publish_dir`] does the same for a multi-file output (a report): everything is written into a
 //! hidden staging directory beside the destination, which then replaces the destination as a
@@ -29,7 +35,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
-use std::time::SystemTime;
+use std::time::Duration;
 
 use thiserror::Error;
 
@@ -168,6 +174,21 @@ fn write_descriptor(d: &FdLink, bytes: &[u8], path: &Path) -> Result<(), OutputE
         };
         return written.map_err(io_err(path));
     }
+    let append = descriptor_append(d, path)?;
+    let mut file = OpenOptions::new()
+        .write(true)
+        .append(append)
+        .open(&d.link)
+        .map_err(io_err(path))?;
+    file.write_all(bytes)
+        .and_then(|()| file.flush())
+        .map_err(io_err(path))
+}
+
+/// Whether texel may write through descriptor `d` (not this process's standard output or error),
+/// and whether it appends: a directory, a descriptor open for reading only, or a regular file's
+/// that does not append is refused.
+fn descriptor_append(d: &FdLink, path: &Path) -> Result<bool, OutputError> {
     let meta = fs::metadata(&d.link).map_err(io_err(path))?;
     if meta.is_dir() {
         return Err(refuse(
@@ -201,19 +222,29 @@ fn write_descriptor(d: &FdLink, bytes: &[u8], path: &Path) -> Result<(), OutputE
              >> or give the file's own path",
         ));
     }
-    let mut file = OpenOptions::new()
-        .write(true)
-        .append(append)
-        .open(&d.link)
-        .map_err(io_err(path))?;
-    file.write_all(bytes)
-        .and_then(|()| file.flush())
-        .map_err(io_err(path))
+    Ok(append)
+}
+
+/// Apply [`check_link`] to every directory of `path` that is a symbolic link (`d/link/x.png`):
+/// the kernel applies its rule inside a path only where `fs.protected_symlinks` is on.
+fn check_ancestors(path: &Path, original: &Path) -> Result<(), OutputError> {
+    for dir in path.ancestors().skip(1) {
+        if dir.as_os_str().is_empty() {
+            break;
+        }
+        if let Ok(meta) = fs::symlink_metadata(dir) {
+            if meta.file_type().is_symlink() {
+                check_link(dir, &meta, original)?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Follow `path` through symbolic links (without following the last component of a missing one)
 /// and classify what it names.
 fn resolve(path: &Path) -> Result<Destination, OutputError> {
+    check_ancestors(path, path)?;
     // A path that reaches an open descriptor's link is that descriptor, whatever it holds: a
     // shell's `>> log.txt` behind /dev/stdout is appended to, never replaced, and a deleted file
     // behind the link is not recreated under its link text's name.
@@ -239,11 +270,13 @@ fn resolve(path: &Path) -> Result<Destination, OutputError> {
         };
         let ft = meta.file_type();
         if ft.is_symlink() {
+            check_link(&p, &meta, path)?;
             let target = fs::read_link(&p).map_err(io_err(path))?;
             p = match p.parent() {
                 Some(dir) if target.is_relative() => dir.join(target),
                 _ => target,
             };
+            check_ancestors(&p, path)?;
             continue;
         }
         if ft.is_file() {
@@ -281,6 +314,7 @@ fn descriptor_on_path(path: &Path) -> Result<Option<FdLink>, OutputError> {
         }
         match fs::symlink_metadata(&p) {
             Ok(m) if m.file_type().is_symlink() => {
+                check_link(&p, &m, path)?;
                 let target = fs::read_link(&p).map_err(io_err(path))?;
                 p = match p.parent() {
                     Some(dir) if target.is_relative() => dir.join(target),
@@ -291,6 +325,44 @@ fn descriptor_on_path(path: &Path) -> Result<Option<FdLink>, OutputError> {
         }
     }
     Ok(None)
+}
+
+/// The rule the kernel's `fs.protected_symlinks` enforces when it follows a link, applied to each
+/// link texel follows by hand (the kernel checks the links inside a path itself): a link in a
+/// sticky, world-writable directory (such as `/tmp`) is followed only when it belongs to the
+/// directory's owner or to the user texel runs as. Another user's link planted there could
+/// otherwise make texel replace a file that user may not write. `link`'s metadata is `meta`;
+/// errors name `original`, the path the caller was given.
+#[cfg(unix)]
+fn check_link(link: &Path, meta: &fs::Metadata, original: &Path) -> Result<(), OutputError> {
+    use std::os::unix::fs::MetadataExt;
+    let dir = match link.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let Ok(dir_meta) = fs::metadata(dir) else {
+        return Ok(());
+    };
+    let sticky_and_open = dir_meta.mode() & 0o1002 == 0o1002;
+    let me = rustix::process::geteuid().as_raw();
+    if sticky_and_open && meta.uid() != dir_meta.uid() && meta.uid() != me {
+        return Err(refuse(
+            original,
+            std::io::ErrorKind::PermissionDenied,
+            &format!(
+                "leads through the symbolic link {}, which lies in a sticky, world-writable \
+                 directory and belongs to neither you nor the directory's owner: texel does not \
+                 follow it (the kernel's protected_symlinks rule)",
+                link.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(not(unix))]
+fn check_link(_link: &Path, _meta: &fs::Metadata, _original: &Path) -> Result<(), OutputError> {
+    Ok(())
 }
 
 #[cfg(unix)]
@@ -328,21 +400,82 @@ fn split_dest(path: &Path) -> Result<(PathBuf, String), OutputError> {
     Ok((dir, name_tag(name)))
 }
 
-/// Whether process `pid` still runs (Linux: `/proc/PID`). Elsewhere, a temporary counts as stale
-/// once it is a day old.
-fn owner_gone(pid: u32, entry: &fs::DirEntry) -> bool {
-    if pid == std::process::id() {
-        return false;
-    }
-    if Path::new("/proc/self").exists() {
-        return !Path::new("/proc").join(pid.to_string()).exists();
-    }
-    entry
-        .metadata()
-        .and_then(|m| m.modified())
+/// How long a temporary whose lock is free is still kept while a process of its PID runs here
+/// (the PID may have been reused, or the owner may be between creating and locking it).
+const REUSED_PID_AGE: Duration = Duration::from_secs(3600);
+
+/// How long a temporary is kept where its lock cannot be tried (a file system without locks).
+const UNLOCKABLE_AGE: Duration = Duration::from_secs(24 * 3600);
+
+/// Whether the temporary `p` (a file or directory whose name carries `pid`, with metadata
+/// `meta`) is abandoned. Its owner holds an exclusive lock on it ([`hold`]) for as long as it
+/// works on it, so a lock another process can take means the owner is gone, whatever PID
+/// namespace or host it ran in; a PID alone decides nothing. Where the PID still runs here, the
+/// temporary is kept for [`REUSED_PID_AGE`] all the same, and where no lock can be tried, for
+/// [`UNLOCKABLE_AGE`].
+fn abandoned(p: &Path, pid: u32, meta: &fs::Metadata) -> bool {
+    let age = meta
+        .modified()
         .ok()
         .and_then(|t| t.elapsed().ok())
-        .is_some_and(|age| age.as_secs() > 24 * 3600)
+        .unwrap_or_default();
+    match lock_state(p, meta) {
+        LockState::Held => false,
+        LockState::Free => {
+            let runs_here = Path::new("/proc/self").exists()
+                && Path::new("/proc").join(pid.to_string()).exists();
+            !runs_here || age > REUSED_PID_AGE
+        }
+        LockState::Unknown => age > UNLOCKABLE_AGE,
+    }
+}
+
+/// Whether another open file holds a lock on a temporary.
+enum LockState {
+    /// Its owner holds it.
+    Held,
+    /// Nobody does.
+    Free,
+    /// It cannot be opened or locked here.
+    Unknown,
+}
+
+/// Try the lock of temporary `p` (a regular file or directory, never followed if it is a link).
+fn lock_state(p: &Path, meta: &fs::Metadata) -> LockState {
+    if !meta.is_file() && !meta.is_dir() {
+        return LockState::Unknown;
+    }
+    let Some(file) = open_no_follow(p) else {
+        return LockState::Unknown;
+    };
+    match file.try_lock() {
+        Ok(()) => LockState::Free,
+        Err(fs::TryLockError::WouldBlock) => LockState::Held,
+        Err(fs::TryLockError::Error(_)) => LockState::Unknown,
+    }
+}
+
+/// Open `p` for reading without following a link or blocking on a FIFO.
+#[cfg(unix)]
+fn open_no_follow(p: &Path) -> Option<fs::File> {
+    use rustix::fs::{Mode, OFlags};
+    let flags = OFlags::RDONLY | OFlags::NOFOLLOW | OFlags::NONBLOCK | OFlags::CLOEXEC;
+    rustix::fs::open(p, flags, Mode::empty())
+        .ok()
+        .map(fs::File::from)
+}
+
+#[cfg(not(unix))]
+fn open_no_follow(p: &Path) -> Option<fs::File> {
+    fs::File::open(p).ok()
+}
+
+/// Hold the lock that marks the temporary `p` as in use ([`abandoned`]) while the returned file is
+/// open. Where locks are not supported the temporary is simply not marked.
+fn hold(p: &Path) -> Option<fs::File> {
+    let file = fs::File::open(p).ok()?;
+    file.try_lock().ok()?;
+    Some(file)
 }
 
 /// Remove temporaries `dir/{tag}PID.N...tmp` whose process is gone (left by a SIGKILL).
@@ -358,12 +491,12 @@ fn settle_stale_old(p: &Path, target: Option<&Path>) {
     } else if let Some(target) = target {
         let kept = visible_sibling(target, "kept");
         if fs::rename(p, &kept).is_ok() {
-            eprintln!(
+            crate::term::stderr_line(format_args!(
                 "texel: warning: an interrupted earlier publish of {} left files texel did not \
                  write; they are kept in {}",
                 target.display(),
                 kept.display()
-            );
+            ));
         }
     }
 }
@@ -383,9 +516,12 @@ fn remove_stale(dir: &Path, tag: &str, target: Option<&Path>) {
         let Some(pid) = rest.split('.').next().and_then(|p| p.parse::<u32>().ok()) else {
             continue;
         };
-        if owner_gone(pid, &entry) {
-            let p = entry.path();
-            if entry.file_type().is_ok_and(|t| t.is_dir()) {
+        let p = entry.path();
+        let Ok(meta) = fs::symlink_metadata(&p) else {
+            continue;
+        };
+        if abandoned(&p, pid, &meta) {
+            if meta.is_dir() {
                 if rest.ends_with(".old.tmp") {
                     settle_stale_old(&p, target);
                 } else {
@@ -439,6 +575,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
             .open(&tmp)
             .map_err(io_err(path))?;
         guard.push(tmp.clone());
+        // Marks the temporary as in use until it is renamed (see `abandoned`); a file system
+        // without locks leaves it unmarked.
+        let _ = file.try_lock();
         file
     };
     // A replaced file keeps its permissions (a fresh one gets the umask's).
@@ -449,22 +588,140 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         .write_all(bytes)
         .and_then(|()| file.sync_all())
         .map_err(io_err(path));
-    drop(file);
     let mut guard = pending();
     let result = written.and_then(|()| fs::rename(&tmp, &target).map_err(io_err(path)));
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
     }
     unregister(&mut guard, &tmp);
+    // The lock lasts until the temporary is renamed or removed.
+    drop(file);
     result
 }
 
+/// Check, before any work, that [`write_atomic`] (or a write to standard output for `-`) could
+/// publish at `path`: a new or regular file's directory exists and takes a new file (a temporary
+/// is created there and removed), a descriptor is open for writing as [`write_atomic`] needs; a
+/// device or FIFO is not opened (a FIFO would wait for its reader). Nothing is written or
+/// replaced.
+///
+/// # Errors
+/// What [`write_atomic`] would report for the path: a directory, a socket, a missing or
+/// read-only directory, a descriptor open for reading, a link it does not follow.
+pub fn check_output(path: &Path) -> Result<(), OutputError> {
+    if path.as_os_str() == "-" {
+        return Ok(());
+    }
+    let target = match resolve(path)? {
+        Destination::Descriptor(d) if d.own && (d.fd == 1 || d.fd == 2) => return Ok(()),
+        Destination::Descriptor(d) => return descriptor_append(&d, path).map(|_| ()),
+        Destination::Special(_) => return Ok(()),
+        Destination::Replaceable(p) => p,
+    };
+    let (dir, tag) = split_dest(&target)?;
+    let probe = temporary(&dir, &tag, "");
+    let mut guard = pending();
+    let made = OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(io_err(path));
+    if made.is_ok() {
+        guard.push(probe.clone());
+        let _ = fs::remove_file(&probe);
+        unregister(&mut guard, &probe);
+    }
+    made.map(|_| ())
+}
+
+/// What an output path finally names, to tell two outputs apart: the stream (standard output
+/// for `-` and its links), the file's device and inode, and the path it resolves to.
+#[derive(Debug, Default)]
+struct Identity {
+    /// This process's descriptor the path reaches (1 for `-`).
+    stream: Option<u32>,
+    /// The device and inode of what it names, where that exists.
+    node: Option<(u64, u64)>,
+    /// The file it resolves to (a missing file through its directory).
+    path: Option<PathBuf>,
+}
+
+#[cfg(unix)]
+fn node_of(p: &Path) -> Option<(u64, u64)> {
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
+    let m = fs::metadata(p).ok()?;
+    // The null device swallows anything: two outputs there do not mix.
+    let null = fs::metadata("/dev/null").ok();
+    if m.file_type().is_char_device() && null.is_some_and(|n| n.rdev() == m.rdev()) {
+        return None;
+    }
+    Some((m.dev(), m.ino()))
+}
+
+#[cfg(not(unix))]
+fn node_of(_p: &Path) -> Option<(u64, u64)> {
+    None
+}
+
+fn identity(path: &Path) -> Identity {
+    if path.as_os_str() == "-" {
+        return Identity {
+            stream: Some(1),
+            node: node_of(Path::new("/proc/self/fd/1")),
+            path: None,
+        };
+    }
+    match resolve(path) {
+        Ok(Destination::Descriptor(d)) => Identity {
+            stream: d.own.then_some(d.fd),
+            node: node_of(&d.link),
+            path: None,
+        },
+        Ok(Destination::Special(p)) => Identity {
+            node: node_of(&p),
+            ..Identity::default()
+        },
+        Ok(Destination::Replaceable(p)) => {
+            let (dir, name) = (
+                p.parent().filter(|d| !d.as_os_str().is_empty()),
+                p.file_name(),
+            );
+            let resolved = fs::canonicalize(dir.unwrap_or(Path::new(".")))
+                .ok()
+                .zip(name)
+                .map(|(d, n)| d.join(n));
+            Identity {
+                stream: None,
+                node: node_of(&p),
+                path: resolved.or_else(|| std::path::absolute(&p).ok()),
+            }
+        }
+        Err(_) => Identity {
+            path: std::path::absolute(path).ok(),
+            ..Identity::default()
+        },
+    }
+}
+
+/// Whether two output paths can name one file or one stream, whatever their spelling: `-`,
+/// `/dev/stdout`, `/dev/fd/1` and `/proc/self/fd/1` are all standard output (and the file or pipe
+/// behind it); links, dangling ones included, are followed to the file they would write; an
+/// existing file is known by its device and inode. The null device is never one output.
+pub fn same_output(a: &Path, b: &Path) -> bool {
+    let (x, y) = (identity(a), identity(b));
+    fn both<T: PartialEq>(p: Option<T>, q: Option<T>) -> bool {
+        p.is_some() && p == q
+    }
+    both(x.stream, y.stream) || both(x.node, y.node) || both(x.path, y.path)
+}
+
 /// Whether an existing directory may be published over by [`publish_dir`]: it is empty, or it
-/// holds [`OUTPUT_MARKER`] (every directory `publish_dir` publishes does). Anything else may hold
-/// a user's own files and is refused.
+/// holds texel's [`OUTPUT_MARKER`] (every directory `publish_dir` publishes does). Anything else,
+/// a directory with an empty or foreign `.texel-output` included, may hold a user's own files
+/// and is refused.
 fn replaceable_dir(dir: &Path) -> bool {
     match fs::read_dir(dir) {
-        Ok(mut entries) => entries.next().is_none() || dir.join(OUTPUT_MARKER).is_file(),
+        Ok(mut entries) => entries.next().is_none() || texel_marker(dir).is_some(),
         Err(_) => false,
     }
 }
@@ -472,69 +729,43 @@ fn replaceable_dir(dir: &Path) -> bool {
 /// The first line of [`OUTPUT_MARKER`]; the files texel wrote follow the line `files:`.
 const MARKER_HEADER: &str = "written by texel; may be replaced by texel";
 
-/// Which entries of a published directory texel wrote, as its marker says.
-enum Owned {
-    /// The files listed in the marker (relative paths); an unmarked directory lists none.
-    Listed(HashSet<PathBuf>),
-    /// A marker without a list: the files older than the marker ([`older`]).
-    Before(SystemTime),
+/// The text of `dir`'s marker, if it is texel's: a regular file (not a link) that starts with
+/// [`MARKER_HEADER`].
+fn texel_marker(dir: &Path) -> Option<String> {
+    let marker = dir.join(OUTPUT_MARKER);
+    if !fs::symlink_metadata(&marker).is_ok_and(|m| m.is_file()) {
+        return None;
+    }
+    let text = fs::read_to_string(&marker).ok()?;
+    (text.lines().next() == Some(MARKER_HEADER)).then_some(text)
 }
 
+/// Which entries of a published directory texel wrote: the files its marker lists (relative
+/// paths). A directory without texel's marker, or a marker that lists nothing, owns nothing:
+/// only listed files are ever replaced or removed.
+struct Owned(HashSet<PathBuf>);
+
 impl Owned {
-    /// Read the marker of `dir` (a directory without one owns nothing).
+    /// Read the marker of `dir`.
     fn of(dir: &Path) -> Owned {
-        let marker = dir.join(OUTPUT_MARKER);
-        let Ok(text) = fs::read_to_string(&marker) else {
-            return Owned::Listed(HashSet::new());
+        let Some(text) = texel_marker(dir) else {
+            return Owned(HashSet::new());
         };
         let mut lines = text.lines();
         if lines.any(|l| l == "files:") {
-            return Owned::Listed(lines.map(PathBuf::from).collect());
+            return Owned(lines.map(PathBuf::from).collect());
         }
-        match fs::metadata(&marker).and_then(|m| m.modified()) {
-            Ok(t) => Owned::Before(t),
-            Err(_) => Owned::Listed(HashSet::new()),
-        }
+        Owned(HashSet::new())
     }
 
-    /// Whether texel wrote the file at `rel` (`full` is its path now).
-    fn file(&self, rel: &Path, full: &Path) -> bool {
-        if rel == Path::new(OUTPUT_MARKER) {
-            return true;
-        }
-        match self {
-            Owned::Listed(set) => set.contains(rel),
-            Owned::Before(t) => fs::symlink_metadata(full).is_ok_and(|m| older(&m, *t)),
-        }
+    /// Whether texel wrote the file at `rel`.
+    fn file(&self, rel: &Path) -> bool {
+        rel == Path::new(OUTPUT_MARKER) || self.0.contains(rel)
     }
 
     /// Whether the directory at `rel` may hold files texel wrote.
     fn may_hold(&self, rel: &Path) -> bool {
-        match self {
-            Owned::Listed(set) => set.iter().any(|p| p.starts_with(rel)),
-            Owned::Before(_) => true,
-        }
-    }
-}
-
-/// Whether a file's modification and (on Unix) status-change times both lie strictly before `t`:
-/// a file moved or copied into a directory after its marker keeps an old modification time, but
-/// gets a new change time.
-fn older(m: &fs::Metadata, t: SystemTime) -> bool {
-    let modified = m.modified().is_ok_and(|x| x < t);
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        let since = |x: SystemTime| x.duration_since(SystemTime::UNIX_EPOCH).ok();
-        let changed = since(t).is_some_and(|d| {
-            let c = std::time::Duration::new(m.ctime().max(0) as u64, m.ctime_nsec().max(0) as u32);
-            c < d
-        });
-        modified && changed
-    }
-    #[cfg(not(unix))]
-    {
-        modified
+        self.0.iter().any(|p| p.starts_with(rel))
     }
 }
 
@@ -590,7 +821,7 @@ fn clashes_or_foreign(
         let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
         if is_dir && owned.may_hold(&r) {
             clashes_or_foreign(old, new, owned, &r, out);
-        } else if (is_dir || !owned.file(&r, &entry.path()))
+        } else if (is_dir || !owned.file(&r))
             && new.is_none_or(|n| fs::symlink_metadata(n.join(&r)).is_ok())
         {
             out.push(r);
@@ -615,7 +846,7 @@ fn carry_over(old: &Path, new: &Path, owned: &Owned, rel: &Path) {
             }
             carry_over(old, new, owned, &r);
             let _ = fs::remove_dir(&from);
-        } else if !is_dir && owned.file(&r, &from) {
+        } else if !is_dir && owned.file(&r) {
             let _ = fs::remove_file(&from);
         } else if fs::symlink_metadata(&to).is_err() {
             if is_dir {
@@ -681,6 +912,7 @@ pub fn publish_dir<T, E: From<OutputError>>(
         )
         .into());
     }
+    check_ancestors(dest, dest)?;
     let mut target = dest.to_path_buf();
     let mut links = 0;
     let exists =
@@ -690,11 +922,13 @@ pub fn publish_dir<T, E: From<OutputError>>(
                 Err(e) => return Err(io_err(dest)(e).into()),
                 Ok(m) if m.file_type().is_symlink() && links < MAX_LINKS => {
                     links += 1;
+                    check_link(&target, &m, dest)?;
                     let t = fs::read_link(&target).map_err(io_err(dest))?;
                     target = match target.parent() {
                         Some(dir) if t.is_relative() => dir.join(t),
                         _ => t,
                     };
+                    check_ancestors(&target, dest)?;
                 }
                 Ok(m) if m.is_dir() => break true,
                 Ok(_) => return Err(refuse(
@@ -709,32 +943,50 @@ pub fn publish_dir<T, E: From<OutputError>>(
         return Err(refuse(
             dest,
             std::io::ErrorKind::AlreadyExists,
-            "is a directory texel did not write (it is not empty and has no .texel-output marker): \
-             choose a new or empty directory, or remove it",
+            "is a directory texel did not write (it is not empty and holds no .texel-output \
+             marker written by texel): choose a new or empty directory, or remove it",
         )
         .into());
     }
-    let marked = exists && target.join(OUTPUT_MARKER).is_file();
     if exists {
-        check_inputs_outside(dest, &target, inputs)?;
+        check_replaceable_dir(dest, &target)?;
+    }
+    let marked = exists && texel_marker(&target).is_some();
+    if exists {
+        if let Some(input) = inputs_inside(&target, inputs).first() {
+            return Err(refuse(
+                dest,
+                std::io::ErrorKind::InvalidInput,
+                &format!(
+                    "holds the input {}, which publishing the output there could replace or \
+                     move: choose another output directory",
+                    input.display()
+                ),
+            )
+            .into());
+        }
     }
     let (parent, tag) = split_dest(&target)?;
     fs::create_dir_all(&parent).map_err(io_err(dest))?;
     remove_stale(&parent, &tag, Some(&target));
     let staging = temporary(&parent, &tag, "");
-    {
+    let lock = {
         let mut guard = pending();
         fs::create_dir(&staging).map_err(io_err(dest))?;
         guard.push(staging.clone());
-    }
+        hold(&staging)
+    };
     let filled = fill(&staging).and_then(|v| {
         write_marker(&staging)
             .map_err(|e| E::from(io_err(dest)(e)))
             .map(|()| v)
     });
+    if filled.is_ok() {
+        keep_mode_and_owner(&target, &staging);
+    }
     let mut guard = pending();
     let result = filled.and_then(|v| {
-        swap_in(dest, &target, &staging, marked, (&parent, &tag))
+        swap_in(dest, &target, &staging, marked, inputs, (&parent, &tag))
             .map(|()| v)
             .map_err(E::from)
     });
@@ -742,30 +994,98 @@ pub fn publish_dir<T, E: From<OutputError>>(
         let _ = fs::remove_dir_all(&staging);
     }
     unregister(&mut guard, &staging);
+    drop(lock);
     result
 }
 
-/// Refuse when one of `inputs` lies inside the existing directory `target`.
-fn check_inputs_outside(dest: &Path, target: &Path, inputs: &[&Path]) -> Result<(), OutputError> {
-    let Ok(dir) = fs::canonicalize(target) else {
-        return Ok(());
-    };
-    for input in inputs {
-        if let Ok(p) = fs::canonicalize(input) {
-            if p.starts_with(&dir) {
-                return Err(refuse(
-                    dest,
-                    std::io::ErrorKind::InvalidInput,
-                    &format!(
-                        "holds the input {}, which publishing the output there could replace \
-                         or move: choose another output directory",
-                        input.display()
-                    ),
-                ));
-            }
+/// Refuse, before any work, an existing directory `target` that publishing could not rename
+/// (a mount point: `rename` fails with EBUSY) or should not (in a sticky, world-writable
+/// directory, one that belongs to neither the user texel runs as nor that directory's owner:
+/// another user's planted directory would get texel's output, and its owner).
+fn check_replaceable_dir(dest: &Path, target: &Path) -> Result<(), OutputError> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let parent = match target.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let (Ok(meta), Ok(up)) = (fs::metadata(target), fs::metadata(parent)) else {
+            return Ok(());
+        };
+        if meta.dev() != up.dev() || is_mount_root(target) {
+            return Err(refuse(
+                dest,
+                std::io::ErrorKind::InvalidInput,
+                "is a mount point, which texel cannot replace (it publishes a directory by \
+                 renaming it into place): give a directory inside it, such as OUT/report",
+            ));
+        }
+        let me = rustix::process::geteuid().as_raw();
+        if up.mode() & 0o1002 == 0o1002 && meta.uid() != me && meta.uid() != up.uid() {
+            return Err(refuse(
+                dest,
+                std::io::ErrorKind::PermissionDenied,
+                "lies in a sticky, world-writable directory and belongs to neither you nor that \
+                 directory's owner: texel does not publish into another user's directory there",
+            ));
         }
     }
+    let _ = (dest, target);
     Ok(())
+}
+
+/// Whether `dir` is the root of a mount, a bind mount of the same file system included (statx's
+/// `STATX_ATTR_MOUNT_ROOT`; `false` where the kernel does not say).
+#[cfg(target_os = "linux")]
+fn is_mount_root(dir: &Path) -> bool {
+    use rustix::fs::{AtFlags, StatxAttributes, StatxFlags, CWD};
+    rustix::fs::statx(CWD, dir, AtFlags::NO_AUTOMOUNT, StatxFlags::empty()).is_ok_and(|r| {
+        r.stx_attributes_mask.contains(StatxAttributes::MOUNT_ROOT)
+            && r.stx_attributes.contains(StatxAttributes::MOUNT_ROOT)
+    })
+}
+
+#[cfg(all(unix, not(target_os = "linux")))]
+fn is_mount_root(_dir: &Path) -> bool {
+    false
+}
+
+/// The inputs inside the existing directory `target`: those of `inputs` and every file this
+/// process has opened as an input ([`crate::input::files_opened`]: a scene's textures, meshes and
+/// environment maps, `--extra` images), as the caller named them.
+fn inputs_inside(target: &Path, inputs: &[&Path]) -> Vec<PathBuf> {
+    let Ok(dir) = fs::canonicalize(target) else {
+        return Vec::new();
+    };
+    let named = inputs
+        .iter()
+        .filter_map(|&input| Some((fs::canonicalize(input).ok()?, input.to_path_buf())));
+    let opened = crate::input::files_opened()
+        .into_iter()
+        .map(|p| (p.clone(), p));
+    named
+        .chain(opened)
+        .filter(|(canonical, _)| canonical.starts_with(&dir))
+        .map(|(_, given)| given)
+        .collect()
+}
+
+/// Give a staged directory the permissions (and, where the user may, the owner and group) of the
+/// directory it replaces: `mkdir -m 700 out` stays private after a publish.
+fn keep_mode_and_owner(target: &Path, staging: &Path) {
+    let Ok(meta) = fs::metadata(target) else {
+        return;
+    };
+    if !meta.is_dir() {
+        return;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let _ = std::os::unix::fs::chown(staging, Some(meta.uid()), Some(meta.gid()));
+    }
+    let _ = fs::set_permissions(staging, meta.permissions());
 }
 
 /// Put the filled `staging` in `target`'s place, keeping whatever texel did not write. `marked`:
@@ -776,6 +1096,7 @@ fn swap_in(
     target: &Path,
     staging: &Path,
     marked: bool,
+    inputs: &[&Path],
     (parent, tag): (&Path, &str),
 ) -> Result<(), OutputError> {
     let exists = fs::symlink_metadata(target).is_ok();
@@ -785,31 +1106,44 @@ fn swap_in(
     // What the directory holds now, not what it held when the run started.
     let owned = Owned::of(target);
     let mut clash = Vec::new();
-    if marked && !target.join(OUTPUT_MARKER).is_file() {
+    if marked && texel_marker(target).is_none() {
         clash.push(PathBuf::from(
             "(the whole directory: its .texel-output marker is gone)",
         ));
     } else {
         clashes(target, staging, &owned, Path::new(""), &mut clash);
     }
-    if !clash.is_empty() {
+    // An input the run has read since it started (an image the fill opened) is never replaced.
+    let inside = inputs_inside(target, inputs);
+    if !clash.is_empty() || !inside.is_empty() {
         let kept = visible_sibling(target, "new");
         let at = match fs::rename(staging, &kept) {
             Ok(()) => format!("the new output is in {}", kept.display()),
             Err(_) => "the new output is discarded".to_string(),
         };
-        let names: Vec<String> = clash.iter().map(|p| p.display().to_string()).collect();
+        let list = |v: &[PathBuf]| {
+            v.iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let why = if clash.is_empty() {
+            format!("holds inputs of this run ({})", list(&inside))
+        } else {
+            format!(
+                "now holds files texel did not write under names the new output uses ({})",
+                list(&clash)
+            )
+        };
         return Err(refuse(
             dest,
             std::io::ErrorKind::AlreadyExists,
-            &format!(
-                "now holds files texel did not write under names the new output uses ({}): it is \
-                 left as it is, and {at}",
-                names.join(", ")
-            ),
+            &format!("{why}: it is left as it is, and {at}"),
         ));
     }
     let old = temporary(parent, tag, ".old");
+    // Marks the directory moved aside as in use while its files are carried over.
+    let _lock = hold(target);
     fs::rename(target, &old).map_err(io_err(dest))?;
     if let Err(e) = fs::rename(staging, target) {
         let _ = fs::rename(&old, target);
@@ -825,12 +1159,12 @@ fn swap_in(
     }
     let kept = visible_sibling(target, "kept");
     let _ = fs::rename(&old, &kept);
-    eprintln!(
+    crate::term::stderr_line(format_args!(
         "texel: warning: files saved into {} while texel published it clash with the new \
          output's names; they are kept in {}",
         dest.display(),
         kept.display()
-    );
+    ));
     Ok(())
 }
 
@@ -1075,36 +1409,120 @@ mod tests {
     }
 
     #[test]
-    fn publish_reads_a_marker_without_a_list() {
-        let d = scratch("atomic-legacy");
+    fn a_marker_owns_only_the_files_it_lists() {
+        let d = scratch("atomic-unlisted");
+        // texel's header without a list: nothing is texel's, so nothing is removed.
         let out = d.join("out");
         fs::create_dir(&out).unwrap();
         fs::write(out.join("old.png"), b"o").unwrap();
-        // Files older than such a marker are texel's; a later one is the user's (the pauses are
-        // longer than the kernel's coarse clock tick).
-        std::thread::sleep(std::time::Duration::from_millis(50));
         fs::write(out.join(OUTPUT_MARKER), format!("{MARKER_HEADER}\n")).unwrap();
-        std::thread::sleep(std::time::Duration::from_millis(50));
-        // A file moved in keeps its old modification time, but not its change time.
-        let moved = d.join("photo.jpg");
-        fs::write(&moved, b"p").unwrap();
-        let f = fs::File::options().write(true).open(&moved).unwrap();
-        f.set_modified(SystemTime::UNIX_EPOCH + std::time::Duration::from_secs(1))
-            .unwrap();
-        drop(f);
-        fs::rename(&moved, out.join("photo.jpg")).unwrap();
-        publish_dir(
-            &out,
-            &[],
-            fill_with(&["new.png"], || {
-                fs::write(out.join("later.txt"), b"l").unwrap()
-            }),
-        )
-        .unwrap();
-        assert_eq!(
-            names(&out),
-            vec![OUTPUT_MARKER, "later.txt", "new.png", "photo.jpg"]
-        );
+        publish_dir(&out, &[], fill_with(&["new.png"], || ())).unwrap();
+        assert_eq!(names(&out), vec![OUTPUT_MARKER, "new.png", "old.png"]);
+        assert_eq!(fs::read(out.join("old.png")).unwrap(), b"o");
+        // An empty marker (`touch .texel-output`) or a foreign one is not texel's: the directory is
+        // refused and keeps every file.
+        for text in ["", "files:\nthesis.tex\n"] {
+            let mine = d.join("thesis");
+            fs::create_dir_all(&mine).unwrap();
+            fs::write(mine.join("thesis.tex"), b"chapter 1").unwrap();
+            fs::write(mine.join(OUTPUT_MARKER), text).unwrap();
+            let e = publish_dir(&mine, &[], fill_with(&["new.png"], || ())).unwrap_err();
+            assert!(e.to_string().contains("did not write"), "{e}");
+            assert_eq!(names(&mine), vec![OUTPUT_MARKER, "thesis.tex"]);
+            assert_eq!(fs::read(mine.join("thesis.tex")).unwrap(), b"chapter 1");
+        }
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_locked_temporary_is_never_stale() {
+        let d = scratch("atomic-locked");
+        let tag = name_tag(std::ffi::OsStr::new("out"));
+        // A staging directory of a process this namespace cannot see (PID beyond pid_max): held by
+        // its lock, it stays; once the lock is gone, the next publish removes it.
+        let staging = d.join(format!("{tag}4294967294.0.tmp"));
+        fs::create_dir(&staging).unwrap();
+        fs::write(staging.join("half.png"), b"h").unwrap();
+        let lock = hold(&staging).expect("this file system takes locks");
+        publish_dir(&d.join("out"), &[], fill_with(&["a.png"], || ())).unwrap();
+        assert!(staging.join("half.png").exists());
+        drop(lock);
+        publish_dir(&d.join("out"), &[], fill_with(&["a.png"], || ())).unwrap();
+        assert!(!staging.exists());
+        // The same for a file's temporary.
+        let a = name_tag(std::ffi::OsStr::new("a.png"));
+        let tmp = d.join(format!("{a}4294967294.0.tmp"));
+        fs::write(&tmp, b"half").unwrap();
+        let lock = hold(&tmp).unwrap();
+        write_atomic(&d.join("a.png"), b"whole").unwrap();
+        assert!(tmp.exists());
+        drop(lock);
+        write_atomic(&d.join("a.png"), b"whole").unwrap();
+        assert!(!tmp.exists());
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_published_directory_keeps_its_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = scratch("atomic-mode");
+        let out = d.join("priv");
+        fs::create_dir(&out).unwrap();
+        fs::set_permissions(&out, fs::Permissions::from_mode(0o700)).unwrap();
+        publish_dir(&out, &[], fill_with(&["a.png"], || ())).unwrap();
+        let mode = fs::metadata(&out).unwrap().permissions().mode() & 0o7777;
+        assert_eq!(mode, 0o700);
+        // And again over texel's own output.
+        fs::set_permissions(&out, fs::Permissions::from_mode(0o750)).unwrap();
+        publish_dir(&out, &[], fill_with(&["b.png"], || ())).unwrap();
+        let mode = fs::metadata(&out).unwrap().permissions().mode() & 0o7777;
+        assert_eq!(mode, 0o750);
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn publish_never_replaces_a_file_the_process_opened() {
+        let d = scratch("atomic-opened");
+        let out = d.join("mips");
+        publish_dir(&out, &[], fill_with(&["level-00.png"], || ())).unwrap();
+        // The run reads a file of the old output (a texture of its scene) without naming it.
+        let texture = out.join("level-00.png");
+        crate::input::read_regular(&texture, 1 << 20).unwrap();
+        let e = publish_dir(&out, &[], fill_with(&["level-00.png"], || ())).unwrap_err();
+        assert!(e.to_string().contains("holds the input"), "{e}");
+        assert_eq!(fs::read(&texture).unwrap(), b"level-00.png");
+        fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A link another user planted in a sticky, world-writable directory is not followed; the
+    /// directory owner's and one's own are. Needs root (to give the link another owner).
+    #[cfg(unix)]
+    #[test]
+    fn a_planted_link_in_a_sticky_directory_is_not_followed() {
+        use std::os::unix::fs::PermissionsExt;
+        if rustix::process::geteuid().as_raw() != 0 {
+            eprintln!("skipped: needs root to give a link another owner");
+            return;
+        }
+        let d = scratch("atomic-planted");
+        let tmp = d.join("tmp");
+        fs::create_dir(&tmp).unwrap();
+        fs::set_permissions(&tmp, fs::Permissions::from_mode(0o1777)).unwrap();
+        let victim = d.join("victim.conf");
+        fs::write(&victim, b"root's settings").unwrap();
+        let link = tmp.join("out.png");
+        std::os::unix::fs::symlink(&victim, &link).unwrap();
+        std::os::unix::fs::lchown(&link, Some(12345), Some(12345)).unwrap();
+        let e = write_atomic(&link, b"png").unwrap_err();
+        assert!(e.to_string().contains("protected_symlinks"), "{e}");
+        assert_eq!(fs::read(&victim).unwrap(), b"root's settings");
+        let e = publish_dir::<(), OutputError>(&link, &[], |_| Ok(())).unwrap_err();
+        assert!(e.to_string().contains("protected_symlinks"), "{e}");
+        // The same link owned by the directory's owner (root) is followed.
+        std::os::unix::fs::lchown(&link, Some(0), Some(0)).unwrap();
+        write_atomic(&link, b"png").unwrap();
+        assert_eq!(fs::read(&victim).unwrap(), b"png");
         fs::remove_dir_all(&d).unwrap();
     }
 

@@ -19,10 +19,12 @@ pub enum Error {
     /// Turning a frame into an image, or scoring one.
     #[error(transparent)]
     Quality(#[from] texel_quality::QualityError),
-    /// An allocation the memory budget cannot hold ([`crate::MemoryBudget::take`]).
+    /// An allocation the memory budget cannot hold ([`crate::MemoryBudget::take`], or a texture's
+    /// own refusal restated by [`crate::MemoryBudget::restate`]): its bytes, and with what is
+    /// already held their sum, rounded up (a limit of the sum gets past this step).
     #[error(
         "{what} needs about {}{}, over {limit}: raise the limit or make the input smaller",
-        crate::memory::mib(*bytes),
+        crate::memory::mib_up(*bytes),
         crate::memory::held(*used, *bytes)
     )]
     OverBudget {

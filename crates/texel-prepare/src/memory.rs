@@ -5,6 +5,13 @@
 //! [`texel_texture::Limits::max_bytes`] is set to what is left while it loads, so its file, decoded
 //! image, texels and pyramid scratch are bounded too, then its pyramid is charged). The per-pixel and
 //! per-element figures are upper bounds read off the code, listed with each constant.
+//!
+//! A refusal states the whole need: what the refused step needs, what is already held, and their
+//! sum, rounded up, so that a limit of the sum gets past that step. A texture's own refusal under
+//! limits set from what the budget had left ([`MemoryBudget::texture_limits`]) is restated so
+//! ([`MemoryBudget::restate`]).
+
+use texel_texture::{Limits, TextureError};
 
 use crate::Error;
 
@@ -22,6 +29,11 @@ pub const VERTEX_BYTES: u64 = 48 + std::mem::size_of::<texel_raster::Vertex>() a
 /// What a scene keeps per mesh beyond its vertices and triangles, as an allowance: the mesh's
 /// record and names, its vectors' allocations, and the renderer's per-draw state.
 pub const MESH_BYTES: u64 = 4096;
+
+/// What building a ripmap holds per level-0 texel while it runs, beyond the ripmap itself: the
+/// `f32` scratch of texel-texture's ripmap build (the decoded level 0, an x-reduced image and a
+/// y chain), which the texture's own limit counts too.
+pub const RIPMAP_SCRATCH_PER_TEXEL: u64 = 40;
 
 /// What a scene keeps per triangle: its indices (12 bytes). The rasterizer's per-frame set-up and
 /// tile bins depend on where the triangle lands on screen: [`raster_bytes`].
@@ -96,7 +108,15 @@ pub fn mib(bytes: u64) -> String {
     format!("{:.1} MiB", bytes as f64 / f64::from(1 << 20))
 }
 
-/// ` on top of X already held, Y in all` when `used > 0`, for [`Error::OverBudget`]'s message.
+/// `bytes` in MiB with one decimal, rounded up: a need, which a limit of the figure printed
+/// covers.
+pub fn mib_up(bytes: u64) -> String {
+    let tenths = (u128::from(bytes) * 10).div_ceil(1 << 20);
+    format!("{}.{} MiB", tenths / 10, tenths % 10)
+}
+
+/// ` on top of X already held, Y in all` when `used > 0`, for [`Error::OverBudget`]'s message
+/// (the sum rounded up).
 pub(crate) fn held(used: u64, bytes: u64) -> String {
     if used == 0 {
         String::new()
@@ -104,7 +124,7 @@ pub(crate) fn held(used: u64, bytes: u64) -> String {
         format!(
             " on top of {} already held, {} in all",
             mib(used),
-            mib(used.saturating_add(bytes))
+            mib_up(used.saturating_add(bytes))
         )
     }
 }
@@ -359,6 +379,76 @@ impl MemoryBudget {
     pub fn release(&mut self, bytes: u64) {
         self.used = self.used.saturating_sub(bytes);
     }
+
+    /// Bytes accounted for.
+    pub fn used(&self) -> u64 {
+        self.used
+    }
+
+    /// The texture limits of work done within what is left: [`Limits::default`] with
+    /// [`Limits::max_bytes`] set to [`MemoryBudget::remaining`]. A texture made under them keeps
+    /// them, and they bound its ripmap and summed-area table too.
+    pub fn texture_limits(&self) -> Limits {
+        Limits {
+            max_bytes: self.remaining(),
+            ..Limits::default()
+        }
+    }
+
+    /// `e` stated against this budget where it is a texture's refusal of memory
+    /// ([`TextureError::OverMemoryLimit`], [`TextureError::StructureOverMemoryLimit`], bare or in
+    /// a [`texel_scene::SceneError::Texture`]) under limits this budget gave
+    /// ([`MemoryBudget::texture_limits`], now or earlier, before later charges): an
+    /// [`Error::OverBudget`] whose sum is the limit this budget would need for the texture to
+    /// fit, the texture's own limit being what that budget would have left. Other errors are
+    /// returned as they are.
+    pub fn restate(&self, e: impl Into<Error>) -> Error {
+        let e = e.into();
+        let (name, path, source) = match &e {
+            Error::Scene(texel_scene::SceneError::Texture { name, path, source }) => {
+                (Some(name.as_str()), path.as_deref(), source)
+            }
+            Error::Texture(source) => (None, None, source),
+            _ => return e,
+        };
+        let texture = match (name, path) {
+            (Some(n), Some(p)) => format!("texture {n:?} from {}", p.display()),
+            (Some(n), None) => format!("texture {n:?}"),
+            (None, _) => "a texture".to_string(),
+        };
+        let (what, bytes, max) = match *source {
+            TextureError::OverMemoryLimit {
+                width,
+                height,
+                bytes,
+                max,
+            } => (
+                format!("loading {texture} ({width}x{height}, with its mip pyramid)"),
+                bytes,
+                max,
+            ),
+            TextureError::StructureOverMemoryLimit {
+                structure,
+                width,
+                height,
+                bytes,
+                max,
+            } => (
+                format!("building the {structure} of {texture} ({width}x{height})"),
+                bytes,
+                max,
+            ),
+            _ => return e,
+        };
+        // The texture's limit moves with this budget's: it is short by `bytes - max`.
+        let total = self.limit.saturating_add(bytes.saturating_sub(max));
+        Error::OverBudget {
+            what,
+            bytes: total.saturating_sub(self.used),
+            used: self.used,
+            limit: self.name.clone(),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -405,6 +495,73 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("y needs about 2.0 MiB, over X: raise"), "{e}");
+    }
+
+    #[test]
+    fn needs_round_up() {
+        assert_eq!(mib_up(0), "0.0 MiB");
+        assert_eq!(mib_up(1 << 20), "1.0 MiB");
+        assert_eq!(mib_up((1 << 20) + 1), "1.1 MiB");
+        assert_eq!(mib_up((5 << 20) + (1 << 20) / 2), "5.5 MiB");
+        // Rounded to the nearest tenth, this need would print below itself.
+        let e = MemoryBudget::new(1 << 20, "X")
+            .take("y", (2 << 20) + 1000)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("y needs about 2.1 MiB, over X"), "{e}");
+    }
+
+    #[test]
+    fn a_texture_refusal_is_restated_with_the_whole_need() {
+        let mut b = MemoryBudget::new(100 << 20, "--max-memory 100.0 MiB");
+        b.take("the frame", 30 << 20).unwrap();
+        let limits = b.texture_limits();
+        assert_eq!(limits.max_bytes, 70 << 20);
+        // A texture refused under what was left: the whole need is what is held plus its bytes.
+        let refusal = TextureError::OverMemoryLimit {
+            width: 4096,
+            height: 4096,
+            bytes: 90 << 20,
+            max: limits.max_bytes,
+        };
+        let scene = texel_scene::SceneError::Texture {
+            name: "t".into(),
+            path: None,
+            source: refusal,
+        };
+        match b.restate(scene) {
+            Error::OverBudget {
+                what, bytes, used, ..
+            } => {
+                assert_eq!((bytes, used), (90 << 20, 30 << 20));
+                assert!(
+                    what.starts_with("loading texture \"t\" (4096x4096"),
+                    "{what}"
+                );
+            }
+            e => panic!("{e}"),
+        }
+        // A structure refused later, under the limits the texture kept from its load, after
+        // more was charged: the budget needs its limit plus what the texture is short by.
+        b.take("texture t", 20 << 20).unwrap();
+        let later = TextureError::StructureOverMemoryLimit {
+            structure: "ripmap",
+            width: 4096,
+            height: 4096,
+            bytes: 120 << 20,
+            max: limits.max_bytes,
+        };
+        let e = b.restate(later);
+        let text = e.to_string();
+        assert!(
+            text.contains(
+                "needs about 100.0 MiB on top of 50.0 MiB already held, 150.0 MiB in all"
+            ),
+            "{text}"
+        );
+        // Other errors pass through.
+        let other = b.restate(TextureError::InvalidLodBias(f32::NAN));
+        assert!(matches!(other, Error::Texture(_)), "{other}");
     }
 }
 

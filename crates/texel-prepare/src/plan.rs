@@ -24,7 +24,7 @@ impl PreparedScene {
     /// ([`PreparedScene::build_structures_within`]).
     ///
     /// # Errors
-    /// [`Error::OverBudget`]; [`Error::Texture`] for a structure over a texture's limit.
+    /// [`Error::OverBudget`], also for a structure over a texture's own limit.
     pub fn plan(
         &self,
         filter: Option<Filter>,

@@ -4,7 +4,7 @@
 //! through this.
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use texel_raster::environment::{self, Environment, EnvironmentMaps};
 use texel_raster::layers::{Layer, LayerBlend, Layers, MAX_LAYERS};
@@ -21,7 +21,9 @@ use texel_texture::base::color::srgb_to_linear;
 use texel_texture::{AddressMode, ColorSpace, Format, Limits, Sampler, Texture};
 
 use crate::bake::{self, Composite};
-use crate::memory::{raster_bytes, FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_BYTES};
+use crate::memory::{
+    raster_bytes, FRAME_BYTES_PER_PIXEL, RIPMAP_SCRATCH_PER_TEXEL, TRIANGLE_BYTES, VERTEX_BYTES,
+};
 use crate::tessellate::Tessellated;
 use crate::{Error, Filter, MemoryBudget};
 
@@ -162,8 +164,10 @@ pub fn relay_sky(
 pub struct PreparedScene {
     /// The scene as loaded.
     pub scene: Scene,
-    /// Every texture the meshes use, by name, with its pyramid.
-    pub textures: BTreeMap<String, Texture>,
+    /// Every texture the meshes use, by name, with its pyramid. Names whose specs load to the
+    /// same texels ([`texel_scene::Scene::texture_groups`]: one glTF image, one file in one
+    /// colour space) share one texture, loaded and charged once.
+    pub textures: BTreeMap<String, Arc<Texture>>,
     /// Each mesh's vertices.
     pub vertices: Vec<Vec<Vertex>>,
     /// Output width in pixels.
@@ -173,13 +177,16 @@ pub struct PreparedScene {
     /// The colour handling the textures were loaded with.
     pub color: ColorHandling,
     /// Per texture, the non-finite channel values replaced (only with
-    /// [`SceneOptions::replace_non_finite`]; textures with none are not listed).
+    /// [`SceneOptions::replace_non_finite`]; textures with none are not listed; a shared texture
+    /// under the first name that reads it).
     pub replaced: Vec<(String, u64)>,
     /// Textures that [`TextureStorage::Float`] left stored because their float pyramid did not
-    /// fit what the memory budget had left, with the bytes it would have taken.
+    /// fit what the memory budget had left, with the bytes it would have taken (a shared texture
+    /// under the first name that reads it).
     pub kept_stored: Vec<(String, u64)>,
-    /// The (texture, structure) pairs [`PreparedScene::build_structures_within`] has charged.
-    charged: Mutex<BTreeSet<(String, &'static str)>>,
+    /// The (texture, structure) pairs [`PreparedScene::build_structures_within`] has charged,
+    /// each texture by its address (names that share a texture share its structures).
+    charged: Mutex<BTreeSet<(usize, &'static str)>>,
     /// [`SceneOptions::precision`].
     pub precision: Precision,
     /// [`SceneOptions::specular_aa`].
@@ -189,11 +196,12 @@ pub struct PreparedScene {
     /// [`SceneOptions::displacement`].
     displacement: Option<texel_scene::Displacement>,
     /// LEAN moment maps ([`texel_raster::material::lean_map`]) of the normal maps of materials
-    /// that use LEAN, by the normal map's texture name.
-    lean_maps: BTreeMap<String, MomentMap>,
+    /// that use LEAN, by the normal map's texture name (one per shared texture).
+    lean_maps: BTreeMap<String, Arc<MomentMap>>,
     /// Slope moment maps ([`texel_raster::material::height_moments`]) of the height maps of
-    /// bump-mapped materials without a normal map that use LEAN or Toksvig, by texture name.
-    height_moments: BTreeMap<String, MomentMap>,
+    /// bump-mapped materials without a normal map that use LEAN or Toksvig, by texture name
+    /// (one per shared texture).
+    height_moments: BTreeMap<String, Arc<MomentMap>>,
     /// [`SceneOptions::layer_order`].
     layer_order: Option<LayerOrder>,
     /// [`SceneOptions::surface_uv`]; [`PreparedScene::set_surface_uv`] changes it.
@@ -228,10 +236,7 @@ fn environment_maps(
     budget: &mut MemoryBudget,
     replace_non_finite: bool,
 ) -> Result<(EnvironmentMaps, u64), Error> {
-    let limits = Limits {
-        max_bytes: budget.remaining(),
-        ..Limits::default()
-    };
+    let limits = budget.texture_limits();
     if let texel_scene::EnvironmentSource::Sky(sky) = &spec.source {
         // A procedural sky is charged before any of it is made: its layers' pyramids, the
         // texels of the layer being made, and the prefiltered maps.
@@ -251,7 +256,9 @@ fn environment_maps(
             });
         }
     }
-    let (faces, replaced) = spec.load_with(&limits, replace_non_finite)?;
+    let (faces, replaced) = spec
+        .load_with(&limits, replace_non_finite)
+        .map_err(|e| budget.restate(e))?;
     budget.take(
         "the environment map",
         faces.iter().map(Texture::pyramid_bytes).sum(),
@@ -283,8 +290,14 @@ impl PreparedScene {
             .size
             .unwrap_or((scene.output.width, scene.output.height));
         charge_geometry(&scene, (width, height), budget)?;
-        let (mut textures, mut replaced) = load_textures(&scene, options, budget)?;
-        let kept_stored = store_textures(&mut textures, options, budget)?;
+        let mut loaded = load_textures(&scene, options, budget)?;
+        let kept_stored = store_textures(&mut loaded, options, budget)?;
+        let Loaded {
+            textures,
+            names,
+            mut replaced,
+        } = loaded;
+        let textures = share_textures(textures, names);
         if let Some(spec) = &scene.environment {
             scene.environment = Some(relay_sky(spec, options.environment_mapping)?);
         }
@@ -455,7 +468,7 @@ impl PreparedScene {
 
     /// Build the acceleration structures `samplers` need (ripmaps, summed-area tables) ahead of
     /// drawing, and return the bytes of every structure the frame uses (pyramids included),
-    /// counting each texture once.
+    /// counting each texture once (names that share a texture count it once).
     ///
     /// # Errors
     /// [`Error::Texture`] when a structure does not fit the texture's memory limit.
@@ -465,36 +478,60 @@ impl PreparedScene {
             let tex = &self.textures[&mesh.texture];
             tex.build_structures(sampler)?;
             let b = tex.structure_bytes(sampler.descriptor());
-            let e = bytes.entry(mesh.texture.clone()).or_insert(0u64);
+            let e = bytes.entry(Arc::as_ptr(tex) as usize).or_insert(0u64);
             *e = (*e).max(b);
         }
         Ok(bytes.values().sum())
     }
 
-    /// `PreparedScene::prepare`, charging `budget` for each ripmap and summed-area table before
-    /// it is built (once per texture and kind: they are kept for later frames).
+    /// [`PreparedScene::build_structures`], charging `budget` for each ripmap and summed-area
+    /// table before it is built (once per texture and kind, names that share a texture sharing
+    /// its structures: they are kept for later frames), and for a ripmap's build scratch while
+    /// it is built ([`crate::memory::RIPMAP_SCRATCH_PER_TEXEL`]).
     ///
     /// # Errors
-    /// [`Error::OverBudget`], and those of `PreparedScene::prepare`.
+    /// [`Error::OverBudget`], for the budget's refusal and for a texture's own (its limits were
+    /// what the budget had left when it loaded: [`MemoryBudget::restate`], with the build's
+    /// scratch), and those of [`PreparedScene::build_structures`].
     pub fn build_structures_within(
         &self,
         samplers: &[Sampler],
         budget: &mut MemoryBudget,
     ) -> Result<u64, Error> {
         for (mesh, sampler) in self.scene.meshes.iter().zip(samplers) {
-            let kind = match sampler.descriptor().min_filter {
-                texel_texture::FilterMode::Ripmap => "ripmap",
-                texel_texture::FilterMode::SummedArea => "summed-area table",
+            // The structure, and what its build holds per level-0 texel while it runs.
+            let (kind, scratch_per_texel) = match sampler.descriptor().min_filter {
+                texel_texture::FilterMode::Ripmap => ("ripmap", RIPMAP_SCRATCH_PER_TEXEL),
+                texel_texture::FilterMode::SummedArea => ("summed-area table", 0),
                 _ => continue,
             };
-            let key = (mesh.texture.clone(), kind);
+            let tex = &self.textures[&mesh.texture];
+            let key = (Arc::as_ptr(tex) as usize, kind);
             let mut charged = self.charged.lock().unwrap_or_else(|e| e.into_inner());
             if charged.contains(&key) {
                 continue;
             }
-            let tex = &self.textures[&mesh.texture];
             let extra = tex.structure_bytes(sampler.descriptor()) - tex.pyramid_bytes();
-            budget.take(&format!("the {kind} of texture {:?}", mesh.texture), extra)?;
+            let scratch = u64::from(tex.width()) * u64::from(tex.height()) * scratch_per_texel;
+            let with = if scratch > 0 {
+                " with its build scratch"
+            } else {
+                ""
+            };
+            budget.take(
+                &format!("the {kind} of texture {:?}{with}", mesh.texture),
+                extra.saturating_add(scratch),
+            )?;
+            let built = tex.build_structures(sampler);
+            budget.release(scratch);
+            if let Err(source) = built {
+                budget.release(extra);
+                return Err(budget.restate(texel_scene::SceneError::Texture {
+                    name: mesh.texture.clone(),
+                    path: None,
+                    source,
+                }));
+            }
             charged.insert(key);
         }
         self.build_structures(samplers)
@@ -683,14 +720,19 @@ impl PreparedScene {
                 .shading_samples
                 .unwrap_or(spec.shading_samples)
                 .clamp(1, texel_scene::MAX_SHADING_SAMPLES),
-            lean: spec.normal.as_ref().and_then(|n| self.lean_maps.get(n)),
+            lean: spec
+                .normal
+                .as_ref()
+                .and_then(|n| self.lean_maps.get(n))
+                .map(Arc::as_ref),
             height_map: spec.height.as_deref().map(|h| maps.red(h)),
             height_scale: spec.height_scale,
             displacement: Displacement::None,
             height_moments: spec
                 .height
                 .as_ref()
-                .and_then(|h| self.height_moments.get(h)),
+                .and_then(|h| self.height_moments.get(h))
+                .map(Arc::as_ref),
             layers: None,
             occlusion_map: spec.occlusion.as_deref().map(|o| maps.red(o)),
             occlusion_strength: spec.occlusion_strength,
@@ -811,11 +853,25 @@ fn charge_geometry(
     Ok(())
 }
 
-/// Textures by name, and the names whose non-finite texels were replaced, with their counts.
-type Loaded = (BTreeMap<String, Texture>, Vec<(String, u64)>);
+/// Textures by name, names that load to the same texels sharing one.
+type Textures = BTreeMap<String, Arc<Texture>>;
 
-/// Every texture the meshes use, each loaded within what `budget` has left and charged its
-/// pyramid; also the textures whose non-finite texels were replaced, with their counts.
+/// Moment maps by texture name, names that share a texture sharing one.
+type MomentMaps = BTreeMap<String, Arc<MomentMap>>;
+
+/// The distinct textures a scene's meshes use ([`load_textures`]).
+struct Loaded {
+    /// One texture per group of names whose specs load to the same texels.
+    textures: Vec<Texture>,
+    /// Per texture, the names that read it (the first one names it in messages).
+    names: Vec<Vec<String>>,
+    /// The textures whose non-finite texels were replaced, by first name, with their counts.
+    replaced: Vec<(String, u64)>,
+}
+
+/// Every texture the meshes use, loaded once per group of names whose specs load to the same
+/// texels ([`Scene::texture_groups`]), each within what `budget` has left and charged its
+/// pyramid once.
 fn load_textures(
     scene: &Scene,
     options: &SceneOptions,
@@ -825,35 +881,56 @@ fn load_textures(
         ColorHandling::Srgb => None,
         ColorHandling::Raw => Some(ColorSpace::Linear),
     };
-    let mut textures = BTreeMap::new();
-    let mut replaced = Vec::new();
-    for u in scene.used_textures() {
-        let spec = scene.texture_spec(&u)?;
-        let limits = Limits {
-            max_bytes: budget.remaining(),
-            ..Limits::default()
-        };
-        let space = if u.color { override_space } else { None };
-        let loaded = spec.load_with(u.name, space, &limits, options.replace_non_finite)?;
+    let mut out = Loaded {
+        textures: Vec::new(),
+        names: Vec::new(),
+        replaced: Vec::new(),
+    };
+    for group in scene.texture_groups(override_space)? {
+        let name = group.uses[0].name;
+        let limits = budget.texture_limits();
+        let loaded = group
+            .spec
+            .load_with(name, Some(group.color), &limits, options.replace_non_finite)
+            .map_err(|e| budget.restate(e))?;
         if loaded.replaced > 0 {
-            replaced.push((u.name.to_string(), loaded.replaced));
+            out.replaced.push((name.to_string(), loaded.replaced));
         }
-        budget.take(
-            &format!("texture {:?}", u.name),
-            loaded.texture.pyramid_bytes(),
-        )?;
-        textures.insert(u.name.to_string(), loaded.texture);
+        let what = match group.uses.len() {
+            1 => format!("texture {name:?}"),
+            n => format!("texture {name:?} (shared by {n} names)"),
+        };
+        budget.take(&what, loaded.texture.pyramid_bytes())?;
+        out.textures.push(loaded.texture);
+        out.names
+            .push(group.uses.iter().map(|u| u.name.to_string()).collect());
     }
-    Ok((textures, replaced))
+    Ok(out)
 }
 
-/// Keep `textures` as `options.texture_storage` asks: with [`TextureStorage::Float`] each 8-bit
-/// texture is replaced by its float copy where the copy fits what `budget` has left (charged
-/// while both exist, the 8-bit pyramid released after); the names and float bytes of those that
-/// did not fit. A copy that fits the budget fits its texture's own limits too: those were what
-/// the budget had left when the texture was loaded, before its own pyramid was charged.
+/// The textures by name: each of `textures` under every one of its `names`, shared.
+fn share_textures(
+    textures: Vec<Texture>,
+    names: Vec<Vec<String>>,
+) -> BTreeMap<String, Arc<Texture>> {
+    let mut out = BTreeMap::new();
+    for (texture, names) in textures.into_iter().zip(names) {
+        let texture = Arc::new(texture);
+        for name in names {
+            out.insert(name, Arc::clone(&texture));
+        }
+    }
+    out
+}
+
+/// Keep the `loaded` textures as `options.texture_storage` asks: with [`TextureStorage::Float`]
+/// each 8-bit texture is replaced by its float copy where the copy fits what `budget` has left
+/// (charged while both exist, the 8-bit pyramid released after); the first names and float
+/// bytes of those that did not fit. A copy that fits the budget fits its texture's own limits
+/// too: those were what the budget had left when the texture was loaded, before its own pyramid
+/// was charged.
 fn store_textures(
-    textures: &mut BTreeMap<String, Texture>,
+    loaded: &mut Loaded,
     options: &SceneOptions,
     budget: &mut MemoryBudget,
 ) -> Result<Vec<(String, u64)>, Error> {
@@ -861,7 +938,8 @@ fn store_textures(
     if options.texture_storage == TextureStorage::Stored {
         return Ok(kept);
     }
-    for (name, texture) in textures.iter_mut() {
+    for (texture, names) in loaded.textures.iter_mut().zip(&loaded.names) {
+        let name = &names[0];
         let format = texture.format();
         let codes_read = options.precision == Precision::Gpu && format == Format::Rgba8Unorm;
         if format == Format::Rgba32Float || codes_read {
@@ -903,9 +981,9 @@ fn own_samplers(scene: &Scene) -> Result<(Vec<TextureSampler>, BTreeMap<String, 
 /// The maps a scene's materials derive from their textures ([`derive_maps`]).
 struct Derived {
     /// LEAN moment maps of normal maps, by texture name.
-    lean_maps: BTreeMap<String, MomentMap>,
+    lean_maps: BTreeMap<String, Arc<MomentMap>>,
     /// Slope moment maps of height maps, by texture name.
-    height_moments: BTreeMap<String, MomentMap>,
+    height_moments: BTreeMap<String, Arc<MomentMap>>,
     /// Baked layered materials, by material name.
     composites: BTreeMap<String, Baked>,
 }
@@ -917,7 +995,7 @@ struct Derived {
 fn derive_maps(
     scene: &Scene,
     options: &SceneOptions,
-    textures: &BTreeMap<String, Texture>,
+    textures: &BTreeMap<String, Arc<Texture>>,
     budget: &mut MemoryBudget,
 ) -> Result<Derived, Error> {
     let mut derived = Derived {
@@ -925,6 +1003,8 @@ fn derive_maps(
         height_moments: BTreeMap::new(),
         composites: BTreeMap::new(),
     };
+    // Each moment map made, by its texture's address: names that share a texture share it.
+    let mut made: Vec<(usize, Moments, Arc<MomentMap>)> = Vec::new();
     for (material, mat) in &scene.materials {
         let aa = specular_aa(mat, options.specular_aa);
         let shape = displacement(mat, options.displacement);
@@ -950,7 +1030,15 @@ fn derive_maps(
                 continue;
             };
             if !out.contains_key(name) {
-                let moments = moment_map(kind, map, budget, name)?;
+                let address = Arc::as_ptr(map) as usize;
+                let moments = match made.iter().find(|(a, k, _)| *a == address && *k == kind) {
+                    Some((_, _, m)) => Arc::clone(m),
+                    None => {
+                        let m = Arc::new(moment_map(kind, map, budget, name)?);
+                        made.push((address, kind, Arc::clone(&m)));
+                        m
+                    }
+                };
                 out.insert(name.clone(), moments);
             }
         }
@@ -973,7 +1061,7 @@ fn derive_maps(
 fn bake_layers(
     scene: &Scene,
     (material, mat): (&String, &texel_scene::MaterialSpec),
-    (textures, lean_maps): (&BTreeMap<String, Texture>, &BTreeMap<String, MomentMap>),
+    (textures, lean_maps): (&Textures, &MomentMaps),
     (aa, bumped): (SpecularAa, bool),
     budget: &mut MemoryBudget,
 ) -> Result<Baked, Error> {
@@ -992,17 +1080,14 @@ fn bake_layers(
         own_of: &BTreeMap::new(),
     };
     let layers = layers_of(mat, maps, lean_maps);
-    let limits = Limits {
-        max_bytes: budget.remaining(),
-        ..Limits::default()
-    };
+    let limits = budget.texture_limits();
     let what = format!("{material} (its layers baked)");
     let composite = bake::bake(&layers, &level0, &limits).map_err(|source| {
-        texel_scene::SceneError::Texture {
+        budget.restate(texel_scene::SceneError::Texture {
             name: what.clone(),
             path: None,
             source,
-        }
+        })
     })?;
     budget.take(
         &format!("the baked layers of material {material:?}"),
@@ -1045,7 +1130,7 @@ fn generate_tangents(scene: &mut Scene) {
 fn tessellate(
     scene: &Scene,
     vertices: &[Vec<Vertex>],
-    (textures, composites): (&BTreeMap<String, Texture>, &BTreeMap<String, Baked>),
+    (textures, composites): (&BTreeMap<String, Arc<Texture>>, &BTreeMap<String, Baked>),
     size: (u32, u32),
     options: &SceneOptions,
     budget: &mut MemoryBudget,
@@ -1150,13 +1235,13 @@ fn displaced_geometry(
 fn heights_of<'a>(
     mesh: &texel_scene::Mesh,
     scene: &Scene,
-    textures: &'a BTreeMap<String, Texture>,
+    textures: &'a BTreeMap<String, Arc<Texture>>,
     composites: &'a BTreeMap<String, Baked>,
 ) -> Option<&'a Texture> {
     let name = mesh.material.as_ref()?;
     let spec = scene.materials.get(name)?;
     match &spec.height {
-        Some(h) => textures.get(h),
+        Some(h) => textures.get(h).map(Arc::as_ref),
         None => composites.get(name)?.composite.height.as_ref(),
     }
 }
@@ -1206,10 +1291,7 @@ fn moment_map(
     budget: &mut MemoryBudget,
     what: &str,
 ) -> Result<MomentMap, Error> {
-    let limits = Limits {
-        max_bytes: budget.remaining(),
-        ..Limits::default()
-    };
+    let limits = budget.texture_limits();
     let (built, name) = match kind {
         Moments::Lean => (
             texel_raster::material::lean_map(map, &limits),
@@ -1220,10 +1302,12 @@ fn moment_map(
             "slope moments",
         ),
     };
-    let moments = built.map_err(|source| texel_scene::SceneError::Texture {
-        name: format!("{what} ({name})"),
-        path: None,
-        source,
+    let moments = built.map_err(|source| {
+        budget.restate(texel_scene::SceneError::Texture {
+            name: format!("{what} ({name})"),
+            path: None,
+            source,
+        })
     })?;
     budget.take(&format!("the {name} of {what}"), moments.pyramid_bytes())?;
     Ok(moments)
@@ -1234,7 +1318,7 @@ fn moment_map(
 /// [`PreparedScene::samplers`]), else the mesh's.
 #[derive(Clone, Copy)]
 struct MapInputs<'a> {
-    textures: &'a BTreeMap<String, Texture>,
+    textures: &'a BTreeMap<String, Arc<Texture>>,
     /// The mesh's sampler.
     mesh: &'a Sampler,
     /// The textures' own samplers.
@@ -1284,7 +1368,7 @@ fn red<'a>(texture: &'a Texture, sampler: &'a Sampler) -> ChannelInput<'a> {
 fn layers_of<'a>(
     spec: &MaterialSpec,
     maps: MapInputs<'a>,
-    lean_maps: &'a BTreeMap<String, MomentMap>,
+    lean_maps: &'a BTreeMap<String, Arc<MomentMap>>,
 ) -> Layers<'a> {
     let input = |name: &String| maps.input(name);
     let mut layers = [Layer::default(); MAX_LAYERS];
@@ -1307,7 +1391,11 @@ fn layers_of<'a>(
             roughness_map,
             normal_map: l.normal.as_ref().map(input),
             normal_scale: l.normal_scale,
-            lean: l.normal.as_ref().and_then(|n| lean_maps.get(n)),
+            lean: l
+                .normal
+                .as_ref()
+                .and_then(|n| lean_maps.get(n))
+                .map(Arc::as_ref),
             height,
             height_map,
         };

@@ -37,6 +37,92 @@ pub fn write_png_atomic(
     Ok(write_atomic(path, &encode_png(width, height, rgba8)?)?)
 }
 
+/// The PNG `png` with a `tEXt` chunk (PNG 1.2, 11.3.4.3) holding `keyword` and `text` right after
+/// its header chunk, so that a reader (`pngcheck -t`, exiftool, Pillow's `info`) finds them. The
+/// keyword is 1 to 79 Latin-1 characters; characters beyond Latin-1 become `?`.
+pub fn png_with_text(png: &[u8], keyword: &str, text: &str) -> Vec<u8> {
+    // Signature (8) and IHDR (length 4, type 4, 13 bytes of data, CRC 4).
+    const AFTER_HEADER: usize = 8 + 25;
+    let latin1 = |s: &str| -> Vec<u8> {
+        s.chars()
+            .map(|c| u8::try_from(u32::from(c)).unwrap_or(b'?'))
+            .collect()
+    };
+    let mut data = latin1(keyword);
+    data.truncate(79);
+    data.push(0);
+    data.extend(latin1(text));
+    let mut chunk = Vec::with_capacity(data.len() + 12);
+    chunk.extend((data.len() as u32).to_be_bytes());
+    chunk.extend(b"tEXt");
+    chunk.extend(&data);
+    let crc = crc32fast::hash(&chunk[4..]);
+    chunk.extend(crc.to_be_bytes());
+    let at = AFTER_HEADER.min(png.len());
+    let mut out = Vec::with_capacity(png.len() + chunk.len());
+    out.extend(&png[..at]);
+    out.extend(chunk);
+    out.extend(&png[at..]);
+    out
+}
+
+/// Encode linear RGBA floats as OpenEXR ([`encode_exr`]) with text attributes (`name`, `value`)
+/// in its header; characters beyond Latin-1 become `?`.
+///
+/// # Errors
+/// As [`encode_exr`].
+pub fn encode_exr_with_text(
+    width: u32,
+    height: u32,
+    rgba: &[[f32; 4]],
+    text: &[(&str, &str)],
+) -> Result<Vec<u8>, QualityError> {
+    use exr::meta::attribute::{AttributeValue, Text};
+    use exr::prelude::WritableImage;
+    use exr::prelude::{Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2};
+    if text.is_empty() {
+        return encode_exr(width, height, rgba);
+    }
+    check_data_len(width, height, 1, rgba.len())?;
+    let w = width as usize;
+    let latin1 = |s: &str| {
+        let clean: String = s
+            .chars()
+            .map(|c| if u32::from(c) < 256 { c } else { '?' })
+            .collect();
+        Text::new_or_none(clean).unwrap_or_default()
+    };
+    let mut attributes = LayerAttributes::default();
+    for (name, value) in text {
+        attributes
+            .other
+            .insert(latin1(name), AttributeValue::Text(latin1(value)));
+    }
+    let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
+        let [r, g, b, a] = rgba[y * w + x];
+        (r, g, b, a)
+    });
+    let layer = Layer::new(
+        (w, height as usize),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        channels,
+    );
+    let mut out = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .non_parallel()
+        .to_buffered(&mut out)
+        .map_err(|e| QualityError::Image {
+            path: PathBuf::new(),
+            source: image::ImageError::Encoding(image::error::EncodingError::new(
+                image::error::ImageFormatHint::Exact(image::ImageFormat::OpenExr),
+                e,
+            )),
+        })?;
+    Ok(out.into_inner())
+}
+
 /// Encode `width x height` linear RGBA floats (row 0 at the top) as OpenEXR (32-bit float
 /// channels R, G, B, A) in memory.
 ///
@@ -77,6 +163,30 @@ mod tests {
     use std::fs;
 
     use super::*;
+
+    #[test]
+    fn text_reaches_png_and_exr_readers() {
+        let png = encode_png(2, 1, &[1, 2, 3, 255, 4, 5, 6, 255]).unwrap();
+        let marked = png_with_text(&png, "texel:partial", "interrupted at 8 samples");
+        // The image decodes to the same pixels, and the chunk is there with a valid CRC (the
+        // decoder checks it).
+        let a = image::load_from_memory(&png).unwrap().to_rgba8();
+        let b = image::load_from_memory(&marked).unwrap().to_rgba8();
+        assert_eq!(a.as_raw(), b.as_raw());
+        let needle = b"tEXttexel:partial\0interrupted at 8 samples";
+        assert!(marked.windows(needle.len()).any(|w| w == needle));
+        let px = [[0.5, -1.0, 3.0e5, 1.0], [0.0, 0.25, 1.0, 0.5]];
+        let exr = encode_exr_with_text(2, 1, &px, &[("texel:partial", "yes")]).unwrap();
+        let back = image::load_from_memory(&exr).unwrap().to_rgba32f();
+        assert_eq!(back.as_raw(), &px.concat());
+        let meta =
+            exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&exr), false).unwrap();
+        let value = &meta.headers[0].own_attributes.other
+            [&exr::meta::attribute::Text::from("texel:partial")];
+        assert!(
+            matches!(value, exr::meta::attribute::AttributeValue::Text(t) if t.to_string() == "yes")
+        );
+    }
 
     #[test]
     fn exr_round_trips_floats_exactly() {

@@ -58,7 +58,9 @@ pub use size::MAX_SIDE;
 
 pub use band::{default_band_rows, horizon_band};
 pub use crop::{crop_enlarge, horizon_crop_rect, Rect};
-pub use encode::{encode_exr, write_exr_atomic, write_png_atomic};
+pub use encode::{
+    encode_exr, encode_exr_with_text, png_with_text, write_exr_atomic, write_png_atomic,
+};
 pub use error::QualityError;
 pub use flicker::{excess_change, mean_abs_change};
 pub use heatmap::{error_map, heat_map, legend_image, legend_svg, viridis, OUTSIDE, VIRIDIS};

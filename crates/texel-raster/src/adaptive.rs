@@ -103,7 +103,8 @@ pub struct ReferenceEstimate {
     pub spp: Vec<u32>,
     /// Whether each pixel met the tolerance.
     pub converged: Vec<bool>,
-    /// Whether the stop flag ended the work early (the passes done are all complete).
+    /// Whether the stop flag ended the work early (each pixel holds whole passes; a pass that was
+    /// stopped reached some pixels and not others).
     pub interrupted: bool,
     /// The plan it was made with.
     pub plan: ReferencePlan,
@@ -320,7 +321,8 @@ fn estimate(
 /// Render a reference of `draws` that converges as `plan` says (see the module docs).
 ///
 /// `progress`, if given, is called from worker threads as pixels finish. `stop`, if given, is
-/// read between passes: once it is set, the estimate so far is returned, marked interrupted.
+/// read between pixel rows: once it is set, no further row starts and the estimate so far is
+/// returned, marked interrupted (each pixel the mean of the whole passes it got).
 ///
 /// # Errors
 /// As [`crate::render`]; [`RasterError::InvalidReferencePlan`] for a plan outside its ranges; a
@@ -370,19 +372,28 @@ pub fn render_reference_adaptive(
                         });
                     }
                 };
-                let frame = pass(
+                let (frame, partial) = pass(
                     pass_seed(plan.seed, done_passes + k),
                     active.as_deref(),
                     Some(&status),
+                    stop,
                 )?;
+                // A stopped pass rendered whole pixel rows: those pixels take it, the others
+                // keep the passes they had.
                 for &i in &indices {
-                    stats[i].add(frame.color[i]);
-                    depth[i] = depth[i].min(frame.depth[i]);
+                    if partial.as_ref().is_none_or(|rendered| rendered[i]) {
+                        stats[i].add(frame.color[i]);
+                        depth[i] = depth[i].min(frame.depth[i]);
+                    }
+                }
+                if partial.is_some() {
+                    interrupted = true;
+                    break;
                 }
             }
-            // Round 0 gives every pixel the same passes: none has one only if it was stopped
-            // before the first.
-            if stats[0].n == 0 {
+            // Round 0 gives every pixel the first pass: a pixel without one was stopped before
+            // it, and the estimate has nothing to show there.
+            if interrupted && round == 0 && stats.iter().any(|s| s.n == 0) {
                 return Err(RasterError::Interrupted);
             }
             if interrupted {

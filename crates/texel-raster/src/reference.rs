@@ -30,7 +30,7 @@
 //! scissor rectangle limits the pixels rendered, which are the same as without it; the rest keep
 //! the background.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use glam::{DVec2, DVec3, Vec4};
 use rayon::prelude::*;
@@ -98,14 +98,22 @@ pub fn render_reference_strata(
     seed: u64,
     progress: Option<Progress>,
 ) -> Result<Frame, RasterError> {
-    with_passes(settings, draws, strata, |pass| pass(seed, None, progress))
+    with_passes(settings, draws, strata, |pass| {
+        pass(seed, None, progress, None).map(|(frame, _)| frame)
+    })
 }
 
 /// One pass of the reference: every pixel (or, with `Some(active)`, those whose entry of the
 /// row-major mask is true; the others keep the background) gets one stratified estimate with the
-/// given seed.
-pub(crate) type Pass<'p> =
-    dyn FnMut(u64, Option<&[bool]>, Option<Progress>) -> Result<Frame, RasterError> + 'p;
+/// given seed. A stop flag, once set, ends the pass between pixel rows: the pass then also returns
+/// which pixels it rendered (row-major), each of them whole.
+pub(crate) type Pass<'p> = dyn FnMut(
+        u64,
+        Option<&[bool]>,
+        Option<Progress>,
+        Option<&AtomicBool>,
+    ) -> Result<(Frame, Option<Vec<bool>>), RasterError>
+    + 'p;
 
 /// Validate `settings`, `draws` and `strata`, make the level-0 samplers and materials the
 /// reference reads through, and hand `body` a function that renders one pass with them (on the
@@ -175,13 +183,16 @@ pub(crate) fn with_passes<T: Send>(
             seed: 0,
             active: None,
         };
-        let mut pass = |seed: u64, active: Option<&[bool]>, progress: Option<Progress>| {
+        let mut pass = |seed: u64,
+                        active: Option<&[bool]>,
+                        progress: Option<Progress>,
+                        stop: Option<&AtomicBool>| {
             let ctx = Context {
                 seed,
                 active,
                 ..shared.clone()
             };
-            Ok(reference_pass(&ctx, &bins, progress))
+            Ok(reference_pass(&ctx, &bins, progress, stop))
         };
         body(&mut pass)
     })
@@ -291,8 +302,14 @@ struct Context<'a> {
 }
 
 /// One pass of the reference with `ctx`'s seed over its active pixels (the others keep the
-/// background).
-fn reference_pass(ctx: &Context, bins: &[Vec<u32>], progress: Option<Progress>) -> Frame {
+/// background). Once `stop` is set, no further pixel row starts; the rows rendered are then
+/// returned as a row-major mask (`None`: the whole pass).
+fn reference_pass(
+    ctx: &Context,
+    bins: &[Vec<u32>],
+    progress: Option<Progress>,
+    stop: Option<&AtomicBool>,
+) -> (Frame, Option<Vec<bool>>) {
     let settings = ctx.settings;
     let (width, height) = (settings.width, settings.height);
     let pixels = width as usize * height as usize;
@@ -310,15 +327,23 @@ fn reference_pass(ctx: &Context, bins: &[Vec<u32>], progress: Option<Progress>) 
     let (tx, _) = tile_counts(width, height);
     let color = split_rows(&mut frame.color, width, height);
     let depth = split_rows(&mut frame.depth, width, height);
+    let mut rendered = if stop.is_some() {
+        vec![false; pixels]
+    } else {
+        Vec::new()
+    };
+    let rendered_rows = split_rows(&mut rendered, width, height);
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let done = AtomicU64::new(0);
     let total = pixels as u64;
     color
         .into_par_iter()
         .zip(depth)
+        .zip(rendered_rows)
         .zip(bins.par_iter())
         .enumerate()
         .with_max_len(1)
-        .for_each(|(k, ((mut color, mut depth), bin))| {
+        .for_each(|(k, (((mut color, mut depth), mut marks), bin))| {
             let (x0, y0) = ((k as u32 % tx) * TILE, (k as u32 / tx) * TILE);
             let mut scratch = Scratch::default();
             // The tile's columns inside the scissor (as offsets into its rows).
@@ -326,6 +351,12 @@ fn reference_pass(ctx: &Context, bins: &[Vec<u32>], progress: Option<Progress>) 
             let tw = color.first().map_or(0, |r| r.len() as u32);
             let (c0, c1) = (sx0.clamp(x0, x0 + tw) - x0, sx1.clamp(x0, x0 + tw) - x0);
             for (r, (crow, drow)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
+                if stopped() {
+                    break;
+                }
+                if let Some(row) = marks.get_mut(r) {
+                    row.fill(true);
+                }
                 let j = y0 + r as u32;
                 if c0 < c1 && (sy0..sy1).contains(&j) {
                     let (c0, c1) = (c0 as usize, c1 as usize);
@@ -339,7 +370,8 @@ fn reference_pass(ctx: &Context, bins: &[Vec<u32>], progress: Option<Progress>) 
                 p(now, total);
             }
         });
-    frame
+    let whole = rendered.iter().all(|&r| r);
+    (frame, (!whole).then_some(rendered))
 }
 
 /// Per-thread buffers for one pixel row of a tile.

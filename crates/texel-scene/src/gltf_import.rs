@@ -89,6 +89,9 @@ struct Ctx<'a> {
     out: Vec<Mesh>,
     textures: BTreeMap<String, TextureSpec>,
     materials: BTreeMap<String, MaterialSpec>,
+    /// Each glTF image read so far, by index: the textures that name one image share its source
+    /// (one copy of its bytes, one decode when the scene is prepared).
+    images: BTreeMap<usize, TextureSource>,
 }
 
 impl Ctx<'_> {
@@ -312,7 +315,15 @@ impl Ctx<'_> {
         };
         let name = format!("{}texture{}.{space}", self.prefix, t.index());
         if !self.textures.contains_key(&name) {
-            let source = self.image(&t.source())?;
+            let image = t.source();
+            let source = match self.images.get(&image.index()) {
+                Some(source) => source.clone(),
+                None => {
+                    let source = self.image(&image)?;
+                    self.images.insert(image.index(), source.clone());
+                    source
+                }
+            };
             let s = t.sampler();
             let sampler = TextureSampler {
                 address_mode_u: wrap(s.wrap_s()),
@@ -329,7 +340,8 @@ impl Ctx<'_> {
     }
 
     /// Where glTF image `image`'s bytes are: a buffer view (GLB or embedded buffers), a base64
-    /// `data:` URI, or a file beside the glTF (as buffers are found).
+    /// `data:` URI, or a file beside the glTF (as buffers are found). Read once per image
+    /// ([`Ctx::texture`] keeps what it returns).
     fn image(&self, image: &gltf::Image) -> Result<TextureSource, SceneError> {
         let i = image.index();
         let origin = format!("{}, image {i}", self.path.display());
@@ -762,7 +774,8 @@ pub struct GltfScene {
     /// Every triangle primitive, one mesh each.
     pub meshes: Vec<Mesh>,
     /// The textures the meshes and imported materials name (`"PREFIX#textureN.srgb"` or
-    /// `.linear` for glTF texture `N` read as colours or as data, `"PREFIX#white"`).
+    /// `.linear` for glTF texture `N` read as colours or as data, `"PREFIX#white"`). Textures of
+    /// one glTF image share its source: [`crate::Scene::texture_groups`] loads it once.
     pub textures: BTreeMap<String, TextureSpec>,
     /// The imported materials (`"PREFIX#materialN"` for glTF material `N`).
     pub materials: BTreeMap<String, MaterialSpec>,
@@ -978,6 +991,7 @@ fn import_slice(
         out: Vec::new(),
         textures: BTreeMap::new(),
         materials: BTreeMap::new(),
+        images: BTreeMap::new(),
     };
     if document.scenes().len() == 0 {
         for mesh in document.meshes() {

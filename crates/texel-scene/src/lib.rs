@@ -5,7 +5,8 @@
 //!   (format: [`mod@file`]), and validates it ([`Scene::validate`]).
 //! - [`Camera::clip_from_world`] gives the OpenGL-style clip transform.
 //! - [`TextureSpec::load`] / [`Scene::load_textures`] build `texel_texture::Texture`s, with an
-//!   optional colour-space override (the CLI's `--color raw`).
+//!   optional colour-space override (the CLI's `--color raw`); textures that load to the same
+//!   texels ([`TextureKey`], [`Scene::texture_groups`]) are loaded once and shared.
 //!
 //! ```
 //! use texel_scene::{Scene, TextureSource, Procedural};
@@ -66,4 +67,4 @@ pub use model::{
 pub use obj::{load_obj, load_obj_bytes, load_obj_with};
 pub use procedural::{NoiseKind, Procedural, MAX_WAVES, MAX_WAVE_TERMS};
 pub use texel_texture::mapping::sphere::Mapping;
-pub use texture::TextureUse;
+pub use texture::{TextureGroup, TextureKey, TextureUse};

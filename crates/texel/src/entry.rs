@@ -61,6 +61,31 @@ fn prepare(
     PreparedScene::new(scene.clone(), &options, budget)
 }
 
+/// The files a scene reads, found by loading and preparing it as rendering does (so by the code
+/// that reads them): the scene file, its meshes (OBJ, glTF and the glTF's buffers and images),
+/// textures and environment maps, each once, in the order they are first opened. `arg` is a path
+/// or `builtin:NAME` (which reads no file); `max_memory` bounds the preparation as
+/// [`RenderOptions::max_memory`] does. What a job needs beside it on another machine.
+///
+/// # Errors
+/// As [`render_scene`] before its first pixel: the scene cannot be loaded, a texture cannot be
+/// decoded, the budget is exceeded.
+pub fn scene_inputs(arg: &str, max_memory: Option<u64>) -> Result<Vec<std::path::PathBuf>, Error> {
+    let (prepared, files) = texel_io::record_opened(|| -> Result<(), Error> {
+        let scene = Scene::load(arg)?;
+        let mut budget = MemoryBudget::limit_or_default(max_memory);
+        prepare(
+            &scene,
+            None,
+            ColorHandling::default(),
+            TextureStorage::Stored,
+            &mut budget,
+        )?;
+        Ok(())
+    });
+    prepared.map(|()| files)
+}
+
 /// A frame's colour as an 8-bit image in `encoding`: an 8-bit frame of that encoding as stored,
 /// anything else through [`Frame::to_8bit`] (a float frame is quantised exactly as an 8-bit
 /// target of the same draws would store it).

@@ -95,7 +95,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     shared.quit();
     let _ = thread.join();
     ran.context("the window's event loop failed")?;
-    eprintln!("{}", app.summary());
+    texel_io::stderr_line(app.summary());
     match app.failure {
         Some(e) => Err(e),
         None => Ok(()),

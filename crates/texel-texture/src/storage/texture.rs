@@ -124,6 +124,33 @@ impl Limits {
     }
 }
 
+/// The bytes of an image file's start that [`file_over_limit`] reads for its header.
+const HEADER_BYTES: u64 = 64 << 10;
+
+/// [`TextureError::OverMemoryLimit`] with what loading the file at `path` needs in all
+/// ([`Limits::load_bytes`]), where the file is larger than `limits` allow and its header can be
+/// read from its first [`HEADER_BYTES`]; `None` otherwise.
+fn file_over_limit(path: &Path, limits: &Limits) -> Option<TextureError> {
+    use std::io::Read;
+    let len = std::fs::metadata(path).ok()?.len();
+    if len <= limits.max_bytes {
+        return None;
+    }
+    let mut head = Vec::new();
+    texel_io::open_regular(path)
+        .ok()?
+        .take(HEADER_BYTES)
+        .read_to_end(&mut head)
+        .ok()?;
+    let (width, height, color) = Texture::header(&head).ok()?;
+    Some(TextureError::OverMemoryLimit {
+        width,
+        height,
+        bytes: Limits::load_bytes(len, width, height, color).max(len),
+        max: limits.max_bytes,
+    })
+}
+
 /// How [`Texture::load_with`] and [`Texture::decode_with`] read an image file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoadOptions {
@@ -418,7 +445,9 @@ impl Texture {
         Self::load_with(path, &LoadOptions::new(color, *limits)).map(|l| l.texture)
     }
 
-    /// As [`Texture::load`], with the non-finite-texel policy of `options`.
+    /// As [`Texture::load`], with the non-finite-texel policy of `options`. A file larger than
+    /// [`Limits::max_bytes`] is refused before it is read, with the figures of
+    /// [`Limits::check_load`] where its header can be read from the file's start.
     ///
     /// # Errors
     /// As [`Texture::load`].
@@ -426,7 +455,11 @@ impl Texture {
         path: impl AsRef<Path>,
         options: &LoadOptions,
     ) -> Result<Loaded, TextureError> {
-        let bytes = texel_io::read_regular(path.as_ref(), options.limits.max_bytes)?;
+        let path = path.as_ref();
+        let bytes = match texel_io::read_regular(path, options.limits.max_bytes) {
+            Ok(bytes) => bytes,
+            Err(e) => return Err(file_over_limit(path, &options.limits).unwrap_or(e.into())),
+        };
         Self::decode_with(&bytes, options)
     }
 
