@@ -1,13 +1,17 @@
 //! `texel._texel`: the native half of the `texel` Python package.
 //!
 //! Arrays cross as numpy arrays (rust-numpy). Every call that works releases the GIL and runs
-//! on texel's own threads; while it runs, the calling thread wakes every
-//! [`POLL`] to let Python handle signals, so Ctrl-C stops a reference after its current pass
-//! and raises `KeyboardInterrupt`. texel's errors become Python exceptions carrying texel's
-//! messages ([`errors`]); a panic becomes a `RuntimeError`, never an abort.
+//! on texel's own threads, a pool per process ([`pool`], so a forked child gets its own);
+//! while it runs, the calling thread wakes every [`POLL`] to let Python handle signals, so
+//! Ctrl-C stops a reference after its current pass and raises `KeyboardInterrupt`. What a call
+//! allocates in proportion to its input is charged to a memory budget first ([`memory`]).
+//! texel's errors become Python exceptions carrying texel's messages ([`errors`]); a panic
+//! becomes a `RuntimeError`, never an abort.
 
 mod arrays;
 mod errors;
+mod memory;
+mod pool;
 mod scene;
 mod texture;
 
@@ -21,10 +25,25 @@ use pyo3::prelude::*;
 /// when it finishes).
 const POLL: Duration = Duration::from_millis(50);
 
-/// Run `work` on another thread with the GIL released, handing it a stop flag. When Python
+/// [`run_released_on`] the process's pool ([`pool::shared`]).
+pub(crate) fn run_released<R, F>(py: Python<'_>, work: F) -> PyResult<R>
+where
+    R: Send,
+    F: FnOnce(&AtomicBool) -> PyResult<R> + Send,
+{
+    let pool = pool::shared()?;
+    run_released_on(py, &pool, work)
+}
+
+/// Run `work` on another thread, installed in `pool` (its parallel loops, and those of everything
+/// it calls, run on `pool`'s workers), with the GIL released, handing it a stop flag. When Python
 /// reports a pending signal (Ctrl-C), the flag is set, `work` is waited for (it stops at its next
 /// check, or finishes) and the signal's exception is raised.
-pub(crate) fn run_released<R, F>(py: Python<'_>, work: F) -> PyResult<R>
+pub(crate) fn run_released_on<R, F>(
+    py: Python<'_>,
+    pool: &rayon::ThreadPool,
+    work: F,
+) -> PyResult<R>
 where
     R: Send,
     F: FnOnce(&AtomicBool) -> PyResult<R> + Send,
@@ -34,7 +53,7 @@ where
     let caller = std::thread::current();
     std::thread::scope(|s| {
         let handle = s.spawn(|| {
-            let result = work(&stop);
+            let result = pool.install(|| work(&stop));
             done.store(true, Ordering::Release);
             caller.unpark();
             result
@@ -72,6 +91,7 @@ fn _texel(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::reference_estimate, m)?)?;
     m.add_function(wrap_pyfunction!(scene::compare, m)?)?;
     m.add_function(wrap_pyfunction!(scene::scene_size, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::scene_files, m)?)?;
     m.add_function(wrap_pyfunction!(texture::warp, m)?)?;
     m.add_function(wrap_pyfunction!(texture::encode, m)?)?;
     m.add("FILTERS", texel::Filter::NAMES.to_vec())?;

@@ -29,6 +29,22 @@ def test_wrong_shapes_are_value_errors():
         t.sample(np.zeros((5, 2)), np.zeros((4, 2)), np.zeros((5, 2)))
 
 
+def test_shape_errors_say_what_the_shape_looks_like():
+    with pytest.raises(ValueError, match=r"array has shape \(4, 64, 64\): it looks channels-first \(C, H, W\); texel takes \(H, W, C\)"):
+        texel.Texture(np.zeros((4, 64, 64), np.uint8))
+    with pytest.raises(ValueError, match=r"\(1, 8, 8, 3\): it looks like a batch of one image .* pass array\[0\]"):
+        texel.Texture(np.zeros((1, 8, 8, 3), np.uint8))
+    with pytest.raises(ValueError, match=r"linear has shape \(4, 64, 64\): it looks channels-first"):
+        texel.encode(np.zeros((4, 64, 64), np.float32))
+    with pytest.raises(ValueError, match=r"\(64, 64\): it looks like a grey \(H, W\) image.*linear\[\.\.\., None\]"):
+        texel.encode(np.zeros((64, 64), np.float32))
+    t = texel.Texture(np.zeros((4, 4, 3), dtype=np.uint8))
+    with pytest.raises(ValueError, match=r"uv has shape \(2, 8, 8\): it looks channels-first \(2, \.\.\.\)"):
+        t.sample(np.zeros((2, 8, 8)), filter="nearest")
+    with pytest.raises(TypeError, match="float32"):
+        texel.encode(np.zeros((4, 4), np.float64))
+
+
 def test_nan_values_are_value_errors():
     t = texel.Texture(np.zeros((4, 4, 3), dtype=np.uint8))
     uv = np.zeros((3, 2))

@@ -1,12 +1,13 @@
 """render, reference and compare give what the texel command writes."""
 
 import json
+import pathlib
 
 import numpy as np
 import pytest
 
 import texel
-from conftest import ROOT, read_png
+from conftest import ROOT, SCENE_HEAD, png_bytes, quad_mesh, read_png, solid_png, write_gltf, write_obj
 
 
 @pytest.mark.parametrize(
@@ -51,7 +52,7 @@ def test_reference_equals_the_cli_png_and_its_error_bars_hold(cli, tmp_path):
     assert est["spp"].min() >= 16 and est["spp"].max() <= 64
     assert est["std_error"].shape == (36, 64, 4) and np.all(est["std_error"] >= 0)
     # The image is the encoding of the linear mean.
-    np.testing.assert_array_equal(texel.encode(est["linear"]), est["image"])
+    np.testing.assert_array_equal(texel.encode(est["linear"], color="srgb"), est["image"])
 
 
 def test_a_scissored_reference_is_that_part_of_the_whole():
@@ -90,3 +91,51 @@ def test_the_readme_example_runs(capsys):
     code = section.split("```python\n", 1)[1].split("```", 1)[0]
     exec(compile(code, "README.md", "exec"), {})
     assert "dB against" in capsys.readouterr().out
+
+
+def test_a_path_is_decided_by_the_file_not_by_the_string(tmp_path):
+    solid_png(tmp_path / "red.png", (255, 0, 0))
+    text = SCENE_HEAD + '[textures.red]\npath = "red.png"\n' + quad_mesh("red")
+    plain = tmp_path / "scene.toml"
+    plain.write_text(text)
+    odd = tmp_path / "a\nscene.toml"
+    odd.write_text(text)
+    expected = texel.render(str(plain))
+    assert tuple(expected[12, 16]) == (255, 0, 0, 255)
+    # An existing file whose name holds a line break is the file, not TOML text.
+    np.testing.assert_array_equal(texel.render(str(odd)), expected)
+    np.testing.assert_array_equal(texel.render(odd), expected)
+    # An os.PathLike is always a path, even one that names no file.
+    with pytest.raises(OSError, match="(?i)no such file"):
+        texel.render(tmp_path / "missing\nfile.toml")
+
+
+@pytest.mark.parametrize("kind", ["obj", "gltf", "glb", "GLB"])
+def test_mesh_files_render_framed_by_a_camera_of_their_own(tmp_path, kind):
+    red = np.full((4, 4, 4), [255, 0, 0, 255], np.uint8)
+    if kind == "obj":
+        path = tmp_path / "quad.obj"
+        write_obj(path)
+    else:
+        (tmp_path / "img").mkdir()
+        (tmp_path / "img" / "red.png").write_bytes(png_bytes(red))
+        path = tmp_path / f"quad.{kind}"
+        write_gltf(path, png_bytes(red), image_uri="img/red.png", buffer_uri="quad.bin")
+    assert texel.scene_size(path) == (640, 480)
+    image = texel.render(str(path), size=(64, 48))
+    np.testing.assert_array_equal(texel.render(path, size=(64, 48)), image)
+    if kind == "obj":
+        # texel reads no OBJ materials: the procedural checker, its white checks on the mesh.
+        assert np.any(image[12:36, 20:44, :3] > 0)
+    else:
+        # The glTF's own material and texture, at the frame's centre.
+        assert tuple(image[24, 32]) == (255, 0, 0, 255)
+    # The frame's corners see past the mesh's bounding sphere: the background.
+    assert tuple(image[0, 0]) == (0, 0, 0, 255)
+    # Its files are the mesh's own.
+    files = [pathlib.Path(f).name for f in texel.scene_files(path)]
+    assert files[0] == path.name
+    if kind == "gltf":
+        assert sorted(files[1:]) == ["quad.bin", "red.png"]
+    elif kind != "obj":
+        assert files == [path.name]

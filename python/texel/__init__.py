@@ -1,18 +1,26 @@
 """texel: texture mapping and every texture filter, from nearest to EWA, on numpy arrays.
 
 ``Texture`` holds an image and its mip pyramid and samples it with any filter at arrays of points
-and footprints; ``render``, ``reference`` and ``compare`` run texel's scenes (a path, a
-``"builtin:NAME"`` or TOML text) exactly as the ``texel`` command does; ``warp`` maps an image in
-perspective without aliasing. ``texel.distributed`` runs renders and references over Ray.
+and footprints; ``render``, ``reference`` and ``compare`` run texel's scenes (a TOML, OBJ or glTF
+file, a ``"builtin:NAME"`` or TOML text) exactly as the ``texel`` command does; ``warp`` maps an
+image in perspective without aliasing; ``scene_files`` lists the files a scene reads.
+``texel.distributed`` runs renders and references over Ray.
 
-Every call releases the GIL and uses texel's own threads. texel's errors arrive as Python
-exceptions with texel's messages: ``ValueError`` for bad values, ``OSError`` for files,
-``MemoryError`` for what the memory limit refuses, ``KeyboardInterrupt`` after Ctrl-C.
+8-bit arrays are read as stored (``color="linear"``, code ``c`` is ``c / 255``, as OpenCV, scipy
+and torch read them) unless ``color="srgb"`` says they are sRGB-encoded; scenes default to sRGB,
+as their image files are.
+
+Every call releases the GIL and uses texel's own threads, a pool per process (a forked child
+makes its own). What a call allocates in proportion to its input is charged to ``max_memory``,
+else the process's memory limit, before it is allocated. texel's errors arrive as Python
+exceptions with texel's messages: ``ValueError`` for bad values and shapes, ``OSError`` for
+files, ``MemoryError`` for what the memory limit refuses, ``KeyboardInterrupt`` after Ctrl-C.
 """
 
 from __future__ import annotations
 
-from typing import Optional, Sequence, Tuple
+import os
+from typing import Optional, Tuple
 
 from ._texel import (
     BUILTIN_SCENES,
@@ -23,6 +31,7 @@ from ._texel import (
     encode,
     reference_estimate,
     render,
+    scene_files,
     scene_size,
     warp,
 )
@@ -37,13 +46,14 @@ __all__ = [
     "reference",
     "reference_estimate",
     "render",
+    "scene_files",
     "scene_size",
     "warp",
 ]
 
 
 def reference(
-    scene: str,
+    scene: "str | os.PathLike[str]",
     spp: int = 256,
     size: Optional[Tuple[int, int]] = None,
     max_spp: int = 65536,

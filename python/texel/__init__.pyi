@@ -19,11 +19,12 @@ class Texture:
     def __init__(
         self,
         array: npt.NDArray[Union[np.uint8, np.float32]],
-        color: str = "srgb",
+        color: str = "linear",
         address: str = "repeat",
         address_u: Optional[str] = None,
         address_v: Optional[str] = None,
         border: str = "transparent-black",
+        max_memory: Optional[int] = None,
     ) -> None: ...
     @property
     def width(self) -> int: ...
@@ -31,6 +32,14 @@ class Texture:
     def height(self) -> int: ...
     @property
     def dtype(self) -> str: ...
+    @property
+    def color(self) -> str: ...
+    @property
+    def address_u(self) -> str: ...
+    @property
+    def address_v(self) -> str: ...
+    @property
+    def border(self) -> str: ...
     def levels(self) -> List[npt.NDArray[Union[np.uint8, np.float32]]]: ...
     def sample(
         self,
@@ -39,7 +48,11 @@ class Texture:
         duv_dy: Optional[_Coords] = None,
         filter: str = "trilinear",
         lod_bias: float = 0.0,
+        coords: str = "uv",
+        threads: Optional[int] = None,
+        max_memory: Optional[int] = None,
     ) -> npt.NDArray[np.float32]: ...
+    def __reduce__(self) -> Tuple[type, Tuple[object, ...]]: ...
 
 def render(
     scene: _Scene,
@@ -88,10 +101,14 @@ def compare(
 ) -> Dict[str, Dict[str, Union[float, int, List[str]]]]: ...
 def warp(
     image: npt.NDArray[Union[np.uint8, np.float32]],
-    corners: Sequence[float],
+    corners: Union[Sequence[float], Sequence[Tuple[float, float]]],
     size: Optional[Tuple[int, int]] = None,
     filter: str = "ewa",
-    color: str = "srgb",
+    color: str = "linear",
+    max_memory: Optional[int] = None,
 ) -> npt.NDArray[Union[np.uint8, np.float32]]: ...
-def encode(linear: npt.NDArray[np.float32], color: str = "srgb") -> npt.NDArray[np.uint8]: ...
+def encode(
+    linear: npt.NDArray[np.float32], color: str = "linear", max_memory: Optional[int] = None
+) -> npt.NDArray[np.uint8]: ...
 def scene_size(scene: _Scene, size: Optional[Tuple[int, int]] = None) -> Tuple[int, int]: ...
+def scene_files(scene: _Scene, max_memory: Optional[int] = None) -> List[str]: ...

@@ -1,13 +1,18 @@
 """texel over Ray: many renders, or one reference split into tiles, on a cluster.
 
-``render(jobs)`` runs each job (a dict of ``texel.render``'s keyword arguments) as a Ray task;
-``reference(scene, ...)`` splits one reference into tiles, each a task. Results equal the local
-calls bit for bit: every pixel of a reference depends only on the seed and its own samples.
+``render(jobs)`` runs the jobs (dicts of ``texel.render``'s keyword arguments) as Ray tasks, many
+small jobs to a task; ``reference(scene, ...)`` splits one reference into tiles, each a task.
+Results equal the local calls bit for bit: every pixel of a reference depends only on the seed
+and its own samples.
 
-A scene given as a file path travels with the files it names (textures, meshes, environment
-maps, and what OBJ and glTF files name in turn): each distinct scene is put once into Ray's
-object store and unpacked into a temporary directory on the worker that runs it. Builtin scenes
-and TOML text travel as text (the text's relative paths resolve on the worker).
+A scene given as a file path travels with the files texel reads for it, as ``texel.scene_files``
+finds them by loading and preparing the scene (textures, meshes, glTF buffers and images,
+environment maps, however the scene file names them): each distinct scene is put once into
+Ray's object store and unpacked into a temporary directory on the worker that runs it, laid out
+as the files lie around the scene (a file named by a relative path outside the scene's directory,
+``../shared/tex.png``, travels too). Files a scene names by absolute path are read where the task
+runs (a shared file system), not shipped. Builtin scenes and TOML text travel as text (the
+text's relative paths resolve on the worker).
 
 ``address=None`` starts or joins a local Ray (``ray.init()``); ``"auto"`` or ``"ray://HOST:PORT"``
 joins a cluster. Needs the ``ray`` extra: ``pip install ./python[ray]``.
@@ -15,12 +20,10 @@ joins a cluster. Needs the ``ray`` extra: ``pip install ./python[ray]``.
 
 from __future__ import annotations
 
-import json
+import math
 import os
-import re
 import tempfile
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
-from urllib.parse import unquote
 
 import numpy as np
 
@@ -28,9 +31,9 @@ import texel
 
 __all__ = ["render", "reference", "reference_estimate", "bundle"]
 
-# The scene-file keys whose values name files: texture and environment images, mesh files.
-_FILE_KEYS = re.compile(r'^\s*(path|obj|gltf|faces)\s*=(.*)$', re.MULTILINE)
-_QUOTED = re.compile(r'"((?:[^"\\]|\\.)*)"|\'([^\']*)\'')
+# Tasks per worker slot that render(batch=None) aims for: enough to balance uneven jobs, few
+# enough that Ray's per-task cost is spread over many small jobs.
+_TASKS_PER_SLOT = 4
 
 
 def _ray():
@@ -53,73 +56,40 @@ def _connect(address: Optional[str]):
     return ray
 
 
-def _named_files(path: str) -> List[str]:
-    """Files a scene, OBJ, MTL or glTF file names by relative path, that exist."""
-    base = os.path.dirname(path)
-    with open(path, "rb") as f:
-        text = f.read().decode("utf-8", errors="replace")
-    ext = os.path.splitext(path)[1].lower()
-    names: List[str] = []
-    if ext == ".obj":
-        for line in text.splitlines():
-            parts = line.split()
-            if parts and parts[0] == "mtllib":
-                names.extend(parts[1:])
-    elif ext == ".mtl":
-        for line in text.splitlines():
-            parts = line.split()
-            if len(parts) > 1 and (parts[0].startswith("map_") or parts[0] in ("bump", "norm", "disp")):
-                names.append(parts[-1])
-    elif ext == ".gltf":
-        try:
-            doc = json.loads(text)
-        except ValueError:
-            doc = None
-        if isinstance(doc, dict):
-            for key in ("buffers", "images"):
-                items = doc.get(key)
-                for item in items if isinstance(items, list) else []:
-                    uri = item.get("uri") if isinstance(item, dict) else None
-                    if isinstance(uri, str) and uri and not uri.startswith("data:"):
-                        names.append(unquote(uri))
-    elif ext == ".toml":
-        for _, value in _FILE_KEYS.findall(text):
-            names.extend(a or b for a, b in _QUOTED.findall(value))
-    found = []
-    for name in names:
-        # An absolute path is read where the task runs (a shared file system), not shipped.
-        if not name or os.path.isabs(name):
-            continue
-        full = os.path.normpath(os.path.join(base, name))
-        if os.path.isfile(full):
-            found.append(full)
-    return found
+def _is_text(scene: Union[str, "os.PathLike[str]"]) -> bool:
+    """Whether texel reads ``scene`` as a builtin name or TOML text rather than a file: as
+    ``texel.render`` decides (a ``str`` naming no file that is ``builtin:NAME`` or holds a line
+    break; an ``os.PathLike`` is always a file)."""
+    if not isinstance(scene, str):
+        return False
+    return scene.startswith("builtin:") or ("\n" in scene and not os.path.isfile(scene))
 
 
-def bundle(scene: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
+def bundle(scene: Union[str, "os.PathLike[str]"], max_memory: Optional[int] = None) -> Dict[str, Any]:
     """What a scene argument needs on another machine: ``{"scene": TEXT}`` for a builtin scene or
-    TOML text, else ``{"path": RELATIVE, "files": {RELATIVE: BYTES}}`` with the file and every
-    file it names by relative path (``path``, ``obj``, ``gltf`` and ``faces`` in a scene file; what
-    OBJ, MTL and glTF files name in turn), relative to their common directory."""
-    scene = os.fspath(scene)
-    if scene.startswith("builtin:") or "\n" in scene:
+    TOML text, else ``{"path": RELATIVE, "files": {RELATIVE: BYTES}}`` with the scene's file and
+    every file ``texel.scene_files`` says it reads through a relative path, relative to their
+    common directory. ``max_memory`` bounds the preparation that finds them, as in
+    ``texel.render``."""
+    if _is_text(scene):
         return {"scene": scene}
-    if not os.path.isfile(scene):
-        raise FileNotFoundError(f"cannot load scene {scene}: no such file")
-    todo = [os.path.abspath(scene)]
-    seen: List[str] = []
-    while todo:
-        p = todo.pop()
-        if p in seen:
-            continue
-        seen.append(p)
-        todo.extend(os.path.abspath(q) for q in _named_files(p))
-    root = os.path.commonpath([os.path.dirname(p) for p in seen])
+    path = os.path.abspath(os.fspath(scene))
+    base = os.path.dirname(path)
+    # Joined to an absolute scene path, a file the scene names relatively starts with its
+    # directory; one named absolutely is read where the task runs.
+    opened = texel.scene_files(path, max_memory=max_memory)
+    shipped = [path]
+    for p in opened:
+        if p.startswith(base + os.sep):
+            full = os.path.normpath(p)
+            if full not in shipped:
+                shipped.append(full)
+    root = os.path.commonpath([os.path.dirname(p) for p in shipped])
     files = {}
-    for p in seen:
+    for p in shipped:
         with open(p, "rb") as f:
             files[os.path.relpath(p, root)] = f.read()
-    return {"path": os.path.relpath(seen[0], root), "files": files}
+    return {"path": os.path.relpath(path, root), "files": files}
 
 
 def _unpacked(b: Dict[str, Any], work: str) -> str:
@@ -140,9 +110,12 @@ def _unpacked(b: Dict[str, Any], work: str) -> str:
     return scene
 
 
-def _run_render(b: Dict[str, Any], kwargs: Dict[str, Any]) -> np.ndarray:
-    with tempfile.TemporaryDirectory(prefix="texel-job-") as work:
-        return texel.render(_unpacked(b, work), **kwargs)
+def _run_renders(jobs: List[Tuple[int, Dict[str, Any]]], *bundles: Dict[str, Any]) -> List[np.ndarray]:
+    """Render ``jobs`` (each the index of its scene in ``bundles`` and ``texel.render``'s other
+    arguments), each bundle unpacked once."""
+    with tempfile.TemporaryDirectory(prefix="texel-jobs-") as work:
+        scenes = [_unpacked(b, os.path.join(work, str(k))) for k, b in enumerate(bundles)]
+        return [texel.render(scenes[k], **kwargs) for k, kwargs in jobs]
 
 
 def _run_reference(b: Dict[str, Any], kwargs: Dict[str, Any]) -> Dict[str, Any]:
@@ -150,28 +123,58 @@ def _run_reference(b: Dict[str, Any], kwargs: Dict[str, Any]) -> Dict[str, Any]:
         return texel.reference_estimate(_unpacked(b, work), **kwargs)
 
 
+def _batch_size(jobs: int, slots: int) -> int:
+    """Jobs per task for ``jobs`` jobs on ``slots`` workers: about ``_TASKS_PER_SLOT`` tasks per
+    worker, at least one job each."""
+    return max(1, math.ceil(jobs / (_TASKS_PER_SLOT * max(1, slots))))
+
+
+def _batches(jobs: int, size: int) -> List[range]:
+    """Consecutive ranges of at most ``size`` of ``jobs`` job indices, in order."""
+    return [range(k, min(k + size, jobs)) for k in range(0, jobs, size)]
+
+
 def render(
     jobs: Sequence[Dict[str, Any]],
     address: Optional[str] = None,
     cpus_per_job: int = 1,
+    batch: Optional[int] = None,
 ) -> List[np.ndarray]:
-    """Run each job (``texel.render``'s keyword arguments, ``scene`` included) as a Ray task with
-    ``cpus_per_job`` CPUs and texel on as many threads; returns the images in the jobs' order,
-    equal bit for bit to ``[texel.render(**job) for job in jobs]``."""
-    ray = _connect(address)
-    task = ray.remote(num_cpus=cpus_per_job)(_run_render)
-    refs: Dict[str, Any] = {}
-    pending = []
+    """Run the jobs (``texel.render``'s keyword arguments, ``scene`` included) as Ray tasks of
+    ``batch`` jobs each (``None``: about four tasks per worker slot of the cluster, so that many
+    small jobs share a task's cost), each task with ``cpus_per_job`` CPUs and texel on as many
+    threads; returns the images in the jobs' order, equal bit for bit to
+    ``[texel.render(**job) for job in jobs]``."""
+    if batch is not None and batch < 1:
+        raise ValueError(f"batch must be at least 1 job a task, or None; got {batch!r}")
+    if cpus_per_job < 1:
+        raise ValueError(f"cpus_per_job must be at least 1; got {cpus_per_job!r}")
+    specs: List[Tuple[str, Dict[str, Any]]] = []
     for job in jobs:
         job = dict(job)
         if "scene" not in job:
             raise ValueError(f"a job needs a scene: {job!r}")
-        scene = os.fspath(job.pop("scene"))
-        if scene not in refs:
-            refs[scene] = ray.put(bundle(scene))
+        scene = job.pop("scene")
         job.setdefault("threads", cpus_per_job)
-        pending.append(task.remote(refs[scene], job))
-    return ray.get(pending)
+        specs.append((scene if isinstance(scene, str) else os.fspath(scene), job))
+    ray = _connect(address)
+    slots = int(ray.cluster_resources().get("CPU", 1) // cpus_per_job)
+    size = batch or _batch_size(len(specs), slots)
+    task = ray.remote(num_cpus=cpus_per_job)(_run_renders)
+    refs: Dict[str, Any] = {}
+    pending = []
+    for chunk in _batches(len(specs), size):
+        used: List[str] = []
+        work = []
+        for k in chunk:
+            scene, kwargs = specs[k]
+            if scene not in refs:
+                refs[scene] = ray.put(bundle(scene))
+            if scene not in used:
+                used.append(scene)
+            work.append((used.index(scene), kwargs))
+        pending.append(task.remote(work, *[refs[s] for s in used]))
+    return [image for part in ray.get(pending) for image in part]
 
 
 def _splits(n: int, parts: int) -> List[Tuple[int, int]]:
@@ -181,7 +184,7 @@ def _splits(n: int, parts: int) -> List[Tuple[int, int]]:
 
 
 def reference_estimate(
-    scene: str,
+    scene: Union[str, "os.PathLike[str]"],
     spp: int = 256,
     size: Optional[Tuple[int, int]] = None,
     tiles: Tuple[int, int] = (4, 4),
@@ -200,7 +203,7 @@ def reference_estimate(
     width, height = texel.scene_size(scene, size)
     ray = _connect(address)
     task = ray.remote(num_cpus=cpus_per_tile)(_run_reference)
-    ref = ray.put(bundle(scene))
+    ref = ray.put(bundle(scene, max_memory=kwargs.get("max_memory")))
     kwargs.setdefault("threads", cpus_per_tile)
     rects = [
         (x0, y0, x1, y1) for (y0, y1) in _splits(height, rows) for (x0, x1) in _splits(width, columns)
@@ -220,7 +223,7 @@ def reference_estimate(
 
 
 def reference(
-    scene: str,
+    scene: Union[str, "os.PathLike[str]"],
     spp: int = 256,
     size: Optional[Tuple[int, int]] = None,
     tiles: Tuple[int, int] = (4, 4),
