@@ -499,15 +499,35 @@ fn orbit_scores(
     })
 }
 
-/// What `compare` can tell before its first pixel: the frame holds SSIM's window, and every
-/// `--extra` image (its header read, not decoded) has the comparison's size.
-fn check_before_work(scene: &PreparedScene, extras: &[(String, PathBuf)]) -> Result<()> {
+/// What `compare` can tell before the reference: the frame holds SSIM's window, every `--extra`
+/// image (its header read, not decoded) has the comparison's size, and the scene covers a pixel
+/// where that window fits (seen in one nearest-filtered frame: where pixel centres meet a
+/// triangle).
+fn check_before_work(
+    scene: &PreparedScene,
+    extras: &[(String, PathBuf)],
+    budget: &mut MemoryBudget,
+) -> Result<()> {
     let (w, h) = (scene.width, scene.height);
     let side = texel_quality::ssim::WINDOW as u32;
     anyhow::ensure!(
         w >= side && h >= side,
         "invalid --size {w}x{h}: compare scores SSIM over {side}x{side} windows, so each side must \
          be at least {side} pixels"
+    );
+    let probe = scene.plan(Some(Filter::Nearest), budget)?;
+    let covered = render(&probe.settings(), &probe.draws())?.coverage();
+    anyhow::ensure!(
+        covered.iter().any(|&c| c),
+        "the scene covers no pixel centre at {w}x{h}: nothing to compare (check the camera)"
+    );
+    let half = side / 2;
+    let inner = (half..h - half).any(|y| (half..w - half).any(|x| covered[(y * w + x) as usize]));
+    anyhow::ensure!(
+        inner,
+        "the scene covers no pixel at least {half} pixels from the frame's edge, where SSIM's \
+         {side}x{side} window fits: nothing to score (a larger --size, or a camera that sees more \
+         of the scene)"
     );
     for (label, path) in extras {
         let (iw, ih) = Image8::dimensions(path)
@@ -539,7 +559,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     )?;
     check_storage(&args.scene, args.gpu)?;
     let scene = load_scene(&args.scene, input)?;
-    check_before_work(&scene, &extras)?;
+    check_before_work(&scene, &extras, &mut input.budget)?;
     let frames = if args.gpu {
         gpu_rows(&scene, &filters, args.adapter.as_deref(), &mut input.budget)?
     } else {

@@ -358,3 +358,48 @@ fn report_names_reach_no_terminal_raw() {
         "{err}"
     );
 }
+
+#[test]
+fn a_scene_compare_cannot_score_is_refused_before_the_reference() {
+    let d = Dir::new("published-coverage");
+    // Looking away from the quad: nothing covered.
+    let away = d.write(
+        "away.toml",
+        format!(
+            "{}{QUAD}",
+            HEAD.replace("target = [0.0, 0.0, 0.0]", "target = [0.0, 0.0, 6.0]")
+        ),
+    );
+    // The quad seen only in a corner strip, closer to the edge than SSIM's window reaches.
+    let corner = d.write(
+        "corner.toml",
+        format!(
+            "{}\n[[meshes]]\ntexture = \"t\"\npositions = [[-10.0, -10.0, 0.0], [10.0, -10.0, 0.0], \
+             [10.0, -1.2, 0.0], [-10.0, -1.2, 0.0]]\nuvs = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], \
+             [0.0, 0.0]]\ntriangles = [[0, 1, 2], [0, 2, 3]]\n",
+            HEAD
+        ),
+    );
+    for (scene, needle) in [
+        (&away, "covers no pixel centre"),
+        (&corner, "from the frame's edge"),
+    ] {
+        let err = fails(
+            &[
+                "compare",
+                scene.to_str().unwrap(),
+                "--spp",
+                "4096",
+                "--filters",
+                "nearest",
+                "--out",
+                &d.arg("report"),
+            ],
+            1,
+            &[needle],
+        );
+        // Refused before the 4096-sample reference ran (it would print its summary).
+        assert!(!err.contains("reference:"), "{err}");
+        assert!(!d.join("report").exists());
+    }
+}
