@@ -289,7 +289,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         writeln!(
             stdout,
             "texel bench: {} at {}x{}, {threads} threads, {} target, median of {} frames after {} warm-up",
-            args.scene.scene,
+            texel_io::escape(&args.scene.scene),
             scene.width,
             scene.height,
             target_name(args.target),
