@@ -71,9 +71,9 @@ def _scene_of_many_files(tmp_path):
     scene_dir = tmp_path / "scene"
     for d in ["tex", "env", "model/img"]:
         (scene_dir / d).mkdir(parents=True)
-    (tmp_path / "shared").mkdir()
+    (tmp_path / "common").mkdir()
     solid_png(scene_dir / "tex" / "a.png", (200, 10, 10))
-    solid_png(tmp_path / "shared" / "b.png", (10, 200, 10))
+    solid_png(tmp_path / "common" / "b.png", (10, 200, 10))
     faces = ["px", "nx", "py", "ny", "pz", "nz"]
     for k, face in enumerate(faces):
         solid_png(scene_dir / "env" / f"{face}.png", (20 * k, 40, 60))
@@ -89,7 +89,7 @@ def _scene_of_many_files(tmp_path):
     face_lines = "".join(f'  "env/{f}.png",\n' for f in faces)
     text = (
         'textures.a = { path = "tex/a.png" }\n'
-        'textures.b.path = "../shared/b.png"\n'
+        'textures.b.path = "../common/b.png"\n'
         'textures.unused = { path = "tex/unused.png" }\n'
         + SCENE_HEAD
         + "[environment]\nfaces = [\n" + face_lines + "]\nbackground = true\n"
@@ -100,7 +100,7 @@ def _scene_of_many_files(tmp_path):
     )
     scene = scene_dir / "s.toml"
     scene.write_text(text)
-    rel = ["scene/s.toml", "scene/tex/a.png", "shared/b.png",
+    rel = ["scene/s.toml", "scene/tex/a.png", "common/b.png",
            *[f"scene/env/{f}.png" for f in faces],
            "scene/model/quad.gltf", "scene/model/quad.bin", "scene/model/img/red.png",
            "scene/model/blue.glb"]
@@ -131,7 +131,7 @@ def test_a_bundled_scene_renders_on_a_worker_as_here(local_ray, tmp_path):
 
     work = tmp_path / "elsewhere"
     shutil.move(str(tmp_path / "scene"), str(work / "scene"))
-    shutil.move(str(tmp_path / "shared"), str(work / "shared"))
+    shutil.move(str(tmp_path / "common"), str(work / "common"))
     got = ray.get(ray.remote(distributed._run_renders).remote([(0, {})], b))
     np.testing.assert_array_equal(got[0], local)
 

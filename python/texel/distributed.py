@@ -10,7 +10,7 @@ finds them by loading and preparing the scene (textures, meshes, glTF buffers an
 environment maps, however the scene file names them): each distinct scene is put once into
 Ray's object store and unpacked into a temporary directory on the worker that runs it, laid out
 as the files lie around the scene (a file named by a relative path outside the scene's directory,
-``../shared/tex.png``, travels too). Files a scene names by absolute path are read where the task
+``../common/tex.png``, travels too). Files a scene names by absolute path are read where the task
 runs (a shared file system), not shipped. Builtin scenes and TOML text travel as text (the
 text's relative paths resolve on the worker).
 

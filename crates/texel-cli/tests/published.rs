@@ -26,23 +26,32 @@ fn compare_never_replaces_a_file_its_scene_reads() {
     let before = file_bytes(&level);
     let scene = d.write("scene.toml", scene_with_texture(&level));
     let err = fails(
-        &[
-            "compare",
-            scene.to_str().unwrap(),
-            "--size",
-            "16x12",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--out",
-            m.to_str().unwrap(),
-        ],
+        &small_compare(&[scene.to_str().unwrap()], m.to_str().unwrap()),
         1,
         &["holds the input", "level-00-64x64.png"],
     );
     assert!(!err.contains("reference:"), "the comparison ran: {err}");
     assert_eq!(file_bytes(&level), before, "the texture changed");
+}
+
+/// `texel compare` at 16 x 12 with one sample and the nearest filter into `out`, `args` (a scene,
+/// `--extra`) before `--out`.
+fn small_compare(args: &[&str], out: &str) -> Vec<String> {
+    let mut all = vec!["compare".to_string()];
+    all.extend(args.iter().map(|a| a.to_string()));
+    for a in [
+        "--size",
+        "16x12",
+        "--spp",
+        "1",
+        "--filters",
+        "nearest",
+        "--out",
+        out,
+    ] {
+        all.push(a.to_string());
+    }
+    all
 }
 
 /// A 64 x 64 PNG written by `texel render`, for inputs.
@@ -60,17 +69,7 @@ fn an_empty_marker_owns_nothing() {
     d.write("thesis/thesis.tex", "chapter 1");
     d.write("thesis/.texel-output", "");
     fails(
-        &[
-            "compare",
-            "--size",
-            "16x12",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--out",
-            thesis.to_str().unwrap(),
-        ],
+        &small_compare(&[], thesis.to_str().unwrap()),
         1,
         &["did not write"],
     );
@@ -85,17 +84,7 @@ fn a_private_output_directory_stays_private() {
     let private = d.join("priv");
     std::fs::create_dir(&private).unwrap();
     std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o700)).unwrap();
-    ok(&[
-        "compare",
-        "--size",
-        "16x12",
-        "--spp",
-        "1",
-        "--filters",
-        "nearest",
-        "--out",
-        private.to_str().unwrap(),
-    ]);
+    ok(&small_compare(&[], private.to_str().unwrap()));
     assert!(private.join("index.html").is_file());
     let mode = std::fs::metadata(&private).unwrap().permissions().mode() & 0o7777;
     assert_eq!(mode, 0o700, "{mode:o}");
@@ -314,17 +303,7 @@ fn planted_directories_and_directory_links_are_refused() {
     std::fs::create_dir(&planted).unwrap();
     std::os::unix::fs::chown(&planted, Some(4242), Some(4242)).unwrap();
     fails(
-        &[
-            "compare",
-            "--size",
-            "16x12",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--out",
-            planted.to_str().unwrap(),
-        ],
+        &small_compare(&[], planted.to_str().unwrap()),
         1,
         &["another user's directory"],
     );
@@ -337,19 +316,10 @@ fn report_names_reach_no_terminal_raw() {
     let img = d.arg("e.png");
     ok(&["render", "--size", "16x12", "-o", &img]);
     let err = fails(
-        &[
-            "compare",
-            "--size",
-            "16x12",
-            "--spp",
-            "1",
-            "--filters",
-            "nearest",
-            "--extra",
-            &format!("x\u{1b}[2J\u{202e}={img}"),
-            "--out",
+        &small_compare(
+            &["--extra", &format!("x\u{1b}[2J\u{202e}={img}")],
             &d.arg("report"),
-        ],
+        ),
         1,
         &["control or bidirectional", "\\u{1b}"],
     );

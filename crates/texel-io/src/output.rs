@@ -1031,6 +1031,7 @@ fn check_replaceable_dir(dest: &Path, target: &Path) -> Result<(), OutputError> 
             ));
         }
     }
+    #[cfg(not(unix))]
     let _ = (dest, target);
     Ok(())
 }
