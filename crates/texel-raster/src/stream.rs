@@ -11,7 +11,7 @@
 //! the clear the frame already holds. `reset` writes such a frame with non-temporal stores too,
 //! so the draw does not first write back the clear's dirty lines. Images are bit for bit the
 //! same either way (`tests/streaming.rs`); only the memory traffic differs (docs/decisions.md,
-//! entries 37 and 47).
+//! "Frames larger than the last-level cache are streamed like a fast-cleared target").
 
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::OnceLock;

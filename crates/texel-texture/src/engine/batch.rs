@@ -788,7 +788,7 @@ fn filter_unblended<T: Taps, F: Fetch, const N: usize>(
 /// mip level): where every sample lies inside it and the view has a run kernel
 /// ([`Taps::inside_run`]: linear 8-bit texels, sampled with an AVX2 `Lanes` token), the whole chunk
 /// in one loop that tests the token once; otherwise [`filter_unblended`] (docs/decisions.md,
-/// entries 40 and 43).
+/// "The sampler's kernels are dispatched apart from the tile copies").
 #[inline(always)]
 fn filter_one_level<T: Taps, F: Fetch, const N: usize>(
     first: &Pass<N, T>,

@@ -22,9 +22,8 @@
 //! asked (`mul_add`), and no code here asks, and without fast-math flags LLVM emits no
 //! approximate instruction (AVX-512's `vrcp14`, `vrsqrt14`, `vgetexp` are not used for `/`,
 //! `sqrt` or `log2`), so the wider instructions compute the same IEEE operations
-//! (texel-raster's `tests/targets.rs` renders every view on every copy the CPU has;
-//! `scripts/same_images.sh` compares the 134 images of the v4 copy with the v3 copy's, and of a
-//! whole-program x86-64-v3 build with the baseline build's: all identical).
+//! (texel-raster's `tests/targets.rs` renders every view on every copy the CPU has and finds
+//! them identical).
 //!
 //! The copies differ in one more way: `v3` and `v4` hand the kernel [`Lanes::detect`], the
 //! sampler's eight-lane AVX2 quad kernel (safe intrinsics through `pulp`'s run-time token, bit for

@@ -295,7 +295,7 @@ impl<const N: usize, T: Taps> Pass<N, T> {
     /// for bit, without its four divisions and border tests. Reached by samples more than a
     /// texel outside the level: anisotropic probes spread half a major axis beyond their sample,
     /// over several periods of a repeating texture near the ground's horizon (docs/decisions.md,
-    /// entry 46).
+    /// "`Repeat` on power-of-two sides wraps by masks").
     #[inline(always)]
     pub(crate) fn far_repeat(&self, (w, h): (u32, u32), uv: Vec2) -> Option<WrappedTaps> {
         let pow2 = w.is_power_of_two() && h.is_power_of_two();
