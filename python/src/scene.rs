@@ -8,20 +8,17 @@
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
-use std::time::Instant;
 
 use clap::ValueEnum;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use texel::quality::{
-    block_psnr, default_band_rows, Image8, Mask, ReferenceError, Scores, DEFAULT_BLOCK,
-};
-use texel::raster::{draw_into, ReferencePlan, View};
+use texel::compare::CompareJob;
+use texel::quality::{FilterRow, Image8, Report};
+use texel::raster::{ReferencePlan, View};
 use texel::{
-    ColorHandling, Error, Filter, Frame, MemoryBudget, PreparedScene, ReferenceOptions,
-    ReferenceRun, RenderOptions, Scene, SceneOptions, TextureStorage,
+    ColorHandling, Error, Filter, MemoryBudget, PreparedScene, ReferenceOptions, RenderOptions,
+    Scene, SceneOptions, TextureStorage,
 };
 
 use crate::arrays::{array_out, rgba_out};
@@ -30,11 +27,7 @@ use crate::pool::threads_of;
 use crate::run_released;
 use crate::texture::{encoding_of, filter_named, srgb_named};
 
-/// Timed frames per filter in `compare`, after one warm-up frame (the command's count).
-const TIMED_FRAMES: usize = 3;
-
-/// A reference plan from Python's arguments, checked: `spp` to `max_spp` samples a pixel,
-/// `tolerance` in 8-bit steps of the display `color` encodes to.
+/// A reference plan from Python's arguments, checked ([`ReferencePlan::new`]).
 fn plan_of(
     spp: u32,
     max_spp: u32,
@@ -42,23 +35,8 @@ fn plan_of(
     seed: u64,
     color: ColorHandling,
 ) -> PyResult<ReferencePlan> {
-    if max_spp < spp {
-        return Err(PyValueError::new_err(format!(
-            "max_spp {max_spp} is below spp {spp}: the maximum must be at least the minimum"
-        )));
-    }
-    if !(tolerance.is_finite() && tolerance >= 0.0) {
-        return Err(PyValueError::new_err(format!(
-            "tolerance must be a finite number of 8-bit steps, 0 or more; got {tolerance}"
-        )));
-    }
-    Ok(ReferencePlan {
-        min_spp: spp,
-        max_spp,
-        tolerance: tolerance / 255.0,
-        srgb_display: color == ColorHandling::Srgb,
-        seed,
-    })
+    ReferencePlan::new(spp, max_spp, tolerance, color == ColorHandling::Srgb, seed)
+        .map_err(py_err(""))
 }
 
 /// The values of the pixels inside `[x0, y0, x1, y1]` of a `width`-wide frame (a rectangle the
@@ -443,69 +421,6 @@ pub fn reference_estimate<'py>(
     Ok(out)
 }
 
-/// One filter's scores against the reference.
-struct Row {
-    filter: Filter,
-    scores: Scores,
-    psnr_block: f64,
-    texels: (f64, u64),
-    ms: f64,
-    texture_bytes: u64,
-    image: Image8,
-}
-
-/// Render `filter` on `scene`: timed frames, then one counting texels, scored against `reference`.
-fn score_filter(
-    scene: &PreparedScene,
-    filter: Filter,
-    threads: Option<usize>,
-    reference: (&Image8, &Mask),
-    budget: &mut MemoryBudget,
-) -> Result<Row, Error> {
-    let (ref_image, coverage) = reference;
-    let plan = scene.plan(Some(filter), budget)?;
-    let texture_bytes = plan.structure_bytes();
-    let draws = plan.draws();
-    let mut settings = plan.settings();
-    settings.threads = threads;
-    let mut frame = Frame::new(&settings);
-    let mut ms = Vec::new();
-    for k in 0..=TIMED_FRAMES {
-        let t0 = Instant::now();
-        frame.reset(&settings);
-        draw_into(&settings, &draws, &mut frame)?;
-        if k > 0 {
-            ms.push(t0.elapsed().as_secs_f64() * 1e3);
-        }
-    }
-    ms.sort_by(f64::total_cmp);
-    settings.count_texels = true;
-    let counted = texel::render(&settings, &draws)?;
-    let image = texel::frame_image(&counted, texel::encoding(scene.color))?;
-    let scores = Scores::compute(
-        ref_image,
-        &image,
-        coverage,
-        default_band_rows(image.height()),
-    )?;
-    let psnr_block = block_psnr(
-        ref_image,
-        &image,
-        Some(coverage),
-        DEFAULT_BLOCK,
-        texel::encoding(scene.color),
-    )?;
-    Ok(Row {
-        filter,
-        scores,
-        psnr_block,
-        texels: counted.texels_per_pixel(),
-        ms: ms[ms.len() / 2],
-        texture_bytes,
-        image,
-    })
-}
-
 /// Every filter of `filters` (default: all) on `scene` against its converging reference, as
 /// `texel compare` scores them: a dict from filter name to a dict of `psnr` (dB over the covered
 /// pixels, 8-bit images as written), `psnr_band` (the horizon band), `ssim`, `psnr_block` (8x8
@@ -534,83 +449,55 @@ pub fn compare<'py>(
         Some(names) => Filter::parse_list(&names.join(",")).map_err(py_err(""))?,
         None => Filter::ALL.to_vec(),
     };
-    let threads = threads_of(threads)?;
-    let color = color_named(color)?;
-    let size = size_of(size)?;
+    let (threads, color) = (threads_of(threads)?, color_named(color)?);
+    let options = SceneOptions {
+        size: size_of(size)?,
+        color,
+        ..SceneOptions::default()
+    };
     let plan = plan_of(spp, max_spp.unwrap_or(spp), tolerance, seed, color)?;
     let arg = scene_arg(scene)?;
-    let (rows, floors, ties) = run_released(py, move |stop| {
+    let report = run_released(py, move |stop| {
         let loaded = load_py(&arg)?;
-        let run = || -> Result<_, Error> {
-            let mut budget = MemoryBudget::limit_or_default(max_memory);
-            let options = SceneOptions {
-                size,
-                color,
-                ..SceneOptions::default()
-            };
-            let prepared = PreparedScene::new(loaded, &options, &mut budget)?;
-            let pixels = u64::from(prepared.width) * u64::from(prepared.height);
-            budget.take(
-                "the reference, its statistics and the filters' images",
-                pixels * (texel::REFERENCE_BYTES_PER_PIXEL + 32 + 4 * filters.len() as u64),
-            )?;
-            let run = ReferenceRun {
-                plan,
+        let mut budget = MemoryBudget::limit_or_default(max_memory);
+        let run = |budget: &mut MemoryBudget| -> Result<Report, Error> {
+            let prepared = PreparedScene::new(loaded, &options, budget)?;
+            let (label, stop) = (arg.describe(), Some(stop));
+            let job = CompareJob {
                 threads,
-                stop: Some(stop),
-                ..ReferenceRun::default()
+                stop,
+                ..CompareJob::new(&label, &filters, plan)
             };
-            let estimate = prepared.reference(&prepared.scene.camera, &run)?;
-            let (w, h) = (estimate.frame.width, estimate.frame.height);
-            let enc = texel::encoding(color);
-            let ref_image = Image8::from_linear(w, h, &estimate.frame.color, enc)?;
-            let coverage = Mask::new(w, h, estimate.frame.coverage())?;
-            let error = ReferenceError {
-                width: w,
-                height: h,
-                mean: &estimate.frame.color,
-                std_error: &estimate.std_error,
-                encoding: enc,
-            };
-            let floors = (
-                error.noise_floor(Some(&coverage))?,
-                error.block_noise_floor(Some(&coverage), DEFAULT_BLOCK)?,
-            );
-            let mut rows = Vec::new();
-            for &f in &filters {
-                if stop.load(Ordering::Relaxed) {
-                    return Err(Error::Cancelled);
-                }
-                rows.push(score_filter(
-                    &prepared,
-                    f,
-                    threads,
-                    (&ref_image, &coverage),
-                    &mut budget,
-                )?);
-            }
-            let images: Vec<&Image8> = rows.iter().map(|r| &r.image).collect();
-            let ties = error.within_noise(&ref_image, &images, Some(&coverage))?;
-            Ok((rows, floors, ties))
+            job.charge(&prepared, budget)?;
+            texel::compare::compare(&prepared, &job, None, budget)
         };
-        run().map_err(|e| to_py(e, ""))
+        run(&mut budget).map_err(|e| to_py(e, ""))
     })?;
     let out = PyDict::new(py);
-    for (row, tied) in rows.iter().zip(&ties) {
-        let d = PyDict::new(py);
-        d.set_item("psnr", row.scores.psnr_all)?;
-        d.set_item("psnr_band", row.scores.psnr_band)?;
-        d.set_item("ssim", row.scores.ssim)?;
-        d.set_item("psnr_block", row.psnr_block)?;
-        d.set_item("texels_per_pixel", row.texels.0)?;
-        d.set_item("texels_per_pixel_max", row.texels.1)?;
-        d.set_item("ms_per_frame", row.ms)?;
-        d.set_item("texture_bytes", row.texture_bytes)?;
-        d.set_item("noise_floor", floors.0)?;
-        d.set_item("noise_floor_block", floors.1)?;
-        let names: Vec<&str> = tied.iter().map(|&j| rows[j].filter.name()).collect();
-        d.set_item("within_noise_of", names)?;
-        out.set_item(row.filter.name(), d)?;
+    for row in &report.rows {
+        out.set_item(&row.name, row_dict(py, row, &report)?)?;
     }
     Ok(out)
+}
+
+/// One row of a comparison as Python's `compare` returns it.
+fn row_dict<'py>(
+    py: Python<'py>,
+    row: &FilterRow,
+    report: &Report,
+) -> PyResult<Bound<'py, PyDict>> {
+    let floors = report.reference_error.as_ref();
+    let d = PyDict::new(py);
+    d.set_item("psnr", row.psnr_all)?;
+    d.set_item("psnr_band", row.psnr_band)?;
+    d.set_item("ssim", row.ssim)?;
+    d.set_item("psnr_block", row.psnr_block)?;
+    d.set_item("texels_per_pixel", row.texels_per_pixel_mean)?;
+    d.set_item("texels_per_pixel_max", row.texels_per_pixel_max)?;
+    d.set_item("ms_per_frame", row.ms_per_frame)?;
+    d.set_item("texture_bytes", row.texture_bytes)?;
+    d.set_item("noise_floor", floors.map(|f| f.noise_floor))?;
+    d.set_item("noise_floor_block", floors.map(|f| f.noise_floor_block))?;
+    d.set_item("within_noise_of", &row.within_noise_of)?;
+    Ok(d)
 }

@@ -9,7 +9,7 @@ use crate::budget::ByteSize;
 use crate::filters::{filter_parser, Filter};
 
 /// `--tolerance`'s default: half an 8-bit step of the displayed value.
-pub const DEFAULT_TOLERANCE_STEPS: f64 = 0.5;
+pub use texel_raster::adaptive::DEFAULT_TOLERANCE_STEPS;
 
 /// texel: texture mapping and texture filtering on the CPU, measured.
 #[derive(Debug, Parser)]

@@ -14,7 +14,7 @@ use crate::cli::BakeAoArgs;
 use crate::input::{scene_limits, Input};
 use crate::output::{is_exr, write_image, write_linear};
 use crate::progress;
-use crate::threads::{thread_count, with_threads};
+use crate::threads::{thread_count, workers};
 
 /// Run `texel bake-ao`.
 pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
@@ -32,7 +32,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
     let started = Instant::now();
     let bar = progress::bar(u64::from(args.size), "baking");
     let never = AtomicBool::new(false);
-    let map = with_threads(args.threads, || {
+    let map = texel::raster::on_threads(workers(args.threads), || {
         bake_ao(
             &mesh,
             &settings,

@@ -3,27 +3,27 @@
 //! What is timed: one call of `texel_raster::draw_into` — setting up, clipping, binning,
 //! rasterizing, sampling and shading every triangle into a frame cleared beforehand — with the
 //! textures, their pyramids and any ripmap or summed-area table built beforehand. The clear
-//! ([`Frame::reset`], a fill of the reused buffers) is not timed, as `llvmpipe_bench.py` clears its
+//! (`Frame::reset`, a fill of the reused buffers) is not timed, as `llvmpipe_bench.py` clears its
 //! framebuffer and calls `glFinish` before starting the clock; its cost is reported separately
 //! (`clear ms`). No file I/O, no PNG encoding. The median of `--frames` timed frames after
 //! `--warmup` untimed ones (lasting at least [`MIN_WARMUP`] unless `--warmup 0`), on a pool of
 //! `--threads` workers built once.
 //!
-//! The clear leaves the frame marked as holding it ([`Frame::holds_clear`]), as a GPU's fast
+//! The clear leaves the frame marked as holding it (`Frame::holds_clear`), as a GPU's fast
 //! clear does, so a frame larger than the last-level cache is drawn tile by tile in scratch and
 //! streamed out without reading the frame (`--streaming`, [`texel_raster::Streaming`]); the report
 //! says whether the timed frames were (`streamed`).
 
 use std::io::Write;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{Context, Result};
-use texel_raster::{draw_into, DrawCall, Frame, RasterError, RenderSettings};
+use texel::timing::{median, time_frames, warm_up, MIN_WARMUP};
 
 use crate::cli::{BenchArgs, TargetArg};
 use crate::filters::{parse_gpu_list, parse_list, GpuJob};
 use crate::input::{check_storage, load_scene, Input};
-use crate::threads::{thread_count, with_threads};
+use crate::threads::{thread_count, workers};
 
 /// One filter's timings in milliseconds.
 pub struct Timing {
@@ -38,91 +38,8 @@ pub struct Timing {
     /// Median of the untimed clears before the timed frames.
     pub clear_ms: f64,
     /// Whether the timed frames were drawn in scratch and streamed out
-    /// ([`Frame::draw_streams`]).
+    /// (`Frame::draw_streams`).
     pub streamed: bool,
-}
-
-/// Times of one filter's frames in milliseconds.
-pub struct FrameTimes {
-    /// The draw of each timed frame ([`draw_into`] after an untimed clear).
-    pub draw_ms: Vec<f64>,
-    /// The clear ([`Frame::reset`]) before each timed frame.
-    pub clear_ms: Vec<f64>,
-    /// Whether the timed draws streamed their tiles out ([`Frame::draw_streams`]).
-    pub streamed: bool,
-}
-
-/// Shortest warm-up when any is asked for: fast frames (a few ms) ran measurably slower while the
-/// first filter's two warm-up frames were all the machine had run (nearest on one thread: 11.9 ms
-/// first in the list, 7.4 ms after another filter), so warm-up lasts at least this long.
-pub const MIN_WARMUP: Duration = Duration::from_millis(200);
-
-/// Most warm-up frames [`MIN_WARMUP`] can add (a bound for very fast frames).
-const MAX_WARMUP_FRAMES: u32 = 10_000;
-
-/// Untimed warm-up: call `step`, which does `per_call` units of work (frames, passes), until at
-/// least `warmup` units are done and, unless `warmup` is 0, until `min_warmup` has passed or
-/// [`MAX_WARMUP_FRAMES`] units are done.
-fn warm_up<E>(
-    warmup: u32,
-    min_warmup: Duration,
-    per_call: u32,
-    mut step: impl FnMut() -> Result<(), E>,
-) -> Result<(), E> {
-    let start = Instant::now();
-    let mut k = 0u32;
-    while k < warmup || (warmup > 0 && k < MAX_WARMUP_FRAMES && start.elapsed() < min_warmup) {
-        step()?;
-        k = k.saturating_add(per_call.max(1));
-    }
-    Ok(())
-}
-
-/// Draw untimed frames (at least `warmup`, and while `warmup > 0` until `min_warmup` has passed),
-/// then `frames` timed ones into one reused frame, clearing it before each; the timed frames'
-/// clear and draw times in milliseconds.
-pub fn time_frames(
-    settings: &RenderSettings,
-    draws: &[DrawCall],
-    warmup: u32,
-    min_warmup: Duration,
-    frames: u32,
-) -> Result<FrameTimes, RasterError> {
-    let mut frame = Frame::new(settings);
-    let mut times = FrameTimes {
-        draw_ms: Vec::new(),
-        clear_ms: Vec::new(),
-        streamed: false,
-    };
-    warm_up(warmup, min_warmup, 1, || {
-        frame.reset(settings);
-        draw_into(settings, draws, &mut frame)?;
-        std::hint::black_box(&frame);
-        Ok::<_, RasterError>(())
-    })?;
-    for _ in 0..frames {
-        let t0 = Instant::now();
-        frame.reset(settings);
-        let t1 = Instant::now();
-        times.streamed = frame.draw_streams();
-        draw_into(settings, draws, &mut frame)?;
-        let t2 = Instant::now();
-        std::hint::black_box(&frame);
-        times.clear_ms.push((t1 - t0).as_secs_f64() * 1e3);
-        times.draw_ms.push((t2 - t1).as_secs_f64() * 1e3);
-    }
-    Ok(times)
-}
-
-/// Median of a non-empty list.
-pub fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 /// `--gpu`: per job, upload once, then time whole frames (render and read back) on the device,
@@ -219,7 +136,7 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let timings = if let Some(gpu) = &gpu {
         time_gpu(args, gpu, &scene, &jobs, budget)?
     } else {
-        with_threads(args.threads, || -> Result<Vec<Timing>> {
+        texel::raster::on_threads(workers(args.threads), || -> Result<Vec<Timing>> {
             let mut out = Vec::new();
             for filter in &filters {
                 let plan = scene.plan(Some(*filter), budget)?;
@@ -376,17 +293,5 @@ fn precision_name(p: texel::raster::Precision) -> &'static str {
     match p {
         texel::raster::Precision::Exact => "exact",
         texel::raster::Precision::Gpu => "gpu",
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::median;
-
-    #[test]
-    fn medians() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
-        assert_eq!(median(&mut [7.0]), 7.0);
     }
 }

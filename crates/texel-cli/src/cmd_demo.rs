@@ -16,11 +16,12 @@ use texel_quality::Report;
 use crate::cli::DemoArgs;
 use crate::cli::DEFAULT_TOLERANCE_STEPS;
 use crate::cmd_bake_ao::{demo_page, DemoAo};
-use crate::cmd_compare::{compare, Comparison, Extras, COMPARE_BYTES_PER_PIXEL};
+use crate::cmd_compare::Bars;
 use crate::cmd_reference::plan;
 use crate::filters::Filter;
 use crate::input::{load_scene_with, Input};
 use crate::progress;
+use texel::compare::CompareJob;
 use texel::quality::Encoding;
 use texel_raster::{render, ColorTarget, UvEvaluation, View};
 
@@ -130,11 +131,6 @@ fn report_in(
     pb: &ProgressBar,
     input: &mut Input,
 ) -> Result<Report> {
-    input.budget.take(
-        "the comparison's reference and images",
-        u64::from(scene.width) * u64::from(scene.height) * COMPARE_BYTES_PER_PIXEL,
-    )?;
-    std::fs::create_dir(sub).with_context(|| format!("cannot create {}", sub.display()))?;
     let plan = plan(
         spp,
         spp,
@@ -142,17 +138,19 @@ fn report_in(
         true,
         texel_raster::adaptive::DEFAULT_SEED,
     )?;
-    let job = Comparison {
-        label,
-        filters,
-        plan: &plan,
-        orbit: None,
+    let bars = Bars::shared(pb.clone(), label);
+    let job = CompareJob {
+        progress: Some(&bars),
+        ..CompareJob::new(label, filters, plan)
     };
-    let extras = Extras {
-        progress: Some(pb.clone()),
-        ..Extras::default()
-    };
-    compare(scene, &job, &extras, sub, &mut input.budget)
+    job.charge(scene, &mut input.budget)?;
+    std::fs::create_dir(sub).with_context(|| format!("cannot create {}", sub.display()))?;
+    Ok(texel::compare::compare(
+        scene,
+        &job,
+        Some(sub),
+        &mut input.budget,
+    )?)
 }
 
 /// The globes the demo compares evaluated per pixel (their reports from the scene loop) and

@@ -14,12 +14,11 @@ use crate::output::{check_outputs, encoding, write_frame, write_image};
 use crate::progress;
 use texel::PreparedScene;
 
-/// A reference plan from the command line's numbers: `min_spp` to `max_spp` samples a pixel,
-/// converged within `tolerance_steps` 8-bit steps of the display (sRGB-encoded when `srgb`), jitter
-/// from `seed`.
+/// A reference plan from the command line's numbers ([`ReferencePlan::new`]), its errors worded
+/// with the flags' names.
 ///
 /// # Errors
-/// A maximum below the minimum.
+/// A maximum below the minimum, and the plan's other checks.
 pub fn plan(
     min_spp: u32,
     max_spp: u32,
@@ -27,17 +26,25 @@ pub fn plan(
     srgb: bool,
     seed: u64,
 ) -> Result<ReferencePlan> {
-    anyhow::ensure!(
-        max_spp >= min_spp,
-        "--max-spp {max_spp} is below --spp {min_spp}: the maximum must be at least the minimum"
-    );
-    Ok(ReferencePlan {
-        min_spp,
-        max_spp,
-        tolerance: tolerance_steps / 255.0,
-        srgb_display: srgb,
-        seed,
+    ReferencePlan::new(min_spp, max_spp, tolerance_steps, srgb, seed).map_err(|e| match e {
+        texel_raster::RasterError::MaxSppBelowMin { min_spp, max_spp } => anyhow::anyhow!(
+            "--max-spp {max_spp} is below --spp {min_spp}: the maximum must be at least the minimum"
+        ),
+        e => e.into(),
     })
+}
+
+/// Show a reference's round on `pb`.
+pub fn show_status(pb: &indicatif::ProgressBar, s: &ReferenceStatus) {
+    pb.set_length(s.total.max(1));
+    pb.set_position(s.done);
+    pb.set_message(format!(
+        "round {} ({} pixels to {} spp, {:.1} % converged)",
+        s.round,
+        s.active,
+        s.spp,
+        100.0 * s.converged
+    ));
 }
 
 /// Render a prepared scene's converging reference seen by `camera`, as `plan` says
@@ -51,17 +58,7 @@ pub fn reference_estimate(
     pb: &indicatif::ProgressBar,
     stop: Option<&std::sync::atomic::AtomicBool>,
 ) -> Result<ReferenceEstimate> {
-    let status = |s: &ReferenceStatus| {
-        pb.set_length(s.total.max(1));
-        pb.set_position(s.done);
-        pb.set_message(format!(
-            "round {} ({} pixels to {} spp, {:.1} % converged)",
-            s.round,
-            s.active,
-            s.spp,
-            100.0 * s.converged
-        ));
-    };
+    let status = |s: &ReferenceStatus| show_status(pb, s);
     let run = texel::ReferenceRun {
         plan: *plan,
         threads,

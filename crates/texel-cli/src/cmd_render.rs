@@ -8,7 +8,7 @@ use crate::cli::RenderArgs;
 use crate::filters::Filter;
 use crate::input::{check_storage, load_scene, Input};
 use crate::output::{encoding, is_exr, write_frame};
-use crate::threads::with_threads;
+use crate::threads::workers;
 
 /// Run `texel render`.
 pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
@@ -66,7 +66,8 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         let gpu = Gpu::new(args.adapter.as_deref())?;
         texel_gpu::render(&gpu, &settings, &draws, gpu_filter)?
     } else {
-        with_threads(args.threads, || render(&settings, &draws))??
+        settings.threads = workers(args.threads);
+        render(&settings, &draws)?
     };
     write_frame(&args.output, &frame, encoding(color))
 }

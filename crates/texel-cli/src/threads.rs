@@ -1,22 +1,11 @@
-//! Running work on a chosen number of threads.
+//! `--threads` as the libraries take it.
 
-use anyhow::{Context, Result};
-
-/// Run `f` on a rayon pool of `threads` workers, or on the global pool (all cores) for `None`.
-pub fn with_threads<T: Send>(threads: Option<u32>, f: impl FnOnce() -> T + Send) -> Result<T> {
-    match threads {
-        None => Ok(f()),
-        Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n as usize)
-                .build()
-                .context("cannot start worker threads")?;
-            Ok(pool.install(f))
-        }
-    }
+/// `--threads` as a worker count for [`texel::raster::on_threads`] and the settings' `threads`.
+pub fn workers(threads: Option<u32>) -> Option<usize> {
+    threads.map(|n| n as usize)
 }
 
 /// The number of threads work runs on: `threads`, or rayon's default (all cores).
 pub fn thread_count(threads: Option<u32>) -> usize {
-    threads.map_or_else(rayon::current_num_threads, |n| n as usize)
+    workers(threads).unwrap_or_else(rayon::current_num_threads)
 }

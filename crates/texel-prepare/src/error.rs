@@ -40,6 +40,10 @@ pub enum Error {
     /// Ambient occlusion bake settings out of range, or a mesh it cannot bake.
     #[error("cannot bake ambient occlusion: {0}")]
     Bake(String),
+    /// A comparison that cannot be scored: the frame is smaller than SSIM's window, the scene
+    /// covers no pixel where it fits, or an extra image cannot be read or has another size.
+    #[error("{0}")]
+    Compare(String),
     /// The work was cancelled (a signal, or the caller's flag).
     #[error("cancelled")]
     Cancelled,

@@ -54,6 +54,37 @@ pub enum ColorHandling {
     Raw,
 }
 
+impl ColorHandling {
+    /// Both, in the order the command line lists them.
+    pub const ALL: [ColorHandling; 2] = [ColorHandling::Srgb, ColorHandling::Raw];
+
+    /// The name the command line, the scene files, Python and the reports use: `srgb` or `raw`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ColorHandling::Srgb => "srgb",
+            ColorHandling::Raw => "raw",
+        }
+    }
+}
+
+impl std::fmt::Display for ColorHandling {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ColorHandling {
+    type Err = String;
+
+    /// `srgb` or `raw`, case ignored.
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| format!("unknown colour handling {s:?}: valid are srgb, raw"))
+    }
+}
+
 /// How the scene's 8-bit textures are kept for the CPU's filters (the CLI's
 /// `--texture-storage`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -59,12 +59,54 @@ pub struct ReferencePlan {
     pub seed: u64,
 }
 
+/// The tolerance of [`ReferencePlan::default`] in 8-bit steps of the display: half a step.
+pub const DEFAULT_TOLERANCE_STEPS: f64 = 0.5;
+
+impl ReferencePlan {
+    /// A plan from the figures a user gives: `min_spp` to `max_spp` samples a pixel, converged
+    /// within `tolerance_steps` 8-bit steps of the display (sRGB-encoded when `srgb_display`),
+    /// jitter from `seed`. Every command, the Python package and the viewer make their plans here.
+    ///
+    /// # Errors
+    /// [`RasterError::MaxSppBelowMin`] when `max_spp < min_spp`,
+    /// [`RasterError::InvalidTolerance`] for a negative or non-finite tolerance, and
+    /// [`RasterError::InvalidReferencePlan`] for sample counts outside their ranges.
+    pub fn new(
+        min_spp: u32,
+        max_spp: u32,
+        tolerance_steps: f64,
+        srgb_display: bool,
+        seed: u64,
+    ) -> Result<Self, RasterError> {
+        if max_spp < min_spp {
+            return Err(RasterError::MaxSppBelowMin { min_spp, max_spp });
+        }
+        if !(tolerance_steps.is_finite() && tolerance_steps >= 0.0) {
+            return Err(RasterError::InvalidTolerance(tolerance_steps));
+        }
+        let plan = ReferencePlan {
+            min_spp,
+            max_spp,
+            tolerance: tolerance_steps / 255.0,
+            srgb_display,
+            seed,
+        };
+        check_plan(&plan)?;
+        Ok(plan)
+    }
+
+    /// The tolerance in 8-bit steps of the display.
+    pub fn tolerance_steps(&self) -> f64 {
+        self.tolerance * 255.0
+    }
+}
+
 impl Default for ReferencePlan {
     fn default() -> Self {
         ReferencePlan {
             min_spp: 256,
             max_spp: 65_536,
-            tolerance: 0.5 / 255.0,
+            tolerance: DEFAULT_TOLERANCE_STEPS / 255.0,
             srgb_display: true,
             seed: DEFAULT_SEED,
         }

@@ -108,6 +108,17 @@ pub enum RasterError {
         /// The tolerance asked for.
         tolerance: f64,
     },
+    /// A reference plan's maximum samples per pixel below its minimum.
+    #[error("max_spp {max_spp} is below spp {min_spp}: the maximum must be at least the minimum")]
+    MaxSppBelowMin {
+        /// The minimum samples per pixel asked for.
+        min_spp: u32,
+        /// The maximum asked for.
+        max_spp: u32,
+    },
+    /// A reference plan's tolerance, in 8-bit steps, negative or not finite.
+    #[error("tolerance must be a finite number of 8-bit steps, 0 or more; got {0}")]
+    InvalidTolerance(f64),
     /// The work was stopped before it had a result.
     #[error("interrupted before the first pass of the reference completed")]
     Interrupted,

@@ -144,21 +144,34 @@ pub fn draw_into(
     })
 }
 
-/// Run `f` on rayon's global pool (`None`) or on a local pool of `n` threads.
-pub(crate) fn with_threads<T: Send>(
+/// Run `f` on rayon's global pool (`None`: all cores) or on a local pool of `n` threads: how
+/// every texel job (a frame, a reference, a bench, a bake) honours a thread count.
+///
+/// # Errors
+/// [`RasterError::InvalidThreadCount`] for 0, [`RasterError::ThreadPool`] when the pool cannot
+/// start.
+pub fn on_threads<T: Send>(
     threads: Option<usize>,
-    f: impl FnOnce() -> Result<T, RasterError> + Send,
+    f: impl FnOnce() -> T + Send,
 ) -> Result<T, RasterError> {
     match threads {
-        None => f(),
+        None => Ok(f()),
         Some(0) => Err(RasterError::InvalidThreadCount(0)),
-        Some(n) => rayon::ThreadPoolBuilder::new()
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
             .map_err(|e| RasterError::ThreadPool {
                 threads: n,
                 message: e.to_string(),
             })?
-            .install(f),
+            .install(f)),
     }
+}
+
+/// [`on_threads`] for work that can fail.
+pub(crate) fn with_threads<T: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> Result<T, RasterError> + Send,
+) -> Result<T, RasterError> {
+    on_threads(threads, f)?
 }

@@ -26,7 +26,9 @@
 //! For more control (several filters on one loaded scene, debug views, threads, timing), use
 //! [`PreparedScene`] with [`raster::render`] as `examples/render_scene.rs` does.
 
+pub mod compare;
 mod entry;
+pub mod timing;
 
 pub use texel_quality as quality;
 pub use texel_raster as raster;
