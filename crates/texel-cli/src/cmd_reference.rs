@@ -12,7 +12,7 @@ use crate::input::{load_scene, Input};
 use crate::interrupt;
 use crate::output::{check_outputs, encoding, write_frame, write_image};
 use crate::progress;
-use texel::PreparedScene;
+use crate::threads::workers;
 
 /// A reference plan from the command line's numbers ([`ReferencePlan::new`]), its errors worded
 /// with the flags' names.
@@ -47,33 +47,6 @@ pub fn show_status(pb: &indicatif::ProgressBar, s: &ReferenceStatus) {
     ));
 }
 
-/// Render a prepared scene's converging reference seen by `camera`, as `plan` says
-/// (`texel_raster::adaptive`), on `threads` workers (`None`: all cores), showing its rounds on
-/// `pb`. `stop`, once set, ends it after the current pass (see `render_reference_adaptive`).
-pub fn reference_estimate(
-    scene: &PreparedScene,
-    plan: &ReferencePlan,
-    camera: &texel_scene::Camera,
-    threads: Option<usize>,
-    pb: &indicatif::ProgressBar,
-    stop: Option<&std::sync::atomic::AtomicBool>,
-) -> Result<ReferenceEstimate> {
-    let status = |s: &ReferenceStatus| show_status(pb, s);
-    let run = texel::ReferenceRun {
-        plan: *plan,
-        threads,
-        scissor: None,
-        progress: Some(&status),
-        stop,
-    };
-    scene.reference(camera, &run).map_err(|e| match e {
-        texel::Error::Raster(e @ texel_raster::RasterError::Interrupted) => {
-            anyhow::Error::new(interrupt::Interrupted(e.to_string()))
-        }
-        e => e.into(),
-    })
-}
-
 /// Run `texel reference`: the converging reference (`texel_raster::adaptive`), its summary on
 /// stderr, the image and, with `--error-map`, each pixel's error. Ctrl-C during the passes writes
 /// what is done so far, says so, and exits with status 130.
@@ -89,21 +62,24 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     outputs.extend(args.error_map.as_deref().map(|m| ("--error-map", m)));
     check_outputs(&outputs)?;
     let scene = load_scene(&args.scene, input)?;
-    input.budget.take(
-        "the reference's per-pixel statistics",
-        u64::from(scene.width) * u64::from(scene.height) * texel::REFERENCE_BYTES_PER_PIXEL,
-    )?;
     let started = Instant::now();
     let pb = progress::bar(1, "reference");
     let graceful = interrupt::Graceful::begin();
-    let estimate = reference_estimate(
-        &scene,
-        &plan,
-        &scene.scene.camera,
-        args.threads.map(|n| n as usize),
-        &pb,
-        Some(graceful.flag()),
-    )?;
+    let status = |s: &ReferenceStatus| show_status(&pb, s);
+    let run = texel::ReferenceRun {
+        plan,
+        threads: workers(args.threads),
+        scissor: None,
+        progress: Some(&status),
+        stop: Some(graceful.flag()),
+    };
+    let estimate = texel::reference_prepared(&scene, &scene.scene.camera, &run, &mut input.budget)
+        .map_err(|e| match e {
+            texel::Error::Cancelled => anyhow::Error::new(interrupt::Interrupted(
+                texel_raster::RasterError::Interrupted.to_string(),
+            )),
+            e => e.into(),
+        })?;
     drop(graceful);
     pb.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();

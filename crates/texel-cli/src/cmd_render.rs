@@ -2,12 +2,12 @@
 
 use anyhow::{bail, Context, Result};
 use texel_gpu::{Gpu, GpuFilter};
-use texel_raster::{render, ColorTarget, Derivatives, UvEvaluation, View};
+use texel_raster::{render, ColorTarget, Derivatives, UvEvaluation};
 
 use crate::cli::RenderArgs;
 use crate::filters::Filter;
 use crate::input::{check_storage, load_scene, Input};
-use crate::output::{encoding, is_exr, write_frame};
+use crate::output::{is_exr, write_frame};
 use crate::threads::workers;
 
 /// Run `texel render`.
@@ -30,15 +30,8 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     let mut settings = plan.settings();
     settings.derivatives = args.derivatives;
     settings.perspective = args.perspective;
-    settings.view = args.view;
-    // The frame is rendered into the 8-bit target the PNG holds; debug views hold display values
-    // meant for sRGB encoding whatever --color says.
-    let color = if settings.view == View::Color {
-        args.scene.color
-    } else {
-        settings.target = ColorTarget::Srgb8;
-        texel::ColorHandling::Srgb
-    };
+    // The frame is rendered into the 8-bit target the PNG holds; a debug view into sRGB.
+    let encoding = texel::show_view(&mut settings, args.view, args.scene.color);
     if is_exr(&args.output) {
         // OpenEXR keeps the colour in float, unclamped.
         settings.target = ColorTarget::Float;
@@ -69,7 +62,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         settings.threads = workers(args.threads);
         render(&settings, &draws)?
     };
-    write_frame(&args.output, &frame, encoding(color))
+    write_frame(&args.output, &frame, encoding)
 }
 
 /// The context of a failed write of a result to standard output.

@@ -8,9 +8,9 @@ use texel_prepare::{
     ColorHandling, Error, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions, TextureStorage,
 };
 use texel_raster::{
-    render, ColorTarget, Frame, RasterError, ReferenceEstimate, ReferencePlan, View,
+    render, ColorTarget, Frame, RasterError, ReferenceEstimate, ReferencePlan, RenderSettings, View,
 };
-use texel_scene::Scene;
+use texel_scene::{Camera, Scene};
 use texel_texture::Filter;
 
 use crate::quality;
@@ -130,12 +130,27 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Err
     )?;
     let plan = prepared.plan(options.filter, &mut budget)?;
     let mut settings = plan.settings();
-    settings.view = options.view;
     settings.threads = options.threads;
-    if options.view != View::Color {
-        settings.target = ColorTarget::Srgb8;
-    }
+    show_view(&mut settings, options.view, options.color);
     Ok(render(&settings, &plan.draws())?)
+}
+
+/// Set `settings` to draw `view`, and say how its 8-bit image is encoded: the textured colour
+/// as the colour handling `color` says; a debug view, whose values are meant for display, into
+/// an sRGB target and encoded sRGB whatever `color` is. How `texel render`, [`render_scene`] and
+/// [`render_image`] draw a view.
+pub fn show_view(
+    settings: &mut RenderSettings,
+    view: View,
+    color: ColorHandling,
+) -> quality::Encoding {
+    settings.view = view;
+    if view == View::Color {
+        encoding(color)
+    } else {
+        settings.target = ColorTarget::Srgb8;
+        quality::Encoding::Srgb
+    }
 }
 
 /// [`render_scene`]'s frame as the 8-bit RGBA image `texel render -o FILE.png` writes: encoded
@@ -145,11 +160,8 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Err
 /// As [`render_scene`].
 pub fn render_image(scene: &Scene, options: &RenderOptions) -> Result<quality::Image8, Error> {
     let frame = render_scene(scene, options)?;
-    let color = match options.view {
-        View::Color => options.color,
-        _ => ColorHandling::Srgb,
-    };
-    Ok(frame_image(&frame, encoding(color))?)
+    let encoding = show_view(&mut RenderSettings::default(), options.view, options.color);
+    Ok(frame_image(&frame, encoding)?)
 }
 
 /// How [`reference_scene`] makes a reference.
@@ -189,27 +201,37 @@ pub fn reference_scene(
         TextureStorage::Stored,
         &mut budget,
     )?;
-    budget.take(
-        "the reference's per-pixel statistics",
-        u64::from(prepared.width) * u64::from(prepared.height) * REFERENCE_BYTES_PER_PIXEL,
-    )?;
     let plan = ReferencePlan {
         srgb_display: options.color == ColorHandling::Srgb,
         ..options.plan
     };
-    prepared
-        .reference(
-            &prepared.scene.camera,
-            &ReferenceRun {
-                plan,
-                threads: options.threads,
-                scissor: options.scissor,
-                progress: None,
-                stop,
-            },
-        )
-        .map_err(|e| match e {
-            Error::Raster(RasterError::Interrupted) => Error::Cancelled,
-            e => e,
-        })
+    let run = ReferenceRun {
+        plan,
+        threads: options.threads,
+        scissor: options.scissor,
+        progress: None,
+        stop,
+    };
+    reference_prepared(&prepared, &prepared.scene.camera, &run, &mut budget)
+}
+
+/// The converging reference of a prepared scene seen by `camera`, as `texel reference` and
+/// [`reference_scene`] make it: [`REFERENCE_BYTES_PER_PIXEL`] charged to `budget` for its
+/// statistics (and kept: the estimate holds them), then [`PreparedScene::reference`]. A stop before the first pass is
+/// [`Error::Cancelled`]; one after it returns the estimate so far, marked interrupted.
+///
+/// # Errors
+/// [`Error::OverBudget`], [`Error::Cancelled`] and [`PreparedScene::reference`]'s.
+pub fn reference_prepared(
+    prepared: &PreparedScene,
+    camera: &Camera,
+    run: &ReferenceRun,
+    budget: &mut MemoryBudget,
+) -> Result<ReferenceEstimate, Error> {
+    let bytes = u64::from(prepared.width) * u64::from(prepared.height) * REFERENCE_BYTES_PER_PIXEL;
+    budget.take("the reference's per-pixel statistics", bytes)?;
+    prepared.reference(camera, run).map_err(|e| match e {
+        Error::Raster(RasterError::Interrupted) => Error::Cancelled,
+        e => e,
+    })
 }

@@ -36,8 +36,8 @@ pub use texel_scene as scene;
 pub use texel_texture as texture;
 
 pub use entry::{
-    encoding, frame_image, reference_scene, render_image, render_scene, scene_inputs,
-    ReferenceOptions, RenderOptions, REFERENCE_BYTES_PER_PIXEL,
+    encoding, frame_image, reference_prepared, reference_scene, render_image, render_scene,
+    scene_inputs, show_view, ReferenceOptions, RenderOptions, REFERENCE_BYTES_PER_PIXEL,
 };
 pub use texel_prepare as prepare;
 pub use texel_prepare::{ao, bake, bvh, memory, tessellate};

@@ -22,8 +22,8 @@ use std::path::PathBuf;
 use texel::quality::Image8;
 use texel::raster::{Derivatives, Precision, ReferencePlan};
 use texel::{
-    render, ColorHandling, ColorTarget, Filter, MemoryBudget, PreparedScene, ReferenceRun, Scene,
-    SceneOptions, TextureStorage, View,
+    render, ColorHandling, Filter, MemoryBudget, PreparedScene, ReferenceRun, Scene, SceneOptions,
+    TextureStorage, View,
 };
 
 /// Each tile's size in pixels.
@@ -177,16 +177,10 @@ fn render_tile(scene: &mut Prepared, tile: &Tile) -> Image8 {
     let mut budget = MemoryBudget::limit_or_default(None);
     let plan = prepared.plan(tile.filter, &mut budget).unwrap();
     let mut settings = plan.settings();
-    settings.view = tile.view;
     settings.derivatives = tile.derivatives;
-    let color = if tile.view == View::Color {
-        tile.color
-    } else {
-        settings.target = ColorTarget::Srgb8;
-        ColorHandling::Srgb
-    };
+    let encoding = texel::show_view(&mut settings, tile.view, tile.color);
     let frame = render(&settings, &plan.draws()).unwrap();
-    texel::frame_image(&frame, texel::encoding(color)).unwrap()
+    texel::frame_image(&frame, encoding).unwrap()
 }
 
 /// The tiles laid out `COLUMNS` to a row, black between none (tiles abut).
