@@ -34,7 +34,7 @@ use texel_quality::{
     mean_abs_change, psnr, Encoding, FilterRow, Image8, Mask, Orbit, QualityError, ReferenceError,
     ReferenceSummary, Report, Scores, DEFAULT_BLOCK,
 };
-use texel_raster::{render, Frame, RasterError, ReferenceEstimate, ReferencePlan, ReferenceStatus};
+use texel_raster::{render, Frame, ReferenceEstimate, ReferencePlan, ReferenceStatus};
 use texel_scene::Camera;
 use texel_texture::Filter;
 
@@ -203,11 +203,6 @@ pub fn slug(label: &str) -> String {
         .collect()
 }
 
-/// The 8-bit encoding a prepared scene's images are written in.
-fn encoding_of(scene: &PreparedScene) -> Encoding {
-    crate::encoding(scene.color)
-}
-
 /// What `compare` can tell before the reference: the frame holds SSIM's window, and the scene
 /// covers a pixel where that window fits (seen in one nearest-filtered frame: where pixel centres
 /// meet a triangle).
@@ -262,10 +257,9 @@ fn reference(
         progress: Some(&status),
         stop: job.stop,
     };
-    scene.reference(camera, &run).map_err(|e| match e {
-        Error::Raster(RasterError::Interrupted) => Error::Cancelled,
-        e => e,
-    })
+    scene
+        .reference(camera, &run)
+        .map_err(crate::entry::cancelled)
 }
 
 /// The reference's figures for the report, over the covered pixels.
@@ -414,7 +408,7 @@ pub fn compare(
     budget: &mut MemoryBudget,
 ) -> Result<Report, Error> {
     check_scene(scene, budget)?;
-    let enc = encoding_of(scene);
+    let enc = crate::encoding(scene.color);
     let frames = job.orbit.map_or(1, |o| o.frames);
     let stage = Stage::Reference { n: 0, of: frames };
     if let Some(p) = job.progress {

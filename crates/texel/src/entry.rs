@@ -230,8 +230,14 @@ pub fn reference_prepared(
 ) -> Result<ReferenceEstimate, Error> {
     let bytes = u64::from(prepared.width) * u64::from(prepared.height) * REFERENCE_BYTES_PER_PIXEL;
     budget.take("the reference's per-pixel statistics", bytes)?;
-    prepared.reference(camera, run).map_err(|e| match e {
+    prepared.reference(camera, run).map_err(cancelled)
+}
+
+/// A reference stopped before its first pass ([`RasterError::Interrupted`]) as
+/// [`Error::Cancelled`]; any other error as it is.
+pub(crate) fn cancelled(e: Error) -> Error {
+    match e {
         Error::Raster(RasterError::Interrupted) => Error::Cancelled,
         e => e,
-    })
+    }
 }
