@@ -83,6 +83,20 @@ pub enum Command {
     /// Example (scripted, as the tests run it): texel view --keys 5 --frames 3 --no-hud --screenshot s.png
     #[command(after_help = crate::controls::key_table())]
     View(ViewArgs),
+    /// Run and grade a student's GLSL fragment shader for the lab's eight modes on OpenGL (EGL:
+    /// Mesa's llvmpipe without a GPU), against texel's modes under the GL rules and the lab's
+    /// formulas and the supersampled reference; write a report (Markdown, JSON, HTML).
+    ///
+    /// Example: texel lab modes.frag --out texel-lab/
+    ///
+    /// Example: texel lab modes.frag --vertex lab.vert --scene builtin:ground --modes 1-4
+    Lab(crate::cmd_lab::LabArgs),
+    /// The device half of `texel lab`, run by it in a child process with a time limit.
+    #[command(hide = true)]
+    LabDevice {
+        /// The work folder holding `job.json`.
+        dir: std::path::PathBuf,
+    },
     /// List the Vulkan and GL adapters the GPU path (`render --gpu`) can use.
     ///
     /// Example: texel gpu-info
@@ -149,6 +163,12 @@ pub struct SceneArgs {
     /// memory budget stays stored.
     #[arg(long, value_enum, value_name = "STORAGE")]
     pub texture_storage: Option<texel::TextureStorage>,
+    /// The rules the lab's modes 1-8 (`--lab-mode`, the filters nearest to aniso16, the viewer's
+    /// keys 1-8) follow on the CPU: gl (the OpenGL / Vulkan rules) or lab (the lab handout's
+    /// formulas: docs/guide/conventions.md). The other filters, the GPU path and the reference
+    /// have the GL rules only.
+    #[arg(long, default_value = "gl", value_name = "RULES")]
+    pub convention: texel::texture::Convention,
 }
 
 /// A finite number in `[lo, hi]` of `unit` (the error names both).

@@ -124,6 +124,8 @@ pub struct MaterialOverrides {
     pub precision: texel::raster::Precision,
     /// `--texture-storage`, or the command's default.
     pub texture_storage: TextureStorage,
+    /// `--convention`.
+    pub convention: texel::texture::Convention,
 }
 
 impl MaterialOverrides {
@@ -139,6 +141,7 @@ impl MaterialOverrides {
             surface_uv: args.surface_uv,
             precision: args.precision,
             texture_storage: args.texture_storage.unwrap_or_default(),
+            convention: args.convention,
         }
     }
 }
@@ -222,6 +225,7 @@ pub fn load_scene_with(
         surface_uv: overrides.surface_uv.unwrap_or_default(),
         precision: overrides.precision,
         texture_storage: overrides.texture_storage,
+        convention: overrides.convention,
     };
     let prepared = PreparedScene::new(loaded, &options, &mut input.budget)
         .map_err(|e| input.explain(e.into()))?;

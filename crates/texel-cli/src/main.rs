@@ -10,6 +10,7 @@ mod cmd_bake_ao;
 mod cmd_bench;
 mod cmd_compare;
 mod cmd_demo;
+mod cmd_lab;
 mod cmd_mips;
 mod cmd_reference;
 mod cmd_render;
@@ -60,6 +61,8 @@ fn main() -> ExitCode {
         Command::Mips(args) => cmd_mips::run(&args, &mut input),
         Command::BakeAo(args) => cmd_bake_ao::run(&args, &mut input),
         Command::View(args) => view::run(&args, input),
+        Command::Lab(args) => cmd_lab::run(&args, &mut input),
+        Command::LabDevice { dir } => cmd_lab::device(&dir),
         Command::GpuInfo => cmd_render::gpu_info(),
     };
     match result {

@@ -10,6 +10,7 @@ mod errors;
 mod gpu;
 mod help;
 mod hostile;
+mod lab;
 mod meshes;
 mod mips;
 mod nothing_lost;

@@ -623,6 +623,14 @@ impl Gpu {
         if draws.iter().any(|d| d.material.is_some()) {
             return Err(GpuError::Unsupported("materials"));
         }
+        if draws
+            .iter()
+            .any(|d| d.sampler.convention() != texel_texture::Convention::Gl)
+        {
+            return Err(GpuError::Unsupported(
+                "the lab convention (the WGSL shader follows the GL rules)",
+            ));
+        }
         let per_pixel = |d: &DrawCall| {
             d.uv_mapping
                 .is_some_and(|m| m.evaluation == texel_raster::UvEvaluation::PerPixel)

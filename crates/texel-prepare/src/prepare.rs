@@ -18,7 +18,7 @@ use texel_scene::{
     SpecularAaSpec, TextureSampler,
 };
 use texel_texture::base::color::srgb_to_linear;
-use texel_texture::{AddressMode, ColorSpace, Format, Limits, Sampler, Texture};
+use texel_texture::{AddressMode, ColorSpace, Convention, Format, Limits, Sampler, Texture};
 
 use crate::bake::{self, Composite};
 use crate::memory::{
@@ -150,6 +150,9 @@ pub struct SceneOptions {
     pub precision: Precision,
     /// How 8-bit textures are kept (the CLI's `--texture-storage`): images do not depend on it.
     pub texture_storage: TextureStorage,
+    /// The rules the lab's eight modes follow in [`PreparedScene::samplers`] (the CLI's
+    /// `--convention`; [`texel_texture::Sampler::with_convention`]).
+    pub convention: Convention,
 }
 
 /// `spec` with its procedural sky laid out in `mapping` at about the same texel angle: an
@@ -220,6 +223,8 @@ pub struct PreparedScene {
     charged: Mutex<BTreeSet<(usize, &'static str)>>,
     /// [`SceneOptions::precision`].
     pub precision: Precision,
+    /// [`SceneOptions::convention`].
+    pub convention: Convention,
     /// [`SceneOptions::specular_aa`].
     specular_aa: Option<SpecularAa>,
     /// [`SceneOptions::shading_samples`].
@@ -370,6 +375,7 @@ impl PreparedScene {
             kept_stored,
             charged: Mutex::new(BTreeSet::new()),
             precision: options.precision,
+            convention: options.convention,
             specular_aa: options.specular_aa,
             shading_samples: options.shading_samples,
             displacement: options.displacement,
@@ -412,7 +418,10 @@ impl PreparedScene {
             .map(|s| (s.address_mode_u, s.address_mode_v));
         let mut out: Vec<Sampler> = meshes
             .chain(own)
-            .map(|(u, v)| Ok(Sampler::new(filter.descriptor(u, v))?))
+            .map(|(u, v)| {
+                let s = Sampler::new(filter.descriptor(u, v))?;
+                Ok(s.with_convention(self.convention)?)
+            })
             .collect::<Result<_, Error>>()?;
         self.push_environment_sampler(&mut out, filter)?;
         Ok(out)

@@ -51,3 +51,4 @@ pub use storage::texture::{
     replace_non_finite, ColorSpace, Format, LevelInfo, LevelTexels, Limits, LoadOptions, Loaded,
     Texture, MAX_TEXEL, NON_FINITE_CLAMP,
 };
+pub use technique::lab::{Convention, Rules};

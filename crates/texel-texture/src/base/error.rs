@@ -148,6 +148,9 @@ pub enum TextureError {
     /// A lab mode outside 1..=8.
     #[error("unknown lab mode {0}: valid modes are 1 (nearest) to 8 (anisotropic 16x)")]
     UnknownLabMode(u8),
+    /// The lab convention asked of a sampler that is not one of the lab's eight modes.
+    #[error("the lab convention applies to the lab's eight modes only (nearest, bilinear, mip-nearest, trilinear, aniso2-16 with their default lod range)")]
+    LabConventionNeedsLabMode,
     /// A filter name that is not one of [`crate::Filter::NAMES`].
     #[error("unknown filter {name:?}: valid filters are {}, or all", valid.join(", "))]
     UnknownFilter {

@@ -24,6 +24,7 @@ use crate::storage::view::{codes_of, with_pyramid, Counted, Pyramid};
 use crate::technique::aniso::Probes;
 use crate::technique::aniso::{anisotropic, filter_planned, plan_chunk, Plan};
 use crate::technique::ewa::ewa;
+use crate::technique::lab::Rules;
 use crate::technique::mip::{mip_nearest, trilinear};
 use crate::technique::ripmap::ripmap;
 use crate::technique::sat::summed_area;
@@ -339,6 +340,9 @@ impl Sampler {
     fn filter<P: Pyramid>(&self, p: &P, q: &Query) -> Vec4 {
         let d = &self.desc;
         let addr = &self.params.addr;
+        if let Technique::Lab(mode) = self.technique {
+            return crate::technique::lab::sample_rules(p, addr, mode, &Rules::LAB, &q.fp);
+        }
         if q.lod <= 0.0 {
             return filter_level(&d.mag_filter, &p.level(0), addr, q.uv());
         }
@@ -359,6 +363,9 @@ impl Sampler {
                 Ok(t) => summed_area(p, t, &self.params, q),
                 Err(_) => trilinear(p, Bilinear, addr, q),
             },
+            Technique::Lab(mode) => {
+                crate::technique::lab::sample_rules(p, addr, mode, &Rules::LAB, &q.fp)
+            }
         }
     }
 }

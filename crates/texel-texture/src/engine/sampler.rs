@@ -59,8 +59,10 @@ use crate::base::filter::{
     FilterMode, MipmapFilterMode, EWA_DEFAULT_ANISOTROPY, MAX_CUBIC_PARAMETER,
 };
 pub use crate::base::footprint::UV_LIMIT;
+use crate::base::named::Filter;
 use crate::storage::tables::{Ripmap, SummedAreaTable};
 use crate::storage::texture::Texture;
+use crate::technique::lab::Convention;
 use crate::technique::Params;
 
 /// The minification technique, resolved once in [`Sampler::new`].
@@ -76,6 +78,8 @@ pub(super) enum Technique {
     Ripmap,
     /// Summed-area table.
     SummedArea,
+    /// Lab mode 1-8 under the lab handout's formulas ([`crate::technique::lab`]).
+    Lab(u8),
 }
 
 /// A validated sampler. Cheap to copy; sampling never fails.
@@ -177,6 +181,45 @@ impl Sampler {
     /// The descriptor this sampler was created from.
     pub fn descriptor(&self) -> &SamplerDescriptor {
         &self.desc
+    }
+
+    /// This sampler under `convention`: [`Convention::Gl`] is the descriptor's own filter;
+    /// [`Convention::Lab`] evaluates the descriptor's lab mode by the handout's formulas
+    /// ([`crate::technique::lab`], texel by texel).
+    ///
+    /// # Errors
+    /// [`TextureError::LabConventionNeedsLabMode`] for [`Convention::Lab`] on a descriptor that
+    /// is not one of the eight lab modes (with any address modes and border colour).
+    pub fn with_convention(self, convention: Convention) -> Result<Sampler, TextureError> {
+        let fresh = Sampler::new(self.desc)?;
+        if convention == Convention::Gl {
+            return Ok(fresh);
+        }
+        let d = self.desc;
+        let mode = (1..=8u8)
+            .find(|&m| {
+                Filter::from_lab_mode(m).is_ok_and(|f| {
+                    SamplerDescriptor {
+                        border_color: d.border_color,
+                        ..f.descriptor(d.address_mode_u, d.address_mode_v)
+                    } == d
+                })
+            })
+            .ok_or(TextureError::LabConventionNeedsLabMode)?;
+        Ok(Sampler {
+            technique: Technique::Lab(mode),
+            lod_free: false,
+            batched: false,
+            ..fresh
+        })
+    }
+
+    /// The convention this sampler's lab mode follows ([`Sampler::with_convention`]).
+    pub fn convention(&self) -> Convention {
+        match self.technique {
+            Technique::Lab(_) => Convention::Lab,
+            _ => Convention::Gl,
+        }
     }
 
     /// What the techniques read of the descriptor.

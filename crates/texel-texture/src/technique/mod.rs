@@ -1,10 +1,12 @@
 //! Techniques: how a footprint becomes kernel reads across levels or tables. Mipmapping
 //! ([`mip`]), the hardware-style anisotropic probes ([`aniso`]), EWA ([`ewa`]), ripmaps
-//! ([`ripmap`]) and summed-area tables ([`sat`]). Each takes the pyramid, a query and the small
+//! ([`ripmap`]) and summed-area tables ([`sat`]); the lab's eight modes under either convention
+//! ([`lab`]). Each takes the pyramid, a query and the small
 //! parameter set it needs, never the whole sampler.
 
 pub mod aniso;
 pub mod ewa;
+pub mod lab;
 pub mod mip;
 pub mod ripmap;
 pub mod sat;

@@ -1,0 +1,283 @@
+//! `texel lab`: a student's shader rendered in a child process with a time limit
+//! ([`texel::lab::run_device`] under `texel lab-device`), then graded ([`texel::lab::grade`]) and
+//! the report published into `--out`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use texel::lab::{self, Job, Names};
+
+use crate::cli::Size;
+use crate::input::Input;
+
+/// The largest shader file read.
+const MAX_SHADER_BYTES: u64 = 1 << 20;
+
+/// `texel lab`'s arguments.
+#[derive(Debug, Args)]
+pub struct LabArgs {
+    /// The student's fragment shader (GLSL, any version the driver accepts).
+    pub shader: PathBuf,
+    /// The student's vertex shader; it gets the attributes `position` (vec3, world space) and
+    /// `texCoordIn` (vec2) and the uniform `clipFromWorld` (mat4), and must write the varying.
+    /// Default: texel's own, which passes `texCoordIn` on unchanged.
+    #[arg(long)]
+    pub vertex: Option<PathBuf>,
+    /// A scene to grade on (repeatable): lab-tunnel, lab-plane, lab-wall (the default: all
+    /// three), builtin:NAME or a scene file; unlit scenes only.
+    #[arg(long = "scene", value_name = "SCENE")]
+    pub scenes: Vec<String>,
+    /// The modes to run: a list and ranges of 1-8, e.g. 1-4 or 1,2,5-8.
+    #[arg(long, default_value = "1-8", value_parser = parse_modes)]
+    pub modes: ModeList,
+    /// Report folder (made or replaced whole).
+    #[arg(long, default_value = "texel-lab")]
+    pub out: PathBuf,
+    /// The sampler uniform's name.
+    #[arg(long, default_value = "texSlot")]
+    pub sampler: String,
+    /// The mode uniform's name.
+    #[arg(long = "mode-uniform", default_value = "texMode")]
+    pub mode_uniform: String,
+    /// The texture coordinate varying's name.
+    #[arg(long, default_value = "texCoord")]
+    pub varying: String,
+    /// Seconds the device may take for every scene and mode together before the shader is
+    /// stopped (an endless loop).
+    #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u64).range(1..=86400))]
+    pub timeout: u64,
+    /// Frame size overriding the scenes' (320x240 for the lab's own).
+    #[arg(long)]
+    pub size: Option<Size>,
+    /// Timed frames per mode on the device (after one untimed).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub frames: u64,
+    /// Samples a pixel of the reference the PSNR is measured against.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub spp: u32,
+    /// Worker threads for grading (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    pub threads: Option<u64>,
+}
+
+/// Modes 1-8, in order, without repeats.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModeList(pub Vec<u8>);
+
+fn parse_modes(s: &str) -> Result<ModeList, String> {
+    let mut out = Vec::new();
+    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (a, b) = part.split_once('-').unwrap_or((part, part));
+        let num = |t: &str| -> Result<u8, String> {
+            t.trim()
+                .parse::<u8>()
+                .ok()
+                .filter(|m| (1..=8).contains(m))
+                .ok_or_else(|| format!("mode {t:?} is not 1 to 8"))
+        };
+        let (a, b) = (num(a)?, num(b)?);
+        if a > b {
+            return Err(format!("mode range {part:?} runs backwards"));
+        }
+        out.extend(a..=b);
+    }
+    out.sort_unstable();
+    out.dedup();
+    if out.is_empty() {
+        return Err("no modes given".into());
+    }
+    Ok(ModeList(out))
+}
+
+fn read_source(path: &Path, what: &str) -> Result<String> {
+    let bytes = texel_io::read_regular(path, MAX_SHADER_BYTES)
+        .with_context(|| format!("cannot read the {what} {}", path.display()))?;
+    String::from_utf8(bytes)
+        .with_context(|| format!("the {what} {} is not UTF-8 text", path.display()))
+}
+
+/// A work folder removed when dropped.
+struct WorkDir(PathBuf);
+
+impl WorkDir {
+    fn new() -> Result<WorkDir> {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        let dir = std::env::temp_dir().join(format!("texel-lab-{}-{nanos}", std::process::id()));
+        std::fs::create_dir(&dir).with_context(|| format!("cannot make {}", dir.display()))?;
+        Ok(WorkDir(dir))
+    }
+}
+
+impl Drop for WorkDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Run `texel lab`.
+pub fn run(args: &LabArgs, _input: &mut Input) -> Result<()> {
+    let fragment = read_source(&args.shader, "fragment shader")?;
+    let vertex = match &args.vertex {
+        Some(p) => Some(read_source(p, "vertex shader")?),
+        None => None,
+    };
+    let mut job = Job::new(fragment);
+    job.vertex = vertex;
+    job.names = Names {
+        sampler: args.sampler.clone(),
+        mode: args.mode_uniform.clone(),
+        varying: args.varying.clone(),
+    };
+    if !args.scenes.is_empty() {
+        job.scenes = args.scenes.clone();
+    }
+    job.modes = args.modes.0.clone();
+    job.frames = args.frames as usize;
+    job.size = args.size.map(|s| (s.width, s.height));
+    // Scenes are checked here, before the device starts, so a bad one is reported as such.
+    for s in &job.scenes {
+        lab::LabScene::load(s, job.size)?;
+    }
+    for v in lab::source::violations(&job.fragment) {
+        texel_io::stderr_line(format_args!(
+            "texel: warning: line {}: `{}` breaks the lab's rule (texelFetch and textureSize only); the shader is still graded, and marked",
+            v.line, v.call
+        ));
+    }
+    for line in lab::source::level_size_queries(&job.fragment) {
+        texel_io::stderr_line(format_args!(
+            "texel: note: line {line} asks textureSize for a per-pixel level; Mesa's llvmpipe answers one size for a whole quad, so use max(textureSize(texSlot, 0) >> level, ivec2(1))"
+        ));
+    }
+    let work = WorkDir::new()?;
+    let job_path = work.0.join("job.json");
+    std::fs::write(&job_path, serde_json::to_vec(&job)?)
+        .with_context(|| format!("cannot write {}", job_path.display()))?;
+    device_in_child(&work.0, Duration::from_secs(args.timeout))?;
+    let shader_name = texel_io::escape(&args.shader.display().to_string()).into_owned();
+    let options = lab::GradeOptions {
+        reference_spp: args.spp,
+        threads: args.threads.map(|t| t as usize),
+    };
+    let (report, images) = texel::raster::on_threads(options.threads, || {
+        lab::grade(&job, &shader_name, &work.0, &options)
+    })??;
+    let mut inputs: Vec<&Path> = vec![args.shader.as_path()];
+    if let Some(v) = &args.vertex {
+        inputs.push(v);
+    }
+    texel_io::publish_dir(&args.out, &inputs, |dir| {
+        lab::report::write(&report, &images, dir).map_err(anyhow::Error::from)
+    })
+    .with_context(|| format!("cannot write the report to {}", args.out.display()))?;
+    let mut summary = format!("score {:.1} / 100\n", report.score);
+    for m in &report.modes {
+        summary.push_str(&format!(
+            "{:<12} mode {}  {:<7}  gl {:5.1} %  lab {:5.1} %  {:5.1} dB\n",
+            m.scene,
+            m.mode,
+            match m.verdict {
+                lab::Verdict::Gl => "gl",
+                lab::Verdict::Lab => "lab",
+                lab::Verdict::Neither => "neither",
+            },
+            100.0 * m.agreement_gl,
+            100.0 * m.agreement_lab,
+            m.psnr_reference
+        ));
+        for d in &m.diagnosis {
+            summary.push_str(&format!("    {d}\n"));
+        }
+    }
+    texel_io::stdout_text(&summary).context(crate::cmd_render::STDOUT)?;
+    texel_io::stderr_line(format_args!(
+        "report: {}",
+        args.out.join("report.html").display()
+    ));
+    Ok(())
+}
+
+/// Run `texel lab-device DIR` and wait at most `limit`; a child still running then is killed.
+fn device_in_child(dir: &Path, limit: Duration) -> Result<()> {
+    let exe = std::env::current_exe().context("cannot find the texel executable")?;
+    let mut child = Command::new(exe)
+        .arg("lab-device")
+        .arg(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .context("cannot start the device process")?;
+    let start = Instant::now();
+    let graceful = crate::interrupt::Graceful::begin();
+    let status = loop {
+        if let Some(status) = child
+            .try_wait()
+            .context("cannot wait for the device process")?
+        {
+            break status;
+        }
+        if graceful.flag().load(std::sync::atomic::Ordering::SeqCst) {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(crate::interrupt::Interrupted(
+                "the lab was interrupted before grading".into(),
+            )
+            .into());
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            bail!(
+                "the shader did not finish within {} s and was stopped (an endless loop, or a frame too slow: --timeout sets the limit)",
+                limit.as_secs()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    if status.success() {
+        return Ok(());
+    }
+    // The driver's log on one line, as every texel error is.
+    let log = std::fs::read_to_string(dir.join("error.txt"))
+        .unwrap_or_else(|_| format!("the device process ended with {status}"));
+    let line: Vec<&str> = log
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    bail!("{}", line.join(" "))
+}
+
+/// `texel lab-device DIR`: render the job in `DIR/job.json` into `DIR`; on failure write the
+/// message to `DIR/error.txt`.
+pub fn device(dir: &Path) -> Result<()> {
+    let text = std::fs::read_to_string(dir.join("job.json"))
+        .with_context(|| format!("cannot read {}", dir.join("job.json").display()))?;
+    let job: Job = serde_json::from_str(&text).context("the job file is not valid")?;
+    if let Err(e) = lab::run_device(&job, dir) {
+        let _ = std::fs::write(dir.join("error.txt"), e.to_string());
+        return Err(e.into());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mode_lists() {
+        assert_eq!(parse_modes("1-8").unwrap().0, (1..=8).collect::<Vec<u8>>());
+        assert_eq!(parse_modes("5, 1-2,2").unwrap().0, vec![1, 2, 5]);
+        assert!(parse_modes("0").is_err());
+        assert!(parse_modes("9").is_err());
+        assert!(parse_modes("4-2").is_err());
+        assert!(parse_modes("").is_err());
+    }
+}
