@@ -90,7 +90,7 @@ pub enum Command {
     /// Example: texel lab modes.frag --out texel-lab/
     ///
     /// Example: texel lab modes.frag --vertex lab.vert --scene builtin:ground --modes 1-4
-    Lab(crate::cmd_lab::LabArgs),
+    Lab(LabArgs),
     /// The device half of `texel lab`, run by it in a child process with a time limit.
     #[command(hide = true)]
     LabDevice {
@@ -221,6 +221,12 @@ pub struct RenderArgs {
     /// TEXEL_ADAPTER environment variable, else the first, real GPUs first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
+    /// A student's GLSL fragment shader for the lab's modes (`texel lab`'s interface), drawn on
+    /// OpenGL in the left half with keys 1-8 setting texMode (Tab splits it against texel's own
+    /// mode on the right); the file is read again when it changes, and a version that does not
+    /// compile shows its error while the last good one keeps running.
+    #[arg(long, value_name = "FRAG", conflicts_with = "gpu")]
+    pub shader: Option<PathBuf>,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
     #[arg(short, long, value_parser = image_output())]
@@ -243,6 +249,12 @@ pub struct ViewArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
+    /// A student's GLSL fragment shader for the lab's modes (`texel lab`'s interface), drawn on
+    /// OpenGL in the left half with keys 1-8 setting texMode (Tab splits it against texel's own
+    /// mode on the right); the file is read again when it changes, and a version that does not
+    /// compile shows its error while the last good one keeps running.
+    #[arg(long, value_name = "FRAG", conflicts_with = "gpu")]
+    pub shader: Option<PathBuf>,
     /// Key presses applied before the first frame, comma-separated: 0-9, a-z, tab, esc, f12,
     /// [, ], left, right, up, down, pageup, pagedown, each optionally shift+KEY (e.g. 1,5,v,tab).
     /// A movement key moves the camera by a quarter second's travel.
@@ -343,6 +355,12 @@ pub struct CompareArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
+    /// A student's GLSL fragment shader for the lab's modes (`texel lab`'s interface), drawn on
+    /// OpenGL in the left half with keys 1-8 setting texMode (Tab splits it against texel's own
+    /// mode on the right); the file is read again when it changes, and a version that does not
+    /// compile shows its error while the last good one keeps running.
+    #[arg(long, value_name = "FRAG", conflicts_with = "gpu")]
+    pub shader: Option<PathBuf>,
     /// Also render a slow camera orbit of N frames (2 to 1000; the scene's own view first) and
     /// report per filter its PSNR averaged over the frames and its flicker: its change between
     /// consecutive frames less the reference's, per pixel, as a mean absolute value in 8-bit
@@ -435,6 +453,12 @@ pub struct BenchArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
+    /// A student's GLSL fragment shader for the lab's modes (`texel lab`'s interface), drawn on
+    /// OpenGL in the left half with keys 1-8 setting texMode (Tab splits it against texel's own
+    /// mode on the right); the file is read again when it changes, and a version that does not
+    /// compile shows its error while the last good one keeps running.
+    #[arg(long, value_name = "FRAG", conflicts_with = "gpu")]
+    pub shader: Option<PathBuf>,
 }
 
 /// Which instruction-set copy the tile rasterizer and the sampler's batch kernels run
@@ -628,4 +652,80 @@ fn image_output() -> impl TypedValueParser<Value = PathBuf> {
 /// clap's parser for `--screenshot`: [`crate::output::png_output`].
 fn png_output() -> impl TypedValueParser<Value = PathBuf> {
     clap::builder::OsStringValueParser::new().try_map(crate::output::png_output)
+}
+
+/// `texel lab`'s arguments.
+#[derive(Debug, Args)]
+pub struct LabArgs {
+    /// The student's fragment shader (GLSL, any version the driver accepts).
+    pub shader: PathBuf,
+    /// The student's vertex shader; it gets the attributes `position` (vec3, world space) and
+    /// `texCoordIn` (vec2) and the uniform `clipFromWorld` (mat4), and must write the varying.
+    /// Default: texel's own, which passes `texCoordIn` on unchanged.
+    #[arg(long)]
+    pub vertex: Option<PathBuf>,
+    /// A scene to grade on (repeatable): lab-tunnel, lab-plane, lab-wall (the default: all
+    /// three), builtin:NAME or a scene file; unlit scenes only.
+    #[arg(long = "scene", value_name = "SCENE")]
+    pub scenes: Vec<String>,
+    /// The modes to run: a list and ranges of 1-8, e.g. 1-4 or 1,2,5-8.
+    #[arg(long, default_value = "1-8", value_parser = parse_modes)]
+    pub modes: ModeList,
+    /// Report folder (made or replaced whole).
+    #[arg(long, default_value = "texel-lab")]
+    pub out: PathBuf,
+    /// The sampler uniform's name.
+    #[arg(long, default_value = "texSlot")]
+    pub sampler: String,
+    /// The mode uniform's name.
+    #[arg(long = "mode-uniform", default_value = "texMode")]
+    pub mode_uniform: String,
+    /// The texture coordinate varying's name.
+    #[arg(long, default_value = "texCoord")]
+    pub varying: String,
+    /// Seconds the device may take for every scene and mode together before the shader is
+    /// stopped (an endless loop).
+    #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u64).range(1..=86400))]
+    pub timeout: u64,
+    /// Frame size overriding the scenes' (320x240 for the lab's own).
+    #[arg(long)]
+    pub size: Option<Size>,
+    /// Timed frames per mode on the device (after one untimed).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub frames: u64,
+    /// Samples a pixel of the reference the PSNR is measured against.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub spp: u32,
+    /// Worker threads for grading (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    pub threads: Option<u64>,
+}
+
+/// `texel lab --modes`: modes 1-8, in order, without repeats.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModeList(pub Vec<u8>);
+
+pub fn parse_modes(s: &str) -> Result<ModeList, String> {
+    let mut out = Vec::new();
+    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (a, b) = part.split_once('-').unwrap_or((part, part));
+        let num = |t: &str| -> Result<u8, String> {
+            t.trim()
+                .parse::<u8>()
+                .ok()
+                .filter(|m| (1..=8).contains(m))
+                .ok_or_else(|| format!("mode {t:?} is not 1 to 8"))
+        };
+        let (a, b) = (num(a)?, num(b)?);
+        if a > b {
+            return Err(format!("mode range {part:?} runs backwards"));
+        }
+        out.extend(a..=b);
+    }
+    out.sort_unstable();
+    out.dedup();
+    if out.is_empty() {
+        return Err("no modes given".into());
+    }
+    Ok(ModeList(out))
 }

@@ -7,92 +7,16 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
-use clap::Args;
 use texel::lab::{self, Job, Names};
 
-use crate::cli::Size;
+use crate::cli::LabArgs;
 use crate::input::Input;
 
 /// The largest shader file read.
 const MAX_SHADER_BYTES: u64 = 1 << 20;
 
-/// `texel lab`'s arguments.
-#[derive(Debug, Args)]
-pub struct LabArgs {
-    /// The student's fragment shader (GLSL, any version the driver accepts).
-    pub shader: PathBuf,
-    /// The student's vertex shader; it gets the attributes `position` (vec3, world space) and
-    /// `texCoordIn` (vec2) and the uniform `clipFromWorld` (mat4), and must write the varying.
-    /// Default: texel's own, which passes `texCoordIn` on unchanged.
-    #[arg(long)]
-    pub vertex: Option<PathBuf>,
-    /// A scene to grade on (repeatable): lab-tunnel, lab-plane, lab-wall (the default: all
-    /// three), builtin:NAME or a scene file; unlit scenes only.
-    #[arg(long = "scene", value_name = "SCENE")]
-    pub scenes: Vec<String>,
-    /// The modes to run: a list and ranges of 1-8, e.g. 1-4 or 1,2,5-8.
-    #[arg(long, default_value = "1-8", value_parser = parse_modes)]
-    pub modes: ModeList,
-    /// Report folder (made or replaced whole).
-    #[arg(long, default_value = "texel-lab")]
-    pub out: PathBuf,
-    /// The sampler uniform's name.
-    #[arg(long, default_value = "texSlot")]
-    pub sampler: String,
-    /// The mode uniform's name.
-    #[arg(long = "mode-uniform", default_value = "texMode")]
-    pub mode_uniform: String,
-    /// The texture coordinate varying's name.
-    #[arg(long, default_value = "texCoord")]
-    pub varying: String,
-    /// Seconds the device may take for every scene and mode together before the shader is
-    /// stopped (an endless loop).
-    #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u64).range(1..=86400))]
-    pub timeout: u64,
-    /// Frame size overriding the scenes' (320x240 for the lab's own).
-    #[arg(long)]
-    pub size: Option<Size>,
-    /// Timed frames per mode on the device (after one untimed).
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=1000))]
-    pub frames: u64,
-    /// Samples a pixel of the reference the PSNR is measured against.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub spp: u32,
-    /// Worker threads for grading (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
-    pub threads: Option<u64>,
-}
-
-/// Modes 1-8, in order, without repeats.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ModeList(pub Vec<u8>);
-
-fn parse_modes(s: &str) -> Result<ModeList, String> {
-    let mut out = Vec::new();
-    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        let (a, b) = part.split_once('-').unwrap_or((part, part));
-        let num = |t: &str| -> Result<u8, String> {
-            t.trim()
-                .parse::<u8>()
-                .ok()
-                .filter(|m| (1..=8).contains(m))
-                .ok_or_else(|| format!("mode {t:?} is not 1 to 8"))
-        };
-        let (a, b) = (num(a)?, num(b)?);
-        if a > b {
-            return Err(format!("mode range {part:?} runs backwards"));
-        }
-        out.extend(a..=b);
-    }
-    out.sort_unstable();
-    out.dedup();
-    if out.is_empty() {
-        return Err("no modes given".into());
-    }
-    Ok(ModeList(out))
-}
-
-fn read_source(path: &Path, what: &str) -> Result<String> {
+/// The text of a shader file (a regular file of at most 1 MiB, UTF-8).
+pub fn read_source(path: &Path, what: &str) -> Result<String> {
     let bytes = texel_io::read_regular(path, MAX_SHADER_BYTES)
         .with_context(|| format!("cannot read the {what} {}", path.display()))?;
     String::from_utf8(bytes)
@@ -269,7 +193,7 @@ pub fn device(dir: &Path) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::cli::parse_modes;
 
     #[test]
     fn mode_lists() {

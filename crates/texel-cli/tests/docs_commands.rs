@@ -5,8 +5,8 @@
 //! later command may read what an earlier one wrote), and checks that each exits 0 and writes
 //! what it names (`-o`, `--out`, `--screenshot`, `--error-map`).
 //!
-//! - `--gpu` commands need a Vulkan adapter, `view` an X server: without them they are skipped
-//!   with the reason, unless `CI=true`.
+//! - `--gpu` commands need a Vulkan adapter, `view` an X server, `lab` OpenGL through EGL: without
+//!   them they are skipped with the reason, unless `CI=true`.
 //! - `cargo run -p texel --example NAME` runs the example binary that `cargo test --workspace`
 //!   builds.
 //! - Peer scripts (`scripts/peers/`, `scripts/vs_llvmpipe.py`) need a Python environment made
@@ -157,6 +157,11 @@ fn shrink(args: &[String]) -> (Vec<String>, Vec<String>) {
             set(&mut a, "--size", "48x27");
             set(&mut a, "--spp", "1");
         }
+        "lab" => {
+            set(&mut a, "--size", "80x60");
+            set(&mut a, "--spp", "1");
+            set(&mut a, "--frames", "1");
+        }
         _ => {}
     }
     let mut outputs: Vec<String> = OUTPUT_FLAGS
@@ -196,6 +201,9 @@ fn can_run(args: &[String], x: &mut Option<Option<Xvfb>>) -> bool {
     }
     if args.first().is_some_and(|s| s == "view") {
         return x.get_or_insert_with(Xvfb::start).is_some();
+    }
+    if args.first().is_some_and(|s| s == "lab") && !crate::lab::have_gl() {
+        return false;
     }
     true
 }

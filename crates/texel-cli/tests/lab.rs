@@ -16,7 +16,7 @@ const GL: &str = include_str!("../../texel-lab/glsl/solution-gl.frag");
 const LAB: &str = include_str!("../../texel-lab/glsl/solution-lab.frag");
 
 /// Whether OpenGL through EGL works here; panics under `CI=true` when it does not.
-fn have_gl() -> bool {
+pub(crate) fn have_gl() -> bool {
     match texel::lab::Gl::new() {
         Ok(_) => true,
         Err(e) => {

@@ -4,6 +4,7 @@
 //! X server fails them (`.ci/run` installs Debian's `xvfb`).
 
 use std::io::{BufRead, BufReader};
+use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 
 use texel_quality::{psnr, Image8};
@@ -295,4 +296,124 @@ fn with_gpu_the_viewer_shows_what_render_gpu_writes() {
     );
     let want = render(&d, "ripmap-render.png", &["--filter", "ripmap"]);
     assert!(psnr(&shot, &want, None).unwrap() >= 50.0);
+}
+
+/// The share of pixels of `a` and `b` within 6 codes in R, G and B (the lab's measure).
+fn agree(a: &Image8, b: &Image8) -> f64 {
+    let (pa, pb) = (a.pixels(), b.pixels());
+    let ok = pa
+        .iter()
+        .zip(pb)
+        .filter(|(x, y)| (0..3).all(|k| x[k].abs_diff(y[k]) <= 6))
+        .count();
+    ok as f64 / pa.len() as f64
+}
+
+/// `texel view --shader`: texel's GL solution in the window draws what texel's own mode draws
+/// (quad derivatives, the same lab scene); Tab puts texel's mode on the right.
+#[test]
+fn shader_in_the_window_matches_texels_mode() {
+    if !crate::lab::have_gl() {
+        return;
+    }
+    let Some(x) = Xvfb::start() else { return };
+    let d = Dir::new("view-shader");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let scene = root.join("scenes/lab/tunnel.toml").display().to_string();
+    let shader = root
+        .join("crates/texel-lab/glsl/solution-gl.frag")
+        .display()
+        .to_string();
+    let shot = |name: &str, extra: &[&str]| {
+        let mut a = args(&[
+            "view", &scene, "--size", "160x120", "--no-hud", "--frames", "2",
+        ]);
+        a.extend(args(extra));
+        a.extend(["--screenshot".to_string(), d.arg(name)]);
+        let out = x.texel(&a);
+        let err = stderr(&out);
+        assert!(out.status.success(), "texel {a:?}: {err}");
+        load(d.join(name))
+    };
+    for mode in ["1", "4", "8"] {
+        let keys = format!("q,{mode}");
+        let ours = shot("ours.png", &["--keys", &keys]);
+        let theirs = shot("shader.png", &["--keys", &keys, "--shader", &shader]);
+        let a = agree(&ours, &theirs);
+        assert!(a >= 0.97, "mode {mode}: {a}");
+    }
+}
+
+/// A shader edited while the window runs is read again: here one that paints every pixel red,
+/// then one that does not compile, which leaves the red one running. One that does not compile
+/// at the start is refused before the window opens.
+#[test]
+fn shader_edits_are_picked_up_and_broken_ones_refused() {
+    if !crate::lab::have_gl() {
+        return;
+    }
+    let Some(x) = Xvfb::start() else { return };
+    let d = Dir::new("view-shader-edit");
+    let gl = include_str!("../../texel-lab/glsl/solution-gl.frag");
+    let path = d.write("modes.frag", gl);
+    let red = gl.replacen(
+        "void main() {\n",
+        "void main() {\n    if (texMode > 0) { fragColor = vec4(1.0, 0.0, 0.0, 1.0); return; }\n",
+        1,
+    );
+    let shot = d.arg("edited.png");
+    let a = args(&[
+        "view",
+        "builtin:ground",
+        "--size",
+        "96x54",
+        "--no-hud",
+        "--frames",
+        "8000",
+        "--keys",
+        "4",
+        "--shader",
+        &path.display().to_string(),
+        "--screenshot",
+        &shot,
+    ]);
+    // About 1,700 frames a second here: the edit lands within the first tenth of the run.
+    let child = Command::new(env!("CARGO_BIN_EXE_texel"))
+        .args(&a)
+        .env("DISPLAY", x.display())
+        .env_remove("WAYLAND_DISPLAY")
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    std::fs::write(&path, &red).unwrap();
+    // Then an edit that does not compile: the red one keeps running.
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    std::fs::write(&path, "#version 330 core\nvoid main() { oops }\n").unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = load(d.join("edited.png"));
+    let red_px = img
+        .pixels()
+        .iter()
+        .filter(|p| p[0] == 255 && p[1] == 0 && p[2] == 0)
+        .count();
+    // The ground covers the frame below the horizon.
+    assert!(red_px * 3 > img.pixels().len(), "{red_px} red pixels");
+
+    let out = x.texel(&args(&[
+        "view",
+        "builtin:ground",
+        "--frames",
+        "1",
+        "--shader",
+        &path.display().to_string(),
+    ]));
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("does not compile"), "{err}");
 }

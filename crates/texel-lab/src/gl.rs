@@ -607,6 +607,45 @@ impl Session<'_> {
         Ok(Capture { uv_dx, dy_draw })
     }
 
+    /// Move the camera: the frames drawn after this call see the scene through `clip_from_world`.
+    pub fn set_clip_from_world(&mut self, clip_from_world: [f32; 16]) {
+        self.scene.3 = clip_from_world;
+    }
+
+    /// Make the render targets `width x height` (nothing is done at the current size).
+    ///
+    /// # Errors
+    /// [`GlError::Failed`] when the driver refuses the size.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), GlError> {
+        if (width, height) == (self.scene.0, self.scene.1) {
+            return Ok(());
+        }
+        // SAFETY: see the module docs; the renderbuffers were made by this session.
+        unsafe {
+            for rb in self.renderbuffers.drain(..) {
+                self.gl.gl.delete_renderbuffer(rb);
+            }
+        }
+        self.scene.0 = width;
+        self.scene.1 = height;
+        self.targets()
+    }
+
+    /// One frame of the student's shader in `mode`, top row first.
+    ///
+    /// # Errors
+    /// [`GlError::Failed`].
+    pub fn draw_frame(&self, mode: i32) -> Result<Vec<[u8; 4]>, GlError> {
+        self.draw(self.student, &[glow::COLOR_ATTACHMENT0], Some(mode));
+        let image = self
+            .read(glow::COLOR_ATTACHMENT0, glow::UNSIGNED_BYTE, 4)
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect();
+        self.gl.check("the student's frame")?;
+        Ok(image)
+    }
+
     /// The student's frame in `mode`, top row first, and the median time of `frames` frames in
     /// milliseconds (each drawn and finished; the first, which compiles the driver's code, not
     /// counted).

@@ -95,23 +95,45 @@ impl LabScene {
             .first()
             .map_or(glam::Mat4::IDENTITY, |d| d.clip_from_world)
             .to_cols_array();
-        GlScene {
-            width: self.prepared.width,
-            height: self.prepared.height,
-            background: bg,
+        device_scene(
+            &draws,
+            (self.prepared.width, self.prepared.height),
+            bg,
             clip_from_world,
-            draws: draws.iter().map(device_draw).collect(),
-        }
+        )
+    }
+}
+
+/// What the device uploads for `draws` seen through `clip_from_world` at `size`: each texture's
+/// levels as the 8-bit codes texel stores (a texture decoded to float is encoded back in its
+/// source's colour space, so the codes are the file's).
+pub fn device_scene(
+    draws: &[DrawCall],
+    (width, height): (u32, u32),
+    background: [u8; 4],
+    clip_from_world: [f32; 16],
+) -> GlScene {
+    GlScene {
+        width,
+        height,
+        background,
+        clip_from_world,
+        draws: draws.iter().map(device_draw).collect(),
     }
 }
 
 fn device_draw(d: &DrawCall) -> GlDraw {
     let t = d.texture;
+    let srgb = t.source_format() == texel_texture::Format::Rgba8Srgb;
     let levels = (0..t.levels().len())
         .filter_map(|k| {
             let info = &t.levels()[k];
             let texels = match t.level_texels(k)? {
                 LevelTexels::Unorm8(c) => c.to_vec(),
+                LevelTexels::Float(f) if srgb => f
+                    .iter()
+                    .map(|&p| texel_texture::base::color::rgba_to_srgb8(p))
+                    .collect(),
                 LevelTexels::Float(f) => f
                     .iter()
                     .map(|p| p.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8))

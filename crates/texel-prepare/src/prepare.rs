@@ -151,7 +151,8 @@ pub struct SceneOptions {
     /// How 8-bit textures are kept (the CLI's `--texture-storage`): images do not depend on it.
     pub texture_storage: TextureStorage,
     /// The rules the lab's eight modes follow in [`PreparedScene::samplers`] (the CLI's
-    /// `--convention`; [`texel_texture::Sampler::with_convention`]).
+    /// `--convention`; [`texel_texture::Sampler::with_convention`]); the other filters have the
+    /// GL rules only.
     pub convention: Convention,
 }
 
@@ -420,7 +421,11 @@ impl PreparedScene {
             .chain(own)
             .map(|(u, v)| {
                 let s = Sampler::new(filter.descriptor(u, v))?;
-                Ok(s.with_convention(self.convention)?)
+                // The convention is a rule of the lab's eight modes; the other filters have one.
+                Ok(match filter.lab_mode() {
+                    Some(_) => s.with_convention(self.convention)?,
+                    None => s,
+                })
             })
             .collect::<Result<_, Error>>()?;
         self.push_environment_sampler(&mut out, filter)?;

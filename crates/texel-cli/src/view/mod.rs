@@ -44,6 +44,20 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     } else {
         None
     };
+    if let Some(path) = &args.shader {
+        // A shader that does not compile at the start is an error before any window opens;
+        // later edits that do not compile are shown in the window.
+        let source = crate::cmd_lab::read_source(path, "shader")?;
+        let gl = texel::lab::Gl::new()?;
+        let empty = texel::lab::scene::device_scene(
+            &[],
+            (2, 2),
+            [0; 4],
+            glam::Mat4::IDENTITY.to_cols_array(),
+        );
+        gl.session(&source, None, &texel::lab::Names::default(), &empty)
+            .with_context(|| format!("the shader {}", path.display()))?;
+    }
     let size = (scene.width, scene.height);
     let fly = Fly::new(scene.scene.camera, movement_speed(&scene));
     let state = ViewState::new(Mode::Filter(texel::Filter::Trilinear), args.scene.color);
@@ -67,6 +81,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
         input,
         threads: args.threads,
         gpu,
+        shader: args.shader.clone(),
     };
     let shared = Arc::new(Shared::default());
     let thread = {

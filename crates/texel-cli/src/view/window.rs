@@ -505,7 +505,7 @@ impl ApplicationHandler<Rendered> for App {
         if let Some(e) = r.error {
             self.error = Some(e);
         } else {
-            self.error = None;
+            self.error = r.notice.clone();
             // Frames of an older request still show (they are newer than what is on screen),
             // but only the current request's count towards --frames.
             let current = self.submitted.as_ref().map_or(0, |s| s.generation);

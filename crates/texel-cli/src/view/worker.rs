@@ -22,6 +22,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
+use texel::lab::gl::{Gl, GlScene, Names, Session};
 use texel::scene::Camera;
 use texel::{Filter, PreparedScene, Sampler, SamplerDescriptor};
 use texel_gpu::{Gpu, GpuDraws, GpuFilter};
@@ -174,6 +175,9 @@ pub struct Rendered {
     pub parts: Vec<PartInfo>,
     /// An error to show instead of a new image (the pixels are then empty).
     pub error: Option<String>,
+    /// A message to show beside the image (a student's shader that no longer compiles while the
+    /// last good one keeps running).
+    pub notice: Option<String>,
 }
 
 /// What the render thread owns.
@@ -192,6 +196,164 @@ pub struct Worker {
     pub threads: Option<u32>,
     /// `--gpu`: the device.
     pub gpu: Option<Gpu>,
+    /// `--shader`: the student's fragment shader, drawn on OpenGL in the left half.
+    pub shader: Option<std::path::PathBuf>,
+}
+
+/// The student's shader: an OpenGL thread of its own (a context is current on one thread, and
+/// the frame may be rendered on a pool's), whether it holds a built program, the file's
+/// modification time it was built from, and the last compile error while an older build keeps
+/// running.
+#[derive(Default)]
+struct ShaderState {
+    thread: Option<ShaderThread>,
+    built: bool,
+    modified: Option<std::time::SystemTime>,
+    notice: Option<String>,
+}
+
+/// The student's shader (`--shader`) drawn in lab mode `mode` over `draws` at `size`, top row
+/// first. The file is read again when its modification time changes; a version that does not
+/// compile leaves the last good one running and its error in `ShaderState::notice`.
+fn shader_frame(
+    state: &mut ShaderState,
+    path: Option<&std::path::Path>,
+    draws: &[DrawCall],
+    settings: &RenderSettings,
+    clip: glam::Mat4,
+    size: (u32, u32),
+    mode: i32,
+) -> Result<Vec<[u8; 4]>> {
+    let path = path.context("no --shader")?;
+    let thread = state.thread.as_ref().context("no OpenGL thread")?;
+    let modified = std::fs::metadata(path).and_then(|m| m.modified()).ok();
+    if !state.built || modified != state.modified {
+        state.modified = modified;
+        let bg = settings
+            .background
+            .map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+        let scene = texel::lab::scene::device_scene(draws, size, bg, clip.to_cols_array());
+        let built = crate::cmd_lab::read_source(path, "shader").and_then(|source| {
+            thread
+                .run(ShaderJob::Build(source, scene))
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+        });
+        match built {
+            Ok(_) => {
+                state.built = true;
+                state.notice = None;
+            }
+            Err(e) if state.built => {
+                state.notice = Some(format!(
+                    "{} (the last good shader keeps running)",
+                    crate::chain_line(&e)
+                ));
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    let px = thread
+        .run(ShaderJob::Frame(size, clip.to_cols_array(), mode))
+        .map_err(|e| anyhow::anyhow!(e))?;
+    px.context("the OpenGL thread returned no frame")
+}
+
+/// Work for the shader's OpenGL thread.
+enum ShaderJob {
+    /// Compile and link this source over this scene; an error keeps the last program.
+    Build(String, GlScene),
+    /// One frame at this size, seen through this `clip_from_world`, in this mode.
+    Frame((u32, u32), [f32; 4 * 4], i32),
+}
+
+/// The OpenGL thread's two channels: jobs in, results out (a frame's pixels, or `None` for a
+/// build).
+struct ShaderThread {
+    jobs: Option<std::sync::mpsc::Sender<ShaderJob>>,
+    results: std::sync::mpsc::Receiver<Result<Option<Vec<[u8; 4]>>, String>>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Drop for ShaderThread {
+    /// Close the job channel and wait for the thread, so that its context is destroyed before
+    /// the process exits (Mesa aborts at exit with a context still current on a live thread).
+    fn drop(&mut self) {
+        self.jobs = None;
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl ShaderThread {
+    /// Start the thread with its OpenGL context.
+    fn start() -> Result<ShaderThread, String> {
+        use std::sync::mpsc::channel;
+        let (jobs, job_rx) = channel::<ShaderJob>();
+        let (result_tx, results) = channel();
+        let (ready_tx, ready) = channel();
+        let thread = std::thread::Builder::new()
+            .name("texel-view-glsl".into())
+            .spawn(move || {
+                let gl = match Gl::new() {
+                    Ok(g) => g,
+                    Err(e) => {
+                        let _ = ready_tx.send(Err(e.to_string()));
+                        return;
+                    }
+                };
+                let _ = ready_tx.send(Ok(()));
+                let mut session: Option<Session<'_>> = None;
+                for job in job_rx {
+                    let out = match job {
+                        ShaderJob::Build(source, scene) => {
+                            match gl.session(&source, None, &Names::default(), &scene) {
+                                Ok(s) => {
+                                    session = Some(s);
+                                    Ok(None)
+                                }
+                                Err(e) => Err(e.to_string()),
+                            }
+                        }
+                        ShaderJob::Frame(size, clip, mode) => match session.as_mut() {
+                            Some(s) => s
+                                .resize(size.0, size.1)
+                                .and_then(|()| {
+                                    s.set_clip_from_world(clip);
+                                    s.draw_frame(mode)
+                                })
+                                .map(Some)
+                                .map_err(|e| e.to_string()),
+                            None => Err("no shader is built".into()),
+                        },
+                    };
+                    if result_tx.send(out).is_err() {
+                        break;
+                    }
+                }
+            })
+            .map_err(|e| e.to_string())?;
+        ready
+            .recv()
+            .map_err(|_| "the OpenGL thread ended".to_string())??;
+        Ok(ShaderThread {
+            jobs: Some(jobs),
+            results,
+            thread: Some(thread),
+        })
+    }
+
+    /// Run `job` and wait for its result.
+    fn run(&self, job: ShaderJob) -> Result<Option<Vec<[u8; 4]>>, String> {
+        self.jobs
+            .as_ref()
+            .ok_or_else(|| "the OpenGL thread ended".to_string())?
+            .send(job)
+            .map_err(|_| "the OpenGL thread ended".to_string())?;
+        self.results
+            .recv()
+            .map_err(|_| "the OpenGL thread ended".to_string())?
+    }
 }
 
 /// Per-image state kept between frames.
@@ -229,6 +391,17 @@ pub fn run(mut worker: Worker, shared: Arc<Shared>, send: impl Fn(Rendered) -> b
         None => None,
     };
     let gpu = worker.gpu.take();
+    let mut shader = ShaderState::default();
+    if worker.shader.is_some() {
+        match ShaderThread::start() {
+            Ok(t) => shader.thread = Some(t),
+            Err(e) => {
+                send(error_frame(0, &e));
+                return;
+            }
+        }
+    }
+    let polling = shader.thread.is_some();
     let mut gpu_draws: HashMap<SamplerKey, GpuDraws<'_>> = HashMap::new();
     let mut samplers: HashMap<SamplerKey, Vec<Sampler>> = HashMap::new();
     let mut costs: HashMap<(Mode, View, bool), f64> = HashMap::new();
@@ -241,6 +414,7 @@ pub fn run(mut worker: Worker, shared: Arc<Shared>, send: impl Fn(Rendered) -> b
             worker: &mut worker,
             gpu: gpu.as_ref(),
             gpu_draws: &mut gpu_draws,
+            shader: &mut shader,
             samplers: &mut samplers,
             costs: &mut costs,
             progress: &mut progress,
@@ -267,7 +441,11 @@ pub fn run(mut worker: Worker, shared: Arc<Shared>, send: impl Fn(Rendered) -> b
                 continue;
             }
             Err(e) => {
-                idle = true;
+                // A student's shader is polled for a fixed file: keep trying.
+                idle = !polling;
+                if !idle {
+                    std::thread::sleep(std::time::Duration::from_millis(200));
+                }
                 error_frame(req.generation, &crate::chain_line(&e))
             }
         };
@@ -288,6 +466,7 @@ fn error_frame(generation: u64, message: &str) -> Rendered {
         scale: 1,
         parts: Vec::new(),
         error: Some(message.to_string()),
+        notice: None,
     }
 }
 
@@ -295,6 +474,7 @@ struct FrameContext<'a, 'g> {
     worker: &'a mut Worker,
     gpu: Option<&'g Gpu>,
     gpu_draws: &'a mut HashMap<SamplerKey, GpuDraws<'g>>,
+    shader: &'a mut ShaderState,
     samplers: &'a mut HashMap<SamplerKey, Vec<Sampler>>,
     costs: &'a mut HashMap<(Mode, View, bool), f64>,
     progress: &'a mut Progress,
@@ -351,6 +531,8 @@ struct Part {
     rect: [u32; 4],
     /// Drawn by the GPU path.
     gpu: bool,
+    /// Drawn by the student's shader (`--shader`) on OpenGL.
+    shader: bool,
     /// The fly camera's `clip_from_world`.
     clip: glam::Mat4,
 }
@@ -478,13 +660,19 @@ impl FrameContext<'_, '_> {
         }
         let t0 = Instant::now();
         let mut parts = Vec::new();
-        for (&mode, &rect) in modes.iter().zip(&rects) {
+        for (k, (&mode, &rect)) in modes.iter().zip(&rects).enumerate() {
             let started = Instant::now();
             let gpu = use_gpu(mode);
+            // The student's shader draws the left half (or the whole frame) in the lab's modes.
+            let shader = k == 0
+                && self.shader.thread.is_some()
+                && state.view == View::Color
+                && matches!(mode, Mode::Filter(f) if f.lab_mode().is_some());
             let part = Part {
                 mode,
                 rect,
                 gpu,
+                shader,
                 clip,
             };
             if !self.draw_part(req, &part, &settings, &mut frame)? {
@@ -496,7 +684,13 @@ impl FrameContext<'_, '_> {
             *c = 0.5 * *c + 0.5 * ms / px.max(1.0);
             parts.push(PartInfo {
                 mode,
-                backend: if gpu { "gpu" } else { "cpu" },
+                backend: if shader {
+                    "glsl"
+                } else if gpu {
+                    "gpu"
+                } else {
+                    "cpu"
+                },
                 samples: None,
                 within: None,
                 stats: None,
@@ -519,6 +713,7 @@ impl FrameContext<'_, '_> {
             scale,
             parts,
             error: None,
+            notice: self.shader.notice.clone(),
         }))
     }
 
@@ -589,6 +784,38 @@ impl FrameContext<'_, '_> {
             with_environment(settings, &self.worker.scenes, self.samplers, key, part.clip);
         let bands = bands(rect, self.cost(part.mode, state.view, false), req.moving);
         match part.mode {
+            Mode::Filter(f) if part.shader => {
+                let mode = f.lab_mode().map_or(0, i32::from);
+                let size = (w, frame.height);
+                let path = self.worker.shader.as_deref();
+                let px = shader_frame(self.shader, path, &draws, &settings, part.clip, size, mode)?;
+                // The shader's codes are in the texture's own encoding (it filters the codes as
+                // they are stored): sRGB codes decode through the sRGB curve, linear ones by 255.
+                let srgb = draws.first().is_some_and(|d| {
+                    d.texture.source_format() == texel::texture::Format::Rgba8Srgb
+                });
+                let decode = |c: u8| {
+                    let v = f32::from(c) / 255.0;
+                    if srgb {
+                        texel::texture::base::color::srgb_to_linear(v)
+                    } else {
+                        v
+                    }
+                };
+                let linear: Vec<[f32; 4]> = px
+                    .iter()
+                    .map(|p| {
+                        [
+                            decode(p[0]),
+                            decode(p[1]),
+                            decode(p[2]),
+                            f32::from(p[3]) / 255.0,
+                        ]
+                    })
+                    .collect();
+                copy_rect(&linear, &mut frame.color, w, rect);
+                frame.forget_clear();
+            }
             Mode::Filter(f) if part.gpu => {
                 let gpu_dev = self.gpu.expect("use_gpu checked");
                 let g = match self.gpu_draws.entry(key) {
@@ -955,6 +1182,7 @@ mod tests {
                     input,
                     threads: None,
                     gpu: None,
+                    shader: None,
                 },
                 samplers: HashMap::new(),
                 costs: HashMap::new(),
@@ -967,10 +1195,12 @@ mod tests {
 
         fn render(&mut self, req: &Request) -> Option<Rendered> {
             let mut gpu_draws = HashMap::new();
+            let mut shader = ShaderState::default();
             let mut ctx = FrameContext {
                 worker: &mut self.worker,
                 gpu: None,
                 gpu_draws: &mut gpu_draws,
+                shader: &mut shader,
                 samplers: &mut self.samplers,
                 costs: &mut self.costs,
                 progress: &mut self.progress,

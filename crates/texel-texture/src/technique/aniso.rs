@@ -1,7 +1,7 @@
 //! Hardware-style anisotropic filtering: N trilinear probes along the footprint's major axis.
 //!
-//! Formula (EXT_texture_filter_anisotropic, "Texture Minification"; also the lab's formula and
-//! docs/guide/conventions.md):
+//! Formula (EXT_texture_filter_anisotropic, "Texture Minification"; docs/guide/conventions.md; the
+//! lab handout's own formula, with probes at the footprint's ends, is [`crate::technique::lab`]'s):
 //! with `Px = (dudx * W, dvdx * H)` and `Py = (dudy * W, dvdy * H)` in texels of level
 //! 0, `Pmax`/`Pmin` the longer/shorter of the two,
 //!
