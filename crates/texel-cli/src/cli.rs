@@ -221,12 +221,6 @@ pub struct RenderArgs {
     /// TEXEL_ADAPTER environment variable, else the first, real GPUs first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
-    /// A student's GLSL fragment shader for the lab's modes (`texel lab`'s interface), drawn on
-    /// OpenGL in the left half with keys 1-8 setting texMode (Tab splits it against texel's own
-    /// mode on the right); the file is read again when it changes, and a version that does not
-    /// compile shows its error while the last good one keeps running.
-    #[arg(long, value_name = "FRAG", conflicts_with = "gpu")]
-    pub shader: Option<PathBuf>,
     /// Output PNG (`-` writes it to standard output); a name ending in `.exr` writes OpenEXR
     /// instead: the linear colour as 32-bit floats, unclamped.
     #[arg(short, long, value_parser = image_output())]
@@ -355,12 +349,6 @@ pub struct CompareArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
-    /// A student's GLSL fragment shader for the lab's modes (`texel lab`'s interface), drawn on
-    /// OpenGL in the left half with keys 1-8 setting texMode (Tab splits it against texel's own
-    /// mode on the right); the file is read again when it changes, and a version that does not
-    /// compile shows its error while the last good one keeps running.
-    #[arg(long, value_name = "FRAG", conflicts_with = "gpu")]
-    pub shader: Option<PathBuf>,
     /// Also render a slow camera orbit of N frames (2 to 1000; the scene's own view first) and
     /// report per filter its PSNR averaged over the frames and its flicker: its change between
     /// consecutive frames less the reference's, per pixel, as a mean absolute value in 8-bit
@@ -453,12 +441,6 @@ pub struct BenchArgs {
     /// With --gpu: the adapter whose name contains NAME (default: TEXEL_ADAPTER, else the first).
     #[arg(long, value_name = "NAME", requires = "gpu")]
     pub adapter: Option<String>,
-    /// A student's GLSL fragment shader for the lab's modes (`texel lab`'s interface), drawn on
-    /// OpenGL in the left half with keys 1-8 setting texMode (Tab splits it against texel's own
-    /// mode on the right); the file is read again when it changes, and a version that does not
-    /// compile shows its error while the last good one keeps running.
-    #[arg(long, value_name = "FRAG", conflicts_with = "gpu")]
-    pub shader: Option<PathBuf>,
 }
 
 /// Which instruction-set copy the tile rasterizer and the sampler's batch kernels run

@@ -23,16 +23,19 @@ pub fn read_source(path: &Path, what: &str) -> Result<String> {
         .with_context(|| format!("the {what} {} is not UTF-8 text", path.display()))
 }
 
-/// A work folder removed when dropped.
+/// The device's work folder: inside the report's staging directory (so a signal's clean-up
+/// removes it with the rest, and it is never published), private to this user, removed when
+/// dropped.
 struct WorkDir(PathBuf);
 
 impl WorkDir {
-    fn new() -> Result<WorkDir> {
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos());
-        let dir = std::env::temp_dir().join(format!("texel-lab-{}-{nanos}", std::process::id()));
-        std::fs::create_dir(&dir).with_context(|| format!("cannot make {}", dir.display()))?;
+    fn new(staging: &Path) -> Result<WorkDir> {
+        use std::os::unix::fs::DirBuilderExt;
+        let dir = staging.join(".device");
+        std::fs::DirBuilder::new()
+            .mode(0o700)
+            .create(&dir)
+            .with_context(|| format!("cannot make {}", dir.display()))?;
         Ok(WorkDir(dir))
     }
 }
@@ -43,8 +46,17 @@ impl Drop for WorkDir {
     }
 }
 
+/// Bytes one scene costs the lab at `w x h` with `modes` modes: the capture (32 a pixel) and a
+/// frame per mode (4) on disk and in memory, and the report's images (the shader's, texel's and
+/// the heat map per mode, and the reference: 4 bytes a pixel each) with texel's evaluations
+/// (twice 4 a pixel per mode while grading).
+fn scene_bytes(w: u32, h: u32, modes: usize) -> u64 {
+    let px = u64::from(w) * u64::from(h);
+    px.saturating_mul(32 + 4 + 4 * (1 + 3 * modes as u64) + 8 * modes as u64)
+}
+
 /// Run `texel lab`.
-pub fn run(args: &LabArgs, _input: &mut Input) -> Result<()> {
+pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
     let fragment = read_source(&args.shader, "fragment shader")?;
     let vertex = match &args.vertex {
         Some(p) => Some(read_source(p, "vertex shader")?),
@@ -63,9 +75,15 @@ pub fn run(args: &LabArgs, _input: &mut Input) -> Result<()> {
     job.modes = args.modes.0.clone();
     job.frames = args.frames as usize;
     job.size = args.size.map(|s| (s.width, s.height));
-    // Scenes are checked here, before the device starts, so a bad one is reported as such.
+    // Scenes are checked here, before the device starts, so a bad one is reported as such, and
+    // what the lab keeps of each is charged to the memory budget.
     for s in &job.scenes {
-        lab::LabScene::load(s, job.size)?;
+        let scene = lab::LabScene::load(s, job.size)?;
+        let (w, h) = scene.size();
+        input.budget.take(
+            &format!("the lab's capture, frames and images of {s}"),
+            scene_bytes(w, h, job.modes.len()),
+        )?;
     }
     for v in lab::source::violations(&job.fragment) {
         texel_io::stderr_line(format_args!(
@@ -78,25 +96,35 @@ pub fn run(args: &LabArgs, _input: &mut Input) -> Result<()> {
             "texel: note: line {line} asks textureSize for a per-pixel level; Mesa's llvmpipe answers one size for a whole quad, so use max(textureSize(texSlot, 0) >> level, ivec2(1))"
         ));
     }
-    let work = WorkDir::new()?;
-    let job_path = work.0.join("job.json");
-    std::fs::write(&job_path, serde_json::to_vec(&job)?)
-        .with_context(|| format!("cannot write {}", job_path.display()))?;
-    device_in_child(&work.0, Duration::from_secs(args.timeout))?;
     let shader_name = texel_io::escape(&args.shader.display().to_string()).into_owned();
     let options = lab::GradeOptions {
         reference_spp: args.spp,
         threads: args.threads.map(|t| t as usize),
     };
-    let (report, images) = texel::raster::on_threads(options.threads, || {
-        lab::grade(&job, &shader_name, &work.0, &options)
-    })??;
+    // What the command reads must not lie inside what it replaces.
     let mut inputs: Vec<&Path> = vec![args.shader.as_path()];
     if let Some(v) = &args.vertex {
         inputs.push(v);
     }
-    texel_io::publish_dir(&args.out, &inputs, |dir| {
-        lab::report::write(&report, &images, dir).map_err(anyhow::Error::from)
+    inputs.extend(
+        job.scenes
+            .iter()
+            .map(Path::new)
+            .filter(|p| p.extension().is_some()),
+    );
+    let limit = Duration::from_secs(args.timeout);
+    let report = texel_io::publish_dir(&args.out, &inputs, |dir| {
+        let work = WorkDir::new(dir)?;
+        let job_path = work.0.join("job.json");
+        std::fs::write(&job_path, serde_json::to_vec(&job)?)
+            .with_context(|| format!("cannot write {}", job_path.display()))?;
+        device_in_child(&work.0, limit)?;
+        let (report, images) = texel::raster::on_threads(options.threads, || {
+            lab::grade(&job, &shader_name, &work.0, &options)
+        })??;
+        drop(work);
+        lab::report::write(&report, &images, dir)?;
+        Ok::<_, anyhow::Error>(report)
     })
     .with_context(|| format!("cannot write the report to {}", args.out.display()))?;
     let mut summary = format!("score {:.1} / 100\n", report.score);
@@ -129,12 +157,17 @@ pub fn run(args: &LabArgs, _input: &mut Input) -> Result<()> {
 /// Run `texel lab-device DIR` and wait at most `limit`; a child still running then is killed.
 fn device_in_child(dir: &Path, limit: Duration) -> Result<()> {
     let exe = std::env::current_exe().context("cannot find the texel executable")?;
+    use std::os::unix::process::CommandExt;
+    let log =
+        std::fs::File::create(dir.join("stderr.txt")).context("cannot make the device's log")?;
+    // A process group of its own: Ctrl-C reaches texel, which stops the child itself.
     let mut child = Command::new(exe)
         .arg("lab-device")
         .arg(dir)
         .stdin(Stdio::null())
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
+        .stderr(log)
+        .process_group(0)
         .spawn()
         .context("cannot start the device process")?;
     let start = Instant::now();

@@ -628,7 +628,13 @@ impl Session<'_> {
         }
         self.scene.0 = width;
         self.scene.1 = height;
-        self.targets()
+        let made = self.targets();
+        if made.is_err() {
+            // No targets of any size now: the next call makes them again.
+            self.scene.0 = 0;
+            self.scene.1 = 0;
+        }
+        made
     }
 
     /// One frame of the student's shader in `mode`, top row first.

@@ -206,6 +206,8 @@ pub struct Questions {
 pub struct LevelRange {
     /// Scene.
     pub scene: String,
+    /// The scene's reference image in the report folder.
+    pub reference_image: String,
     /// The smallest N (the lab's formula, before its clamp at M).
     pub n_min: f64,
     /// The largest N.
@@ -362,6 +364,20 @@ pub fn grade(
     let mut mag: BTreeMap<u8, (f64, f64, usize)> = BTreeMap::new();
     for (k, spec) in job.scenes.iter().enumerate() {
         let scene = LabScene::load(spec, job.size)?;
+        // File names from the scene's name: letters, digits and `-` only, and the scene's
+        // position, so that two scenes of one name keep their own images.
+        let safe: String = scene
+            .name
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        let file_stem = format!("{k}-{safe}");
         let (w, h) = scene.size();
         let n = (w as usize) * (h as usize);
         let capture = read_capture(&capture_path(dir, k), n)?;
@@ -373,9 +389,10 @@ pub fn grade(
             .map(|(a, b)| *a && *b)
             .collect();
         let ref_mask = Mask::new(w, h, ref_mask)?;
-        let ref_name = format!("images/{}-reference.png", scene.name);
-        images.push((ref_name, reference.0.clone()));
-        let levels = level_range(&scene, &capture, &mask);
+        let ref_name = format!("images/{file_stem}-reference.png");
+        images.push((ref_name.clone(), reference.0.clone()));
+        let mut levels = level_range(&scene, &capture, &mask);
+        levels.0.reference_image = ref_name;
         let magnified = levels.1.clone();
         questions.levels.push(levels.0);
         questions.memory.push(memory(&scene));
@@ -421,7 +438,7 @@ pub fn grade(
                     }
                 }
             }
-            let stem = format!("images/{}-mode{mode}", scene.name);
+            let stem = format!("images/{file_stem}-mode{mode}");
             let names = [
                 format!("{stem}-shader.png"),
                 format!("{stem}-texel.png"),

@@ -213,14 +213,14 @@ fn html(r: &LabReport) -> String {
             pct(m.agreement_gl),
             pct(m.agreement_lab),
             db(m.psnr_reference),
-            m.images[0],
-            m.images[1],
-            m.images[2]
+            esc(&m.images[0]),
+            esc(&m.images[1]),
+            esc(&m.images[2])
         );
     }
     let _ = writeln!(s, "</table><h2>Reference</h2>");
     for l in &r.questions.levels {
-        let _ = writeln!(s, "<figure style=\"display:inline-block\"><img src=\"images/{}-reference.png\"><figcaption>{}</figcaption></figure>", esc(&l.scene), esc(&l.scene));
+        let _ = writeln!(s, "<figure style=\"display:inline-block\"><img src=\"{}\"><figcaption>{}</figcaption></figure>", esc(&l.reference_image), esc(&l.scene));
     }
     let _ = writeln!(
         s,

@@ -76,13 +76,17 @@ pub fn version_of(source: &str) -> GlslVersion {
     }
 }
 
-/// `source` with its comments replaced by spaces (newlines kept, so line numbers hold).
+/// `source` with its comments and line continuations (`\` before a newline) replaced by spaces
+/// (newlines kept, so line numbers hold).
 pub fn strip_comments(source: &str) -> String {
     let b = source.as_bytes();
     let mut out = String::with_capacity(source.len());
     let mut i = 0;
     while i < b.len() {
-        if b[i] == b'/' && b.get(i + 1) == Some(&b'/') {
+        if b[i] == b'\\' && b.get(i + 1) == Some(&b'\n') {
+            out.push_str(" \n");
+            i += 2;
+        } else if b[i] == b'/' && b.get(i + 1) == Some(&b'/') {
             while i < b.len() && b[i] != b'\n' {
                 i += 1;
             }
@@ -106,16 +110,35 @@ pub fn strip_comments(source: &str) -> String {
     out
 }
 
+/// Names the compiler defines itself (GLSL 4.60, "Predefined Macros"); the profile macros'
+/// values depend on the context, so blocks under them count as kept either way.
+const PREDEFINED: [&str; 1] = ["__VERSION__"];
+
+/// Whether `name` is one of GLSL's profile macros (`GL_core_profile`, ...).
+fn is_profile(name: &str) -> bool {
+    name.starts_with("GL_") && name.ends_with("_profile")
+}
+
+/// One open `#if` block: whether its current branch is kept, whether an earlier branch was,
+/// whether its parent is kept, and whether its conditions cannot be decided.
+#[derive(Clone, Copy)]
+struct Block {
+    active: bool,
+    taken: bool,
+    parent: bool,
+    unknown: bool,
+}
+
 /// The lines the preprocessor keeps (true) or drops, by evaluating `#if`, `#ifdef`, `#ifndef`,
-/// `#elif`, `#else`, `#endif` over the names `#define`d so far. A condition it cannot evaluate
-/// counts as true, so nothing the compiler might see escapes the check.
+/// `#elif`, `#else`, `#endif` over the names `#define`d so far and the predefined ones. Where a
+/// condition cannot be decided (operators, macros with values, the profile macros) every branch
+/// counts as kept, so nothing the compiler might see escapes the check.
 fn active_lines(clean: &str) -> Vec<bool> {
-    let mut defined: BTreeSet<String> = BTreeSet::new();
-    // Per open block: (this branch active, some branch taken, parent active).
-    let mut stack: Vec<(bool, bool, bool)> = Vec::new();
+    let mut defined: BTreeSet<String> = PREDEFINED.iter().map(|s| s.to_string()).collect();
+    let mut stack: Vec<Block> = Vec::new();
     let mut out = Vec::new();
     for line in clean.lines() {
-        let active = stack.last().is_none_or(|s| s.0);
+        let active = stack.last().is_none_or(|b| b.active);
         let t = line.trim();
         let Some(rest) = t.strip_prefix('#') else {
             out.push(active);
@@ -125,7 +148,14 @@ fn active_lines(clean: &str) -> Vec<bool> {
         let (word, arg) = rest
             .split_once(char::is_whitespace)
             .map_or((rest, ""), |(w, a)| (w, a.trim()));
-        let cond = |arg: &str, defined: &BTreeSet<String>| evaluate(arg, defined);
+        let decide = |word: &str, arg: &str, defined: &BTreeSet<String>| -> Option<bool> {
+            match word {
+                _ if is_profile(arg) && word != "if" && word != "elif" => None,
+                "ifdef" => Some(defined.contains(arg)),
+                "ifndef" => Some(!defined.contains(arg)),
+                _ => evaluate(arg, defined),
+            }
+        };
         match word {
             "define" if active => {
                 if let Some(name) = arg.split(|c: char| !c.is_alphanumeric() && c != '_').next() {
@@ -138,22 +168,32 @@ fn active_lines(clean: &str) -> Vec<bool> {
                 defined.remove(arg);
             }
             "if" | "ifdef" | "ifndef" => {
-                let c = match word {
-                    "ifdef" => defined.contains(arg),
-                    "ifndef" => !defined.contains(arg),
-                    _ => cond(arg, &defined),
-                };
-                stack.push((active && c, c, active));
+                let c = decide(word, arg, &defined);
+                stack.push(Block {
+                    active: active && c.unwrap_or(true),
+                    taken: c.unwrap_or(true),
+                    parent: active,
+                    unknown: c.is_none(),
+                });
             }
             "elif" => {
                 if let Some(top) = stack.last_mut() {
-                    let c = !top.1 && cond(arg, &defined);
-                    *top = (top.2 && c, top.1 || c, top.2);
+                    let c = decide(word, arg, &defined);
+                    let unknown = top.unknown || c.is_none();
+                    let keep = unknown || !top.taken && c.unwrap_or(true);
+                    *top = Block {
+                        active: top.parent && keep,
+                        taken: top.taken || keep,
+                        parent: top.parent,
+                        unknown,
+                    };
                 }
             }
             "else" => {
                 if let Some(top) = stack.last_mut() {
-                    *top = (top.2 && !top.1, true, top.2);
+                    let keep = top.unknown || !top.taken;
+                    top.active = top.parent && keep;
+                    top.taken = true;
                 }
             }
             "endif" => {
@@ -167,25 +207,29 @@ fn active_lines(clean: &str) -> Vec<bool> {
     out
 }
 
-/// A preprocessor condition: `0`, `1` (any integer), `defined(X)`, `defined X`, `!` of one;
-/// anything else is true.
-fn evaluate(arg: &str, defined: &BTreeSet<String>) -> bool {
+/// A preprocessor condition: an integer, `defined(X)` or `defined X`, after any number of `!`;
+/// `None` for anything else (operators, macros with values, the profile macros).
+fn evaluate(arg: &str, defined: &BTreeSet<String>) -> Option<bool> {
     let a = arg.trim();
-    if let Some(rest) = a.strip_prefix('!') {
-        return !evaluate(rest, defined);
-    }
-    if let Ok(n) = a.parse::<i64>() {
-        return n != 0;
-    }
-    if let Some(rest) = a.strip_prefix("defined") {
-        let name = rest
+    let rest = a.trim_start_matches(|c: char| c == '!' || c.is_whitespace());
+    let negations = a[..a.len() - rest.len()].matches('!').count();
+    let value = if let Ok(n) = rest.parse::<i64>() {
+        n != 0
+    } else if let Some(r) = rest.strip_prefix("defined") {
+        let name = r
             .trim()
             .trim_start_matches('(')
             .trim_end_matches(')')
             .trim();
-        return defined.contains(name);
-    }
-    true
+        let plain = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !plain || is_profile(name) {
+            return None;
+        }
+        defined.contains(name)
+    } else {
+        return None;
+    };
+    Some(value ^ (negations % 2 == 1))
 }
 
 /// Identifiers of `line` with their byte offsets.
@@ -222,6 +266,10 @@ fn is_type(word: &str) -> bool {
             })
 }
 
+/// The longest level argument [`level_size_queries`] reads: a line of many unclosed calls costs
+/// its length, not its square.
+const MAX_ARGUMENT: usize = 256;
+
 /// Calls of `textureSize` whose level is not the literal `0`, by line: Mesa's llvmpipe answers one
 /// size for every pixel of a 2x2 quad (and more) whatever their levels, so a shader that asks a
 /// per-pixel level's size reads wrong texels along level boundaries there. Level 0's size halved
@@ -238,17 +286,16 @@ pub fn level_size_queries(source: &str) -> Vec<usize> {
             if id != "textureSize" {
                 continue;
             }
-            let rest = &line[at + id.len()..];
-            let Some(args) = rest.trim_start().strip_prefix('(') else {
+            let Some(args) = line[at + id.len()..].trim_start().strip_prefix('(') else {
                 continue;
             };
             // The second argument: after the first top-level comma, up to the closing paren.
-            let (mut depth, mut comma, mut end) = (0i32, None, args.len());
-            for (i, c) in args.char_indices() {
+            let (mut depth, mut comma, mut end) = (0i32, None, None);
+            for (i, c) in args.char_indices().take_while(|(i, _)| *i < MAX_ARGUMENT) {
                 match c {
                     '(' => depth += 1,
                     ')' if depth == 0 => {
-                        end = i;
+                        end = Some(i);
                         break;
                     }
                     ')' => depth -= 1,
@@ -256,8 +303,11 @@ pub fn level_size_queries(source: &str) -> Vec<usize> {
                     _ => {}
                 }
             }
-            let level = comma.map_or("", |c| args[c + 1..end].trim());
-            if !level.is_empty() && level != "0" && !out.contains(&(k + 1)) {
+            let level = match (comma, end) {
+                (Some(c), Some(e)) => args[c + 1..e].trim(),
+                _ => "",
+            };
+            if !level.is_empty() && level != "0" && out.last() != Some(&(k + 1)) {
                 out.push(k + 1);
             }
         }
@@ -280,38 +330,44 @@ pub fn comment_lines(source: &str) -> (usize, usize) {
     (comments, code)
 }
 
-/// Every use of a texture built-in other than [`ALLOWED`], with its line, in source order.
+/// Every use of a texture built-in other than [`ALLOWED`], with its line, in source order: a
+/// call (`name` then `(`, on a later line too) of a name beginning with `tex` that the shader
+/// does not define, and any mention of one of GLSL's texture built-ins by name (a macro may call
+/// it: `#define SAMPLE texture`, `ID(texture)(...)`).
 pub fn violations(source: &str) -> Vec<Violation> {
     let clean = strip_comments(source);
     let active = active_lines(&clean);
-    // Functions the shader defines: `type name (`.
+    let lines: Vec<&str> = clean.lines().collect();
+    let kept = |k: usize| active.get(k).copied().unwrap_or(true);
+    // The next non-blank text after byte `at` of line `k`, on a later line if this one ends.
+    let next = |k: usize, at: usize| -> &str {
+        let after = lines[k][at..].trim_start();
+        if !after.is_empty() {
+            return after;
+        }
+        lines[k + 1..]
+            .iter()
+            .map(|l| l.trim_start())
+            .find(|l| !l.is_empty())
+            .unwrap_or("")
+    };
+    // Functions the shader defines: `type name (` on a kept line.
     let mut own: BTreeSet<&str> = BTreeSet::new();
-    for line in clean.lines() {
+    for (k, line) in lines.iter().enumerate().filter(|(k, _)| kept(*k)) {
         let ids = identifiers(line);
         for w in ids.windows(2) {
-            let after = &line[w[1].0 + w[1].1.len()..];
-            if is_type(w[0].1) && after.trim_start().starts_with('(') {
+            if is_type(w[0].1) && next(k, w[1].0 + w[1].1.len()).starts_with('(') {
                 own.insert(w[1].1);
             }
         }
     }
     let mut out = Vec::new();
-    for (k, line) in clean.lines().enumerate() {
-        let t = line.trim_start();
-        let is_define = t
-            .strip_prefix('#')
-            .is_some_and(|r| r.trim_start().starts_with("define"));
-        // Active #define lines are marked active; other directives and dropped blocks are not.
-        if !active.get(k).copied().unwrap_or(true) {
-            continue;
-        }
+    for (k, line) in lines.iter().enumerate().filter(|(k, _)| kept(*k)) {
         for (at, id) in identifiers(line) {
             if !id.starts_with("tex") || ALLOWED.contains(&id) || own.contains(id) {
                 continue;
             }
-            let after = line[at + id.len()..].trim_start();
-            // A call, or a name a macro stands for.
-            if after.starts_with('(') || is_define && BUILTINS.contains(&id) {
+            if BUILTINS.contains(&id) || next(k, at + id.len()).starts_with('(') {
                 out.push(Violation {
                     line: k + 1,
                     call: id.to_string(),
@@ -419,6 +475,40 @@ mod tests {
     fn the_shaders_own_functions_are_not_builtins() {
         let src = "vec4 texBilinear(int level, vec2 p) { return vec4(0.0); }\nvoid main() { vec4 c = texBilinear(0, uv); vec2 texCoord2 = texCoord; }\n";
         assert!(calls(src).is_empty());
+    }
+
+    #[test]
+    fn conditions_it_cannot_decide_keep_every_branch() {
+        let src = "#ifdef GL_core_profile\nvec4 a = texture(s, uv);\n#else\nvec4 b = texture2D(s, uv);\n#endif\n#if defined(A) && 1\nvec4 c = textureLod(s, uv, 0.0);\n#endif\n#if !!0\nvec4 d = textureGrad(s, uv, x, y);\n#endif\n#ifdef __VERSION__\nvec4 e = textureProj(s, p);\n#endif\n";
+        assert_eq!(
+            calls(src),
+            vec![
+                (2, "texture".into()),
+                (4, "texture2D".into()),
+                (7, "textureLod".into()),
+                (13, "textureProj".into())
+            ]
+        );
+    }
+
+    #[test]
+    fn calls_across_lines_and_through_macros_count() {
+        let src = "vec4 a = texture\n    (s, uv);\n#define ID(x) x\nvec4 b = ID(textureLod)(s, uv, 0.0);\n#if 0\nvec4 texture(sampler2D s, vec2 p);\n#endif\n";
+        assert_eq!(
+            calls(src),
+            vec![(1, "texture".into()), (4, "textureLod".into())]
+        );
+    }
+
+    #[test]
+    fn deep_negations_and_long_lines_are_cheap() {
+        let src = format!(
+            "#if {}0\nvec4 a = texture(s, uv);\n#endif\n",
+            "!".repeat(200_001)
+        );
+        assert_eq!(calls(&src), vec![(2, "texture".into())]);
+        let line = "textureSize(s, ".repeat(50_000);
+        assert!(level_size_queries(&line).is_empty());
     }
 
     #[test]

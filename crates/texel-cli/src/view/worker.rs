@@ -210,7 +210,13 @@ struct ShaderState {
     built: bool,
     modified: Option<std::time::SystemTime>,
     notice: Option<String>,
+    /// The file's modification time when a frame of it took longer than [`SHADER_FRAME_LIMIT`]:
+    /// its thread is left behind, and no new one starts until the file changes.
+    stuck: Option<Option<std::time::SystemTime>>,
 }
+
+/// The longest a frame of the student's shader may take before the viewer gives up on it.
+const SHADER_FRAME_LIMIT: std::time::Duration = std::time::Duration::from_secs(10);
 
 /// The student's shader (`--shader`) drawn in lab mode `mode` over `draws` at `size`, top row
 /// first. The file is read again when its modification time changes; a version that does not
@@ -225,19 +231,40 @@ fn shader_frame(
     mode: i32,
 ) -> Result<Vec<[u8; 4]>> {
     let path = path.context("no --shader")?;
-    let thread = state.thread.as_ref().context("no OpenGL thread")?;
     let modified = std::fs::metadata(path).and_then(|m| m.modified()).ok();
+    if let Some(when) = state.stuck {
+        if when == modified {
+            anyhow::bail!(
+                "{}: a frame took longer than {} s and the shader was stopped; save a new version to try again",
+                path.display(),
+                SHADER_FRAME_LIMIT.as_secs()
+            );
+        }
+        state.stuck = None;
+    }
+    if state.thread.is_none() {
+        state.thread = Some(ShaderThread::start().map_err(|e| anyhow::anyhow!(e))?);
+        state.built = false;
+    }
+    // A job's answer, or `Err(())` when the thread did not answer in time.
+    let ask = |state: &ShaderState, job: ShaderJob| match &state.thread {
+        Some(t) => t.run(job),
+        None => Ok(Err("no OpenGL thread".to_string())),
+    };
     if !state.built || modified != state.modified {
         state.modified = modified;
         let bg = settings
             .background
             .map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
         let scene = texel::lab::scene::device_scene(draws, size, bg, clip.to_cols_array());
-        let built = crate::cmd_lab::read_source(path, "shader").and_then(|source| {
-            thread
-                .run(ShaderJob::Build(source, scene))
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
-        });
+        let source = crate::cmd_lab::read_source(path, "shader");
+        let built = match source {
+            Ok(source) => match ask(state, ShaderJob::Build(source, scene)) {
+                Ok(r) => r.map_err(|e| anyhow::anyhow!("{}: {e}", path.display())),
+                Err(()) => return Err(stuck(state, modified, path)),
+            },
+            Err(e) => Err(e),
+        };
         match built {
             Ok(_) => {
                 state.built = true;
@@ -252,10 +279,30 @@ fn shader_frame(
             Err(e) => return Err(e),
         }
     }
-    let px = thread
-        .run(ShaderJob::Frame(size, clip.to_cols_array(), mode))
-        .map_err(|e| anyhow::anyhow!(e))?;
-    px.context("the OpenGL thread returned no frame")
+    match ask(state, ShaderJob::Frame(size, clip.to_cols_array(), mode)) {
+        Ok(r) => r
+            .map_err(|e| anyhow::anyhow!(e))?
+            .context("the OpenGL thread returned no frame"),
+        Err(()) => Err(stuck(state, modified, path)),
+    }
+}
+
+/// Give up on a shader thread that did not answer: leave it behind, remember the file's time.
+fn stuck(
+    state: &mut ShaderState,
+    when: Option<std::time::SystemTime>,
+    path: &std::path::Path,
+) -> anyhow::Error {
+    if let Some(t) = state.thread.take() {
+        t.abandon();
+    }
+    state.stuck = Some(when);
+    state.built = false;
+    anyhow::anyhow!(
+        "{}: a frame took longer than {} s and the shader was stopped; save a new version to try again",
+        path.display(),
+        SHADER_FRAME_LIMIT.as_secs()
+    )
 }
 
 /// Work for the shader's OpenGL thread.
@@ -343,16 +390,28 @@ impl ShaderThread {
         })
     }
 
-    /// Run `job` and wait for its result.
-    fn run(&self, job: ShaderJob) -> Result<Option<Vec<[u8; 4]>>, String> {
-        self.jobs
-            .as_ref()
-            .ok_or_else(|| "the OpenGL thread ended".to_string())?
-            .send(job)
-            .map_err(|_| "the OpenGL thread ended".to_string())?;
-        self.results
-            .recv()
-            .map_err(|_| "the OpenGL thread ended".to_string())?
+    /// Run `job` and wait for its result, at most [`SHADER_FRAME_LIMIT`]; `Ok(Err(..))` is the
+    /// job's own error, `Err(())` a thread that did not answer in time.
+    #[allow(clippy::type_complexity)]
+    fn run(&self, job: ShaderJob) -> Result<Result<Option<Vec<[u8; 4]>>, String>, ()> {
+        let ended = || Ok(Err("the OpenGL thread ended".to_string()));
+        let Some(jobs) = self.jobs.as_ref() else {
+            return ended();
+        };
+        if jobs.send(job).is_err() {
+            return ended();
+        }
+        match self.results.recv_timeout(SHADER_FRAME_LIMIT) {
+            Ok(r) => Ok(r),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => Err(()),
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => ended(),
+        }
+    }
+
+    /// Leave the thread running without waiting for it (a shader that never finishes).
+    fn abandon(mut self) {
+        self.jobs = None;
+        self.thread = None;
     }
 }
 
