@@ -3,11 +3,11 @@
 //! `texCoord`, texture access through `texelFetch` and `textureSize` only); texel runs it unchanged
 //! on OpenGL ([`gl`], through EGL: Mesa's llvmpipe without a GPU), checks the access rule
 //! ([`source`]), and grades every mode on every scene against its own mode under the OpenGL rules
-//! and under the handout's formulas ([`grade`]), with the supersampled reference beside it.
+//! and under the handout's formulas ([`mod@grade`]), with the supersampled reference beside it.
 //!
 //! The work is split in two so that a shader that never finishes cannot hang the grader:
 //! [`run_device`] renders (the CLI runs it in a child process with a time limit) and writes what
-//! it rendered into a folder; [`grade`] reads that folder and makes the [`LabReport`], which
+//! it rendered into a folder; [`grade()`] reads that folder and makes the [`LabReport`], which
 //! [`report::write`] writes as JSON, Markdown and HTML. docs/guide/lab.md walks a student
 //! through it.
 
@@ -289,7 +289,7 @@ pub struct LabReport {
     pub reference_spp: u32,
 }
 
-/// How [`grade`] scores.
+/// How [`grade()`] scores.
 #[derive(Clone, Copy, Debug)]
 pub struct GradeOptions {
     /// Samples a pixel of the reference.

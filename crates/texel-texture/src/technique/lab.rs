@@ -16,8 +16,9 @@
 //!   from `|Pmin|`, or from `|Pmax| / lambda_max` when the ratio exceeds `lambda_max`. One probe
 //!   (`lambda <= 1`, where `i / (n - 1)` is `0 / 0`) is the trilinear sample at `P`.
 //!
-//! The evaluator [`sample_rules`] reads the levels texel by texel (no staged kernels): it is the
-//! lab convention's route ([`crate::Sampler::with_convention`]) and the grader's oracle for a
+//! The evaluator ([`Texture::sample_rules`]) reads the levels texel by texel (no staged
+//! kernels): it is the lab convention's route ([`crate::Sampler::with_convention`]) and the
+//! grader's oracle for a
 //! student's shader and for its likely mistakes (each a [`Rules`] one knob away from a
 //! convention). Under [`Rules::GL`] it equals the sampler's own modes (tested).
 
