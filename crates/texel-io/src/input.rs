@@ -327,6 +327,8 @@ mod tests {
             3
         });
         assert_eq!(n, 3);
+        // The recorder is the process's: other tests of this binary may read files meanwhile.
+        let files: Vec<_> = files.into_iter().filter(|f| f.starts_with(&d)).collect();
         assert_eq!(files, vec![b.clone(), a.clone()]);
         // Nothing is recorded once the recorder is done.
         let ((), inner) = record_opened(|| ());

@@ -643,6 +643,11 @@ impl Session<'_> {
     /// [`GlError::Failed`].
     pub fn draw_frame(&self, mode: i32) -> Result<Vec<[u8; 4]>, GlError> {
         self.draw(self.student, &[glow::COLOR_ATTACHMENT0], Some(mode));
+        self.student_image()
+    }
+
+    /// The student's frame as drawn last, top row first.
+    fn student_image(&self) -> Result<Vec<[u8; 4]>, GlError> {
         let image = self
             .read(glow::COLOR_ATTACHMENT0, glow::UNSIGNED_BYTE, 4)
             .chunks_exact(4)
@@ -671,13 +676,7 @@ impl Session<'_> {
             }
         }
         times.sort_by(f64::total_cmp);
-        let image = self
-            .read(glow::COLOR_ATTACHMENT0, glow::UNSIGNED_BYTE, 4)
-            .chunks_exact(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect();
-        self.gl.check("the student's frame")?;
-        Ok((image, times[times.len() / 2]))
+        Ok((self.student_image()?, times[times.len() / 2]))
     }
 }
 

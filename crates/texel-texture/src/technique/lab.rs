@@ -18,9 +18,8 @@
 //!
 //! The evaluator ([`Texture::sample_rules`]) reads the levels texel by texel (no staged
 //! kernels): it is the lab convention's route ([`crate::Sampler::with_convention`]) and the
-//! grader's oracle for a
-//! student's shader and for its likely mistakes (each a [`Rules`] one knob away from a
-//! convention). Under [`Rules::GL`] it equals the sampler's own modes (tested).
+//! grader's oracle for a student's shader and for its likely mistakes (each a [`Rules`] one knob
+//! away from a convention). Under [`Rules::GL`] it equals the sampler's own modes (tested).
 
 use glam::{Vec2, Vec4};
 
