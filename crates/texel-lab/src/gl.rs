@@ -340,7 +340,7 @@ struct Uploaded {
 }
 
 /// The student's shaders linked and a scene uploaded, with render targets of its size.
-pub struct Session<'g> {
+pub struct ShaderDraws<'g> {
     gl: &'g Gl,
     student: glow::Program,
     capture: glow::Program,
@@ -358,13 +358,13 @@ impl Gl {
     /// # Errors
     /// [`GlError::Compile`], [`GlError::Link`]; [`GlError::Interface`] when the program has no
     /// active mode uniform or sampler uniform under `names`; [`GlError::Failed`].
-    pub fn session(
+    pub fn prepare(
         &self,
         fragment: &str,
         vertex: Option<&str>,
         names: &Names,
         scene: &GlScene,
-    ) -> Result<Session<'_>, GlError> {
+    ) -> Result<ShaderDraws<'_>, GlError> {
         let version = version_of(fragment);
         let own;
         let vertex = match vertex {
@@ -392,7 +392,7 @@ impl Gl {
         let vversion = version_of(vertex);
         let (capture_fs, outputs) = capture_shader(&vversion, &names.varying);
         let capture = self.link(vertex, &capture_fs, outputs)?;
-        let mut session = Session {
+        let mut prepared = ShaderDraws {
             gl: self,
             student,
             capture,
@@ -408,11 +408,11 @@ impl Gl {
             names: names.clone(),
         };
         for d in &scene.draws {
-            let up = session.upload(d)?;
-            session.draws.push(up);
+            let up = prepared.upload(d)?;
+            prepared.draws.push(up);
         }
-        session.targets()?;
-        Ok(session)
+        prepared.targets()?;
+        Ok(prepared)
     }
 }
 
@@ -420,7 +420,7 @@ fn bytes<T: Copy, const N: usize>(v: &[[T; N]], f: impl Fn(T) -> [u8; 4]) -> Vec
     v.iter().flatten().flat_map(|&x| f(x)).collect()
 }
 
-impl Session<'_> {
+impl ShaderDraws<'_> {
     fn upload(&self, d: &GlDraw) -> Result<Uploaded, GlError> {
         let gl = &self.gl.gl;
         // SAFETY: see the module docs; each buffer holds exactly the bytes the attribute
@@ -620,7 +620,7 @@ impl Session<'_> {
         if (width, height) == (self.scene.0, self.scene.1) {
             return Ok(());
         }
-        // SAFETY: see the module docs; the renderbuffers were made by this session.
+        // SAFETY: see the module docs; the renderbuffers were made by these draws.
         unsafe {
             for rb in self.renderbuffers.drain(..) {
                 self.gl.gl.delete_renderbuffer(rb);
@@ -680,10 +680,10 @@ impl Session<'_> {
     }
 }
 
-impl Drop for Session<'_> {
+impl Drop for ShaderDraws<'_> {
     fn drop(&mut self) {
         let gl = &self.gl.gl;
-        // SAFETY: see the module docs; every object was made by this session.
+        // SAFETY: see the module docs; every object was made by these draws.
         unsafe {
             for d in &self.draws {
                 gl.delete_vertex_array(d.vao);

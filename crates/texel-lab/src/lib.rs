@@ -134,13 +134,13 @@ pub fn run_device(job: &Job, dir: &Path) -> Result<DeviceRun, Error> {
     };
     for (k, spec) in job.scenes.iter().enumerate() {
         let scene = LabScene::load(spec, job.size)?;
-        let session = gl.session(
+        let prepared = gl.prepare(
             &job.fragment,
             job.vertex.as_deref(),
             &job.names,
             &scene.device_scene(),
         )?;
-        let capture = session.capture()?;
+        let capture = prepared.capture()?;
         let mut raw = Vec::new();
         for p in capture.uv_dx.iter().chain(&capture.dy_draw) {
             raw.extend(p.iter().flat_map(|x| x.to_le_bytes()));
@@ -149,7 +149,7 @@ pub fn run_device(job: &Job, dir: &Path) -> Result<DeviceRun, Error> {
         std::fs::write(&path, raw).map_err(|e| io(&path, e))?;
         let mut times = BTreeMap::new();
         for &mode in &job.modes {
-            let (image, ms) = session.frame(i32::from(mode), job.frames)?;
+            let (image, ms) = prepared.frame(i32::from(mode), job.frames)?;
             let path = frame_path(dir, k, mode);
             std::fs::write(&path, image.concat()).map_err(|e| io(&path, e))?;
             times.insert(mode, ms);

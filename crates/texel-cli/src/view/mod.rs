@@ -55,7 +55,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
             [0; 4],
             glam::Mat4::IDENTITY.to_cols_array(),
         );
-        gl.session(&source, None, &texel::lab::Names::default(), &empty)
+        gl.prepare(&source, None, &texel::lab::Names::default(), &empty)
             .with_context(|| format!("the shader {}", path.display()))?;
     }
     let size = (scene.width, scene.height);

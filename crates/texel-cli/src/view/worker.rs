@@ -22,7 +22,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use texel::lab::gl::{Gl, GlScene, Names, Session};
+use texel::lab::gl::{Gl, GlScene, Names, ShaderDraws};
 use texel::scene::Camera;
 use texel::{Filter, PreparedScene, Sampler, SamplerDescriptor};
 use texel_gpu::{Gpu, GpuDraws, GpuFilter};
@@ -350,19 +350,19 @@ impl ShaderThread {
                     }
                 };
                 let _ = ready_tx.send(Ok(()));
-                let mut session: Option<Session<'_>> = None;
+                let mut prepared: Option<ShaderDraws<'_>> = None;
                 for job in job_rx {
                     let out = match job {
                         ShaderJob::Build(source, scene) => {
-                            match gl.session(&source, None, &Names::default(), &scene) {
+                            match gl.prepare(&source, None, &Names::default(), &scene) {
                                 Ok(s) => {
-                                    session = Some(s);
+                                    prepared = Some(s);
                                     Ok(None)
                                 }
                                 Err(e) => Err(e.to_string()),
                             }
                         }
-                        ShaderJob::Frame(size, clip, mode) => match session.as_mut() {
+                        ShaderJob::Frame(size, clip, mode) => match prepared.as_mut() {
                             Some(s) => s
                                 .resize(size.0, size.1)
                                 .and_then(|()| {
