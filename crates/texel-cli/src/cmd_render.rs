@@ -18,13 +18,10 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     };
     crate::output::check_outputs(&[("-o", &args.output)])?;
     check_storage(&args.scene, args.gpu)?;
-    if args.scene.convention == texel::texture::Convention::Lab {
-        if filter.and_then(Filter::lab_mode).is_none() {
-            bail!("--convention lab applies to the lab's eight modes: give --lab-mode 1..8 or one of nearest, bilinear, mip-nearest, trilinear, aniso2-aniso16");
-        }
-        if args.gpu {
-            bail!("--convention lab runs on the CPU: the WGSL shader follows the GL rules");
-        }
+    if args.scene.convention == texel::texture::Convention::Lab
+        && filter.and_then(Filter::lab_mode).is_none()
+    {
+        bail!("--convention lab applies to the lab's eight modes: give --lab-mode 1..8 or one of nearest, bilinear, mip-nearest, trilinear, aniso2-aniso16");
     }
     let mut scene = load_scene(&args.scene, input)?;
     if args.gpu && args.scene.surface_uv.is_none() && scene.maps_uv_per_pixel() {

@@ -44,6 +44,53 @@ fn gpu_refuses_filters_it_does_not_have() {
     );
 }
 
+/// `--convention lab --gpu` renders the handout's formulas in the shader: the image is the CPU's
+/// under the same convention (2x2-quad derivatives, as the device's) to within a code on nearly
+/// every pixel, and not the GL rules' image.
+#[test]
+fn gpu_renders_the_lab_convention() {
+    if !have_adapter() {
+        return;
+    }
+    let d = Dir::new("gpu-convention");
+    let run = |name: &str, extra: &[&str]| {
+        let png = d.arg(name);
+        let mut args = vec![
+            "render",
+            "builtin:ground",
+            "--lab-mode",
+            "6",
+            "--size",
+            "96x64",
+        ];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", &png]);
+        let out = texel(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        Image8::load(&png).unwrap()
+    };
+    let gpu_lab = run("gpu-lab.png", &["--gpu", "--convention", "lab"]);
+    let cpu_lab = run(
+        "cpu-lab.png",
+        &["--convention", "lab", "--derivatives", "quad"],
+    );
+    let gpu_gl = run("gpu-gl.png", &["--gpu"]);
+    let close = |a: &Image8, b: &Image8| {
+        let near = a
+            .pixels()
+            .iter()
+            .zip(b.pixels())
+            .filter(|(p, q)| (0..3).all(|c| p[c].abs_diff(q[c]) <= 1))
+            .count();
+        near as f64 / a.pixels().len() as f64
+    };
+    let same = close(&gpu_lab, &cpu_lab);
+    let other = close(&gpu_lab, &gpu_gl);
+    eprintln!("within a code: gpu lab vs cpu lab {same:.4}, vs gpu gl {other:.4}");
+    assert!(same >= 0.99, "{same}");
+    assert!(other < 0.9, "{other}");
+}
+
 #[test]
 fn gpu_names_the_adapters_when_the_requested_one_is_missing() {
     let d = Dir::new("gpu-adapter");

@@ -22,6 +22,10 @@ struct Params {
 // pipeline, so the compiler drops the other modes' code instead of branching around it per pixel.
 override MODE: u32 = 4u;
 
+// Which rules modes 1-8 follow, as a pipeline constant: 0 the OpenGL / Vulkan rules (texel's
+// default), 1 the lab handout's formulas (`--convention lab`, texel_texture::technique::lab).
+override CONVENTION: u32 = 0u;
+
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var tex: texture_2d<f32>;
 @group(0) @binding(2) var<storage, read> srgb: array<f32, 256>;
@@ -108,15 +112,18 @@ fn size_of(level: i32) -> vec2<f32> {
 
 // ---- Filters inside one level --------------------------------------------------------------------
 
-// Nearest: the texel containing xy = uv * size.
+// Nearest: the texel containing xy = uv * size; under the lab's formulas xy rounded,
+// floor(xy + 1/2).
 fn nearest(uv: vec2<f32>, level: i32) -> vec4<f32> {
-    let ij = vec2<i32>(floor(uv * size_of(level)));
+    let ij = vec2<i32>(floor(uv * size_of(level) + select(0.0, 0.5, CONVENTION == 1u)));
     return fetch(ij.x, ij.y, level);
 }
 
-// Bilinear: the 2x2 texels around xy - 1/2, weighted by the fractions.
+// Bilinear: the 2x2 texels around xy - 1/2, weighted by the fractions; under the lab's formulas
+// the texels floor(xy) and floor(xy) + 1 (the handout's ceiling, the same image), weighted by
+// fract(xy).
 fn bilinear(uv: vec2<f32>, level: i32) -> vec4<f32> {
-    let x = uv * size_of(level) - 0.5;
+    let x = uv * size_of(level) - select(0.5, 0.0, CONVENTION == 1u);
     let f = floor(x);
     let ij = vec2<i32>(f);
     let ab = x - f;
@@ -216,6 +223,83 @@ fn anisotropic(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, px: vec2<f32
         sum += trilinear(uv + ((i + 0.5) / n - 0.5) * axis, lod);
     }
     return sum / n;
+}
+
+// ---- The lab's formulas (CONVENTION 1) ------------------------------------------------------------
+
+// A length in texels that is NaN or not below FLT_MAX becomes FLT_MAX, which `lab_lod` maps to
+// the coarsest level (the CPU's NaN and infinity).
+fn lab_sane(l: f32) -> f32 {
+    return select(3.4e38, l, l < 3.4e38);
+}
+
+// log2 of a length in texels, unbiased and unclamped: the handout's N = M + log2 |P|; FLT_MAX (a
+// footprint beyond the horizon) the coarsest level.
+fn lab_lod(len: f32) -> f32 {
+    if !(len < 3.4e38) {
+        return last_level();
+    }
+    return log2(len);
+}
+
+// Mode 3: bilinear in the coarser level ceil(N), N clamped to [0, q].
+fn lab_mip_nearest(uv: vec2<f32>, lod: f32) -> vec4<f32> {
+    return bilinear(uv, i32(ceil(clamp(lod, 0.0, last_level()))));
+}
+
+// Modes 5-8: lambda = min(|Pmax| / |Pmin|, max), n = ceil(lambda) bilinear-trilinear probes at
+// P + (i / (n - 1) - 1/2) Pmax, averaged; the level from |Pmin|, or from |Pmax| / max where the
+// ratio exceeds max; one probe (lambda <= 1) is trilinear at P. `lx`, `ly` are the axes' lengths
+// in texels (the uv length times the longer side).
+fn lab_anisotropic(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, lx: f32, ly: f32)
+    -> vec4<f32> {
+    let x_major = lx >= ly;
+    let lmaj = select(ly, lx, x_major);
+    let lmin = select(lx, ly, x_major);
+    let axis = select(duv_dy, duv_dx, x_major);
+    let max_n = f32(params.mode.z);
+    let finite = lmaj < 3.4e38 && all(abs(axis) < vec2<f32>(3.4e38));
+    let ratio = select(1.0, lmaj / lmin, finite);
+    // The count as the CPU's `probe_count`: ceil of the ratio less its rounding tolerance; a
+    // ratio that is NaN (0 / 0) one probe.
+    let r = lmaj / lmin * (1.0 - 1e-5);
+    var n = 1.0;
+    if r > max_n {
+        n = max_n;
+    } else if r >= 1.0 {
+        n = clamp(ceil(r), 1.0, max_n);
+    }
+    let lod = lab_lod(select(lmin, lmaj / max_n, ratio > max_n));
+    if n <= 1.0 {
+        return trilinear(uv, lod);
+    }
+    var sum = vec4<f32>(0.0);
+    for (var i = 0.0; i < n; i += 1.0) {
+        sum += trilinear(uv + (i / (n - 1.0) - 0.5) * axis, lod);
+    }
+    return sum / n;
+}
+
+// Lab mode `mode` (1-8) under the handout's formulas. Magnification (N <= 0) reads level 0 in
+// modes 3 and 4; the anisotropic modes probe there as everywhere.
+fn lab_mode(mode: u32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec4<f32> {
+    let side = f32(max(textureDimensions(tex).x, textureDimensions(tex).y));
+    let lx = lab_sane(length(duv_dx) * side);
+    let ly = lab_sane(length(duv_dy) * side);
+    let lod = lab_lod(max(lx, ly));
+    if mode == 1u {
+        return nearest(uv, 0);
+    }
+    if mode == 2u || (mode <= 4u && lod <= 0.0) {
+        return bilinear(uv, 0);
+    }
+    if mode == 3u {
+        return lab_mip_nearest(uv, lod);
+    }
+    if mode == 4u {
+        return trilinear(uv, lod);
+    }
+    return lab_anisotropic(uv, duv_dx, duv_dy, lx, ly);
 }
 
 // ---- EWA (Heckbert 1989, pbrt-v4's MIPMap::EWA; texel-texture/src/ewa.rs) --------------------
@@ -357,7 +441,9 @@ fn fs_main(in: VertexOut) -> FragmentOut {
     let lod = lod_of(max(length(px), length(py)));
     let mode = MODE;
     var c: vec4<f32>;
-    if mode >= 20u {
+    if CONVENTION == 1u && mode <= 8u {
+        c = lab_mode(mode, in.uv, duv_dx, duv_dy);
+    } else if mode >= 20u {
         // The device's own sampler (the hardware rows): sRGB is decoded by the texture format.
         c = textureSampleGrad(tex, hw, in.uv, duv_dx, duv_dy);
     } else if mode == 1u {

@@ -4,8 +4,9 @@
 //! `textureDimensions` and `textureNumLevels` — the filtering lab's rule — so every filter's
 //! arithmetic is written out: one function per technique (nearest, bilinear, mip-nearest,
 //! trilinear, anisotropic 2x-16x, bicubic, EWA), address modes on integer texel indices and the sRGB
-//! decode through the CPU's own 256-entry table, as `docs/guide/conventions.md` fixes them. The
-//! pyramid is
+//! decode through the CPU's own 256-entry table, as `docs/guide/conventions.md` fixes them.
+//! Modes 1-8 follow either convention of the CPU's samplers (`CONVENTION`, a pipeline constant:
+//! the GL rules, or the lab's formulas of `texel_texture::technique::lab`). The pyramid is
 //! texel-texture's, uploaded level by level in the texture's own format (`Rgba8Unorm` codes or
 //! `Rgba32Float`), so both paths filter the same texels. The hardware sampler is the peer
 //! ([`GpuFilter::HwTrilinear`], [`GpuFilter::HwAniso16`]: `textureSampleGrad`).
@@ -374,14 +375,51 @@ const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// position (3), uv (2), colour (4) as `f32`.
 const VERTEX_FLOATS: usize = 9;
 
-/// The pipeline of one shader mode (`MODE`, a pipeline constant).
+/// The convention the shader's modes 1-8 follow for `draws`: the one their samplers share
+/// ([`texel_texture::Sampler::convention`]).
+///
+/// # Errors
+/// [`GpuError::Unsupported`] for draws of both conventions, and for the lab convention with a
+/// filter other than the lab's eight modes.
+fn convention_of(
+    draws: &[DrawCall],
+    filter: GpuFilter,
+) -> Result<texel_texture::Convention, GpuError> {
+    use texel_texture::Convention;
+    let lab = draws
+        .iter()
+        .filter(|d| d.sampler.convention() == Convention::Lab)
+        .count();
+    if lab == 0 {
+        return Ok(Convention::Gl);
+    }
+    if lab < draws.len() {
+        return Err(GpuError::Unsupported(
+            "draws of both conventions in one pass (one pipeline has one)",
+        ));
+    }
+    match filter {
+        GpuFilter::Shader(_) if (1..=8).contains(&filter.mode().0) => Ok(Convention::Lab),
+        _ => Err(GpuError::Unsupported(
+            "the lab convention with a filter other than the lab's eight modes",
+        )),
+    }
+}
+
+/// The pipeline of one shader mode (`MODE`) under one convention (`CONVENTION`), both pipeline
+/// constants.
 fn create_pipeline(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
     mode: u32,
+    convention: texel_texture::Convention,
 ) -> wgpu::RenderPipeline {
     let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x2, 2 => Float32x4];
-    let constants = [("MODE", f64::from(mode))];
+    let lab = convention == texel_texture::Convention::Lab;
+    let constants = [
+        ("MODE", f64::from(mode)),
+        ("CONVENTION", f64::from(u8::from(lab))),
+    ];
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("texel filters"),
         layout: None,
@@ -623,14 +661,7 @@ impl Gpu {
         if draws.iter().any(|d| d.material.is_some()) {
             return Err(GpuError::Unsupported("materials"));
         }
-        if draws
-            .iter()
-            .any(|d| d.sampler.convention() != texel_texture::Convention::Gl)
-        {
-            return Err(GpuError::Unsupported(
-                "the lab convention (the WGSL shader follows the GL rules)",
-            ));
-        }
+        let convention = convention_of(draws, filter)?;
         let per_pixel = |d: &DrawCall| {
             d.uv_mapping
                 .is_some_and(|m| m.evaluation == texel_raster::UvEvaluation::PerPixel)
@@ -642,7 +673,7 @@ impl Gpu {
         }
         let device = &self.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let pipeline = create_pipeline(device, &self.module, filter.mode().0);
+        let pipeline = create_pipeline(device, &self.module, filter.mode().0, convention);
         let mut prepared = Vec::new();
         let mut uniforms = Vec::new();
         for draw in draws {

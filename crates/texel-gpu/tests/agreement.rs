@@ -8,6 +8,7 @@
 //! one the tests print why and pass, unless `CI=true`, where a missing adapter fails them.
 
 use texel::raster::{ColorTarget, Derivatives};
+use texel::texture::Convention;
 use texel::{Filter, MemoryBudget, PreparedScene, Scene, SceneOptions};
 use texel_gpu::{Gpu, GpuError, GpuFilter};
 
@@ -63,8 +64,14 @@ fn psnr(a: &texel::Frame, b: &texel::Frame) -> (f64, u8, usize) {
 
 /// `scene` prepared at the tests' reduced size, 160 x 96.
 fn small(scene: &str) -> PreparedScene {
+    small_with(scene, Convention::Gl)
+}
+
+/// `scene` at 160 x 96 with the lab modes under `convention`.
+fn small_with(scene: &str, convention: Convention) -> PreparedScene {
     let options = SceneOptions {
         size: Some((160, 96)),
+        convention,
         ..SceneOptions::default()
     };
     let scene = Scene::load(scene).unwrap();
@@ -73,12 +80,17 @@ fn small(scene: &str) -> PreparedScene {
 
 /// Every filter the GPU path has against the CPU path on `scene`.
 fn agree(scene: &str) {
+    agree_in(scene, Convention::Gl, GpuFilter::filters().collect());
+}
+
+/// `filters` on the GPU against the CPU path on `scene`, the lab modes under `convention`.
+fn agree_in(scene: &str, convention: Convention, filters: Vec<Filter>) {
     let Some(gpu) = gpu() else { return };
-    let prepared = small(scene);
+    let prepared = small_with(scene, convention);
     let mut settings = prepared.settings();
     settings.derivatives = Derivatives::Quad;
     settings.target = ColorTarget::Float;
-    for filter in GpuFilter::filters() {
+    for filter in filters {
         let name = filter.name();
         let samplers = prepared.samplers(filter).unwrap();
         let draws = prepared.draws(&samplers);
@@ -123,6 +135,53 @@ fn zoneplate_agrees_with_the_cpu() {
 #[test]
 fn cube_agrees_with_the_cpu() {
     agree("builtin:cube");
+}
+
+/// The lab's eight modes under the handout's formulas, on the scenes the lab grades on and on
+/// the ground (uv to +-250, every level). Not on the zone plate: its pixel centres map to texel
+/// centres one to one, which is where the handout's rounding `round(x)` switches texels, so
+/// nearest there follows the last bit of each path's interpolation.
+#[test]
+fn the_lab_convention_agrees_with_the_cpu() {
+    let modes: Vec<Filter> = (1..=8).map(|m| Filter::from_lab_mode(m).unwrap()).collect();
+    for scene in [
+        "builtin:ground",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/lab/plane.toml"),
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/lab/tunnel.toml"),
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/lab/wall.toml"),
+    ] {
+        eprintln!("{scene}, --convention lab:");
+        agree_in(scene, Convention::Lab, modes.clone());
+    }
+}
+
+/// The two conventions differ on the GPU as on the CPU (the lab's texel centres move every
+/// bilinear tap), and draws of both conventions in one pass, or the lab convention with a filter
+/// outside the eight modes, are refused.
+#[test]
+fn the_conventions_differ_and_mixed_draws_are_refused() {
+    let Some(gpu) = gpu() else { return };
+    let gl = small_with("builtin:zoneplate", Convention::Gl);
+    let lab = small_with("builtin:zoneplate", Convention::Lab);
+    let mut settings = gl.settings();
+    settings.target = ColorTarget::Float;
+    let f = GpuFilter::Shader(Filter::Bilinear);
+    let gl_samplers = gl.samplers(Filter::Bilinear).unwrap();
+    let lab_samplers = lab.samplers(Filter::Bilinear).unwrap();
+    let a = texel_gpu::render(&gpu, &settings, &gl.draws(&gl_samplers), f).unwrap();
+    let b = texel_gpu::render(&gpu, &settings, &lab.draws(&lab_samplers), f).unwrap();
+    let (db, worst, _) = psnr(&a, &b);
+    eprintln!("gl against lab, bilinear: {db:.1} dB, largest difference {worst}/255");
+    assert!(db < 40.0 && worst > 8, "{db:.1} dB, {worst}/255");
+    let mut mixed = gl.draws(&gl_samplers);
+    mixed.extend(lab.draws(&lab_samplers));
+    let e = gpu.prepare(&mixed, f).err().expect("refused");
+    assert!(e.to_string().contains("both conventions"), "{e}");
+    let e = gpu
+        .prepare(&lab.draws(&lab_samplers), GpuFilter::Shader(Filter::Ewa))
+        .err()
+        .expect("refused");
+    assert!(e.to_string().contains("lab's eight modes"), "{e}");
 }
 
 /// With timestamp queries (lavapipe has them) the render pass's device time is positive and no
