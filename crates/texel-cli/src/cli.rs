@@ -164,9 +164,9 @@ pub struct SceneArgs {
     #[arg(long, value_enum, value_name = "STORAGE")]
     pub texture_storage: Option<texel::TextureStorage>,
     /// The rules the lab's modes 1-8 (`--lab-mode`, the filters nearest to aniso16, the viewer's
-    /// keys 1-8) follow on the CPU: gl (the OpenGL / Vulkan rules) or lab (the lab handout's
-    /// formulas: docs/guide/conventions.md). The other filters, the GPU path and the reference
-    /// have the GL rules only.
+    /// keys 1-8) follow, on the CPU and in the WGSL shader of --gpu: gl (the OpenGL / Vulkan
+    /// rules) or lab (the lab handout's formulas: docs/guide/conventions.md). The other filters
+    /// and the reference have the GL rules only.
     #[arg(long, default_value = "gl", value_name = "RULES")]
     pub convention: texel::texture::Convention,
 }
