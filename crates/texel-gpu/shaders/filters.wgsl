@@ -338,12 +338,19 @@ fn ellipse_area(q: vec4<f32>) -> f32 {
     return PI * sqrt(max(q.w, 0.0));
 }
 
-// The ellipse in level `level` convolved with the unit reconstruction filter: Q = D S D + I,
-// D = diag(level size / level-0 size); shrunk to MAX_ELLIPSE_AREA texels when `shrink`.
-// Returns (q00, q01, q11, det Q).
+// The CPU's ewa::KERNEL_SCALE: the weights' covariance is (D (S + I) D + I) / 12, the pixel
+// box's carried through the Jacobian plus level 0's bilinear tent and the level's own spread.
+const KERNEL_SCALE: f32 = 0.61238357;
+
+// The kernel's ellipse in level `level`: Q = KERNEL_SCALE (D (S + I) D + I), D = diag(level size
+// / level-0 size); shrunk to MAX_ELLIPSE_AREA texels when `shrink`. Returns (q00, q01, q11, det Q).
 fn in_level(s: vec4<f32>, level: i32, shrink: bool) -> vec4<f32> {
     let d = size_of(level) / size_of(0);
-    var q = vec3<f32>(d.x * d.x * s.x + 1.0, d.x * d.y * s.y, d.y * d.y * s.z + 1.0);
+    var q = KERNEL_SCALE * vec3<f32>(
+        d.x * d.x * (s.x + 1.0) + 1.0,
+        d.x * d.y * s.y,
+        d.y * d.y * (s.z + 1.0) + 1.0,
+    );
     var det = q.x * q.z - q.y * q.y;
     let area = ellipse_area(vec4<f32>(q, det));
     if shrink && area > MAX_ELLIPSE_AREA {
