@@ -7,6 +7,8 @@
 //! The chart plots quality (PSNR over the covered pixels, dB, linear axis) against time
 //! (ms per frame, logarithmic axis, decades with 1-2-5 ticks), one labelled point per timed filter.
 //! External images have no time: each is drawn as a dashed horizontal line at its PSNR, labelled.
+//! The frontier ([`Report::frontier`]: the rows no other row beats on both axes) is drawn in orange,
+//! its points joined fastest first.
 //! Point labels go to the first of four places around their point that overlaps no point and no earlier label.
 //! Rows with infinite PSNR (identical to the reference) cannot be placed and are listed under it.
 
@@ -56,12 +58,14 @@ fn num(v: f64) -> String {
 
 /// The quality-against-time scatter chart of `report` as an SVG element (module docs).
 pub fn chart_svg(report: &Report) -> String {
-    let timed: Vec<(&str, f64, f64)> = report
+    let frontier = report.frontier();
+    let timed: Vec<(&str, f64, f64, bool)> = report
         .rows
         .iter()
-        .filter_map(|r| match r.ms_per_frame {
+        .enumerate()
+        .filter_map(|(i, r)| match r.ms_per_frame {
             Some(ms) if ms > 0.0 && ms.is_finite() && r.psnr_all.is_finite() => {
-                Some((r.name.as_str(), ms, r.psnr_all))
+                Some((r.name.as_str(), ms, r.psnr_all, frontier.contains(&i)))
             }
             _ => None,
         })
@@ -180,6 +184,30 @@ pub fn chart_svg(report: &Report) -> String {
             by + 12.0,
         );
     }
+    // The frontier's points joined fastest first (the ones with a finite PSNR, which are plotted).
+    let line: Vec<String> = frontier
+        .iter()
+        .filter_map(|&i| {
+            let r = &report.rows[i];
+            let ms = r.ms_per_frame?;
+            r.psnr_all
+                .is_finite()
+                .then(|| format!("{:.1},{:.1}", px(ms), py(r.psnr_all)))
+        })
+        .collect();
+    if line.len() > 1 {
+        s += &format!(
+            "<polyline points=\"{}\" fill=\"none\" stroke=\"#e67e22\" stroke-width=\"2\"/>\n",
+            line.join(" ")
+        );
+    }
+    if !line.is_empty() {
+        s += &format!(
+            "<text x=\"{:.1}\" y=\"{:.1}\" fill=\"#e67e22\">orange: the frontier (no other filter both faster and better)</text>\n",
+            LEFT + 6.0,
+            TOP + ph - 8.0
+        );
+    }
     // Labels: the first of four places around the point (right-above, right-below, left-above,
     // left-below) that overlaps no point and no label placed before; text width estimated at 7 px a character.
     // Every point is an obstacle too, and so is every dashed line's label.
@@ -188,7 +216,7 @@ pub fn chart_svg(report: &Report) -> String {
         .map(|t| (px(t.1) - 5.0, py(t.2) - 5.0, px(t.1) + 5.0, py(t.2) + 5.0))
         .chain(line_labels.iter().copied())
         .collect();
-    for (name, ms, db) in &timed {
+    for (name, ms, db, on) in &timed {
         let (x, yy) = (px(*ms), py(*db));
         let tw = 7.0 * name.chars().count() as f64;
         let boxes = [
@@ -205,10 +233,12 @@ pub fn chart_svg(report: &Report) -> String {
         let (bx, by) = boxes.iter().copied().find(|b| free(b)).unwrap_or(boxes[0]);
         placed.push((bx, by, bx + tw, by + 14.0));
         s += &format!(
-            "<circle cx=\"{x:.1}\" cy=\"{yy:.1}\" r=\"4\" fill=\"#1f77b4\"><title>{}: {} dB, {} ms</title></circle>\n<text x=\"{bx:.1}\" y=\"{:.1}\">{}</text>\n",
+            "<circle cx=\"{x:.1}\" cy=\"{yy:.1}\" r=\"4\" fill=\"{}\"><title>{}: {} dB, {} ms{}</title></circle>\n<text x=\"{bx:.1}\" y=\"{:.1}\">{}</text>\n",
+            if *on { "#e67e22" } else { "#1f77b4" },
             escape(name),
             fmt_psnr(*db),
             num(*ms),
+            if *on { ", on the frontier" } else { "" },
             by + 11.0,
             escape(name)
         );
@@ -388,6 +418,11 @@ mod tests {
             pre[c + 4..].split('"').next().unwrap().parse().unwrap()
         };
         assert!(cy("trilinear") < cy("nearest"));
+        // The frontier: nearest (fastest) and self (infinite PSNR, not plotted); trilinear is
+        // beaten by self at the same time. One plotted frontier point: no line, one orange dot.
+        assert_eq!(sample().frontier().len(), 2);
+        assert_eq!(svg.matches("fill=\"#e67e22\"><title>nearest").count(), 1);
+        assert_eq!(svg.matches("<polyline").count(), 0);
         let empty = Report {
             rows: vec![],
             ..sample()

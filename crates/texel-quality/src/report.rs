@@ -327,6 +327,46 @@ impl Report {
         Ok(serde_json::from_str(s)?)
     }
 
+    /// Indices into `rows` of the frontier of quality against time, fastest first: the timed rows
+    /// (a positive, finite ms per frame and a PSNR over the covered pixels that is not NaN) that no
+    /// other timed row beats on both axes, as fast or faster and at least as good, better in one.
+    /// Rows equal on both axes are on it together.
+    pub fn frontier(&self) -> Vec<usize> {
+        let mut timed: Vec<(usize, f64, f64)> = self
+            .rows
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| match r.ms_per_frame {
+                Some(ms) if ms > 0.0 && ms.is_finite() && !r.psnr_all.is_nan() => {
+                    Some((i, ms, r.psnr_all))
+                }
+                _ => None,
+            })
+            .collect();
+        // Fastest first, and within one time the best first.
+        timed.sort_by(|a, b| a.1.total_cmp(&b.1).then(b.2.total_cmp(&a.2)));
+        let mut out = Vec::new();
+        // The best PSNR of the strictly faster rows.
+        let mut best = f64::NEG_INFINITY;
+        let mut k = 0;
+        while k < timed.len() {
+            let ms = timed[k].1;
+            let top = timed[k].2;
+            let group = timed[k..].iter().take_while(|t| t.1 == ms).count();
+            if top > best {
+                out.extend(
+                    timed[k..k + group]
+                        .iter()
+                        .filter(|t| t.2 == top)
+                        .map(|t| t.0),
+                );
+            }
+            best = best.max(top);
+            k += group;
+        }
+        out
+    }
+
     /// The Markdown table (GitHub flavour) with a one-paragraph header.
     pub fn to_markdown(&self) -> String {
         let mut s = format!(
@@ -363,6 +403,18 @@ impl Report {
             let cells: Vec<String> = row_cells(r, orbit).iter().map(|c| md_cell(c)).collect();
             s += &format!("| {} |\n", cells.join(" | "));
         }
+        let frontier = self.frontier();
+        if !frontier.is_empty() {
+            let names: Vec<String> = frontier
+                .iter()
+                .map(|&i| md_cell(&self.rows[i].name))
+                .collect();
+            s += &format!(
+                "\nThe frontier of quality against time (the rows no other row beats on both PSNR \
+                 all and ms/frame), fastest first: {}.\n",
+                names.join(", ")
+            );
+        }
         s
     }
 
@@ -384,6 +436,58 @@ impl Report {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    /// The frontier against its definition, pair by pair, on random rows with ties in time and
+    /// in PSNR, untimed rows and infinite PSNR.
+    #[test]
+    fn frontier_is_the_undominated_timed_rows() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % n
+        };
+        for _ in 0..500 {
+            let mut report = sample();
+            let n = 1 + next(9) as usize;
+            report.rows = (0..n)
+                .map(|k| {
+                    let mut r = report.rows[0].clone();
+                    r.name = format!("r{k}");
+                    r.ms_per_frame = match next(6) {
+                        0 => None,
+                        _ => Some(1.0 + next(4) as f64),
+                    };
+                    r.psnr_all = match next(8) {
+                        0 => f64::INFINITY,
+                        _ => 10.0 + next(4) as f64,
+                    };
+                    r
+                })
+                .collect();
+            let timed = |r: &FilterRow| r.ms_per_frame.is_some();
+            let beats = |a: &FilterRow, b: &FilterRow| {
+                let (ta, tb) = (a.ms_per_frame.unwrap(), b.ms_per_frame.unwrap());
+                ta <= tb && a.psnr_all >= b.psnr_all && (ta < tb || a.psnr_all > b.psnr_all)
+            };
+            let want: Vec<usize> = (0..n)
+                .filter(|&i| {
+                    let r = &report.rows[i];
+                    timed(r) && !report.rows.iter().any(|o| timed(o) && beats(o, r))
+                })
+                .collect();
+            let mut got = report.frontier();
+            // Fastest first.
+            let ms: Vec<f64> = got
+                .iter()
+                .map(|&i| report.rows[i].ms_per_frame.unwrap())
+                .collect();
+            assert!(ms.windows(2).all(|w| w[0] <= w[1]), "{ms:?}");
+            got.sort_unstable();
+            assert_eq!(got, want);
+        }
+    }
 
     pub(crate) fn sample() -> Report {
         let mut tri = FilterRow::new(
