@@ -254,11 +254,7 @@ impl Stats {
     }
 
     fn std_error(&self) -> [f64; 4] {
-        if self.n < 2 {
-            return [f64::INFINITY; 4];
-        }
-        let n = f64::from(self.n);
-        self.m2.map(|m2| (m2.max(0.0) / (n - 1.0) / n).sqrt())
+        self.m2.map(|m2| pass_std_error(m2, self.n))
     }
 
     /// The largest distance over R, G, B between the displayed mean and the displayed ends of the
@@ -275,6 +271,17 @@ impl Stats {
             srgb,
         )
     }
+}
+
+/// The standard error of the mean of `n` independent pass means whose squared deviations from
+/// their mean sum to `m2` (the passes' sample deviation over `sqrt(n)`); infinite below two
+/// passes. A negative `m2` (rounding in a caller's `sum x^2 - n mean^2`) counts as 0.
+pub fn pass_std_error(m2: f64, n: u32) -> f64 {
+    if n < 2 {
+        return f64::INFINITY;
+    }
+    let n = f64::from(n);
+    (m2.max(0.0) / (n - 1.0) / n).sqrt()
 }
 
 /// The largest distance over R, G, B between the displayed value of `mean` (linear) and the
@@ -506,6 +513,12 @@ mod tests {
             / (n - 1.0);
         assert!((s.mean[0] - mean).abs() < 1e-12);
         assert!((s.std_error()[0] - (var / n).sqrt()).abs() < 1e-12);
+        // From a sum of squares, as the viewer keeps its passes: the same error.
+        let squares: f64 = xs.iter().map(|&x| f64::from(x).powi(2)).sum();
+        let se = pass_std_error(squares - n * mean * mean, xs.len() as u32);
+        assert!((se - (var / n).sqrt()).abs() < 1e-12);
+        assert!(pass_std_error(0.0, 1).is_infinite());
+        assert_eq!(pass_std_error(-1e-18, 3), 0.0);
     }
 
     #[test]

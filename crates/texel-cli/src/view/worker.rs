@@ -607,8 +607,8 @@ fn reference_spp(req: &Request) -> [u32; 2] {
 
 /// The share of the pixels of `rect` (in a frame `w` wide) whose accumulated reference, `passes`
 /// equal passes in `progress`, has a 95 % interval of its displayed value (sRGB when `srgb`)
-/// within half an 8-bit step: each pass mean is one independent estimate, so the standard error
-/// of their mean is the passes' sample deviation over `sqrt(passes)`.
+/// within half an 8-bit step: each pass mean is one independent estimate
+/// ([`texel_raster::adaptive::pass_std_error`]).
 fn share_within(progress: &Progress, rect: [u32; 4], w: u32, passes: u32, srgb: bool) -> f64 {
     let n = f64::from(passes);
     let tolerance = crate::cli::DEFAULT_TOLERANCE_STEPS / 255.0;
@@ -618,8 +618,7 @@ fn share_within(progress: &Progress, rect: [u32; 4], w: u32, passes: u32, srgb: 
         let mean: [f64; 3] =
             std::array::from_fn(|c| f64::from(sum[c]) / f64::from(progress.samples));
         let se = std::array::from_fn(|c| {
-            let var = (squares[c] - n * mean[c] * mean[c]).max(0.0) / (n - 1.0);
-            (var / n).sqrt()
+            texel_raster::adaptive::pass_std_error(squares[c] - n * mean[c] * mean[c], passes)
         });
         texel_raster::adaptive::display_half_width(mean, se, passes, srgb) <= tolerance
     };
