@@ -18,20 +18,20 @@
 //!    [`weight_lut`]'s code, next to it). The result is `sum(w T) / sum(w)`: weights normalised.
 //!
 //! The kernel is Heckbert's resampling filter for texel's reference, matched by its second
-//! moments: the reference averages the texture over the pixel's square, a box whose second moments are
-//! `1/12` pixel^2 per axis; carried through the Jacobian `M` they are `S / 12` texels^2 of level
-//! 0, `D S D / 12` in level `k`. The reference reconstructs level 0 bilinearly, a tent of `2/12`
-//! level-0 texel^2 per axis, `2 D^2 / 12` in level `k`; and each texel of level `k` is the mean of
-//! the `2^k x 2^k` level-0 texels it covers, whose spread is `(I - D^2) / 12`. Covariances add, so
-//! the kernel's covariance is `(D (S + I) D + I) / 12`: `(S + 2 I) / 12` on level 0, tending to
-//! `(D S D + I) / 12` on coarse levels. The weight `exp(-2 r^2) - exp(-2)` over `r < 1` (the Gaussian truncated at
-//! two standard deviations and lowered to reach zero there) has per-axis second moment
-//! `v Q` with `v = (1 - 5 e^-2) / (4 (1 - 3 e^-2)) = 0.13608` ([`kernel_variance`]), so
-//! `KERNEL_SCALE = 1 / (12 v) = 0.61238`. pbrt-v4's kernel (`MIPFilterLUT` on `D S D + I`) has
-//! covariance `0.136 (D S D + I)`, 1.63 times the pixel box's, which is why it blurs against the
-//! reference (docs/decisions.md, "EWA's kernel matches the reference's
-//! pixel"). The truncation stays at two standard deviations and the level rule stays (step 2):
-//! both measured against wider truncations and finer levels there.
+//! moments. The reference averages the texture over the pixel's square, a box whose second
+//! moments are `1/12` pixel^2 per axis; carried through the Jacobian `M` they are `S / 12`
+//! texels^2 of level 0, `D S D / 12` in level `k`. The reference reconstructs level 0 bilinearly,
+//! a tent of `2/12` level-0 texel^2 per axis, `2 D^2 / 12` in level `k`; and each texel of level
+//! `k` is the mean of the `2^k x 2^k` level-0 texels it covers, whose spread is `(I - D^2) / 12`.
+//! Covariances add, so the kernel's covariance is `(D (S + I) D + I) / 12`: `(S + 2 I) / 12` on
+//! level 0, tending to `(D S D + I) / 12` on coarse levels. The weight `exp(-2 r^2) - exp(-2)`
+//! over `r < 1` (the Gaussian truncated at two standard deviations and lowered to reach zero
+//! there) has per-axis second moment `v Q` with `v = (1 - 5 e^-2) / (4 (1 - 3 e^-2)) = 0.13608`
+//! ([`kernel_variance`]), so `KERNEL_SCALE = 1 / (12 v) = 0.61238`. pbrt-v4's kernel
+//! (`MIPFilterLUT` on `D S D + I`) has covariance `0.136 (D S D + I)`, 1.63 times the pixel box's,
+//! which is why it blurs against the reference. The truncation and the level rule (step 2) stay:
+//! other truncations and a finer level were measured against them (docs/decisions.md, "EWA's
+//! kernel matches the reference's pixel").
 //!
 //! Decisions:
 //! - One level, the finer of the two around `lod`. pbrt-v4's blend with the coarser level adds
@@ -55,7 +55,7 @@
 //!   [`MAX_VISITS`] visited texels per level backs this up. With the default clamp a level reads at
 //!   most about `pi * 33 * 2.3 * KERNEL_SCALE ~ 150` texels.
 //! - Degenerate footprints: non-finite derivatives fall back to trilinear at the isotropic lod (the
-//!   coarsest allowed level); zero axes give the unit reconstruction circle; a zero-length minor axis
+//!   coarsest allowed level); zero axes give the reconstruction's circle, `Q = KERNEL_SCALE (D^2 + I)`; a zero-length minor axis
 //!   (1e6 : 1 or inf : 1) is clamped like any other. Magnification (`rho <= 1`) is decided by the
 //!   sampler and uses `mag_filter`.
 //! - The setup (eigen-decomposition, level ellipses) runs in `f64` so that axes of 1e30 texels do
