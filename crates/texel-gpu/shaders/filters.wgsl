@@ -283,7 +283,8 @@ fn lab_anisotropic(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, lx: f32,
 // Lab mode `mode` (1-8) under the handout's formulas. Magnification (N <= 0) reads level 0 in
 // modes 3 and 4; the anisotropic modes probe there as everywhere.
 fn lab_mode(mode: u32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec4<f32> {
-    let side = f32(max(textureDimensions(tex).x, textureDimensions(tex).y));
+    let size0 = size_of(0);
+    let side = max(size0.x, size0.y);
     let lx = lab_sane(length(duv_dx) * side);
     let ly = lab_sane(length(duv_dy) * side);
     let lod = lab_lod(max(lx, ly));
@@ -338,9 +339,10 @@ fn ellipse_area(q: vec4<f32>) -> f32 {
     return PI * sqrt(max(q.w, 0.0));
 }
 
-// The CPU's ewa::KERNEL_SCALE: the weights' covariance is (D (S + I) D + I) / 12, the pixel
-// box's carried through the Jacobian plus level 0's bilinear tent and the level's own spread.
-const KERNEL_SCALE: f32 = 0.61238357;
+// The CPU's ewa::KERNEL_SCALE, set by the pipeline: the weights' covariance is
+// (D (S + I) D + I) / 12, the pixel box's carried through the Jacobian plus level 0's bilinear
+// tent and the level's own spread.
+override KERNEL_SCALE: f32;
 
 // The kernel's ellipse in level `level`: Q = KERNEL_SCALE (D (S + I) D + I), D = diag(level size
 // / level-0 size); shrunk to MAX_ELLIPSE_AREA texels when `shrink`. Returns (q00, q01, q11, det Q).

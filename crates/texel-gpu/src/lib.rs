@@ -407,7 +407,7 @@ fn convention_of(
 }
 
 /// The pipeline of one shader mode (`MODE`) under one convention (`CONVENTION`), both pipeline
-/// constants.
+/// constants, with EWA's kernel scale (`KERNEL_SCALE`) the CPU's.
 fn create_pipeline(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
@@ -419,6 +419,7 @@ fn create_pipeline(
     let constants = [
         ("MODE", f64::from(mode)),
         ("CONVENTION", f64::from(u8::from(lab))),
+        ("KERNEL_SCALE", texel_texture::technique::ewa::KERNEL_SCALE),
     ];
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("texel filters"),
