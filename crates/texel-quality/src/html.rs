@@ -63,11 +63,14 @@ pub fn chart_svg(report: &Report) -> String {
         .rows
         .iter()
         .enumerate()
-        .filter_map(|(i, r)| match r.ms_per_frame {
-            Some(ms) if ms > 0.0 && ms.is_finite() && r.psnr_all.is_finite() => {
-                Some((r.name.as_str(), ms, r.psnr_all, frontier.contains(&i)))
-            }
-            _ => None,
+        .filter(|(_, r)| r.psnr_all.is_finite())
+        .filter_map(|(i, r)| {
+            Some((
+                r.name.as_str(),
+                r.time()?,
+                r.psnr_all,
+                frontier.contains(&i),
+            ))
         })
         .collect();
     let lines: Vec<(&str, f64)> = report
@@ -187,13 +190,9 @@ pub fn chart_svg(report: &Report) -> String {
     // The frontier's points joined fastest first (the ones with a finite PSNR, which are plotted).
     let line: Vec<String> = frontier
         .iter()
-        .filter_map(|&i| {
-            let r = &report.rows[i];
-            let ms = r.ms_per_frame?;
-            r.psnr_all
-                .is_finite()
-                .then(|| format!("{:.1},{:.1}", px(ms), py(r.psnr_all)))
-        })
+        .map(|&i| &report.rows[i])
+        .filter(|r| r.psnr_all.is_finite())
+        .filter_map(|r| Some(format!("{:.1},{:.1}", px(r.time()?), py(r.psnr_all))))
         .collect();
     if line.len() > 1 {
         s += &format!(

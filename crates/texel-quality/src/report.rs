@@ -140,6 +140,11 @@ pub struct FilterRow {
 }
 
 impl FilterRow {
+    /// The row's time per frame where it has one that can be compared: positive and finite.
+    pub fn time(&self) -> Option<f64> {
+        self.ms_per_frame.filter(|ms| *ms > 0.0 && ms.is_finite())
+    }
+
     /// A row with `scores` and file name `image`, no timing/texel/memory numbers and no extra
     /// images; set the other fields directly.
     pub fn new(name: impl Into<String>, scores: Scores, image: impl Into<String>) -> Self {
@@ -336,12 +341,8 @@ impl Report {
             .rows
             .iter()
             .enumerate()
-            .filter_map(|(i, r)| match r.ms_per_frame {
-                Some(ms) if ms > 0.0 && ms.is_finite() && !r.psnr_all.is_nan() => {
-                    Some((i, ms, r.psnr_all))
-                }
-                _ => None,
-            })
+            .filter(|(_, r)| !r.psnr_all.is_nan())
+            .filter_map(|(i, r)| Some((i, r.time()?, r.psnr_all)))
             .collect();
         // Fastest first, and within one time the best first.
         timed.sort_by(|a, b| a.1.total_cmp(&b.1).then(b.2.total_cmp(&a.2)));
