@@ -360,10 +360,13 @@ pub fn render<'py>(
 /// The converging reference of `scene` as `texel reference` makes it, with its error bars: a dict
 /// of `image` (the `uint8` PNG values), `linear` (mean linear RGBA, `float32`), `std_error`
 /// (standard error per channel, linear), `spp` (samples per pixel, `uint32`), `converged`
-/// (`bool`), all `H x W (x 4)`, and `interrupted`. With `scissor=(x0, y0, x1, y1)` only those
-/// pixels are rendered and returned, each exactly as in the whole frame.
+/// (`bool`), `exact` (`bool`: the pixel's integral was computed, `texel reference --exact`), all
+/// `H x W (x 4)`, and `interrupted`. With `scissor=(x0, y0, x1, y1)` only those pixels are
+/// rendered and returned, each exactly as in the whole frame. With `exact=True` every pixel whose
+/// visible surface is unlit textured triangles is computed, not sampled (standard error 0, no
+/// samples).
 #[pyfunction]
-#[pyo3(signature = (scene, spp = 256, max_spp = 65536, tolerance = 0.5, seed = texel::raster::adaptive::DEFAULT_SEED, size = None, color = "srgb", threads = None, scissor = None, max_memory = None))]
+#[pyo3(signature = (scene, spp = 256, max_spp = 65536, tolerance = 0.5, seed = texel::raster::adaptive::DEFAULT_SEED, size = None, color = "srgb", threads = None, scissor = None, max_memory = None, exact = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn reference_estimate<'py>(
     py: Python<'py>,
@@ -377,10 +380,11 @@ pub fn reference_estimate<'py>(
     threads: Option<usize>,
     scissor: Option<(u32, u32, u32, u32)>,
     max_memory: Option<u64>,
+    exact: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let color = color_named(color)?;
     let options = ReferenceOptions {
-        plan: plan_of(spp, max_spp, tolerance, seed, color)?,
+        plan: plan_of(spp, max_spp, tolerance, seed, color)?.with_exact(exact),
         size: size_of(size)?,
         color,
         threads: threads_of(threads)?,
@@ -399,6 +403,7 @@ pub fn reference_estimate<'py>(
     let std_error = crop(&e.std_error, w, rect);
     let spp = crop(&e.spp, w, rect);
     let converged = crop(&e.converged, w, rect);
+    let exact = crop(&e.exact, w, rect);
     let out = PyDict::new(py);
     if tw > 0 && th > 0 {
         let encoding = encoding_of(options.color == ColorHandling::Srgb);
@@ -417,6 +422,7 @@ pub fn reference_estimate<'py>(
         "converged",
         array_out(py, &[th as usize, tw as usize], converged)?,
     )?;
+    out.set_item("exact", array_out(py, &[th as usize, tw as usize], exact)?)?;
     out.set_item("interrupted", e.interrupted)?;
     Ok(out)
 }
@@ -427,9 +433,10 @@ pub fn reference_estimate<'py>(
 /// block means in linear light), `texels_per_pixel`, `texels_per_pixel_max`, `ms_per_frame`
 /// (median of 3 after a warm-up), `texture_bytes`, `noise_floor` (the PSNR a perfect filter would
 /// get against this reference), `noise_floor_block` and `within_noise_of` (the filters the
-/// reference's error bars cannot rank this one against).
+/// reference's error bars cannot rank this one against). With `exact=True` the reference is
+/// `texel reference --exact`'s: unlit textured pixels computed, the others sampled.
 #[pyfunction]
-#[pyo3(signature = (scene, filters = None, spp = 256, max_spp = None, tolerance = 0.5, seed = texel::raster::adaptive::DEFAULT_SEED, size = None, color = "srgb", threads = None, max_memory = None))]
+#[pyo3(signature = (scene, filters = None, spp = 256, max_spp = None, tolerance = 0.5, seed = texel::raster::adaptive::DEFAULT_SEED, size = None, color = "srgb", threads = None, max_memory = None, exact = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn compare<'py>(
     py: Python<'py>,
@@ -443,6 +450,7 @@ pub fn compare<'py>(
     color: &str,
     threads: Option<usize>,
     max_memory: Option<u64>,
+    exact: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let filters = match filters {
         // The command line's list syntax: names, or "all".
@@ -455,7 +463,7 @@ pub fn compare<'py>(
         color,
         ..SceneOptions::default()
     };
-    let plan = plan_of(spp, max_spp.unwrap_or(spp), tolerance, seed, color)?;
+    let plan = plan_of(spp, max_spp.unwrap_or(spp), tolerance, seed, color)?.with_exact(exact);
     let arg = scene_arg(scene)?;
     let report = run_released(py, move |stop| {
         let loaded = load_py(&arg)?;

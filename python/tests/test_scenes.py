@@ -55,6 +55,24 @@ def test_reference_equals_the_cli_png_and_its_error_bars_hold(cli, tmp_path):
     np.testing.assert_array_equal(texel.encode(est["linear"], color="srgb"), est["image"])
 
 
+def test_the_exact_reference_equals_the_cli_png_and_has_no_error(cli, tmp_path):
+    out = tmp_path / "exact.png"
+    cli("reference", "builtin:cube", "--size", "64x36", "--spp", "16", "--max-spp", "16",
+        "--exact", "-o", out)
+    est = texel.reference_estimate("builtin:cube", spp=16, max_spp=16, size=(64, 36), exact=True)
+    np.testing.assert_array_equal(est["image"], read_png(out))
+    exact = est["exact"]
+    assert exact.dtype == np.bool_ and exact.shape == (36, 64)
+    # The cube and its background are computed; only pixels where faces meet at the silhouette
+    # may be sampled.
+    assert exact.mean() > 0.95
+    assert np.all(est["std_error"][exact] == 0) and np.all(est["spp"][exact] == 0)
+    assert np.all(est["spp"][~exact] == 16)
+    plain = texel.reference_estimate("builtin:cube", spp=16, max_spp=16, size=(64, 36))
+    assert not plain["exact"].any()
+    np.testing.assert_array_equal(est["linear"][~exact], plain["linear"][~exact])
+
+
 def test_a_scissored_reference_is_that_part_of_the_whole():
     whole = texel.reference_estimate("builtin:ground", spp=16, max_spp=64, size=(40, 24))
     part = texel.reference_estimate(

@@ -62,6 +62,7 @@ def reference(
     color: str = "srgb",
     threads: Optional[int] = None,
     max_memory: Optional[int] = None,
+    exact: bool = False,
 ):
     """The supersampled reference of ``scene``: the ``H x W x 4`` ``uint8`` image that
     ``texel reference SCENE --spp SPP --max-spp MAX_SPP -o FILE.png`` writes, bit for bit.
@@ -69,7 +70,8 @@ def reference(
     Every pixel gets at least ``spp`` samples; pixels whose 95 % interval of the displayed value
     is wider than ``tolerance`` 8-bit steps get more, doubling, up to ``max_spp``. The result
     depends on ``seed`` only, not on the thread count. ``reference_estimate`` returns the error
-    bars too.
+    bars too. With ``exact=True``, as ``texel reference --exact``: every pixel whose visible
+    surface is unlit textured triangles is computed, not sampled.
     """
     return reference_estimate(
         scene,
@@ -81,4 +83,5 @@ def reference(
         color=color,
         threads=threads,
         max_memory=max_memory,
+        exact=exact,
     )["image"]

@@ -74,6 +74,7 @@ def reference(
     color: str = "srgb",
     threads: Optional[int] = None,
     max_memory: Optional[int] = None,
+    exact: bool = False,
 ) -> npt.NDArray[np.uint8]: ...
 def reference_estimate(
     scene: _Scene,
@@ -86,6 +87,7 @@ def reference_estimate(
     threads: Optional[int] = None,
     scissor: Optional[Tuple[int, int, int, int]] = None,
     max_memory: Optional[int] = None,
+    exact: bool = False,
 ) -> Dict[str, Union[np.ndarray, bool]]: ...
 def compare(
     scene: _Scene,
@@ -98,6 +100,7 @@ def compare(
     color: str = "srgb",
     threads: Optional[int] = None,
     max_memory: Optional[int] = None,
+    exact: bool = False,
 ) -> Dict[str, Dict[str, Union[float, int, List[str]]]]: ...
 def warp(
     image: npt.NDArray[Union[np.uint8, np.float32]],

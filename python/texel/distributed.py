@@ -212,7 +212,7 @@ def reference_estimate(
         [task.remote(ref, dict(kwargs, spp=spp, size=size, scissor=r)) for r in rects]
     )
     out: Dict[str, Any] = {}
-    for key in ("image", "linear", "std_error", "spp", "converged"):
+    for key in ("image", "linear", "std_error", "spp", "converged", "exact"):
         first = parts[0][key]
         full = np.zeros((height, width) + first.shape[2:], dtype=first.dtype)
         for (x0, y0, x1, y1), part in zip(rects, parts):

@@ -286,6 +286,11 @@ pub struct ReferenceArgs {
     /// Seed of the jitter; two seeds give independent estimates.
     #[arg(long, default_value_t = texel_raster::adaptive::DEFAULT_SEED)]
     pub seed: u64,
+    /// Compute the box-filtered integral of every pixel whose visible surface is unlit textured
+    /// triangles (standard error 0, accurate to about 1e-6 of its value), and sample only the
+    /// others (lit materials, interpenetrating triangles, sphere mappings).
+    #[arg(long)]
+    pub exact: bool,
     /// Worker threads, 1 to 1024 (default: all cores); the image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
@@ -337,6 +342,10 @@ pub struct CompareArgs {
     /// of the displayed value, 0 to 255 (also the converged share the report gives).
     #[arg(long, default_value_t = DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
     pub tolerance: f64,
+    /// Score against the exact reference: each unlit textured pixel's integral computed, the
+    /// others sampled as --spp says (as `texel reference --exact`).
+    #[arg(long)]
+    pub exact: bool,
     /// An image rendered elsewhere to score against the same reference: LABEL=PATH (repeatable;
     /// labels must differ from each other and from the filters compared).
     #[arg(long, value_name = "LABEL=IMAGE")]

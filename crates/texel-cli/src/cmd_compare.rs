@@ -247,7 +247,8 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         args.tolerance,
         args.scene.color == texel::ColorHandling::Srgb,
         texel_raster::adaptive::DEFAULT_SEED,
-    )?;
+    )?
+    .with_exact(args.exact);
     check_storage(&args.scene, args.gpu)?;
     let scene = load_scene(&args.scene, input)?;
     check_before_work(&scene, &files, &mut input.budget)?;

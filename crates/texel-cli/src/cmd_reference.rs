@@ -57,7 +57,8 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
         args.tolerance,
         args.scene.color == texel::ColorHandling::Srgb,
         args.seed,
-    )?;
+    )?
+    .with_exact(args.exact);
     let mut outputs = vec![("-o", args.output.as_path())];
     outputs.extend(args.error_map.as_deref().map(|m| ("--error-map", m)));
     check_outputs(&outputs)?;
@@ -176,6 +177,32 @@ pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> Str
         e.mean_spp(None),
         e.plan.seed,
     );
+    if e.plan.exact {
+        let sampled: Vec<bool> = e.exact.iter().map(|&x| !x).collect();
+        let sampled_spp: Vec<u32> = e
+            .spp
+            .iter()
+            .zip(&e.exact)
+            .filter(|(_, &x)| !x)
+            .map(|(&n, _)| n)
+            .collect();
+        let _ = write!(
+            line,
+            "; {:.2} % of pixels exact (integral computed, error below 1e-6 of the value){}",
+            100.0 * e.exact_share(None),
+            if sampled_spp.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    ", the others sampled: {}-{} samples (mean {:.0}), {:.2} % converged",
+                    sampled_spp.iter().min().unwrap_or(&0),
+                    sampled_spp.iter().max().unwrap_or(&0),
+                    e.mean_spp(Some(&sampled)),
+                    100.0 * e.converged_share(Some(&sampled))
+                )
+            }
+        );
+    }
     if e.interrupted {
         line += "; interrupted";
     } else if unconverged > 0 {
@@ -211,8 +238,11 @@ fn write_error_map(
         .display_half_width
         .iter()
         .zip(&e.converged)
-        .map(|(&hw, &ok)| {
-            if ok {
+        .zip(&e.exact)
+        .map(|((&hw, &ok), &exact)| {
+            if exact {
+                [255, 255, 255, 255]
+            } else if ok {
                 let [r, g, b] = viridis(hw * 255.0 / ERROR_MAP_MAX_STEPS);
                 [r, g, b, 255]
             } else {

@@ -408,3 +408,75 @@ fn an_interrupted_reference_writes_what_it_has() {
     assert!(marked_partial(old.to_str().unwrap()), "{err}");
     assert!(temp_files(d.path()).is_empty());
 }
+
+/// `--exact`: the ground's every pixel computed, no samples, its error map white (exact), the
+/// summary says so; on the lit glossy plane only the background is, and the image is the
+/// sampled one.
+#[test]
+fn exact_reference_of_the_ground_and_of_a_lit_scene() {
+    let d = Dir::new("reference-exact");
+    let (img, map) = (d.arg("exact.exr"), d.arg("exact-map.png"));
+    let out = ok(&[
+        "reference",
+        "builtin:ground",
+        "--size",
+        "64x36",
+        "--exact",
+        "-o",
+        &img,
+        "--error-map",
+        &map,
+    ]);
+    let err = stderr(&out);
+    assert!(err.contains("100.00 % of pixels exact"), "{err}");
+    assert!(load(&map)
+        .pixels()
+        .iter()
+        .all(|p| *p == [255, 255, 255, 255]));
+    // Agrees with a sampled reference within that reference's own error bars: on at least
+    // 95 % of pixels the difference is within its 99 % interval (2.576 standard errors).
+    let (sampled, se) = (d.arg("sampled.exr"), d.arg("sampled-se.exr"));
+    ok(&[
+        "reference",
+        "builtin:ground",
+        "--size",
+        "64x36",
+        "--spp",
+        "1024",
+        "--max-spp",
+        "1024",
+        "-o",
+        &sampled,
+        "--error-map",
+        &se,
+    ]);
+    let (a, b, e) = (exr(&img), exr(&sampled), exr(&se));
+    let within = a
+        .iter()
+        .zip(&b)
+        .zip(&e)
+        .filter(|((x, y), s)| (0..3).all(|k| (x[k] - y[k]).abs() <= 2.576 * s[k] + 1e-6))
+        .count();
+    let share = within as f64 / a.len() as f64;
+    assert!(share >= 0.95, "{share}");
+    let (lit, plain) = (d.arg("lit.png"), d.arg("plain.png"));
+    let args = [
+        "reference",
+        "builtin:glossy",
+        "--size",
+        "32x18",
+        "--spp",
+        "8",
+        "--max-spp",
+        "8",
+    ];
+    let out = ok(&[&args[..], &["--exact", "-o", &lit]].concat());
+    // Only the sky is exact: every lit pixel is sampled, as without --exact.
+    assert!(
+        stderr(&out).contains("44.44 % of pixels exact"),
+        "{}",
+        stderr(&out)
+    );
+    ok(&[&args[..], &["-o", &plain]].concat());
+    assert_eq!(file_bytes(&lit), file_bytes(&plain));
+}

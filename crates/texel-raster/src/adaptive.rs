@@ -26,6 +26,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::draw::DrawCall;
 use crate::error::RasterError;
+use crate::exact::{render_exact, ExactImage};
 use crate::frame::Frame;
 use crate::reference::{square_strata, with_passes, MAX_SPP_SIDE};
 use crate::settings::RenderSettings;
@@ -57,6 +58,9 @@ pub struct ReferencePlan {
     pub srgb_display: bool,
     /// Seed of the first pass; two seeds give independent estimates.
     pub seed: u64,
+    /// Whether pixels whose visible surface is unlit textured triangles get their integral
+    /// computed ([`crate::exact`]) instead of sampled; the others are sampled as the plan says.
+    pub exact: bool,
 }
 
 /// The tolerance of [`ReferencePlan::default`] in 8-bit steps of the display: half a step.
@@ -90,9 +94,15 @@ impl ReferencePlan {
             tolerance: tolerance_steps / 255.0,
             srgb_display,
             seed,
+            exact: false,
         };
         check_plan(&plan)?;
         Ok(plan)
+    }
+
+    /// The plan with [`ReferencePlan::exact`] set to `exact`.
+    pub fn with_exact(self, exact: bool) -> Self {
+        ReferencePlan { exact, ..self }
     }
 
     /// The tolerance in 8-bit steps of the display.
@@ -109,6 +119,7 @@ impl Default for ReferencePlan {
             tolerance: DEFAULT_TOLERANCE_STEPS / 255.0,
             srgb_display: true,
             seed: DEFAULT_SEED,
+            exact: false,
         }
     }
 }
@@ -141,8 +152,11 @@ pub struct ReferenceEstimate {
     /// Each pixel's half-width of the 95 % interval of the displayed value, the largest over R, G
     /// and B (display units, `[0, 1]`); infinite with fewer than two passes.
     pub display_half_width: Vec<f32>,
-    /// Samples each pixel got.
+    /// Samples each pixel got (0 for an exact pixel).
     pub spp: Vec<u32>,
+    /// Whether each pixel's value is its computed integral (standard error 0; its interval
+    /// half-width is the arithmetic's bound), not a sampled estimate.
+    pub exact: Vec<bool>,
     /// Whether each pixel met the tolerance.
     pub converged: Vec<bool>,
     /// Whether the stop flag ended the work early (each pixel holds whole passes; a pass that was
@@ -156,6 +170,11 @@ impl ReferenceEstimate {
     /// Share of the pixels that met the tolerance (of those `mask` selects, or all).
     pub fn converged_share(&self, mask: Option<&[bool]>) -> f64 {
         share(&self.converged, mask, |&c| c)
+    }
+
+    /// Share of the pixels that are exact (of those `mask` selects, or all).
+    pub fn exact_share(&self, mask: Option<&[bool]>) -> f64 {
+        share(&self.exact, mask, |&e| e)
     }
 
     /// Mean samples per pixel (of those `mask` selects, or all).
@@ -328,10 +347,11 @@ fn check_plan(plan: &ReferencePlan) -> Result<(), RasterError> {
 fn estimate(
     settings: &RenderSettings,
     stats: &[Stats],
-    depth: Vec<f32>,
+    mut depth: Vec<f32>,
     plan: &ReferencePlan,
     per_pass: u32,
     interrupted: bool,
+    exact: Option<&ExactImage>,
 ) -> ReferenceEstimate {
     // An interrupted round leaves its pixels with more passes than the others: each is still the
     // mean of whole passes, and its own statistics say how far it got.
@@ -339,14 +359,42 @@ fn estimate(
         .iter()
         .map(|s| s.display_half_width(plan.srgb_display))
         .collect();
-    let converged = half.iter().map(|&h| h <= plan.tolerance).collect();
+    let mut half = half;
+    let mut converged: Vec<bool> = half.iter().map(|&h| h <= plan.tolerance).collect();
+    let mut color: Vec<[f32; 4]> = stats.iter().map(|s| s.mean.map(|m| m as f32)).collect();
+    let mut std_error: Vec<[f32; 4]> = stats
+        .iter()
+        .map(|s| s.std_error().map(|e| e as f32))
+        .collect();
+    let mut spp: Vec<u32> = stats.iter().map(|s| s.n * per_pass).collect();
+    let pixels = stats.len();
+    let mut is_exact = vec![false; pixels];
+    if let Some(ex) = exact {
+        for i in (0..pixels).filter(|&i| ex.exact[i]) {
+            let (c, b) = (ex.color[i], ex.bound[i]);
+            color[i] = c;
+            std_error[i] = [0.0; 4];
+            spp[i] = 0;
+            depth[i] = ex.depth[i];
+            half[i] = (0..3)
+                .map(|k| {
+                    let (m, h) = (f64::from(c[k]), f64::from(b[k]));
+                    let d = display(m, plan.srgb_display);
+                    (display(m + h, plan.srgb_display) - d)
+                        .max(d - display(m - h, plan.srgb_display))
+                })
+                .fold(0.0, f64::max);
+            converged[i] = true;
+            is_exact[i] = true;
+        }
+    }
     let frame = Frame {
         width: settings.width,
         height: settings.height,
         target: crate::settings::ColorTarget::Float,
         // Every pixel has at least one pass: a stop before the first is an error
         // (`render_reference_adaptive`).
-        color: stats.iter().map(|s| s.mean.map(|m| m as f32)).collect(),
+        color,
         color8: Vec::new(),
         texels_read: Vec::new(),
         depth,
@@ -355,12 +403,10 @@ fn estimate(
     };
     ReferenceEstimate {
         frame,
-        std_error: stats
-            .iter()
-            .map(|s| s.std_error().map(|e| e as f32))
-            .collect(),
+        std_error,
         display_half_width: half.iter().map(|&h| h as f32).collect(),
-        spp: stats.iter().map(|s| s.n * per_pass).collect(),
+        spp,
+        exact: is_exact,
         converged,
         interrupted,
         plan: *plan,
@@ -392,11 +438,39 @@ pub fn render_reference_adaptive(
     let mut depth = vec![f32::INFINITY; pixels];
     let mut interrupted = false;
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let exact = if plan.exact {
+        let status = |done: u64, total: u64| {
+            if let Some(p) = progress {
+                p(&ReferenceStatus {
+                    round: 0,
+                    spp: 0,
+                    active: total,
+                    converged: 0.0,
+                    done,
+                    total,
+                });
+            }
+        };
+        Some(render_exact(settings, draws, Some(&status))?)
+    } else {
+        None
+    };
     with_passes(settings, draws, strata, |pass| {
         // The pixels this round refines, as indices and (after round 0) as the passes' mask;
-        // every other pixel has converged.
-        let mut indices: Vec<usize> = (0..pixels).collect();
-        let mut active: Option<Vec<bool>> = None;
+        // every other pixel has converged or is exact.
+        let mut indices: Vec<usize> = (0..pixels)
+            .filter(|&i| exact.as_ref().is_none_or(|e| !e.exact[i]))
+            .collect();
+        if indices.is_empty() {
+            return Ok(());
+        }
+        let mut active: Option<Vec<bool>> = exact.is_some().then(|| {
+            let mut mask = vec![false; pixels];
+            for &i in &indices {
+                mask[i] = true;
+            }
+            mask
+        });
         let mut done_passes = 0u32;
         let mut round = 0u32;
         let mut add = first_passes;
@@ -442,7 +516,7 @@ pub fn render_reference_adaptive(
             }
             // Round 0 gives every pixel the first pass: a pixel without one was stopped before
             // it, and the estimate has nothing to show there.
-            if interrupted && round == 0 && stats.iter().any(|s| s.n == 0) {
+            if interrupted && round == 0 && indices.iter().any(|&i| stats[i].n == 0) {
                 return Err(RasterError::Interrupted);
             }
             if interrupted {
@@ -470,6 +544,7 @@ pub fn render_reference_adaptive(
         plan,
         per_pass,
         interrupted,
+        exact.as_ref(),
     ))
 }
 

@@ -46,6 +46,7 @@ pub mod camera;
 pub mod clip;
 mod draw;
 mod error;
+pub mod exact;
 mod frame;
 pub mod interp;
 mod point;
@@ -62,6 +63,7 @@ pub mod warp;
 pub use adaptive::{render_reference_adaptive, ReferenceEstimate, ReferencePlan, ReferenceStatus};
 pub use draw::{DrawCall, UvEvaluation, UvMapping, Vertex};
 pub use error::RasterError;
+pub use exact::{render_exact, ExactImage};
 pub use frame::Frame;
 pub use reference::{render_reference, render_reference_strata};
 pub use settings::{
