@@ -223,10 +223,25 @@ def caption(r):
     peer = (f" llvmpipe ran in the same rounds (`{r['commands']['llvmpipe']}`); the last column"
             " gives the per-round ratios." if r["commands"].get("llvmpipe") else "")
     return (f"{r['width']} x {r['height']}, `{r['scene']}`. Quality: `{r['commands']['compare']}`"
-            f" (PSNR over the plane and over the {r['band_rows']} rows below the horizon, against a"
-            f" {r['spp']}-sample reference; these do not depend on the machine).{noise(r)} Time:"
+            f" (PSNR over the plane and over the {r['band_rows']} rows below the horizon, against"
+            f" {against(r)}; these do not depend on the machine).{noise(r)} Time:"
             f" `{r['commands']['bench']}`, median of {r['rounds']} rounds' medians (rounds differ"
             f" by up to {spread(r):.0f} %).{peer} Machine: {machine_line(r)}.")
+
+
+def exact_share(r):
+    """The share of covered pixels the record's reference computed exactly (0 for older ones)."""
+    return (r.get("reference_error") or {}).get("exact", 0.0)
+
+
+def against(r):
+    """The reference a record's quality columns are scored against."""
+    if exact_share(r) >= 1.0:
+        return "the exact reference (each pixel's integral computed, not sampled)"
+    if exact_share(r) > 0.0:
+        return (f"a reference computed exactly on {100 * exact_share(r):.1f} % of the pixels and"
+                f" sampled {r['spp']} times on the others")
+    return f"a {r['spp']}-sample reference"
 
 
 def noise(r):
@@ -234,6 +249,8 @@ def noise(r):
     e = r.get("reference_error")
     if not e:
         return ""
+    if exact_share(r) >= 1.0:
+        return " The reference has no noise, so it ranks every pair of rows."
     floor = "inf" if e["noise_floor"] == "inf" else f"{e['noise_floor']:.2f}"
     pairs = sorted({tuple(sorted((x["filter"], o))) for x in r["filters"]
                     for o in x.get("within_noise_of", [])})

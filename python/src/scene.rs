@@ -433,10 +433,11 @@ pub fn reference_estimate<'py>(
 /// block means in linear light), `texels_per_pixel`, `texels_per_pixel_max`, `ms_per_frame`
 /// (median of 3 after a warm-up), `texture_bytes`, `noise_floor` (the PSNR a perfect filter would
 /// get against this reference), `noise_floor_block` and `within_noise_of` (the filters the
-/// reference's error bars cannot rank this one against). With `exact=True` the reference is
-/// `texel reference --exact`'s: unlit textured pixels computed, the others sampled.
+/// reference's error bars cannot rank this one against). As `texel compare`, the reference is
+/// `texel reference --exact`'s (unlit textured pixels computed, the others sampled); with
+/// `exact=False` it is sampled everywhere (`--sampled-reference`).
 #[pyfunction]
-#[pyo3(signature = (scene, filters = None, spp = 256, max_spp = None, tolerance = 0.5, seed = texel::raster::adaptive::DEFAULT_SEED, size = None, color = "srgb", threads = None, max_memory = None, exact = false))]
+#[pyo3(signature = (scene, filters = None, spp = 256, max_spp = None, tolerance = 0.5, seed = texel::raster::adaptive::DEFAULT_SEED, size = None, color = "srgb", threads = None, max_memory = None, exact = true))]
 #[allow(clippy::too_many_arguments)]
 pub fn compare<'py>(
     py: Python<'py>,

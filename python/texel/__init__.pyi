@@ -100,7 +100,7 @@ def compare(
     color: str = "srgb",
     threads: Optional[int] = None,
     max_memory: Optional[int] = None,
-    exact: bool = False,
+    exact: bool = True,
 ) -> Dict[str, Dict[str, Union[float, int, List[str]]]]: ...
 def warp(
     image: npt.NDArray[Union[np.uint8, np.float32]],

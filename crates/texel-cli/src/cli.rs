@@ -342,9 +342,10 @@ pub struct CompareArgs {
     /// of the displayed value, 0 to 255 (also the converged share the report gives).
     #[arg(long, default_value_t = DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
     pub tolerance: f64,
-    /// Score against the exact reference: each unlit textured pixel's integral computed, the
-    /// others sampled as --spp says (as `texel reference --exact`).
-    #[arg(long)]
+    /// Score against a sampled reference everywhere. By default the reference is `texel
+    /// reference --exact`'s: each unlit textured pixel's integral computed, the others sampled as
+    /// --spp says.
+    #[arg(long = "sampled-reference", action = clap::ArgAction::SetFalse)]
     pub exact: bool,
     /// An image rendered elsewhere to score against the same reference: LABEL=PATH (repeatable;
     /// labels must differ from each other and from the filters compared).

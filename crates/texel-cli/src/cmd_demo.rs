@@ -137,7 +137,9 @@ fn report_in(
         DEFAULT_TOLERANCE_STEPS,
         true,
         texel_raster::adaptive::DEFAULT_SEED,
-    )?;
+    )?
+    // Unlit textured pixels computed, not sampled; lit ones sampled.
+    .with_exact(true);
     let bars = Bars::shared(pb.clone(), label);
     let job = CompareJob {
         progress: Some(&bars),

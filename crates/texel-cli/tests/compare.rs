@@ -38,6 +38,8 @@ fn compare_report_is_consistent_with_its_images() {
         "nearest,bilinear,trilinear,ewa",
         "--extra",
         &format!("gpu={extra}"),
+        // The sampled reference everywhere: this test is about its noise.
+        "--sampled-reference",
         "--out",
         &out_s,
     ]);

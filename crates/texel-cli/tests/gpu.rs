@@ -175,6 +175,7 @@ fn compare_gpu_scores_shader_and_hardware_rows() {
         "--filters",
         "trilinear,aniso16",
         "--gpu",
+        "--sampled-reference",
         "--out",
         &d.arg("report"),
     ]);

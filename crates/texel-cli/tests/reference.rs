@@ -459,6 +459,26 @@ fn exact_reference_of_the_ground_and_of_a_lit_scene() {
         .count();
     let share = within as f64 / a.len() as f64;
     assert!(share >= 0.95, "{share}");
+    // `compare` scores against the exact reference by default, and its report says so: every
+    // covered pixel exact, no noise floor.
+    let report = d.arg("report");
+    ok(&[
+        "compare",
+        "builtin:ground",
+        "--size",
+        "64x36",
+        "--spp",
+        "16",
+        "--filters",
+        "trilinear",
+        "--out",
+        &report,
+    ]);
+    let json = std::fs::read_to_string(d.join("report").join("report.json")).unwrap();
+    let parsed = texel_quality::Report::from_json(&json).unwrap();
+    let e = parsed.reference_error.expect("the reference's figures");
+    assert_eq!(e.exact, 1.0);
+    assert!(e.noise_floor.is_infinite(), "{e:?}");
     let (lit, plain) = (d.arg("lit.png"), d.arg("plain.png"));
     let args = [
         "reference",

@@ -60,6 +60,10 @@ pub struct ReferenceSummary {
     pub tolerance: f64,
     /// Share of the covered pixels that met the tolerance.
     pub converged: f64,
+    /// Share of the covered pixels whose integral was computed, not sampled (exact to the
+    /// arithmetic: standard error 0).
+    #[serde(default)]
+    pub exact: f64,
     /// PSNR (dB) a perfect filter would score against this reference per pixel: no score above
     /// it means anything.
     #[serde(with = "inf_f64")]
@@ -299,21 +303,38 @@ impl ReferenceSummary {
     /// One paragraph: the samples, the share converged, the noise floors and what the "within
     /// noise of" column means.
     pub fn sentence(&self) -> String {
+        let tail = format!(
+            "Noise floor (the PSNR a perfect filter would score against this reference): {} dB \
+             per pixel, {} dB on {b}x{b} block means in linear light (PSNR blocks). \"Within noise \
+             of\" lists the rows whose PSNR difference from the row lies within the reference's 95 % \
+             uncertainty: the reference does not rank them.",
+            fmt_psnr(self.noise_floor),
+            fmt_psnr(self.noise_floor_block),
+            b = self.block,
+        );
+        if self.exact >= 1.0 {
+            return format!(
+                "Reference: every covered pixel exact (its integral computed, to within 1e-6 of \
+                 the value). {tail}"
+            );
+        }
+        let exact = if self.exact > 0.0 {
+            format!(
+                "{:.1} % of the covered pixels exact (their integral computed, to within 1e-6 of \
+                 the value), the others sampled: ",
+                100.0 * self.exact
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "Reference: {}-{} samples per pixel (mean {:.0}); {:.1} % of the covered pixels within \
-             ±{}/255 of the display at 95 % confidence. Noise floor (the PSNR a perfect filter \
-             would score against this reference): {} dB per pixel, {} dB on {b}x{b} block means \
-             in linear light (PSNR blocks). \"Within noise of\" lists the rows whose PSNR \
-             difference from the row lies within the reference's 95 % uncertainty: the reference \
-             does not rank them.",
+            "Reference: {exact}{}-{} samples per pixel (mean {:.0}); {:.1} % of the covered pixels \
+             within ±{}/255 of the display at 95 % confidence. {tail}",
             self.min_spp,
             self.max_spp,
             self.mean_spp,
             100.0 * self.converged,
             self.tolerance,
-            fmt_psnr(self.noise_floor),
-            fmt_psnr(self.noise_floor_block),
-            b = self.block,
         )
     }
 }
@@ -622,6 +643,7 @@ pub(crate) mod tests {
             mean_spp: 700.4,
             tolerance: 0.5,
             converged: 0.9625,
+            exact: 0.0,
             noise_floor: 41.234,
             noise_floor_block: f64::INFINITY,
             block: 8,
@@ -658,5 +680,24 @@ pub(crate) mod tests {
         }
         old.as_object_mut().unwrap().remove("reference_error");
         assert_eq!(Report::from_json(&old.to_string()).unwrap(), sample());
+        // An exact reference says so: in part, then wholly.
+        let mut e = r.reference_error.clone().unwrap();
+        e.exact = 0.25;
+        let text = e.sentence();
+        assert!(
+            text.contains("25.0 % of the covered pixels exact"),
+            "{text}"
+        );
+        assert!(
+            text.contains("the others sampled: 256-4096 samples"),
+            "{text}"
+        );
+        e.exact = 1.0;
+        let text = e.sentence();
+        assert!(
+            text.starts_with("Reference: every covered pixel exact"),
+            "{text}"
+        );
+        assert!(!text.contains("samples per pixel"), "{text}");
     }
 }

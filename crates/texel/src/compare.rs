@@ -275,6 +275,7 @@ fn reference_summary(
         mean_spp: estimate.mean_spp(Some(covered)),
         tolerance: estimate.plan.tolerance_steps(),
         converged: estimate.converged_share(Some(covered)),
+        exact: estimate.exact_share(Some(covered)),
         noise_floor: error.noise_floor(Some(coverage))?,
         noise_floor_block: error.block_noise_floor(Some(coverage), DEFAULT_BLOCK)?,
         block: DEFAULT_BLOCK,
