@@ -13,8 +13,9 @@
 //! intersection's (inclusion-exclusion; the polygons hiding one triangle must not overlap one
 //! another). What no polygon covers is the background colour. A pixel falls back to sampling when
 //! a triangle that reaches it is lit, sphere-mapped or vertex-coloured across its vertices, when
-//! two triangles interpenetrate inside it or three layers overlap, and, with an environment as the
-//! background, where the background shows.
+//! two triangles interpenetrate inside it or three layers overlap, with an environment as the
+//! background where the background shows, and where its preimage reaches beyond
+//! [`MAX_COORDINATE`] texels or its boundary would be cut at more than [`MAX_CUTS`] knots.
 //!
 //! **The integral over one polygon.** The map from screen to texel coordinates `q = (s, t)`
 //! (`s = u W - 1/2`, so texel `i`'s centre sits at `s = i`) is projective, `q = G (x, y, 1)` up to
@@ -71,6 +72,13 @@ pub const MAX_TABLE_BYTES: u64 = 1 << 30;
 
 /// Most pieces one polygon is cut into; a pixel that would need more is sampled.
 const MAX_PIECES: usize = 1 << 16;
+
+/// Most knots one polygon's boundary may be cut at; a pixel that needs more is sampled.
+pub const MAX_CUTS: usize = 1 << 16;
+
+/// Largest texel coordinate a polygon may reach (beyond it `f64` keeps too few fraction bits for
+/// the moments); a pixel whose preimage reaches further is sampled.
+pub const MAX_COORDINATE: f64 = 1e9;
 
 /// Most triangles reaching one pixel that the visibility test considers; more are sampled.
 const MAX_LAYER_CANDIDATES: usize = 48;
@@ -142,24 +150,31 @@ impl Knots {
         }
     }
 
-    /// Call `f` with every active knot strictly between `lo` and `hi`.
-    fn each(&self, lo: f64, hi: f64, mut f: impl FnMut(f64)) {
+    /// Push every active knot strictly between `lo` and `hi` (converted by `f`) onto `cuts`;
+    /// `false` once `cuts` would exceed [`MAX_CUTS`].
+    fn each(&self, lo: f64, hi: f64, cuts: &mut Vec<f64>, f: impl Fn(f64) -> f64) -> bool {
         if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
-            return;
+            return true;
         }
         let mut n = lo.floor() as i64 + 1;
         let end = hi.ceil() as i64;
+        let mut push = |k: i64| {
+            cuts.push(f(k as f64));
+            cuts.len() <= MAX_CUTS
+        };
         match self.period {
             Some(p) => {
                 while n < end {
                     let idx = n.rem_euclid(p) as usize;
                     if self.active[idx] {
-                        f(n as f64);
+                        if !push(n) {
+                            return false;
+                        }
                         n += 1;
                     } else {
                         let d = self.next[idx];
                         if d == u32::MAX {
-                            return;
+                            return true;
                         }
                         n += i64::from(d);
                     }
@@ -168,12 +183,13 @@ impl Knots {
             None => {
                 let top = self.base + self.active.len() as i64;
                 for k in n.max(self.base)..end.min(top) {
-                    if self.active[(k - self.base) as usize] {
-                        f(k as f64);
+                    if self.active[(k - self.base) as usize] && !push(k) {
+                        return false;
                     }
                 }
             }
         }
+        true
     }
 }
 
@@ -521,12 +537,13 @@ struct Weight {
     a: [[f64; 4]; 4],
 }
 
-/// `integral_P f w` over the convex texel-space polygon `poly` (either orientation).
-fn polygon_integral(rows: &Rows, poly: &[DVec2], w: &Weight) -> [f64; 4] {
+/// `integral_P f w` over the convex texel-space polygon `poly` (either orientation); `None`
+/// when its boundary crosses more than [`MAX_CUTS`] bending knots.
+fn polygon_integral(rows: &Rows, poly: &[DVec2], w: &Weight) -> Option<[f64; 4]> {
     let mut total = [0.0; 4];
     let n = poly.len();
     if n < 3 {
-        return total;
+        return Some(total);
     }
     let (mut tmin, mut tmax) = (f64::INFINITY, f64::NEG_INFINITY);
     for p in poly {
@@ -534,19 +551,22 @@ fn polygon_integral(rows: &Rows, poly: &[DVec2], w: &Weight) -> [f64; 4] {
         tmax = tmax.max(p.y);
     }
     if tmax <= tmin {
-        return total;
+        return Some(total);
     }
     let mut cuts: Vec<f64> = poly.iter().map(|p| p.y).collect();
-    rows.row_knots.each(tmin, tmax, |j| cuts.push(j));
+    if !rows.row_knots.each(tmin, tmax, &mut cuts, |j| j) {
+        return None;
+    }
     for e in 0..n {
         let (a, b) = (poly[e], poly[(e + 1) % n]);
         if a.y == b.y || a.x == b.x {
             continue;
         }
         let (lo, hi) = (a.x.min(b.x), a.x.max(b.x));
-        rows.columns.each(lo, hi, |s| {
-            cuts.push(a.y + (s - a.x) / (b.x - a.x) * (b.y - a.y));
-        });
+        let at = |s: f64| a.y + (s - a.x) / (b.x - a.x) * (b.y - a.y);
+        if !rows.columns.each(lo, hi, &mut cuts, at) {
+            return None;
+        }
     }
     cuts.sort_by(f64::total_cmp);
     cuts.dedup();
@@ -602,7 +622,7 @@ fn polygon_integral(rows: &Rows, poly: &[DVec2], w: &Weight) -> [f64; 4] {
             }
         }
     }
-    total
+    Some(total)
 }
 
 /// `sum_(m > deg) (m + 1)(m + 2)/2 d^m`: the Taylor remainder of `(1 + e)^-3` at `|e| <= d`.
@@ -697,7 +717,7 @@ impl Exactable {
                 DVec2::new(v.x / v.z, v.y / v.z)
             })
             .collect();
-        if q.iter().any(|p| !p.is_finite()) {
+        if q.iter().any(|p| !(p.abs().max_element() <= MAX_COORDINATE)) {
             return None;
         }
         let qc = q.iter().copied().sum::<DVec2>() / q.len() as f64;
@@ -723,7 +743,7 @@ impl Exactable {
             deg,
             a,
         };
-        Some(polygon_integral(rows, &q, &w))
+        polygon_integral(rows, &q, &w)
     }
 }
 

@@ -413,3 +413,25 @@ fn pixels_it_cannot_integrate_are_sampled_and_marked() {
     }
     assert!(sampled.exact.iter().all(|&x| !x));
 }
+
+#[test]
+fn absurd_texture_coordinates_are_sampled_not_hung_on() {
+    // uvs of 1e12 periods across a 4 x 4 frame of a texture that bends at every texel: the
+    // preimage is beyond what f64 moments resolve and would cut the boundary at 1e13 knots, so
+    // every pixel falls back to sampling (and says so) instead of running for ever.
+    let (w, h) = (4, 4);
+    let texture = float_texture(8, 8, |i, j| {
+        [((i * 7 + j * 3) % 5) as f32 / 4.0, 0.5, 0.5, 1.0]
+    });
+    let s = sampler(AddressMode::Repeat);
+    let big = 1e12f32;
+    let vertices = quad(
+        w,
+        h,
+        [0.0, 0.0, 4.0, 4.0],
+        [[0., 0.], [big, 0.], [big, big], [0., big]],
+    );
+    let settings = RenderSettings::new(w, h);
+    let e = render_exact(&settings, &[draw(&vertices, &QUAD, &texture, &s)], None).unwrap();
+    assert!(e.exact.iter().all(|&x| !x));
+}
