@@ -717,7 +717,9 @@ impl Exactable {
                 DVec2::new(v.x / v.z, v.y / v.z)
             })
             .collect();
-        if q.iter().any(|p| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE) {
+        if q.iter()
+            .any(|p| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE)
+        {
             return None;
         }
         let qc = q.iter().copied().sum::<DVec2>() / q.len() as f64;
