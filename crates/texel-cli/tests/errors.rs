@@ -468,7 +468,7 @@ fn error_bad_corners() {
 fn any_reference_spp_splits_into_passes() {
     let d = Dir::new("err-spp");
     // Any count splits into passes (67 = 67 passes of one sample), for `texel reference` and
-    // `compare` alike; the comparison's reference is the same image.
+    // `compare --sampled-reference` alike; the comparison's reference is the same image.
     ok(&[
         "reference",
         "--size",
@@ -488,6 +488,7 @@ fn any_reference_spp_splits_into_passes() {
         "67",
         "--filters",
         "nearest",
+        "--sampled-reference",
         "--out",
         &d.arg("c"),
     ]);
