@@ -558,16 +558,43 @@ pub(crate) fn line_column(text: &str, at: usize) -> (usize, usize) {
     (line, col)
 }
 
+/// The `[textures.NAME]` table `t`: a file (relative to `base`) or a procedural texture.
 fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, SceneError> {
-    let bad = |reason: String| SceneError::InvalidTexture {
-        name: name.to_string(),
-        reason,
-    };
+    let bad = |reason: String| invalid_texture(name, reason);
     let color = match t.color.unwrap_or(ColorName::Srgb) {
         ColorName::Srgb => ColorSpace::Srgb,
         ColorName::Linear => ColorSpace::Linear,
     };
-    let given: Vec<&str> = [
+    let given = given_parameters(&t);
+    let source = match (&t.path, t.procedural) {
+        (Some(_), Some(_)) => return Err(bad("give either path or procedural, not both".into())),
+        (None, None) => return Err(bad("give path = \"FILE\" or procedural = \"KIND\"".into())),
+        (Some(p), None) => {
+            if let Some(k) = given.first() {
+                return Err(bad(format!(
+                    "{k} is a parameter of procedural textures, not of a file"
+                )));
+            }
+            TextureSource::File(base.join(p))
+        }
+        (None, Some(kind)) => {
+            TextureSource::Procedural(procedural_texture(name, kind, &t, &given)?)
+        }
+    };
+    Ok(TextureSpec::new(source, color))
+}
+
+/// The error of texture `name` for `reason`.
+fn invalid_texture(name: &str, reason: String) -> SceneError {
+    SceneError::InvalidTexture {
+        name: name.to_string(),
+        reason,
+    }
+}
+
+/// The procedural parameters texture table `t` gives, in the order the scene file docs list them.
+fn given_parameters(t: &RawTexture) -> Vec<&'static str> {
+    [
         ("size", t.size.is_some()),
         ("width", t.width.is_some()),
         ("height", t.height.is_some()),
@@ -587,157 +614,198 @@ fn texture_spec(name: &str, t: RawTexture, base: &Path) -> Result<TextureSpec, S
     .iter()
     .filter(|p| p.1)
     .map(|p| p.0)
-    .collect();
-    let source = match (t.path, t.procedural) {
-        (Some(_), Some(_)) => return Err(bad("give either path or procedural, not both".into())),
-        (None, None) => return Err(bad("give path = \"FILE\" or procedural = \"KIND\"".into())),
-        (Some(p), None) => {
-            if let Some(k) = given.first() {
-                return Err(bad(format!(
-                    "{k} is a parameter of procedural textures, not of a file"
-                )));
-            }
-            TextureSource::File(base.join(p))
-        }
-        (None, Some(kind)) => {
-            let allowed: &[&str] = match kind {
-                Kind::Checker => &["size", "width", "height", "checks"],
-                Kind::Zoneplate => &["size"],
-                Kind::Grid => &["size", "width", "height", "cells", "line_width"],
-                Kind::Uv => &["size", "width", "height"],
-                Kind::Solid => &["size", "width", "height", "rgba"],
-                Kind::Bumps => &["size", "cells", "slope"],
-                Kind::Waves | Kind::WaveHeights => &["size", "waves", "cells", "slope", "seed"],
-                Kind::Bricks | Kind::BrickHeights => &[
-                    "size", "width", "height", "rows", "columns", "mortar", "bevel",
-                ],
-                Kind::Noise => &["size", "cells", "seed", "rgba"],
-                Kind::NoiseHeights => &["size", "cells", "seed"],
-                Kind::Splat => &["size", "cells", "seed", "layers"],
-                Kind::Globe | Kind::GlobeMercator => &["size", "width", "height"],
-            };
-            if let Some(k) = given.iter().find(|k| !allowed.contains(k)) {
-                return Err(bad(format!(
-                    "{k} is not a parameter of {} (it takes {})",
-                    kind.name(),
-                    allowed.join(", ")
-                )));
-            }
-            let default_size = match kind {
-                Kind::Checker | Kind::Zoneplate | Kind::Grid => 1024,
-                Kind::Uv => 256,
-                Kind::Solid => 1,
-                Kind::Bumps | Kind::Waves | Kind::WaveHeights => 512,
-                Kind::Noise | Kind::NoiseHeights | Kind::Splat => 512,
-                Kind::Bricks | Kind::BrickHeights | Kind::Globe | Kind::GlobeMercator => 0,
-            };
-            let (width, height) = match (t.size, t.width, t.height) {
-                (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
-                    return Err(bad("give size or width and height, not both".into()))
-                }
-                (Some(s), None, None) => (s, s),
-                (None, Some(w), Some(h)) => (w, h),
-                (None, None, None) if matches!(kind, Kind::Bricks | Kind::BrickHeights) => {
-                    (1024, 512)
-                }
-                (None, None, None) if matches!(kind, Kind::Globe) => (2048, 1024),
-                (None, None, None) if matches!(kind, Kind::GlobeMercator) => (2048, 2048),
-                (None, None, None) => (default_size, default_size),
-                _ => return Err(bad("width and height go together".into())),
-            };
-            let slope = |v: Option<f32>, default: f32| match v.unwrap_or(default) {
-                s if s.is_finite() && s >= 0.0 => Ok(s),
-                s => Err(bad(format!("slope = {s} must be finite and >= 0"))),
-            };
-            let positive = |v: Option<u32>, key: &str, default: u32| match v {
-                Some(0) => Err(bad(format!("{key} must be at least 1"))),
-                Some(v) => Ok(v),
-                None => Ok(default),
-            };
-            let procedural = match kind {
-                Kind::Checker => Procedural::Checker {
-                    width,
-                    height,
-                    checks: positive(t.checks, "checks", 8)?,
-                },
-                Kind::Zoneplate => Procedural::ZonePlate { size: width },
-                Kind::Grid => {
-                    let line_width = t.line_width.unwrap_or(2.0);
-                    if !(line_width.is_finite() && line_width >= 0.0) {
-                        return Err(bad(format!(
-                            "line_width = {line_width} must be finite and >= 0"
-                        )));
-                    }
-                    Procedural::Grid {
-                        width,
-                        height,
-                        cells: positive(t.cells, "cells", 8)?,
-                        line_width,
-                    }
-                }
-                Kind::Uv => Procedural::Uv { width, height },
-                Kind::Bumps => Procedural::Bumps {
-                    size: width,
-                    cells: positive(t.cells, "cells", 32)?,
-                    slope: slope(t.slope, 0.5)?,
-                },
-                Kind::Waves | Kind::WaveHeights => Procedural::Waves {
-                    size: width,
-                    waves: positive(t.waves, "waves", 64)?,
-                    cells: positive(t.cells, "cells", 32)?,
-                    slope: slope(t.slope, 0.3)?,
-                    seed: t.seed.unwrap_or(1),
-                    heights: matches!(kind, Kind::WaveHeights),
-                },
-                Kind::Bricks | Kind::BrickHeights => {
-                    let texels =
-                        |v: Option<f32>, key: &str, default: f32| match v.unwrap_or(default) {
-                            x if x.is_finite() && x >= 0.0 => Ok(x),
-                            x => Err(bad(format!("{key} = {x} must be finite and >= 0"))),
-                        };
-                    Procedural::Bricks {
-                        width,
-                        height,
-                        rows: positive(t.rows, "rows", 14)?,
-                        columns: positive(t.columns, "columns", 9)?,
-                        mortar: texels(t.mortar, "mortar", 4.0)?,
-                        bevel: texels(t.bevel, "bevel", 3.0)?,
-                        heights: matches!(kind, Kind::BrickHeights),
-                    }
-                }
-                Kind::Globe | Kind::GlobeMercator => Procedural::Globe {
-                    width,
-                    height,
-                    mercator: matches!(kind, Kind::GlobeMercator),
-                },
-                Kind::Solid => Procedural::Solid {
-                    width,
-                    height,
-                    rgba: t.rgba.unwrap_or([255; 4]),
-                },
-                Kind::Noise | Kind::NoiseHeights | Kind::Splat => Procedural::Noise {
-                    size: width,
-                    cells: positive(t.cells, "cells", 8)?,
-                    seed: t.seed.unwrap_or(1),
-                    kind: match kind {
-                        Kind::Noise => NoiseKind::Color {
-                            rgba: t.rgba.unwrap_or([255; 4]),
-                        },
-                        Kind::NoiseHeights => NoiseKind::Heights,
-                        _ => NoiseKind::Splat {
-                            layers: match t.layers.unwrap_or(4) {
-                                l @ 1..=4 => l,
-                                l => return Err(bad(format!("layers = {l} must be 1 to 4"))),
-                            },
-                        },
-                    },
-                },
-            };
-            procedural.check_work().map_err(bad)?;
-            TextureSource::Procedural(procedural)
-        }
+    .collect()
+}
+
+/// The parameters a procedural texture of `kind` takes.
+fn allowed_parameters(kind: Kind) -> &'static [&'static str] {
+    match kind {
+        Kind::Checker => &["size", "width", "height", "checks"],
+        Kind::Zoneplate => &["size"],
+        Kind::Grid => &["size", "width", "height", "cells", "line_width"],
+        Kind::Uv => &["size", "width", "height"],
+        Kind::Solid => &["size", "width", "height", "rgba"],
+        Kind::Bumps => &["size", "cells", "slope"],
+        Kind::Waves | Kind::WaveHeights => &["size", "waves", "cells", "slope", "seed"],
+        Kind::Bricks | Kind::BrickHeights => &[
+            "size", "width", "height", "rows", "columns", "mortar", "bevel",
+        ],
+        Kind::Noise => &["size", "cells", "seed", "rgba"],
+        Kind::NoiseHeights => &["size", "cells", "seed"],
+        Kind::Splat => &["size", "cells", "seed", "layers"],
+        Kind::Globe | Kind::GlobeMercator => &["size", "width", "height"],
+    }
+}
+
+/// Procedural texture `name` of `kind` from table `t`, whose `given` parameters must be ones
+/// `kind` takes: its size resolved, its parameters checked, the work it asks for bounded.
+fn procedural_texture(
+    name: &str,
+    kind: Kind,
+    t: &RawTexture,
+    given: &[&'static str],
+) -> Result<Procedural, SceneError> {
+    let bad = |reason: String| invalid_texture(name, reason);
+    let allowed = allowed_parameters(kind);
+    if let Some(k) = given.iter().find(|k| !allowed.contains(k)) {
+        return Err(bad(format!(
+            "{k} is not a parameter of {} (it takes {})",
+            kind.name(),
+            allowed.join(", ")
+        )));
+    }
+    let (width, height) = texture_size(kind, t).map_err(bad)?;
+    let procedural = build_procedural(name, kind, t, width, height)?;
+    procedural.check_work().map_err(bad)?;
+    Ok(procedural)
+}
+
+/// Width and height of a procedural texture of `kind` from table `t`: `size` for both, or
+/// `width` and `height`, else the kind's default.
+fn texture_size(kind: Kind, t: &RawTexture) -> Result<(u32, u32), String> {
+    let default_size = match kind {
+        Kind::Checker | Kind::Zoneplate | Kind::Grid => 1024,
+        Kind::Uv => 256,
+        Kind::Solid => 1,
+        Kind::Bumps | Kind::Waves | Kind::WaveHeights => 512,
+        Kind::Noise | Kind::NoiseHeights | Kind::Splat => 512,
+        Kind::Bricks | Kind::BrickHeights | Kind::Globe | Kind::GlobeMercator => 0,
     };
-    Ok(TextureSpec::new(source, color))
+    Ok(match (t.size, t.width, t.height) {
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+            return Err("give size or width and height, not both".into())
+        }
+        (Some(s), None, None) => (s, s),
+        (None, Some(w), Some(h)) => (w, h),
+        (None, None, None) if matches!(kind, Kind::Bricks | Kind::BrickHeights) => (1024, 512),
+        (None, None, None) if matches!(kind, Kind::Globe) => (2048, 1024),
+        (None, None, None) if matches!(kind, Kind::GlobeMercator) => (2048, 2048),
+        (None, None, None) => (default_size, default_size),
+        _ => return Err("width and height go together".into()),
+    })
+}
+
+/// Parameter `key` of texture `name`: `v`, at least 1, else `default`.
+fn positive_parameter(
+    name: &str,
+    v: Option<u32>,
+    key: &str,
+    default: u32,
+) -> Result<u32, SceneError> {
+    match v {
+        Some(0) => Err(invalid_texture(name, format!("{key} must be at least 1"))),
+        Some(v) => Ok(v),
+        None => Ok(default),
+    }
+}
+
+/// Parameter `key` of texture `name`: `v`, else `default`, finite and at least 0.
+fn non_negative_parameter(
+    name: &str,
+    v: Option<f32>,
+    key: &str,
+    default: f32,
+) -> Result<f32, SceneError> {
+    match v.unwrap_or(default) {
+        x if x.is_finite() && x >= 0.0 => Ok(x),
+        x => Err(invalid_texture(
+            name,
+            format!("{key} = {x} must be finite and >= 0"),
+        )),
+    }
+}
+
+/// Procedural texture `name` of `kind`, `width` by `height`, with the parameters of table `t`
+/// checked and defaulted.
+fn build_procedural(
+    name: &str,
+    kind: Kind,
+    t: &RawTexture,
+    width: u32,
+    height: u32,
+) -> Result<Procedural, SceneError> {
+    let positive =
+        |v: Option<u32>, key: &str, default: u32| positive_parameter(name, v, key, default);
+    let non_negative =
+        |v: Option<f32>, key: &str, default: f32| non_negative_parameter(name, v, key, default);
+    Ok(match kind {
+        Kind::Checker => Procedural::Checker {
+            width,
+            height,
+            checks: positive(t.checks, "checks", 8)?,
+        },
+        Kind::Zoneplate => Procedural::ZonePlate { size: width },
+        Kind::Grid => {
+            let line_width = non_negative(t.line_width, "line_width", 2.0)?;
+            Procedural::Grid {
+                width,
+                height,
+                cells: positive(t.cells, "cells", 8)?,
+                line_width,
+            }
+        }
+        Kind::Uv => Procedural::Uv { width, height },
+        Kind::Bumps => Procedural::Bumps {
+            size: width,
+            cells: positive(t.cells, "cells", 32)?,
+            slope: non_negative(t.slope, "slope", 0.5)?,
+        },
+        Kind::Waves | Kind::WaveHeights => Procedural::Waves {
+            size: width,
+            waves: positive(t.waves, "waves", 64)?,
+            cells: positive(t.cells, "cells", 32)?,
+            slope: non_negative(t.slope, "slope", 0.3)?,
+            seed: t.seed.unwrap_or(1),
+            heights: matches!(kind, Kind::WaveHeights),
+        },
+        Kind::Bricks | Kind::BrickHeights => Procedural::Bricks {
+            width,
+            height,
+            rows: positive(t.rows, "rows", 14)?,
+            columns: positive(t.columns, "columns", 9)?,
+            mortar: non_negative(t.mortar, "mortar", 4.0)?,
+            bevel: non_negative(t.bevel, "bevel", 3.0)?,
+            heights: matches!(kind, Kind::BrickHeights),
+        },
+        Kind::Globe | Kind::GlobeMercator => Procedural::Globe {
+            width,
+            height,
+            mercator: matches!(kind, Kind::GlobeMercator),
+        },
+        Kind::Solid => Procedural::Solid {
+            width,
+            height,
+            rgba: t.rgba.unwrap_or([255; 4]),
+        },
+        Kind::Noise | Kind::NoiseHeights | Kind::Splat => Procedural::Noise {
+            size: width,
+            cells: positive(t.cells, "cells", 8)?,
+            seed: t.seed.unwrap_or(1),
+            kind: noise_kind(name, kind, t)?,
+        },
+    })
+}
+
+/// What a noise texture of `kind` (noise, noise-heights or splat) makes of its noise, from table
+/// `t`: a colour, heights, or 1 to 4 splat layers.
+fn noise_kind(name: &str, kind: Kind, t: &RawTexture) -> Result<NoiseKind, SceneError> {
+    Ok(match kind {
+        Kind::Noise => NoiseKind::Color {
+            rgba: t.rgba.unwrap_or([255; 4]),
+        },
+        Kind::NoiseHeights => NoiseKind::Heights,
+        _ => NoiseKind::Splat {
+            layers: match t.layers.unwrap_or(4) {
+                l @ 1..=4 => l,
+                l => {
+                    return Err(invalid_texture(
+                        name,
+                        format!("layers = {l} must be 1 to 4"),
+                    ))
+                }
+            },
+        },
+    })
 }
 
 /// The texture a mesh is drawn with: its own `texture`, or its material's `base_color` texture
@@ -788,13 +856,13 @@ fn mesh_texture(
     }
 }
 
-/// The meshes of `[[meshes]]` entry `index`; a glTF file's own textures and materials beside them
-/// where the entry names no material.
 /// glTF files a scene has read, by what the import depended on (path, imported materials, the
 /// entry's texture, the texture the meshes are drawn with): a file named by many entries is read
 /// once.
 type GltfCache = std::collections::HashMap<(PathBuf, bool, Option<String>, String), GltfScene>;
 
+/// The meshes of `[[meshes]]` entry `index`; a glTF file's own textures and materials beside them
+/// where the entry names no material.
 fn meshes(
     index: usize,
     m: RawMesh,
@@ -829,78 +897,15 @@ fn meshes(
     let both = m.address_mode.map(AddressMode::from);
     let mode_u = m.address_mode_u.map(AddressMode::from).or(both);
     let mode_v = m.address_mode_v.map(AddressMode::from).or(both);
-    let mut out = if let Some(positions) = m.positions {
-        let (Some(uvs), Some(triangles)) = (m.uvs, m.triangles) else {
-            return Err(src("inline meshes need positions, uvs and triangles"));
-        };
-        GltfScene::from(vec![Mesh {
-            positions: positions.into_iter().map(Vec3::from).collect(),
-            uvs: uvs.into_iter().map(Vec2::from).collect(),
-            normals: m.normals.map(|v| v.into_iter().map(Vec3::from).collect()),
-            colors: m.colors.map(|v| v.into_iter().map(Vec4::from).collect()),
-            triangles,
-            texture: texture.clone(),
-            address_mode_u: AddressMode::Repeat,
-            address_mode_v: AddressMode::Repeat,
-            filters: None,
-            material: None,
-            tangents: None,
-            uv_mapping: None,
-        }])
+    let material = m.material.clone();
+    let mut out = if m.positions.is_some() {
+        inline_mesh(index, m, texture)?
     } else {
-        if m.uvs.is_some() || m.triangles.is_some() || m.normals.is_some() || m.colors.is_some() {
-            return Err(src(
-                "uvs, triangles, normals and colors are only allowed with inline positions",
-            ));
-        }
-        if let Some(obj) = m.obj {
-            GltfScene::from(vec![crate::obj::load_obj_with(
-                &base.join(obj),
-                &texture,
-                limits,
-            )?])
-        } else {
-            let file = m.gltf.expect("one source");
-            let path = base.join(&file);
-            let key = (
-                path.clone(),
-                own_materials,
-                m.texture.clone(),
-                texture.clone(),
-            );
-            if let Some(done) = cache.get(&key) {
-                let tris: u64 = done.meshes.iter().map(|m| m.triangles.len() as u64).sum();
-                let verts: u64 = done.meshes.iter().map(|m| m.positions.len() as u64).sum();
-                let meshes = done.meshes.len() as u64;
-                if tris > limits.max_triangles
-                    || verts > limits.max_vertices
-                    || meshes > limits.max_meshes
-                {
-                    return Err(SceneError::TooLarge(format!(
-                        "meshes[{index}] ({file}) adds {meshes} meshes, {tris} triangles and \
-                         {verts} vertices to the meshes before it, over what the limits of the \
-                         scene leave ({} meshes, {} triangles, {} vertices)",
-                        limits.max_meshes, limits.max_triangles, limits.max_vertices
-                    )));
-                }
-                done.clone()
-            } else {
-                let loaded = match own_materials {
-                    true => {
-                        crate::gltf_import::import_gltf(&path, m.texture.as_deref(), &file, limits)?
-                    }
-                    false => GltfScene::from(crate::gltf_import::load_gltf_with(
-                        &path, &texture, limits,
-                    )?),
-                };
-                cache.insert(key, loaded.clone());
-                loaded
-            }
-        }
+        file_meshes(index, m, base, limits, own_materials, texture, cache)?
     };
     for mesh in &mut out.meshes {
-        if m.material.is_some() {
-            mesh.material.clone_from(&m.material);
+        if material.is_some() {
+            mesh.material.clone_from(&material);
         }
         if let Some(u) = mode_u {
             mesh.address_mode_u = u;
@@ -913,6 +918,97 @@ fn meshes(
         }
     }
     Ok(out)
+}
+
+/// The mesh of `[[meshes]]` entry `index`'s inline positions, uvs, triangles and optional
+/// normals and colours, drawn with `texture`.
+fn inline_mesh(index: usize, m: RawMesh, texture: String) -> Result<GltfScene, SceneError> {
+    let (Some(positions), Some(uvs), Some(triangles)) = (m.positions, m.uvs, m.triangles) else {
+        return Err(SceneError::MeshSource {
+            mesh: index,
+            reason: "inline meshes need positions, uvs and triangles",
+        });
+    };
+    Ok(GltfScene::from(vec![Mesh {
+        positions: positions.into_iter().map(Vec3::from).collect(),
+        uvs: uvs.into_iter().map(Vec2::from).collect(),
+        normals: m.normals.map(|v| v.into_iter().map(Vec3::from).collect()),
+        colors: m.colors.map(|v| v.into_iter().map(Vec4::from).collect()),
+        triangles,
+        texture,
+        address_mode_u: AddressMode::Repeat,
+        address_mode_v: AddressMode::Repeat,
+        filters: None,
+        material: None,
+        tangents: None,
+        uv_mapping: None,
+    }]))
+}
+
+/// The meshes of `[[meshes]]` entry `index`'s OBJ or glTF file (relative to `base`), which takes
+/// no inline arrays; a glTF file is read once per import (`cache`).
+fn file_meshes(
+    index: usize,
+    m: RawMesh,
+    base: &Path,
+    limits: &SceneLimits,
+    own_materials: bool,
+    texture: String,
+    cache: &mut GltfCache,
+) -> Result<GltfScene, SceneError> {
+    if m.uvs.is_some() || m.triangles.is_some() || m.normals.is_some() || m.colors.is_some() {
+        return Err(SceneError::MeshSource {
+            mesh: index,
+            reason: "uvs, triangles, normals and colors are only allowed with inline positions",
+        });
+    }
+    if let Some(obj) = m.obj {
+        return Ok(GltfScene::from(vec![crate::obj::load_obj_with(
+            &base.join(obj),
+            &texture,
+            limits,
+        )?]));
+    }
+    let file = m.gltf.expect("one source");
+    let path = base.join(&file);
+    let key = (
+        path.clone(),
+        own_materials,
+        m.texture.clone(),
+        texture.clone(),
+    );
+    if let Some(done) = cache.get(&key) {
+        check_cached_fits(index, &file, done, limits)?;
+        return Ok(done.clone());
+    }
+    let loaded = match own_materials {
+        true => crate::gltf_import::import_gltf(&path, m.texture.as_deref(), &file, limits)?,
+        false => GltfScene::from(crate::gltf_import::load_gltf_with(&path, &texture, limits)?),
+    };
+    cache.insert(key, loaded.clone());
+    Ok(loaded)
+}
+
+/// Checks that glTF file `file`'s meshes `done`, read for an earlier entry, fit in what the
+/// scene's limits leave (`limits`) for `[[meshes]]` entry `index`.
+fn check_cached_fits(
+    index: usize,
+    file: &str,
+    done: &GltfScene,
+    limits: &SceneLimits,
+) -> Result<(), SceneError> {
+    let tris: u64 = done.meshes.iter().map(|m| m.triangles.len() as u64).sum();
+    let verts: u64 = done.meshes.iter().map(|m| m.positions.len() as u64).sum();
+    let meshes = done.meshes.len() as u64;
+    if tris > limits.max_triangles || verts > limits.max_vertices || meshes > limits.max_meshes {
+        return Err(SceneError::TooLarge(format!(
+            "meshes[{index}] ({file}) adds {meshes} meshes, {tris} triangles and \
+             {verts} vertices to the meshes before it, over what the limits of the \
+             scene leave ({} meshes, {} triangles, {} vertices)",
+            limits.max_meshes, limits.max_triangles, limits.max_vertices
+        )));
+    }
+    Ok(())
 }
 
 /// Add what mesh `index`'s glTF file imported into the scene's `table`; an entry the scene (or an

@@ -72,6 +72,72 @@ pub fn filters(mag: Option<MagFilter>, min: Option<MinFilter>) -> MeshFilters {
     }
 }
 
+/// How a node's transform places a mesh: points by `world`, tangents by its linear part `linear`,
+/// normals by `normal_from_world` (the inverse transpose), a tangent's `w` times `flip`.
+#[derive(Clone, Copy)]
+struct Placement {
+    world: Mat4,
+    linear: Mat3,
+    normal_from_world: Mat3,
+    flip: f32,
+}
+
+impl Placement {
+    /// The placement by transform `world`.
+    fn new(world: Mat4) -> Self {
+        let linear = Mat3::from_mat4(world);
+        let normal_from_world = linear.inverse().transpose();
+        // A mirroring transform flips the bitangent: a tangent's w follows the determinant's sign.
+        let flip = linear.determinant().signum();
+        Placement {
+            world,
+            linear,
+            normal_from_world,
+            flip,
+        }
+    }
+}
+
+/// The address modes and filters of base colour texture `base_info`'s sampler; Repeat and no
+/// filters without one.
+fn sampler_modes(
+    base_info: Option<&gltf::texture::Info>,
+) -> (AddressMode, AddressMode, Option<MeshFilters>) {
+    let sampler = base_info.map(|info| info.texture().sampler());
+    match &sampler {
+        Some(s) => (
+            wrap(s.wrap_s()),
+            wrap(s.wrap_t()),
+            Some(filters(s.mag_filter(), s.min_filter())),
+        ),
+        None => (AddressMode::Repeat, AddressMode::Repeat, None),
+    }
+}
+
+/// The triangle list a primitive of `mode` makes from `indices` (glTF 2.0 spec 3.7.2.1); `None`
+/// for points and lines.
+fn triangle_list(mode: Mode, indices: &[u32]) -> Option<Vec<[u32; 3]>> {
+    Some(match mode {
+        Mode::Triangles => indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect(),
+        Mode::TriangleStrip => (0..indices.len().saturating_sub(2))
+            .map(|i| {
+                if i % 2 == 0 {
+                    [indices[i], indices[i + 1], indices[i + 2]]
+                } else {
+                    [indices[i + 1], indices[i], indices[i + 2]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (1..indices.len().saturating_sub(1))
+            .map(|i| [indices[0], indices[i], indices[i + 1]])
+            .collect(),
+        _ => return None,
+    })
+}
+
 /// Deepest node nesting followed (the recursion's stack depth).
 const MAX_DEPTH: usize = 256;
 
@@ -125,118 +191,117 @@ impl Ctx<'_> {
     }
 
     fn mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
-        let linear = Mat3::from_mat4(world);
-        let normal_from_world = linear.inverse().transpose();
-        // A mirroring transform flips the bitangent: a tangent's w follows the determinant's sign.
-        let flip = linear.determinant().signum();
+        let placement = Placement::new(world);
         for (pi, prim) in mesh.primitives().enumerate() {
             let what = format!("mesh {} primitive {pi}", mesh.index());
-            let buffers = self.buffers;
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| self.bad(format!("{what}: no readable POSITION")))?
-                .map(|p| world.transform_point3(Vec3::from(p)))
-                .collect();
-            let uvs: Vec<Vec2> = reader
-                .read_tex_coords(0)
-                .ok_or_else(|| {
-                    self.bad(format!("{what}: no readable TEXCOORD_0 (texel needs uvs)"))
-                })?
-                .into_f32()
-                .map(Vec2::from)
-                .collect();
-            let normals = reader.read_normals().map(|it| {
-                it.map(|n| (normal_from_world * Vec3::from(n)).normalize_or_zero())
-                    .collect::<Vec<_>>()
-            });
-            let colors = reader
-                .read_colors(0)
-                .map(|c| c.into_rgba_f32().map(Vec4::from).collect::<Vec<_>>());
-            let n = positions.len() as u32;
-            let indices: Vec<u32> = match prim.indices() {
-                Some(_) => reader
-                    .read_indices()
-                    .ok_or_else(|| self.bad(format!("{what}: indices outside their buffer")))?
-                    .into_u32()
-                    .collect(),
-                None => (0..n).collect(),
-            };
-            let triangles: Vec<[u32; 3]> = match prim.mode() {
-                Mode::Triangles => indices
-                    .chunks_exact(3)
-                    .map(|t| [t[0], t[1], t[2]])
-                    .collect(),
-                Mode::TriangleStrip => (0..indices.len().saturating_sub(2))
-                    .map(|i| {
-                        if i % 2 == 0 {
-                            [indices[i], indices[i + 1], indices[i + 2]]
-                        } else {
-                            [indices[i + 1], indices[i], indices[i + 2]]
-                        }
-                    })
-                    .collect(),
-                Mode::TriangleFan => (1..indices.len().saturating_sub(1))
-                    .map(|i| [indices[0], indices[i], indices[i + 1]])
-                    .collect(),
-                other => {
-                    return Err(self.bad(format!(
-                        "{what}: mode {other:?} has no triangles to texture"
-                    )))
-                }
-            };
-            let tangents = reader.read_tangents().map(|it| {
-                it.map(|t| {
-                    let xyz = (linear * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
-                    xyz.extend(if t[3] < 0.0 { -flip } else { flip })
-                })
-                .collect::<Vec<_>>()
-            });
-            let material = prim.material();
-            let base_info = material.pbr_metallic_roughness().base_color_texture();
-            let sampler = base_info.as_ref().map(|info| info.texture().sampler());
-            let (address_mode_u, address_mode_v, filters) = match &sampler {
-                Some(s) => (
-                    wrap(s.wrap_s()),
-                    wrap(s.wrap_t()),
-                    Some(filters(s.mag_filter(), s.min_filter())),
-                ),
-                None => (AddressMode::Repeat, AddressMode::Repeat, None),
-            };
-            if triangles.is_empty() {
-                // Nothing to draw (glTF allows it); the file is refused only if nothing is left.
-                continue;
+            if let Some(m) = self.primitive(&prim, &what, &placement)? {
+                self.out.push(m);
             }
-            let imported = match material.index() {
-                Some(index) if self.importing() => Some(self.material(&material, index)?),
-                _ => None,
-            };
-            let texture = match (self.texture, base_info) {
-                (Some(t), _) => t.to_string(),
-                (None, Some(info)) if self.importing() => self.texture(
-                    &info.texture(),
-                    info.tex_coord(),
-                    ColorSpace::Srgb,
-                    "baseColorTexture",
-                )?,
-                (None, _) => self.white(),
-            };
-            self.out.push(Mesh {
-                positions,
-                uvs,
-                normals,
-                colors,
-                triangles,
-                texture,
-                address_mode_u,
-                address_mode_v,
-                filters,
-                material: imported,
-                tangents,
-                uv_mapping: None,
-            });
         }
         Ok(())
+    }
+
+    /// Reads primitive `prim` (named `what` in errors) as a mesh placed by `placement`, with its
+    /// sampler's address modes and filters, its material and its texture; `None` where it has
+    /// no triangles.
+    fn primitive(
+        &mut self,
+        prim: &gltf::Primitive,
+        what: &str,
+        placement: &Placement,
+    ) -> Result<Option<Mesh>, SceneError> {
+        let Placement {
+            world,
+            linear,
+            normal_from_world,
+            flip,
+        } = *placement;
+        let buffers = self.buffers;
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| self.bad(format!("{what}: no readable POSITION")))?
+            .map(|p| world.transform_point3(Vec3::from(p)))
+            .collect();
+        let uvs: Vec<Vec2> = reader
+            .read_tex_coords(0)
+            .ok_or_else(|| self.bad(format!("{what}: no readable TEXCOORD_0 (texel needs uvs)")))?
+            .into_f32()
+            .map(Vec2::from)
+            .collect();
+        let normals = reader.read_normals().map(|it| {
+            it.map(|n| (normal_from_world * Vec3::from(n)).normalize_or_zero())
+                .collect::<Vec<_>>()
+        });
+        let colors = reader
+            .read_colors(0)
+            .map(|c| c.into_rgba_f32().map(Vec4::from).collect::<Vec<_>>());
+        let n = positions.len() as u32;
+        let indices: Vec<u32> = match prim.indices() {
+            Some(_) => reader
+                .read_indices()
+                .ok_or_else(|| self.bad(format!("{what}: indices outside their buffer")))?
+                .into_u32()
+                .collect(),
+            None => (0..n).collect(),
+        };
+        let triangles = triangle_list(prim.mode(), &indices).ok_or_else(|| {
+            self.bad(format!(
+                "{what}: mode {:?} has no triangles to texture",
+                prim.mode()
+            ))
+        })?;
+        let tangents = reader.read_tangents().map(|it| {
+            it.map(|t| {
+                let xyz = (linear * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
+                xyz.extend(if t[3] < 0.0 { -flip } else { flip })
+            })
+            .collect::<Vec<_>>()
+        });
+        let material = prim.material();
+        let base_info = material.pbr_metallic_roughness().base_color_texture();
+        let (address_mode_u, address_mode_v, filters) = sampler_modes(base_info.as_ref());
+        if triangles.is_empty() {
+            // Nothing to draw (glTF allows it); the file is refused only if nothing is left.
+            return Ok(None);
+        }
+        let imported = match material.index() {
+            Some(index) if self.importing() => Some(self.material(&material, index)?),
+            _ => None,
+        };
+        let texture = self.primitive_texture(base_info)?;
+        Ok(Some(Mesh {
+            positions,
+            uvs,
+            normals,
+            colors,
+            triangles,
+            texture,
+            address_mode_u,
+            address_mode_v,
+            filters,
+            material: imported,
+            tangents,
+            uv_mapping: None,
+        }))
+    }
+
+    /// The texture a primitive is drawn with: the scene's, else (when importing) its base colour
+    /// texture `base_info`, else white.
+    fn primitive_texture(
+        &mut self,
+        base_info: Option<gltf::texture::Info>,
+    ) -> Result<String, SceneError> {
+        Ok(match (self.texture, base_info) {
+            (Some(t), _) => t.to_string(),
+            (None, Some(info)) if self.importing() => self.texture(
+                &info.texture(),
+                info.tex_coord(),
+                ColorSpace::Srgb,
+                "baseColorTexture",
+            )?,
+            (None, _) => self.white(),
+        })
     }
 
     /// The scene material of glTF material `m` (number `index`), imported on first use: its
@@ -549,134 +614,177 @@ fn check_primitive(prim: &gltf::Primitive, limits: &SceneLimits) -> Result<(), S
 /// component, its last element ends inside the view, and a sparse accessor's indices (u8, u16 or
 /// u32) and values fit their views, which declare no stride.
 fn check_accessors(json: &gltf::json::Root) -> Result<(), String> {
-    use gltf::json::validation::Checked;
-    let view_at = |v: usize, what: &str| -> Result<(u64, Option<u64>), String> {
-        let view = json.buffer_views.get(v).ok_or_else(|| {
-            format!(
-                "{what} refers to buffer view {v}, but the file has {}",
-                json.buffer_views.len()
-            )
-        })?;
-        let b = view.buffer.value();
-        let buffer = json.buffers.get(b).ok_or_else(|| {
-            format!(
-                "buffer view {v} refers to buffer {b}, but the file has {}",
-                json.buffers.len()
-            )
-        })?;
-        let offset = view.byte_offset.map_or(0, |o| o.0);
-        let len = view.byte_length.0;
-        if offset
-            .checked_add(len)
-            .is_none_or(|end| end > buffer.byte_length.0)
-        {
-            return Err(format!(
-                "buffer view {v} (offset {offset}, {len} bytes) reaches past the end of buffer {b} ({} bytes)",
-                buffer.byte_length.0
-            ));
-        }
-        let stride = view.byte_stride.map(|s| s.0 as u64).filter(|&s| s != 0);
-        Ok((len, stride))
-    };
-    // Does `count` elements of `elem` bytes, `stride` apart, from `offset` fit in `len` bytes?
-    let fits = |offset: u64, count: u64, stride: u64, elem: u64, len: u64| {
-        count == 0
-            || (count - 1)
-                .checked_mul(stride)
-                .and_then(|x| x.checked_add(offset))
-                .and_then(|x| x.checked_add(elem))
-                .is_some_and(|end| end <= len)
-    };
     for (i, a) in json.accessors.iter().enumerate() {
-        let what = format!("accessor {i}");
-        let (Checked::Valid(ct), Checked::Valid(ty)) = (&a.component_type, &a.type_) else {
+        check_accessor(json, i, a)?;
+    }
+    Ok(())
+}
+
+/// Checks accessor `i` (`a`): known component and element types, at least one element, its
+/// layout in its buffer view, and its sparse part.
+fn check_accessor(
+    json: &gltf::json::Root,
+    i: usize,
+    a: &gltf::json::Accessor,
+) -> Result<(), String> {
+    use gltf::json::validation::Checked;
+    let what = format!("accessor {i}");
+    let (Checked::Valid(ct), Checked::Valid(ty)) = (&a.component_type, &a.type_) else {
+        return Err(format!(
+            "{what} has an unknown component type or element type"
+        ));
+    };
+    let comp = ct.0.size() as u64;
+    let elem = comp * ty.multiplicity() as u64;
+    let count = a.count.0;
+    if count == 0 {
+        // glTF 2.0 requires count >= 1 (the crate's readers compute count - 1).
+        return Err(format!(
+            "{what} has no elements (glTF 2.0 needs a count of at least 1)"
+        ));
+    }
+    let offset = a.byte_offset.map_or(0, |o| o.0);
+    if let Some(v) = &a.buffer_view {
+        check_accessor_view(json, &what, v.value(), offset, count, comp, elem)?;
+    }
+    if let Some(sp) = &a.sparse {
+        check_sparse(json, &what, sp, count, elem)?;
+    }
+    Ok(())
+}
+
+/// Checks that accessor `what`'s `count` elements of `elem` bytes (`comp`-byte components),
+/// from `offset` in buffer view `v`, are aligned, have an allowed stride and lie inside the view.
+fn check_accessor_view(
+    json: &gltf::json::Root,
+    what: &str,
+    v: usize,
+    offset: u64,
+    count: u64,
+    comp: u64,
+    elem: u64,
+) -> Result<(), String> {
+    let (len, stride) = view_at(json, v, what)?;
+    if !offset.is_multiple_of(comp) {
+        return Err(format!(
+            "{what}'s byteOffset {offset} is not a multiple of its component size {comp}"
+        ));
+    }
+    if let Some(s) = stride {
+        if !(4..=252).contains(&s) || s % comp != 0 || s < elem {
             return Err(format!(
-                "{what} has an unknown component type or element type"
-            ));
-        };
-        let comp = ct.0.size() as u64;
-        let elem = comp * ty.multiplicity() as u64;
-        let count = a.count.0;
-        if count == 0 {
-            // glTF 2.0 requires count >= 1 (the crate's readers compute count - 1).
-            return Err(format!(
-                "{what} has no elements (glTF 2.0 needs a count of at least 1)"
+                "{what} reads buffer view {v} with byteStride {s}, but its elements are {elem} bytes of {comp}-byte components (glTF 2.0 needs a stride of 4 to 252, a multiple of {comp}, at least {elem})"
             ));
         }
-        let offset = a.byte_offset.map_or(0, |o| o.0);
-        if let Some(v) = &a.buffer_view {
-            let (len, stride) = view_at(v.value(), &what)?;
-            if offset % comp != 0 {
-                return Err(format!(
-                    "{what}'s byteOffset {offset} is not a multiple of its component size {comp}"
-                ));
-            }
-            if let Some(s) = stride {
-                if !(4..=252).contains(&s) || s % comp != 0 || s < elem {
-                    return Err(format!(
-                        "{what} reads buffer view {} with byteStride {s}, but its elements are {elem} bytes of {comp}-byte components (glTF 2.0 needs a stride of 4 to 252, a multiple of {comp}, at least {elem})",
-                        v.value()
-                    ));
-                }
-            }
-            if !fits(offset, count, stride.unwrap_or(elem), elem, len) {
-                return Err(format!(
-                    "{what}'s {count} elements of {elem} bytes from offset {offset} reach past the end of buffer view {} ({len} bytes)",
-                    v.value()
-                ));
-            }
+    }
+    if !fits(offset, count, stride.unwrap_or(elem), elem, len) {
+        return Err(format!(
+            "{what}'s {count} elements of {elem} bytes from offset {offset} reach past the end of buffer view {v} ({len} bytes)"
+        ));
+    }
+    Ok(())
+}
+
+/// Checks the sparse part `sp` of accessor `what` (`count` elements of `elem` bytes): at least one
+/// and at most `count` elements, indices u8, u16 or u32, and indices and values inside their
+/// views, which declare no stride.
+fn check_sparse(
+    json: &gltf::json::Root,
+    what: &str,
+    sp: &gltf::json::accessor::sparse::Sparse,
+    count: u64,
+    elem: u64,
+) -> Result<(), String> {
+    use gltf::json::accessor::ComponentType as C;
+    use gltf::json::validation::Checked;
+    let n = sp.count.0;
+    if n == 0 {
+        return Err(format!(
+            "{what} is sparse with no elements (glTF 2.0 needs a count of at least 1)"
+        ));
+    }
+    if n > count {
+        return Err(format!(
+            "{what} has {n} sparse elements but only {count} elements"
+        ));
+    }
+    let Checked::Valid(it) = &sp.indices.component_type else {
+        return Err(format!(
+            "{what}'s sparse indices have an unknown component type"
+        ));
+    };
+    if !matches!(it.0, C::U8 | C::U16 | C::U32) {
+        return Err(format!("{what}'s sparse indices are not u8, u16 or u32"));
+    }
+    let parts = [
+        (
+            "indices",
+            sp.indices.buffer_view.value(),
+            sp.indices.byte_offset.0,
+            it.0.size() as u64,
+        ),
+        (
+            "values",
+            sp.values.buffer_view.value(),
+            sp.values.byte_offset.0,
+            elem,
+        ),
+    ];
+    for (part, v, off, size) in parts {
+        let (len, stride) = view_at(json, v, what)?;
+        if stride.is_some() {
+            return Err(format!(
+                "{what}'s sparse {part} use buffer view {v}, which declares a byteStride"
+            ));
         }
-        if let Some(sp) = &a.sparse {
-            let n = sp.count.0;
-            if n == 0 {
-                return Err(format!(
-                    "{what} is sparse with no elements (glTF 2.0 needs a count of at least 1)"
-                ));
-            }
-            if n > count {
-                return Err(format!(
-                    "{what} has {n} sparse elements but only {count} elements"
-                ));
-            }
-            let Checked::Valid(it) = &sp.indices.component_type else {
-                return Err(format!(
-                    "{what}'s sparse indices have an unknown component type"
-                ));
-            };
-            use gltf::json::accessor::ComponentType as C;
-            if !matches!(it.0, C::U8 | C::U16 | C::U32) {
-                return Err(format!("{what}'s sparse indices are not u8, u16 or u32"));
-            }
-            let parts = [
-                (
-                    "indices",
-                    sp.indices.buffer_view.value(),
-                    sp.indices.byte_offset.0,
-                    it.0.size() as u64,
-                ),
-                (
-                    "values",
-                    sp.values.buffer_view.value(),
-                    sp.values.byte_offset.0,
-                    elem,
-                ),
-            ];
-            for (part, v, off, size) in parts {
-                let (len, stride) = view_at(v, &what)?;
-                if stride.is_some() {
-                    return Err(format!(
-                        "{what}'s sparse {part} use buffer view {v}, which declares a byteStride"
-                    ));
-                }
-                if !fits(off, n, size, size, len) {
-                    return Err(format!(
-                        "{what}'s {n} sparse {part} from offset {off} reach past the end of buffer view {v} ({len} bytes)"
-                    ));
-                }
-            }
+        if !fits(off, n, size, size, len) {
+            return Err(format!(
+                "{what}'s {n} sparse {part} from offset {off} reach past the end of buffer view {v} ({len} bytes)"
+            ));
         }
     }
     Ok(())
+}
+
+/// The length and stride (`None` where undeclared or zero) of buffer view `v`, which `what`
+/// refers to, after checking that it and its buffer exist and that it lies inside the buffer.
+fn view_at(json: &gltf::json::Root, v: usize, what: &str) -> Result<(u64, Option<u64>), String> {
+    let view = json.buffer_views.get(v).ok_or_else(|| {
+        format!(
+            "{what} refers to buffer view {v}, but the file has {}",
+            json.buffer_views.len()
+        )
+    })?;
+    let b = view.buffer.value();
+    let buffer = json.buffers.get(b).ok_or_else(|| {
+        format!(
+            "buffer view {v} refers to buffer {b}, but the file has {}",
+            json.buffers.len()
+        )
+    })?;
+    let offset = view.byte_offset.map_or(0, |o| o.0);
+    let len = view.byte_length.0;
+    if offset
+        .checked_add(len)
+        .is_none_or(|end| end > buffer.byte_length.0)
+    {
+        return Err(format!(
+            "buffer view {v} (offset {offset}, {len} bytes) reaches past the end of buffer {b} ({} bytes)",
+            buffer.byte_length.0
+        ));
+    }
+    let stride = view.byte_stride.map(|s| s.0 as u64).filter(|&s| s != 0);
+    Ok((len, stride))
+}
+
+/// Whether `count` elements of `elem` bytes, `stride` apart, from `offset` fit in `len` bytes.
+fn fits(offset: u64, count: u64, stride: u64, elem: u64, len: u64) -> bool {
+    count == 0
+        || (count - 1)
+            .checked_mul(stride)
+            .and_then(|x| x.checked_add(offset))
+            .and_then(|x| x.checked_add(elem))
+            .is_some_and(|end| end <= len)
 }
 
 /// The triangles and vertices of `mesh`'s primitives, from accessor counts (nothing is read).
@@ -873,42 +981,11 @@ fn import_slice(
         path: path.to_path_buf(),
         source,
     };
-    // The gltf crate subtracts the 12-byte header from the GLB's declared length unchecked.
-    if let Some(rest) = bytes.strip_prefix(b"glTF") {
-        let declared = rest
-            .get(4..8)
-            .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]));
-        match declared {
-            Some(l) if l >= 12 => {}
-            Some(l) => {
-                return Err(bad(format!(
-                    "the GLB header declares a length of {l} bytes, less than the header's 12"
-                )))
-            }
-            None => return Err(bad("the GLB header is cut short".into())),
-        }
-    }
+    check_glb_header(bytes).map_err(bad)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(gerr)?;
-    // gltf-json's validation indexes `accessors` with each primitive's POSITION without a bounds
-    // check (and panics on a dangling one): check those references first.
     let json = document.into_json();
-    for (mi, mesh) in json.meshes.iter().enumerate() {
-        for (pi, prim) in mesh.primitives.iter().enumerate() {
-            let dangling = prim
-                .attributes
-                .values()
-                .chain(prim.indices.as_ref())
-                .find(|a| a.value() >= json.accessors.len());
-            if let Some(a) = dangling {
-                return Err(bad(format!(
-                    "mesh {mi} primitive {pi} refers to accessor {}, but the file has {}",
-                    a.value(),
-                    json.accessors.len()
-                )));
-            }
-        }
-    }
+    check_accessor_references(&json).map_err(bad)?;
     check_accessors(&json).map_err(bad)?;
     let document = gltf::Document::from_json(json).map_err(gerr)?;
     check_hierarchy(&document).map_err(bad)?;
@@ -919,62 +996,7 @@ fn import_slice(
         Some(scene) => scene.nodes().collect(),
         None => Vec::new(),
     };
-    // Count what the scene instantiates before reading any buffer.
-    let (mut tris, mut verts, mut instances) = (0u64, 0u64, 0u64);
-    if roots.is_empty() && document.scenes().len() == 0 {
-        for mesh in document.meshes() {
-            let (t, v) = mesh_counts(&mesh);
-            tris = tris.saturating_add(t);
-            verts = verts.saturating_add(v);
-        }
-        instances = document.meshes().map(|m| m.primitives().len() as u64).sum();
-        if instances > limits.max_meshes {
-            return Err(bad(format!(
-                "{instances} primitives (each becomes a mesh of its own), over the limit of {} \
-                 meshes",
-                limits.max_meshes
-            )));
-        }
-    } else {
-        let mut stack = roots.clone();
-        while let Some(node) = stack.pop() {
-            if let Some(mesh) = node.mesh() {
-                let (t, v) = mesh_counts(&mesh);
-                tris = tris.saturating_add(t);
-                verts = verts.saturating_add(v);
-                instances = instances.saturating_add(mesh.primitives().len() as u64);
-                if instances > limits.max_meshes {
-                    return Err(bad(format!(
-                        "the scene instantiates more primitives than the limit of {} meshes \
-                         (each instance of a primitive becomes a mesh of its own)",
-                        limits.max_meshes
-                    )));
-                }
-            }
-            stack.extend(node.children());
-        }
-    }
-    for mesh in document.meshes() {
-        for (pi, prim) in mesh.primitives().enumerate() {
-            check_primitive(&prim, limits)
-                .map_err(|e| bad(format!("mesh {} primitive {pi}: {e}", mesh.index())))?;
-        }
-    }
-    if tris > limits.max_triangles || verts > limits.max_vertices {
-        return Err(bad(format!(
-            "the scene instantiates {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",
-            limits.max_triangles, limits.max_vertices
-        )));
-    }
-    let total = document
-        .buffers()
-        .fold(0u64, |t, b| t.saturating_add(b.length() as u64));
-    if total > limits.max_mesh_file_bytes {
-        return Err(bad(format!(
-            "its buffers declare {total} bytes, over the limit of {} bytes",
-            limits.max_mesh_file_bytes
-        )));
-    }
+    check_size(&document, &roots, limits).map_err(bad)?;
     let buffers = document
         .buffers()
         .map(|b| read_buffer(&b, base, blob.as_deref()))
@@ -1010,4 +1032,125 @@ fn import_slice(
         textures: ctx.textures,
         materials: ctx.materials,
     })
+}
+
+/// Checks that a GLB header (`bytes` starting with `glTF`) declares a length of at least its own
+/// 12 bytes: the gltf crate subtracts the header from the declared length unchecked.
+fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+    if let Some(rest) = bytes.strip_prefix(b"glTF") {
+        let declared = rest
+            .get(4..8)
+            .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]));
+        match declared {
+            Some(l) if l >= 12 => {}
+            Some(l) => {
+                return Err(format!(
+                    "the GLB header declares a length of {l} bytes, less than the header's 12"
+                ))
+            }
+            None => return Err("the GLB header is cut short".into()),
+        }
+    }
+    Ok(())
+}
+
+/// Checks that every primitive's attributes and indices name accessors the file has:
+/// gltf-json's validation indexes `accessors` with each primitive's POSITION without a bounds
+/// check (and panics on a dangling one).
+fn check_accessor_references(json: &gltf::json::Root) -> Result<(), String> {
+    for (mi, mesh) in json.meshes.iter().enumerate() {
+        for (pi, prim) in mesh.primitives.iter().enumerate() {
+            let dangling = prim
+                .attributes
+                .values()
+                .chain(prim.indices.as_ref())
+                .find(|a| a.value() >= json.accessors.len());
+            if let Some(a) = dangling {
+                return Err(format!(
+                    "mesh {mi} primitive {pi} refers to accessor {}, but the file has {}",
+                    a.value(),
+                    json.accessors.len()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks what the scene from `roots` (every mesh where the file has no scenes) instantiates
+/// against `limits`, from the document alone (no buffer is read): the meshes it makes, each
+/// primitive's accessors, its triangles and vertices, and the bytes the buffers declare.
+fn check_size(
+    document: &gltf::Document,
+    roots: &[gltf::Node],
+    limits: &SceneLimits,
+) -> Result<(), String> {
+    let (tris, verts) = instance_counts(document, roots, limits)?;
+    for mesh in document.meshes() {
+        for (pi, prim) in mesh.primitives().enumerate() {
+            check_primitive(&prim, limits)
+                .map_err(|e| format!("mesh {} primitive {pi}: {e}", mesh.index()))?;
+        }
+    }
+    if tris > limits.max_triangles || verts > limits.max_vertices {
+        return Err(format!(
+            "the scene instantiates {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",
+            limits.max_triangles, limits.max_vertices
+        ));
+    }
+    let total = document
+        .buffers()
+        .fold(0u64, |t, b| t.saturating_add(b.length() as u64));
+    if total > limits.max_mesh_file_bytes {
+        return Err(format!(
+            "its buffers declare {total} bytes, over the limit of {} bytes",
+            limits.max_mesh_file_bytes
+        ));
+    }
+    Ok(())
+}
+
+/// The triangles and vertices the scene from `roots` instantiates (every mesh once where the file
+/// has no scenes), counted from accessors; an error once the primitive instances, each a mesh of
+/// its own, pass `limits.max_meshes`.
+fn instance_counts(
+    document: &gltf::Document,
+    roots: &[gltf::Node],
+    limits: &SceneLimits,
+) -> Result<(u64, u64), String> {
+    let (mut tris, mut verts, mut instances) = (0u64, 0u64, 0u64);
+    if roots.is_empty() && document.scenes().len() == 0 {
+        for mesh in document.meshes() {
+            let (t, v) = mesh_counts(&mesh);
+            tris = tris.saturating_add(t);
+            verts = verts.saturating_add(v);
+        }
+        instances = document.meshes().map(|m| m.primitives().len() as u64).sum();
+        if instances > limits.max_meshes {
+            return Err(format!(
+                "{instances} primitives (each becomes a mesh of its own), over the limit of {} \
+                 meshes",
+                limits.max_meshes
+            ));
+        }
+    } else {
+        let mut stack = roots.to_vec();
+        while let Some(node) = stack.pop() {
+            if let Some(mesh) = node.mesh() {
+                let (t, v) = mesh_counts(&mesh);
+                tris = tris.saturating_add(t);
+                verts = verts.saturating_add(v);
+                instances = instances.saturating_add(mesh.primitives().len() as u64);
+                if instances > limits.max_meshes {
+                    return Err(format!(
+                        "the scene instantiates more primitives than the limit of {} meshes \
+                         (each instance of a primitive becomes a mesh of its own)",
+                        limits.max_meshes
+                    ));
+                }
+            }
+            stack.extend(node.children());
+        }
+    }
+    Ok((tris, verts))
 }

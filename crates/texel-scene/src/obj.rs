@@ -159,36 +159,8 @@ pub fn load_obj_bytes(
         path: path.to_path_buf(),
         reason,
     };
-    let Declared {
-        triangles: tris,
-        vertices: verts,
-        bad_index,
-    } = declared(bytes);
-    if let Some((line, text)) = bad_index {
-        return Err(SceneError::Obj {
-            path: path.to_path_buf(),
-            at: Some(format!("line {line} ({text:?})")),
-            source: tobj::LoadError::FaceVertexOutOfBounds,
-        });
-    }
-    if tris > limits.max_triangles || verts > limits.max_vertices {
-        return Err(bad(format!(
-            "it declares {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",
-            limits.max_triangles, limits.max_vertices
-        )));
-    }
-    let (models, _materials) = parse(bytes).map_err(|source| SceneError::Obj {
-        path: path.to_path_buf(),
-        // Locating the line costs about log2(lines) more parses: done for files up to 64 MiB.
-        at: (bytes.len() <= 64 << 20)
-            .then(|| failing_line(bytes))
-            .flatten()
-            .map(|(line, text)| match text {
-                Some(t) => format!("line {line} ({t:?})"),
-                None => format!("line {line} (not UTF-8 text: is this an OBJ file?)"),
-            }),
-        source,
-    })?;
+    check_declared(bytes, path, limits)?;
+    let models = parse_located(bytes, path)?;
     let no_triangles = || {
         bad("no triangles: an OBJ file needs f lines with 3 or more corners (points and lines are not drawn)".into())
     };
@@ -210,44 +182,95 @@ pub fn load_obj_bytes(
         uv_mapping: None,
     };
     for model in &models {
-        let m = &model.mesh;
-        let n = m.positions.len() / 3;
-        if m.texcoords.len() != 2 * n {
-            return Err(bad(format!(
-                "object {:?} has no texture coordinates (vt) for every vertex: texel needs uvs",
-                model.name
-            )));
-        }
-        let base = u32::try_from(mesh.positions.len())
-            .ok()
-            .filter(|b| u64::from(*b) + n as u64 <= u64::from(u32::MAX))
-            .ok_or_else(|| bad("more than 2^32 vertices".into()))?;
-        mesh.positions
-            .extend(chunks::<3>(&m.positions).map(Vec3::from));
-        mesh.uvs
-            .extend(chunks::<2>(&m.texcoords).map(|[u, v]| Vec2::new(u, 1.0 - v)));
-        if m.normals.len() == 3 * n {
-            if let Some(ns) = &mut mesh.normals {
-                ns.extend(chunks::<3>(&m.normals).map(Vec3::from));
-            }
-        } else {
-            mesh.normals = None;
-        }
-        if m.vertex_color.len() == 3 * n {
-            if let Some(cs) = &mut mesh.colors {
-                cs.extend(chunks::<3>(&m.vertex_color).map(|[r, g, b]| Vec4::new(r, g, b, 1.0)));
-            }
-        } else {
-            mesh.colors = None;
-        }
-        mesh.triangles.extend(
-            m.indices
-                .chunks_exact(3)
-                .map(|t| [base + t[0], base + t[1], base + t[2]]),
-        );
+        append_model(&mut mesh, model).map_err(bad)?;
     }
     if mesh.triangles.is_empty() {
         return Err(no_triangles());
     }
     Ok(mesh)
+}
+
+/// Checks what `bytes` declare, counted without parsing: no index out of range, and triangles
+/// and vertices within `limits`.
+fn check_declared(bytes: &[u8], path: &Path, limits: &SceneLimits) -> Result<(), SceneError> {
+    let Declared {
+        triangles: tris,
+        vertices: verts,
+        bad_index,
+    } = declared(bytes);
+    if let Some((line, text)) = bad_index {
+        return Err(SceneError::Obj {
+            path: path.to_path_buf(),
+            at: Some(format!("line {line} ({text:?})")),
+            source: tobj::LoadError::FaceVertexOutOfBounds,
+        });
+    }
+    if tris > limits.max_triangles || verts > limits.max_vertices {
+        return Err(SceneError::MeshFile {
+            path: path.to_path_buf(),
+            reason: format!(
+                "it declares {tris} triangles and {verts} vertices, over the limits of {} triangles and {} vertices",
+                limits.max_triangles, limits.max_vertices
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Parses `bytes` into `tobj`'s models; a parse error names the line it fails at.
+fn parse_located(bytes: &[u8], path: &Path) -> Result<Vec<tobj::Model>, SceneError> {
+    let (models, _materials) = parse(bytes).map_err(|source| SceneError::Obj {
+        path: path.to_path_buf(),
+        // Locating the line costs about log2(lines) more parses: done for files up to 64 MiB.
+        at: (bytes.len() <= 64 << 20)
+            .then(|| failing_line(bytes))
+            .flatten()
+            .map(|(line, text)| match text {
+                Some(t) => format!("line {line} ({t:?})"),
+                None => format!("line {line} (not UTF-8 text: is this an OBJ file?)"),
+            }),
+        source,
+    })?;
+    Ok(models)
+}
+
+/// Appends `model`'s vertices and triangles to `mesh` (uvs flipped to top-down); drops `mesh`'s
+/// normals or colours where the model lacks them.
+fn append_model(mesh: &mut Mesh, model: &tobj::Model) -> Result<(), String> {
+    let m = &model.mesh;
+    let n = m.positions.len() / 3;
+    if m.texcoords.len() != 2 * n {
+        return Err(format!(
+            "object {:?} has no texture coordinates (vt) for every vertex: texel needs uvs",
+            model.name
+        ));
+    }
+    let base = u32::try_from(mesh.positions.len())
+        .ok()
+        .filter(|b| u64::from(*b) + n as u64 <= u64::from(u32::MAX))
+        .ok_or_else(|| "more than 2^32 vertices".to_string())?;
+    mesh.positions
+        .extend(chunks::<3>(&m.positions).map(Vec3::from));
+    mesh.uvs
+        .extend(chunks::<2>(&m.texcoords).map(|[u, v]| Vec2::new(u, 1.0 - v)));
+    if m.normals.len() == 3 * n {
+        if let Some(ns) = &mut mesh.normals {
+            ns.extend(chunks::<3>(&m.normals).map(Vec3::from));
+        }
+    } else {
+        mesh.normals = None;
+    }
+    if m.vertex_color.len() == 3 * n {
+        if let Some(cs) = &mut mesh.colors {
+            cs.extend(chunks::<3>(&m.vertex_color).map(|[r, g, b]| Vec4::new(r, g, b, 1.0)));
+        }
+    } else {
+        mesh.colors = None;
+    }
+    mesh.triangles.extend(
+        m.indices
+            .chunks_exact(3)
+            .map(|t| [base + t[0], base + t[1], base + t[2]]),
+    );
+    Ok(())
 }

@@ -196,7 +196,6 @@ impl Procedural {
     /// [`Procedural::Waves`] each call draws the wave set again; [`Procedural::generate`] draws it
     /// once for the whole texture.
     pub fn code(&self, i: u32, j: u32) -> [u8; 4] {
-        let grey = |v: u8| [v, v, v, 255];
         match *self {
             Procedural::Checker { width, checks, .. } => {
                 let s = f64::from(width) / f64::from(checks);
@@ -252,31 +251,13 @@ impl Procedural {
                 bevel,
                 heights,
             } => {
-                let bh = f64::from(height) / f64::from(rows.max(1));
-                let bw = f64::from(width) / f64::from(columns.max(1));
-                let (x, y) = (f64::from(i) + 0.5, f64::from(j) + 0.5);
-                let row = (y / bh).floor();
-                let shifted = if row as u64 % 2 == 1 { x + bw / 2.0 } else { x };
-                let col = (shifted / bw).floor();
-                let (lx, ly) = (shifted - col * bw, y - row * bh);
-                let d = lx.min(bw - lx).min(ly).min(bh - ly) - f64::from(mortar) / 2.0;
+                let (d, row, col) = brick_at(width, height, rows, columns, mortar, i, j);
                 if heights {
-                    let b = f64::from(bevel);
-                    let t = if b > 0.0 {
-                        (d / b).clamp(0.0, 1.0)
-                    } else {
-                        f64::from(u8::from(d >= 0.0))
-                    };
-                    grey((255.0 * t * t * (3.0 - 2.0 * t)).round() as u8)
+                    brick_height_code(d, bevel)
                 } else if d < 0.0 {
                     [176, 170, 160, 255]
                 } else {
-                    // Per-brick shade; the column wraps so the texture tiles.
-                    let c = (col as i64).rem_euclid(i64::from(columns.max(1))) as u64;
-                    let h = texel_texture::base::rng::mix64((row as u64) << 32 | c);
-                    let f = 0.8 + 0.3 * (h >> 11) as f64 / (1u64 << 53) as f64;
-                    let s = |v: f64| (v * f).round().clamp(0.0, 255.0) as u8;
-                    [s(150.0), s(62.0), s(46.0), 255]
+                    brick_shade_code(row, col, columns)
                 }
             }
             Procedural::Solid { rgba, .. } => rgba,
@@ -285,27 +266,7 @@ impl Procedural {
                 cells,
                 seed,
                 kind,
-            } => {
-                let v = |seed: u32| noise(size, cells, seed, i, j);
-                let code = |x: f64| (255.0 * x).round().clamp(0.0, 255.0) as u8;
-                match kind {
-                    NoiseKind::Color { rgba } => {
-                        let f = 0.4 + 0.6 * v(seed);
-                        let c = |k: usize| (f64::from(rgba[k]) * f).round() as u8;
-                        [c(0), c(1), c(2), rgba[3]]
-                    }
-                    NoiseKind::Heights => grey(code(v(seed))),
-                    NoiseKind::Splat { layers } => {
-                        let n = layers.clamp(1, 4) as usize;
-                        let mut e = [0.0f64; 4];
-                        for (k, e) in e.iter_mut().enumerate().take(n) {
-                            *e = (24.0 * v(seed.wrapping_add(k as u32))).exp();
-                        }
-                        let sum: f64 = e.iter().sum();
-                        e.map(|x| code(x / sum))
-                    }
-                }
-            }
+            } => noise_code(size, cells, seed, kind, i, j),
         }
     }
 
@@ -453,6 +414,80 @@ impl Procedural {
                 mercator,
             } => Some(globe_projection(width, height, mercator)),
             _ => None,
+        }
+    }
+}
+
+/// The grey code of value `v`, opaque.
+fn grey(v: u8) -> [u8; 4] {
+    [v, v, v, 255]
+}
+
+/// Where texel `(i, j)` of a [`Procedural::Bricks`] texture lies: its distance inside its brick's
+/// edge less half the mortar (negative in the mortar), and the brick's row and column (odd rows
+/// shifted by half a brick).
+fn brick_at(
+    width: u32,
+    height: u32,
+    rows: u32,
+    columns: u32,
+    mortar: f32,
+    i: u32,
+    j: u32,
+) -> (f64, f64, f64) {
+    let bh = f64::from(height) / f64::from(rows.max(1));
+    let bw = f64::from(width) / f64::from(columns.max(1));
+    let (x, y) = (f64::from(i) + 0.5, f64::from(j) + 0.5);
+    let row = (y / bh).floor();
+    let shifted = if row as u64 % 2 == 1 { x + bw / 2.0 } else { x };
+    let col = (shifted / bw).floor();
+    let (lx, ly) = (shifted - col * bw, y - row * bh);
+    let d = lx.min(bw - lx).min(ly).min(bh - ly) - f64::from(mortar) / 2.0;
+    (d, row, col)
+}
+
+/// The height code of a brick texel at distance `d` inside its edge: a smoothstep over `bevel`
+/// texels, or a step where `bevel` is zero.
+fn brick_height_code(d: f64, bevel: f32) -> [u8; 4] {
+    let b = f64::from(bevel);
+    let t = if b > 0.0 {
+        (d / b).clamp(0.0, 1.0)
+    } else {
+        f64::from(u8::from(d >= 0.0))
+    };
+    grey((255.0 * t * t * (3.0 - 2.0 * t)).round() as u8)
+}
+
+/// The colour code of the brick at `row` and `col` of a texture `columns` bricks wide: one shade
+/// per brick.
+fn brick_shade_code(row: f64, col: f64, columns: u32) -> [u8; 4] {
+    // Per-brick shade; the column wraps so the texture tiles.
+    let c = (col as i64).rem_euclid(i64::from(columns.max(1))) as u64;
+    let h = texel_texture::base::rng::mix64((row as u64) << 32 | c);
+    let f = 0.8 + 0.3 * (h >> 11) as f64 / (1u64 << 53) as f64;
+    let s = |v: f64| (v * f).round().clamp(0.0, 255.0) as u8;
+    [s(150.0), s(62.0), s(46.0), 255]
+}
+
+/// The code of texel `(i, j)` of a [`Procedural::Noise`] texture of `kind`.
+fn noise_code(size: u32, cells: u32, seed: u32, kind: NoiseKind, i: u32, j: u32) -> [u8; 4] {
+    let v = |seed: u32| noise(size, cells, seed, i, j);
+    let code = |x: f64| (255.0 * x).round().clamp(0.0, 255.0) as u8;
+    match kind {
+        NoiseKind::Color { rgba } => {
+            let f = 0.4 + 0.6 * v(seed);
+            let c = |k: usize| (f64::from(rgba[k]) * f).round() as u8;
+            [c(0), c(1), c(2), rgba[3]]
+        }
+        NoiseKind::Heights => grey(code(v(seed))),
+        NoiseKind::Splat { layers } => {
+            let n = layers.clamp(1, 4) as usize;
+            let mut e = [0.0f64; 4];
+            for (k, e) in e.iter_mut().enumerate().take(n) {
+                *e = (24.0 * v(seed.wrapping_add(k as u32))).exp();
+            }
+            let sum: f64 = e.iter().sum();
+            e.map(|x| code(x / sum))
         }
     }
 }

@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::camera::MIN_FOVY_DEG;
 use crate::error::SceneError;
 use crate::model::{
-    ColorInput, Displacement, LightSpec, MaterialSpec, ScalarInput, Scene, MAX_LAYERS,
+    ColorInput, Displacement, LightSpec, MaterialSpec, Mesh, ScalarInput, Scene, MAX_LAYERS,
     MAX_OUTPUT_SIDE, MAX_SCENE_LIGHTS, MAX_SHADING_SAMPLES,
 };
 
@@ -36,6 +36,22 @@ fn finite_all<T: Copy>(
     }
 }
 
+/// Checks that every index of mesh `mi`'s triangles names one of its vertices.
+fn check_indices(mi: usize, m: &Mesh) -> Result<(), SceneError> {
+    let n = m.positions.len();
+    for (ti, t) in m.triangles.iter().enumerate() {
+        if let Some(&index) = t.iter().find(|&&i| i as usize >= n) {
+            return Err(SceneError::IndexOutOfRange {
+                mesh: mi,
+                triangle: ti,
+                index,
+                vertices: n,
+            });
+        }
+    }
+    Ok(())
+}
+
 impl Scene {
     /// Check everything a renderer relies on:
     /// output sides in `1..=MAX_OUTPUT_SIDE`; camera values finite, `0 < near < far`,
@@ -49,6 +65,28 @@ impl Scene {
     /// [`SceneError::MeshLength`], [`SceneError::IndexOutOfRange`] or
     /// [`SceneError::UnknownTexture`] or [`SceneError::Empty`].
     pub fn validate(&self) -> Result<(), SceneError> {
+        self.validate_output()?;
+        self.validate_camera()?;
+        if self.meshes.is_empty() {
+            return Err(SceneError::Empty(
+                "the scene has no meshes: there is nothing to render".into(),
+            ));
+        }
+        for (mi, m) in self.meshes.iter().enumerate() {
+            self.validate_mesh(mi, m)?;
+        }
+        self.validate_lights()?;
+        if let Some(e) = &self.environment {
+            e.validate()?;
+        }
+        for (name, m) in &self.materials {
+            self.validate_material(name, m)?;
+        }
+        Ok(())
+    }
+
+    /// Checks that both output sides are in `1..=MAX_OUTPUT_SIDE`.
+    fn validate_output(&self) -> Result<(), SceneError> {
         let o = &self.output;
         if !(1..=MAX_OUTPUT_SIDE).contains(&o.width) || !(1..=MAX_OUTPUT_SIDE).contains(&o.height) {
             return Err(SceneError::OutputSize {
@@ -57,6 +95,12 @@ impl Scene {
                 max: MAX_OUTPUT_SIDE,
             });
         }
+        Ok(())
+    }
+
+    /// Checks the camera: finite values, `0 < near < far`, the field of view's range, a view
+    /// direction that is neither zero nor parallel to `up`, and a finite view matrix.
+    fn validate_camera(&self) -> Result<(), SceneError> {
         let c = &self.camera;
         finite3(|| "camera.eye".into(), c.eye)?;
         finite3(|| "camera.target".into(), c.target)?;
@@ -102,95 +146,78 @@ impl Scene {
                 value: format!("eye {:?}", c.eye.to_array()),
             });
         }
-        if self.meshes.is_empty() {
-            return Err(SceneError::Empty(
-                "the scene has no meshes: there is nothing to render".into(),
-            ));
+        Ok(())
+    }
+
+    /// Checks mesh `mi`: at least one triangle, attributes as long as `positions`, indices in
+    /// range, finite values, a defined texture, tangents as long and finite, a defined material.
+    fn validate_mesh(&self, mi: usize, m: &Mesh) -> Result<(), SceneError> {
+        if m.triangles.is_empty() {
+            return Err(SceneError::Empty(format!(
+                "meshes[{mi}] has no triangles: there is nothing to render"
+            )));
         }
-        for (mi, m) in self.meshes.iter().enumerate() {
-            if m.triangles.is_empty() {
-                return Err(SceneError::Empty(format!(
-                    "meshes[{mi}] has no triangles: there is nothing to render"
-                )));
+        let n = m.positions.len();
+        let len = |attribute: &'static str, got: usize| {
+            if got == n {
+                Ok(())
+            } else {
+                Err(SceneError::MeshLength {
+                    mesh: mi,
+                    attribute,
+                    expected: n,
+                    got,
+                })
             }
-            let n = m.positions.len();
-            let len = |attribute: &'static str, got: usize| {
-                if got == n {
-                    Ok(())
-                } else {
-                    Err(SceneError::MeshLength {
-                        mesh: mi,
-                        attribute,
-                        expected: n,
-                        got,
-                    })
-                }
-            };
-            len("uvs", m.uvs.len())?;
-            if let Some(v) = &m.normals {
-                len("normals", v.len())?;
-            }
-            if let Some(v) = &m.colors {
-                len("colors", v.len())?;
-            }
-            for (ti, t) in m.triangles.iter().enumerate() {
-                if let Some(&index) = t.iter().find(|&&i| i as usize >= n) {
-                    return Err(SceneError::IndexOutOfRange {
-                        mesh: mi,
-                        triangle: ti,
-                        index,
-                        vertices: n,
-                    });
-                }
-            }
-            let s3 = |v: Vec3| format!("{:?}", v.to_array());
-            finite_all(mi, "positions", &m.positions, Vec3::is_finite, s3)?;
-            finite_all(mi, "uvs", &m.uvs, Vec2::is_finite, |v| {
+        };
+        len("uvs", m.uvs.len())?;
+        if let Some(v) = &m.normals {
+            len("normals", v.len())?;
+        }
+        if let Some(v) = &m.colors {
+            len("colors", v.len())?;
+        }
+        check_indices(mi, m)?;
+        let s3 = |v: Vec3| format!("{:?}", v.to_array());
+        finite_all(mi, "positions", &m.positions, Vec3::is_finite, s3)?;
+        finite_all(mi, "uvs", &m.uvs, Vec2::is_finite, |v| {
+            format!("{:?}", v.to_array())
+        })?;
+        if let Some(v) = &m.normals {
+            finite_all(mi, "normals", v, Vec3::is_finite, s3)?;
+        }
+        if let Some(v) = &m.colors {
+            finite_all(mi, "colors", v, Vec4::is_finite, |v| {
                 format!("{:?}", v.to_array())
             })?;
-            if let Some(v) = &m.normals {
-                finite_all(mi, "normals", v, Vec3::is_finite, s3)?;
-            }
-            if let Some(v) = &m.colors {
-                finite_all(mi, "colors", v, Vec4::is_finite, |v| {
-                    format!("{:?}", v.to_array())
-                })?;
-            }
-            if !self.textures.contains_key(&m.texture) {
-                return Err(SceneError::UnknownTexture {
+        }
+        if !self.textures.contains_key(&m.texture) {
+            return Err(SceneError::UnknownTexture {
+                mesh: mi,
+                name: m.texture.clone(),
+                defined: self.textures.keys().cloned().collect::<Vec<_>>().join(", "),
+            });
+        }
+        if let Some(t) = &m.tangents {
+            len("tangents", t.len())?;
+            finite_all(mi, "tangents", t, Vec4::is_finite, |v| {
+                format!("{:?}", v.to_array())
+            })?;
+        }
+        if let Some(name) = &m.material {
+            if !self.materials.contains_key(name) {
+                return Err(SceneError::MeshMaterial {
                     mesh: mi,
-                    name: m.texture.clone(),
-                    defined: self.textures.keys().cloned().collect::<Vec<_>>().join(", "),
+                    reason: format!(
+                        "material {name:?} is not defined (defined: {})",
+                        self.materials
+                            .keys()
+                            .cloned()
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
                 });
             }
-            if let Some(t) = &m.tangents {
-                len("tangents", t.len())?;
-                finite_all(mi, "tangents", t, Vec4::is_finite, |v| {
-                    format!("{:?}", v.to_array())
-                })?;
-            }
-            if let Some(name) = &m.material {
-                if !self.materials.contains_key(name) {
-                    return Err(SceneError::MeshMaterial {
-                        mesh: mi,
-                        reason: format!(
-                            "material {name:?} is not defined (defined: {})",
-                            self.materials
-                                .keys()
-                                .cloned()
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ),
-                    });
-                }
-            }
-        }
-        self.validate_lights()?;
-        if let Some(e) = &self.environment {
-            e.validate()?;
-        }
-        for (name, m) in &self.materials {
-            self.validate_material(name, m)?;
         }
         Ok(())
     }
