@@ -16,6 +16,7 @@ use texel::quality::Encoding;
 use texel::raster::warp::warp_perspective;
 use texel::texture::{
     AddressMode, BorderColor, ColorSpace, FilterMode, Footprint, LevelTexels, Limits, Sampler,
+    SamplerDescriptor,
 };
 use texel::{Filter, MemoryBudget};
 
@@ -200,6 +201,133 @@ impl Texture {
             _ => None,
         }
     }
+
+    /// Charges `budget` for the ripmap or summed-area table `desc` reads, where it is not built
+    /// yet (with the ripmap's scratch); returns the structure's slot in [`Texture::built`].
+    fn charge_structure(
+        &self,
+        budget: &mut MemoryBudget,
+        desc: &SamplerDescriptor,
+    ) -> PyResult<Option<usize>> {
+        let slot = Self::structure_slot(desc.min_filter);
+        if let Some(k) = slot.filter(|&k| !self.built[k].load(Ordering::Acquire)) {
+            let t = &self.texture;
+            let scratch = match k {
+                0 => u64::from(t.width()) * u64::from(t.height()) * RIPMAP_SCRATCH_PER_TEXEL,
+                _ => 0,
+            };
+            let structure = if k == 0 {
+                "ripmap"
+            } else {
+                "summed-area table"
+            };
+            take(
+                budget,
+                &format!(
+                    "the {structure} of the {}x{} texture",
+                    t.width(),
+                    t.height()
+                ),
+                t.structure_bytes(desc)
+                    .saturating_sub(t.pyramid_bytes())
+                    .saturating_add(scratch),
+            )?;
+        }
+        Ok(slot)
+    }
+}
+
+/// The derivatives `sample` is given, read and checked against `uv`'s shape, or else the grid
+/// (its width and height) whose neighbours give them; neither for a filter that reads level 0.
+#[allow(clippy::type_complexity)]
+fn derivatives<'py>(
+    shape: &[usize],
+    duv_dx: Option<&Bound<'py, PyAny>>,
+    duv_dy: Option<&Bound<'py, PyAny>>,
+    filter: Filter,
+    budget: &mut MemoryBudget,
+) -> PyResult<(Option<(Pairs<'py>, Pairs<'py>)>, Option<(usize, usize)>)> {
+    let reads_level0 = matches!(filter, Filter::Nearest | Filter::Bilinear | Filter::Bicubic);
+    let mut derivative = |d: &Bound<'py, PyAny>, what: &str| -> PyResult<Pairs<'py>> {
+        let (s, v) = pairs_in(d, what, budget)?;
+        if s != *shape {
+            return Err(PyValueError::new_err(format!(
+                "{what} has shape {} but uv has {}: they must match",
+                tuple(&[s.as_slice(), &[2]].concat()),
+                tuple(&[shape, &[2]].concat())
+            )));
+        }
+        Ok(v)
+    };
+    let given =
+        match (duv_dx, duv_dy) {
+            (Some(dx), Some(dy)) => Some((derivative(dx, "duv_dx")?, derivative(dy, "duv_dy")?)),
+            (None, None) => None,
+            _ => return Err(PyValueError::new_err(
+                "pass both duv_dx and duv_dy, or neither (then they are derived from the grid uv)",
+            )),
+        };
+    // The grid whose neighbours give the derivatives: its width and height.
+    let grid = match (&given, shape) {
+        (Some(_), _) => None,
+        (None, _) if reads_level0 => None,
+        (None, [.., h, w]) => Some((*w, *h)),
+        (None, _) => {
+            return Err(PyValueError::new_err(format!(
+                "filter {} reads mip levels chosen by the footprint: pass duv_dx and duv_dy, or uv as an (..., H, W, 2) grid whose neighbours give them (uv has shape {})",
+                filter.name(),
+                tuple(&[shape, &[2]].concat())
+            )))
+        }
+    };
+    Ok((given, grid))
+}
+
+/// The points being sampled, in the caller's units, and their derivatives: given, derived from a
+/// grid's neighbours, or none.
+struct Points<'a> {
+    /// `(u, v)` or `(x, y)` pairs, one per point.
+    uv: &'a [f32],
+    /// The given derivatives in x and in y, pairs as `uv`.
+    dx: Option<&'a [f32]>,
+    dy: Option<&'a [f32]>,
+    /// The grid's width and height, when the derivatives come from its neighbours.
+    grid: Option<(usize, usize)>,
+    /// The units' size in texture coordinates' reciprocal: 1 for `uv`, the texture's size for
+    /// pixels.
+    scale: [f32; 2],
+}
+
+impl Points<'_> {
+    /// Point `p`'s footprint in texture coordinates.
+    fn footprint(&self, p: usize) -> Footprint {
+        let (uv, scale) = (self.uv, self.scale);
+        let pair = |d: Option<&[f32]>, p: usize| {
+            d.map_or([0.0; 2], |d| [d[2 * p] / scale[0], d[2 * p + 1] / scale[1]])
+        };
+        let ([dudx, dvdx], [dudy, dvdy]) = match self.grid {
+            None => (pair(self.dx, p), pair(self.dy, p)),
+            Some((w, h)) => {
+                let (x, y) = (p % w, (p / w) % h);
+                // Point p's row starts at `row`; its column at row 0 of its grid is `column`.
+                let (row, column) = (p - x, p - y * w);
+                let along_x = quad_pair(x, w)
+                    .map_or([0.0; 2], |(a, b)| pair_diff(uv, row + b, row + a, scale));
+                let along_y = quad_pair(y, h).map_or([0.0; 2], |(a, b)| {
+                    pair_diff(uv, column + b * w, column + a * w, scale)
+                });
+                (along_x, along_y)
+            }
+        };
+        Footprint {
+            u: uv[2 * p] / scale[0],
+            v: uv[2 * p + 1] / scale[1],
+            dudx,
+            dvdx,
+            dudy,
+            dvdy,
+        }
+    }
 }
 
 /// The difference of `values`' pairs at `b` and `a` (point indices), converted by `scale`.
@@ -377,38 +505,7 @@ impl Texture {
         let pool = pool::for_threads(threads)?;
         let mut budget = budget(max_memory);
         let (shape, points) = pairs_in(uv, "uv", &mut budget)?;
-        let reads_level0 = matches!(filter, Filter::Nearest | Filter::Bilinear | Filter::Bicubic);
-        let mut derivative = |d: &Bound<'py, PyAny>, what: &str| -> PyResult<Pairs<'py>> {
-            let (s, v) = pairs_in(d, what, &mut budget)?;
-            if s != shape {
-                return Err(PyValueError::new_err(format!(
-                    "{what} has shape {} but uv has {}: they must match",
-                    tuple(&[s.as_slice(), &[2]].concat()),
-                    tuple(&[shape.as_slice(), &[2]].concat())
-                )));
-            }
-            Ok(v)
-        };
-        let given = match (duv_dx, duv_dy) {
-            (Some(dx), Some(dy)) => Some((derivative(dx, "duv_dx")?, derivative(dy, "duv_dy")?)),
-            (None, None) => None,
-            _ => return Err(PyValueError::new_err(
-                "pass both duv_dx and duv_dy, or neither (then they are derived from the grid uv)",
-            )),
-        };
-        // The grid whose neighbours give the derivatives: its width and height.
-        let grid = match (&given, shape.as_slice()) {
-            (Some(_), _) => None,
-            (None, _) if reads_level0 => None,
-            (None, [.., h, w]) => Some((*w, *h)),
-            (None, _) => {
-                return Err(PyValueError::new_err(format!(
-                    "filter {} reads mip levels chosen by the footprint: pass duv_dx and duv_dy, or uv as an (..., H, W, 2) grid whose neighbours give them (uv has shape {})",
-                    filter.name(),
-                    tuple(&[shape.as_slice(), &[2]].concat())
-                )))
-            }
-        };
+        let (given, grid) = derivatives(&shape, duv_dx, duv_dy, filter, &mut budget)?;
         if !lod_bias.is_finite() {
             return Err(PyValueError::new_err(format!(
                 "lod_bias must be finite; got {lod_bias}"
@@ -439,42 +536,20 @@ impl Texture {
                 std::mem::size_of::<Footprint>(),
             ),
         )?;
-        let slot = Self::structure_slot(desc.min_filter);
-        if let Some(k) = slot.filter(|&k| !self.built[k].load(Ordering::Acquire)) {
-            let t = &self.texture;
-            let scratch = match k {
-                0 => u64::from(t.width()) * u64::from(t.height()) * RIPMAP_SCRATCH_PER_TEXEL,
-                _ => 0,
-            };
-            let structure = if k == 0 {
-                "ripmap"
-            } else {
-                "summed-area table"
-            };
-            take(
-                &mut budget,
-                &format!(
-                    "the {structure} of the {}x{} texture",
-                    t.width(),
-                    t.height()
-                ),
-                t.structure_bytes(&desc)
-                    .saturating_sub(t.pyramid_bytes())
-                    .saturating_add(scratch),
-            )?;
-        }
+        let slot = self.charge_structure(&mut budget, &desc)?;
         let mut samples: Vec<f32> = Vec::new();
         reserve(&mut samples, values, "the samples")?;
         samples.resize(values, 0.0);
         let dst = samples.as_mut_slice();
-        let (uv, dx, dy) = (
-            points.values(),
-            given.as_ref().map(|(x, _)| x.values()),
-            given.as_ref().map(|(_, y)| y.values()),
-        );
-        let scale = match coords {
-            Coords::Uv => [1.0, 1.0],
-            Coords::Pixels => [self.texture.width() as f32, self.texture.height() as f32],
+        let points = Points {
+            uv: points.values(),
+            dx: given.as_ref().map(|(x, _)| x.values()),
+            dy: given.as_ref().map(|(_, y)| y.values()),
+            grid,
+            scale: match coords {
+                Coords::Uv => [1.0, 1.0],
+                Coords::Pixels => [self.texture.width() as f32, self.texture.height() as f32],
+            },
         };
         let texture = &*self.texture;
         let built = &self.built;
@@ -490,35 +565,8 @@ impl Texture {
                 .enumerate()
                 .for_each(|(k, o)| {
                     let first = k * POINTS_PER_TASK;
-                    let pair = |d: Option<&[f32]>, p: usize| {
-                        d.map_or([0.0; 2], |d| [d[2 * p] / scale[0], d[2 * p + 1] / scale[1]])
-                    };
-                    let derived = |p: usize| -> ([f32; 2], [f32; 2]) {
-                        let Some((w, h)) = grid else {
-                            return (pair(dx, p), pair(dy, p));
-                        };
-                        let (x, y) = (p % w, (p / w) % h);
-                        // Point p's row starts at `row`; its column at row 0 of its grid is `column`.
-                        let (row, column) = (p - x, p - y * w);
-                        let along_x = quad_pair(x, w)
-                            .map_or([0.0; 2], |(a, b)| pair_diff(uv, row + b, row + a, scale));
-                        let along_y = quad_pair(y, h).map_or([0.0; 2], |(a, b)| {
-                            pair_diff(uv, column + b * w, column + a * w, scale)
-                        });
-                        (along_x, along_y)
-                    };
                     let footprints: Vec<Footprint> = (first..first + o.len())
-                        .map(|p| {
-                            let ([dudx, dvdx], [dudy, dvdy]) = derived(p);
-                            Footprint {
-                                u: uv[2 * p] / scale[0],
-                                v: uv[2 * p + 1] / scale[1],
-                                dudx,
-                                dvdx,
-                                dudy,
-                                dvdy,
-                            }
-                        })
+                        .map(|p| points.footprint(p))
                         .collect();
                     sampler.sample_batch(texture, &footprints[..], o);
                 });

@@ -19,6 +19,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use texel::timing::{median, time_frames, warm_up, MIN_WARMUP};
+use texel::{Filter, MemoryBudget, PreparedScene};
 
 use crate::cli::{BenchArgs, TargetArg};
 use crate::filters::{parse_gpu_list, parse_list, GpuJob};
@@ -48,9 +49,9 @@ pub struct Timing {
 fn time_gpu(
     args: &BenchArgs,
     gpu: &texel_gpu::Gpu,
-    scene: &texel::PreparedScene,
+    scene: &PreparedScene,
     jobs: &[GpuJob],
-    budget: &mut texel::MemoryBudget,
+    budget: &mut MemoryBudget,
 ) -> Result<Vec<Timing>> {
     let mut out = Vec::new();
     for &(label, filter, gpu_filter) in jobs {
@@ -136,43 +137,83 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     let timings = if let Some(gpu) = &gpu {
         time_gpu(args, gpu, &scene, &jobs, budget)?
     } else {
-        texel::raster::on_threads(workers(args.threads), || -> Result<Vec<Timing>> {
-            let mut out = Vec::new();
-            for filter in &filters {
-                let plan = scene.plan(Some(*filter), budget)?;
-                let draws = plan.draws();
-                let mut settings = plan.settings();
-                if args.target == TargetArg::Float {
-                    settings.target = texel::ColorTarget::Float;
-                }
-                let mut times =
-                    time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;
-                let (min_ms, max_ms) = times
-                    .draw_ms
-                    .iter()
-                    .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
-                out.push(Timing {
-                    filter: filter.name(),
-                    median_ms: median(&mut times.draw_ms),
-                    min_ms,
-                    max_ms,
-                    clear_ms: median(&mut times.clear_ms),
-                    streamed: times.streamed,
-                });
-            }
-            Ok(out)
-        })??
+        time_cpu(args, &scene, &filters, budget)?
     };
-    let threads = thread_count(args.threads);
-    // Every filter's frames have the same size and target, so all stream or none does.
-    let streamed = timings.iter().any(|t| t.streamed);
-    let renderer = if args.gpu { "texel-gpu" } else { "texel" };
-    let second = if args.gpu { "device_ms" } else { "clear_ms" };
+    let measured = Measured {
+        args,
+        scene: &scene,
+        gpu: gpu.as_ref(),
+        timings: &timings,
+        threads: thread_count(args.threads),
+        streamed: streamed(&timings),
+    };
     let mut stdout = std::io::stdout().lock();
     if args.json {
+        measured.write_json(&mut stdout)
+    } else {
+        measured.write_text(&mut stdout)
+    }
+}
+
+/// Each filter's frame times on the CPU.
+fn time_cpu(
+    args: &BenchArgs,
+    scene: &PreparedScene,
+    filters: &[Filter],
+    budget: &mut MemoryBudget,
+) -> Result<Vec<Timing>> {
+    texel::raster::on_threads(workers(args.threads), || -> Result<Vec<Timing>> {
+        let mut out = Vec::new();
+        for filter in filters {
+            let plan = scene.plan(Some(*filter), budget)?;
+            let draws = plan.draws();
+            let mut settings = plan.settings();
+            if args.target == TargetArg::Float {
+                settings.target = texel::ColorTarget::Float;
+            }
+            let mut times = time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;
+            let (min_ms, max_ms) = times
+                .draw_ms
+                .iter()
+                .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
+            out.push(Timing {
+                filter: filter.name(),
+                median_ms: median(&mut times.draw_ms),
+                min_ms,
+                max_ms,
+                clear_ms: median(&mut times.clear_ms),
+                streamed: times.streamed,
+            });
+        }
+        Ok(out)
+    })?
+}
+
+/// Every filter's frames have the same size and target, so all stream or none does.
+fn streamed(timings: &[Timing]) -> bool {
+    timings.iter().any(|t| t.streamed)
+}
+
+/// A bench run's timings and what they were measured on, as they are printed.
+struct Measured<'a> {
+    args: &'a BenchArgs,
+    scene: &'a PreparedScene,
+    gpu: Option<&'a texel_gpu::Gpu>,
+    timings: &'a [Timing],
+    threads: usize,
+    streamed: bool,
+}
+
+impl Measured<'_> {
+    /// The timings as one JSON object.
+    fn write_json(&self, stdout: &mut impl Write) -> Result<()> {
+        let (args, scene, gpu, timings) = (self.args, self.scene, self.gpu, self.timings);
+        let (threads, streamed) = (self.threads, self.streamed);
+        let renderer = if args.gpu { "texel-gpu" } else { "texel" };
+        let second = if args.gpu { "device_ms" } else { "clear_ms" };
         // With --gpu, the adapter the frames ran on (the CPU's fields stay: they describe the
         // host).
-        let adapter = gpu.as_ref().map_or(String::new(), |g| {
+        let adapter = gpu.map_or(String::new(), |g| {
             format!(
                 "\n \"adapter\": {},",
                 serde_json::Value::from(g.info().to_string())
@@ -186,44 +227,50 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
                 .join(",\n")
         };
         writeln!(
-            stdout,
-            "{{\n \"renderer\": \"{renderer}\",{adapter}\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"texture_storage\": \"{}\",\n \"streaming\": \"{}\",\n \"streamed\": {},\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
-            serde_json::Value::from(cpu_model()),
-            simd_level(),
-            target_name(args.target),
-            precision_name(args.scene.precision),
-            storage_name(&scene),
-            args.streaming.name(),
-            streamed,
-            scene.width,
-            scene.height,
-            args.frames,
-            entries(|t| t.median_ms),
-            entries(|t| t.clear_ms)
-        )
-        .context("cannot write to stdout")?;
-    } else {
+        stdout,
+        "{{\n \"renderer\": \"{renderer}\",{adapter}\n \"cpu\": {},\n \"simd\": \"{}\",\n \"target\": \"{}\",\n \"precision\": \"{}\",\n \"texture_storage\": \"{}\",\n \"streaming\": \"{}\",\n \"streamed\": {},\n \"threads\": {threads},\n \"width\": {},\n \"height\": {},\n \"frames\": {},\n \"median_ms\": {{\n{}\n }},\n \"{second}\": {{\n{}\n }}\n}}",
+        serde_json::Value::from(cpu_model()),
+        simd_level(),
+        target_name(args.target),
+        precision_name(args.scene.precision),
+        storage_name(scene),
+        args.streaming.name(),
+        streamed,
+        scene.width,
+        scene.height,
+        args.frames,
+        entries(|t| t.median_ms),
+        entries(|t| t.clear_ms)
+    )
+    .context("cannot write to stdout")?;
+        Ok(())
+    }
+
+    /// The timings as a table with a header naming the run.
+    fn write_text(&self, stdout: &mut impl Write) -> Result<()> {
+        let (args, scene, gpu, timings) = (self.args, self.scene, self.gpu, self.timings);
+        let (threads, streamed) = (self.threads, self.streamed);
         writeln!(
-            stdout,
-            "texel bench: {} at {}x{}, {threads} threads, {} target, median of {} frames after {} warm-up",
-            texel_io::escape(&args.scene.scene),
-            scene.width,
-            scene.height,
-            target_name(args.target),
-            args.frames,
-            args.warmup
-        )?;
+        stdout,
+        "texel bench: {} at {}x{}, {threads} threads, {} target, median of {} frames after {} warm-up",
+        texel_io::escape(&args.scene.scene),
+        scene.width,
+        scene.height,
+        target_name(args.target),
+        args.frames,
+        args.warmup
+    )?;
         writeln!(
             stdout,
             "cpu: {}; simd: {}; precision: {}; textures: {}; streaming: {} ({})",
             cpu_model(),
             simd_level(),
             precision_name(args.scene.precision),
-            storage_name(&scene),
+            storage_name(scene),
             args.streaming.name(),
             if streamed { "streamed" } else { "in place" }
         )?;
-        if let Some(gpu) = &gpu {
+        if let Some(gpu) = gpu {
             writeln!(stdout, "gpu: {}", gpu.info())?;
         }
         writeln!(
@@ -235,15 +282,15 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
             "max ms",
             if args.gpu { "device ms" } else { "clear ms" }
         )?;
-        for t in &timings {
+        for t in timings {
             writeln!(
                 stdout,
                 "{:<12} {:>10.3} {:>10.3} {:>10.3} {:>10.3}",
                 t.filter, t.median_ms, t.min_ms, t.max_ms, t.clear_ms
             )?;
         }
+        Ok(())
     }
-    Ok(())
 }
 
 /// The target's name in the report.

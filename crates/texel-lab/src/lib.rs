@@ -353,119 +353,49 @@ pub fn grade(
     dir: &Path,
     options: &GradeOptions,
 ) -> Result<(LabReport, Images), Error> {
-    let device: DeviceRun = {
-        let path = dir.join("device.json");
-        let text = std::fs::read_to_string(&path).map_err(|e| io(&path, e))?;
-        serde_json::from_str(&text).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?
-    };
+    let device = read_device(dir)?;
     let mut images: Images = Vec::new();
     let mut modes = Vec::new();
     let mut questions = Questions::default();
-    let mut mag: BTreeMap<u8, (f64, f64, usize)> = BTreeMap::new();
+    let mut mag = Magnification::new();
     for (k, spec) in job.scenes.iter().enumerate() {
         let scene = LabScene::load(spec, job.size)?;
-        // File names from the scene's name: letters, digits and `-` only, and the scene's
-        // position, so that two scenes of one name keep their own images.
-        let safe: String = scene
-            .name
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || c == '-' {
-                    c
-                } else {
-                    '_'
-                }
-            })
-            .collect();
-        let file_stem = format!("{k}-{safe}");
+        let file_stem = file_stem(k, &scene.name);
         let (w, h) = scene.size();
         let n = (w as usize) * (h as usize);
         let capture = read_capture(&capture_path(dir, k), n)?;
         let mask = grade::covered(&capture);
-        let reference = reference(&scene, options)?;
+        let (reference, ref_covered) = reference(&scene, options)?;
         let ref_mask: Vec<bool> = mask
             .iter()
-            .zip(&reference.1)
+            .zip(&ref_covered)
             .map(|(a, b)| *a && *b)
             .collect();
-        let ref_mask = Mask::new(w, h, ref_mask)?;
         let ref_name = format!("images/{file_stem}-reference.png");
-        images.push((ref_name.clone(), reference.0.clone()));
+        images.push((ref_name.clone(), reference.clone()));
         let mut levels = level_range(&scene, &capture, &mask);
         levels.0.reference_image = ref_name;
-        let magnified = levels.1.clone();
         questions.levels.push(levels.0);
         questions.memory.push(memory(&scene));
+        let graded = GradedScene {
+            scene: &scene,
+            capture: &capture,
+            ref_mask: Mask::new(w, h, ref_mask)?,
+            mask,
+            reference,
+            magnified: levels.1,
+            file_stem,
+        };
         for &mode in &job.modes {
             let shader_px = read_frame(&frame_path(dir, k, mode), n)?;
-            let gl =
-                grade::convention_match(&scene, &capture, mode, Convention::Gl, &shader_px, &mask);
-            let lab =
-                grade::convention_match(&scene, &capture, mode, Convention::Lab, &shader_px, &mask);
-            let verdict = grade::verdict(gl.agreement, lab.agreement);
-            let diagnosis = if verdict == Verdict::Neither {
-                grade::diagnose(&scene, &capture, mode, &shader_px, &mask, (&gl, &lab))
-            } else {
-                Vec::new()
-            };
-            let closer = if lab.agreement > gl.agreement {
-                &lab
-            } else {
-                &gl
-            };
-            let shader_img = Image8::new(w, h, shader_px.clone())?;
-            let texel_img = Image8::new(w, h, closer.image.clone())?;
-            let psnr_reference = texel_quality::psnr(&reference.0, &shader_img, Some(&ref_mask))?;
-            let psnr_reference_texel =
-                texel_quality::psnr(&reference.0, &texel_img, Some(&ref_mask))?;
-            let mask_img = Mask::new(w, h, mask.clone())?;
-            let heat = texel_quality::heat_map(&texel_img, &shader_img, Some(&mask_img), 32.0)?;
-            for (part, magnified_part) in [(0, true), (1, false)] {
-                let m: Vec<bool> = mask
-                    .iter()
-                    .zip(&magnified)
-                    .map(|(c, g)| *c && *g == magnified_part)
-                    .collect();
-                if m.iter().any(|x| *x) {
-                    let p =
-                        texel_quality::psnr(&reference.0, &shader_img, Some(&Mask::new(w, h, m)?))?;
-                    let e = mag.entry(mode).or_insert((0.0, 0.0, 0));
-                    if part == 0 {
-                        e.0 += p.min(99.0);
-                    } else {
-                        e.1 += p.min(99.0);
-                        e.2 += 1;
-                    }
-                }
-            }
-            let stem = format!("images/{file_stem}-mode{mode}");
-            let names = [
-                format!("{stem}-shader.png"),
-                format!("{stem}-texel.png"),
-                format!("{stem}-heat.png"),
-            ];
-            images.push((names[0].clone(), shader_img));
-            images.push((names[1].clone(), texel_img));
-            images.push((names[2].clone(), heat));
-            let covered = mask.iter().filter(|c| **c).count().max(1);
-            modes.push(ModeResult {
-                mode,
-                scene: scene.name.clone(),
-                verdict,
-                agreement_gl: gl.agreement,
-                agreement_lab: lab.agreement,
-                psnr_reference,
-                psnr_reference_texel,
-                diagnosis,
-                time_ms: device
-                    .times_ms
-                    .get(k)
-                    .and_then(|t| t.get(&mode))
-                    .copied()
-                    .unwrap_or(f64::NAN),
-                texels_per_pixel: closer.reads as f64 / covered as f64,
-                images: names,
-            });
+            let time_ms = device
+                .times_ms
+                .get(k)
+                .and_then(|t| t.get(&mode))
+                .copied()
+                .unwrap_or(f64::NAN);
+            let result = graded.mode(mode, shader_px, time_ms, &mut mag, &mut images)?;
+            modes.push(result);
         }
     }
     rank_across_scenes(&mut modes);
@@ -474,26 +404,7 @@ pub fn grade(
         .into_iter()
         .map(|(m, (a, b, n))| (m, a / scenes, b / (n.max(1) as f64)))
         .collect();
-    let rubric: Vec<RubricPart> = RUBRIC
-        .iter()
-        .map(|(part, weight, ms)| {
-            let rows: Vec<&ModeResult> = modes.iter().filter(|r| ms.contains(&r.mode)).collect();
-            let good = rows
-                .iter()
-                .filter(|r| r.verdict != Verdict::Neither)
-                .count();
-            RubricPart {
-                part: part.to_string(),
-                weight: *weight,
-                modes: ms.to_vec(),
-                earned: if rows.is_empty() {
-                    0.0
-                } else {
-                    weight * good as f64 / rows.len() as f64
-                },
-            }
-        })
-        .collect();
+    let rubric = rubric(&modes);
     let score = rubric.iter().map(|r| r.earned).sum();
     Ok((
         LabReport {
@@ -512,6 +423,164 @@ pub fn grade(
         },
         images,
     ))
+}
+
+/// Per mode, the sums of the shader's PSNR over each scene's magnified pixels and over its
+/// minified ones, and the number of scenes that have minified pixels.
+type Magnification = BTreeMap<u8, (f64, f64, usize)>;
+
+/// The device run's record, `device.json`, as the capture step writes it.
+fn read_device(dir: &Path) -> Result<DeviceRun, Error> {
+    let path = dir.join("device.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| io(&path, e))?;
+    serde_json::from_str(&text).map_err(|e| Error::Io(format!("{}: {e}", path.display())))
+}
+
+/// File names from the scene's name: letters, digits and `-` only, and the scene's position, so
+/// that two scenes of one name keep their own images.
+fn file_stem(k: usize, name: &str) -> String {
+    let safe: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("{k}-{safe}")
+}
+
+/// The rubric's parts, each earning its weight times the share of its modes' results that match
+/// a convention.
+fn rubric(modes: &[ModeResult]) -> Vec<RubricPart> {
+    RUBRIC
+        .iter()
+        .map(|(part, weight, ms)| {
+            let rows: Vec<&ModeResult> = modes.iter().filter(|r| ms.contains(&r.mode)).collect();
+            let good = rows
+                .iter()
+                .filter(|r| r.verdict != Verdict::Neither)
+                .count();
+            RubricPart {
+                part: part.to_string(),
+                weight: *weight,
+                modes: ms.to_vec(),
+                earned: if rows.is_empty() {
+                    0.0
+                } else {
+                    weight * good as f64 / rows.len() as f64
+                },
+            }
+        })
+        .collect()
+}
+
+/// One scene's capture and reference, against which each mode's frame is graded.
+struct GradedScene<'a> {
+    scene: &'a LabScene,
+    capture: &'a Capture,
+    /// The pixels the scene covers.
+    mask: Vec<bool>,
+    /// The reference image, and the covered pixels it covers too.
+    reference: Image8,
+    ref_mask: Mask,
+    /// Whether each pixel is magnified (its level of detail below 0).
+    magnified: Vec<bool>,
+    file_stem: String,
+}
+
+impl GradedScene<'_> {
+    /// One mode's result for the student's frame `shader_px`, its images added to `images` and
+    /// its magnified and minified PSNR to `mag`.
+    fn mode(
+        &self,
+        mode: u8,
+        shader_px: Vec<[u8; 4]>,
+        time_ms: f64,
+        mag: &mut Magnification,
+        images: &mut Images,
+    ) -> Result<ModeResult, Error> {
+        let (scene, capture, mask) = (self.scene, self.capture, &self.mask[..]);
+        let (w, h) = scene.size();
+        let gl = grade::convention_match(scene, capture, mode, Convention::Gl, &shader_px, mask);
+        let lab = grade::convention_match(scene, capture, mode, Convention::Lab, &shader_px, mask);
+        let verdict = grade::verdict(gl.agreement, lab.agreement);
+        let diagnosis = if verdict == Verdict::Neither {
+            grade::diagnose(scene, capture, mode, &shader_px, mask, (&gl, &lab))
+        } else {
+            Vec::new()
+        };
+        let closer = if lab.agreement > gl.agreement {
+            &lab
+        } else {
+            &gl
+        };
+        let shader_img = Image8::new(w, h, shader_px)?;
+        let texel_img = Image8::new(w, h, closer.image.clone())?;
+        let psnr_reference =
+            texel_quality::psnr(&self.reference, &shader_img, Some(&self.ref_mask))?;
+        let psnr_reference_texel =
+            texel_quality::psnr(&self.reference, &texel_img, Some(&self.ref_mask))?;
+        let mask_img = Mask::new(w, h, mask.to_vec())?;
+        let heat = texel_quality::heat_map(&texel_img, &shader_img, Some(&mask_img), 32.0)?;
+        self.add_magnification(mode, &shader_img, mag)?;
+        let stem = format!("images/{}-mode{mode}", self.file_stem);
+        let names = [
+            format!("{stem}-shader.png"),
+            format!("{stem}-texel.png"),
+            format!("{stem}-heat.png"),
+        ];
+        images.push((names[0].clone(), shader_img));
+        images.push((names[1].clone(), texel_img));
+        images.push((names[2].clone(), heat));
+        let covered = mask.iter().filter(|c| **c).count().max(1);
+        Ok(ModeResult {
+            mode,
+            scene: scene.name.clone(),
+            verdict,
+            agreement_gl: gl.agreement,
+            agreement_lab: lab.agreement,
+            psnr_reference,
+            psnr_reference_texel,
+            diagnosis,
+            time_ms,
+            texels_per_pixel: closer.reads as f64 / covered as f64,
+            images: names,
+        })
+    }
+
+    /// Adds the shader's PSNR over the magnified and over the minified covered pixels, where
+    /// there are any, to `mag`.
+    fn add_magnification(
+        &self,
+        mode: u8,
+        shader_img: &Image8,
+        mag: &mut Magnification,
+    ) -> Result<(), Error> {
+        let (w, h) = self.scene.size();
+        for (part, magnified_part) in [(0, true), (1, false)] {
+            let m: Vec<bool> = self
+                .mask
+                .iter()
+                .zip(&self.magnified)
+                .map(|(c, g)| *c && *g == magnified_part)
+                .collect();
+            if m.iter().any(|x| *x) {
+                let p =
+                    texel_quality::psnr(&self.reference, shader_img, Some(&Mask::new(w, h, m)?))?;
+                let e = mag.entry(mode).or_insert((0.0, 0.0, 0));
+                if part == 0 {
+                    e.0 += p.min(99.0);
+                } else {
+                    e.1 += p.min(99.0);
+                    e.2 += 1;
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A diagnosis without its figures: the same mistake on two scenes has the same key.

@@ -47,6 +47,14 @@ fn mode_name(m: u8) -> &'static str {
 /// The report as Markdown (`html`: as the body of an HTML page, images inline).
 pub fn markdown(r: &LabReport) -> String {
     let mut s = String::new();
+    head(&mut s, r);
+    modes(&mut s, r);
+    questions(&mut s, r);
+    s
+}
+
+/// The title, the score by the rubric's parts, the texture rule and the comments.
+fn head(s: &mut String, r: &LabReport) {
     let _ = writeln!(s, "# texel lab: {}\n", r.shader);
     let _ = writeln!(s, "Device: {} ({}).\n", r.renderer, r.gl_version);
     let _ = writeln!(s, "**Score: {:.1} / 100**\n", r.score);
@@ -86,6 +94,10 @@ pub fn markdown(r: &LabReport) -> String {
     }
     let (c, code) = r.comment_lines;
     let _ = writeln!(s, "\nComments: {c} of the shader's {code} lines of code carry one (the lab asks for comments and documentation).");
+}
+
+/// Each mode's verdict and scores, and the diagnosis of the modes that match neither convention.
+fn modes(s: &mut String, r: &LabReport) {
     let (k, share) = r.agreement_measure;
     let _ = writeln!(
         s,
@@ -128,6 +140,10 @@ pub fn markdown(r: &LabReport) -> String {
             }
         }
     }
+}
+
+/// The lab's questions answered from the measurements.
+fn questions(s: &mut String, r: &LabReport) {
     let _ = writeln!(s, "\n## The lab's questions, measured\n");
     let _ = writeln!(s, "**Magnification and minification.** Mean PSNR (dB) of the shader's modes on the magnified pixels (N < 0) and on the minified ones:\n");
     let _ = writeln!(s, "| mode | magnified | minified |\n|---|---|---|");
@@ -163,7 +179,6 @@ pub fn markdown(r: &LabReport) -> String {
     }
     let _ = writeln!(s, "\nN runs from below 0 up to M. N < 0 means the pixel is smaller than a texel: magnification, read on level 0. Where the anisotropy is 1 the footprint is a circle: one probe, the trilinear sample at P (the handout's i / (lambda - 1) is 0 / 0 there).\n");
     let _ = writeln!(s, "**Look, time and space.** Per mode above: PSNR (look), texels read a pixel and GL milliseconds a frame (time); nearest and bilinear need level 0 alone, the others the pyramid (4/3 of it).");
-    s
 }
 
 fn html(r: &LabReport) -> String {

@@ -90,109 +90,21 @@ pub fn chart_svg(report: &Report) -> String {
         );
         return s;
     }
-    // x: decades around the timed points (one decade 1..10 ms when there are none).
-    let (mut lx0, mut lx1) = timed.iter().fold((f64::MAX, f64::MIN), |(a, b), t| {
-        (a.min(t.1.log10()), b.max(t.1.log10()))
-    });
-    if timed.is_empty() {
-        (lx0, lx1) = (0.0, 1.0);
-    }
-    let (dx0, mut dx1) = (lx0.floor(), lx1.ceil());
-    if dx1 <= dx0 {
-        dx1 = dx0 + 1.0;
-    }
-    // y: padded range of every PSNR shown, snapped to the tick step.
-    let ys = timed.iter().map(|t| t.2).chain(lines.iter().map(|l| l.1));
-    let (y0, y1) = ys.fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(y), b.max(y)));
-    let step = nice_step((y1 - y0).max(1.0) + 2.0);
-    let (ya, yb) = (
-        ((y0 - 1.0) / step).floor() * step,
-        ((y1 + 1.0) / step).ceil() * step,
-    );
-    let pw = CW - LEFT - RIGHT;
-    let ph = CH - TOP - BOTTOM;
-    let px = |ms: f64| LEFT + (ms.log10() - dx0) / (dx1 - dx0) * pw;
-    let py = |db: f64| TOP + (yb - db) / (yb - ya) * ph;
-    s += &format!(
-        "<rect x=\"{LEFT}\" y=\"{TOP}\" width=\"{pw}\" height=\"{ph}\" fill=\"#fff\" stroke=\"#888\"/>\n"
-    );
-    // x ticks: 1, 2, 5 per decade.
-    let mut d = dx0;
-    while d <= dx1 + 1e-9 {
-        for m in [1.0, 2.0, 5.0] {
-            let ms = m * 10f64.powf(d);
-            if ms.log10() > dx1 + 1e-9 {
-                continue;
-            }
-            let x = px(ms);
-            let major = m == 1.0;
-            s += &format!(
-                "<line x1=\"{x:.1}\" y1=\"{TOP}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"{}\"/>\n<text x=\"{x:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text>\n",
-                TOP + ph,
-                if major { "#ccc" } else { "#eee" },
-                TOP + ph + 16.0,
-                num(ms)
-            );
-        }
-        d += 1.0;
-    }
-    // y ticks.
-    let mut y = ya;
-    while y <= yb + 1e-9 {
-        let yy = py(y);
-        s += &format!(
-            "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#ddd\"/>\n<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>\n",
-            LEFT + pw,
-            LEFT - 6.0,
-            yy + 4.0,
-            num(y)
-        );
-        y += step;
-    }
-    s += &format!(
-        "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">time per frame (ms, log scale)</text>\n<text transform=\"translate(16 {:.1}) rotate(-90)\" text-anchor=\"middle\">PSNR over the covered pixels (dB)</text>\n",
-        LEFT + pw / 2.0,
-        CH - 10.0,
-        TOP + ph / 2.0
-    );
-    // Dashed-line labels sit just above their line, at the left end, or at the right end (or
-    // staggered upwards) when an earlier line's label is in the way.
-    let mut line_labels: Vec<(f64, f64, f64, f64)> = Vec::new();
-    for (name, db) in &lines {
-        let yy = py(*db);
-        let text = format!("{} ({} dB, no time)", escape(name), fmt_psnr(*db));
-        let tw = 7.0
-            * format!("{name} ({} dB, no time)", fmt_psnr(*db))
-                .chars()
-                .count() as f64;
-        let free = |bx: f64, by: f64| {
-            line_labels
-                .iter()
-                .all(|&(x0, y0, x1, y1)| bx + tw <= x0 || bx >= x1 || by + 14.0 <= y0 || by >= y1)
-        };
-        let (left, right) = (LEFT + 6.0, LEFT + pw - 6.0 - tw);
-        let (bx, by) = (0..4)
-            .flat_map(|k| {
-                [
-                    (left, yy - 17.0 - 14.0 * k as f64),
-                    (right, yy - 17.0 - 14.0 * k as f64),
-                ]
-            })
-            .find(|&(bx, by)| free(bx, by))
-            .unwrap_or((left, yy - 17.0));
-        line_labels.push((bx, by, bx + tw, by + 14.0));
-        s += &format!(
-            "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#c0392b\" stroke-dasharray=\"6 4\"/>\n<text x=\"{bx:.1}\" y=\"{:.1}\" fill=\"#c0392b\">{text}</text>\n",
-            LEFT + pw,
-            by + 12.0,
-        );
-    }
+    let plot = Plot::new(&timed, &lines);
+    s += &plot.axes();
+    let line_labels = plot.dashed_lines(&lines, &mut s);
     // The frontier's points joined fastest first (the ones with a finite PSNR, which are plotted).
     let line: Vec<String> = frontier
         .iter()
         .map(|&i| &report.rows[i])
         .filter(|r| r.psnr_all.is_finite())
-        .filter_map(|r| Some(format!("{:.1},{:.1}", px(r.time()?), py(r.psnr_all))))
+        .filter_map(|r| {
+            Some(format!(
+                "{:.1},{:.1}",
+                plot.px(r.time()?),
+                plot.py(r.psnr_all)
+            ))
+        })
         .collect();
     if line.len() > 1 {
         s += &format!(
@@ -204,46 +116,197 @@ pub fn chart_svg(report: &Report) -> String {
         s += &format!(
             "<text x=\"{:.1}\" y=\"{:.1}\" fill=\"#e67e22\">orange: the frontier (no other filter both faster and better)</text>\n",
             LEFT + 6.0,
-            TOP + ph - 8.0
+            TOP + plot.ph - 8.0
         );
     }
-    // Labels: the first of four places around the point (right-above, right-below, left-above,
-    // left-below) that overlaps no point and no label placed before; text width estimated at 7 px a character.
-    // Every point is an obstacle too, and so is every dashed line's label.
-    let mut placed: Vec<(f64, f64, f64, f64)> = timed
-        .iter()
-        .map(|t| (px(t.1) - 5.0, py(t.2) - 5.0, px(t.1) + 5.0, py(t.2) + 5.0))
-        .chain(line_labels.iter().copied())
-        .collect();
-    for (name, ms, db, on) in &timed {
-        let (x, yy) = (px(*ms), py(*db));
-        let tw = 7.0 * name.chars().count() as f64;
-        let boxes = [
-            (x + 6.0, yy - 18.0),
-            (x + 6.0, yy + 4.0),
-            (x - 6.0 - tw, yy - 18.0),
-            (x - 6.0 - tw, yy + 4.0),
-        ];
-        let free = |&(bx, by): &(f64, f64)| {
-            placed.iter().all(|&(px0, py0, px1, py1)| {
-                bx + tw <= px0 || bx >= px1 || by + 14.0 <= py0 || by >= py1
-            })
-        };
-        let (bx, by) = boxes.iter().copied().find(|b| free(b)).unwrap_or(boxes[0]);
-        placed.push((bx, by, bx + tw, by + 14.0));
-        s += &format!(
-            "<circle cx=\"{x:.1}\" cy=\"{yy:.1}\" r=\"4\" fill=\"{}\"><title>{}: {} dB, {} ms{}</title></circle>\n<text x=\"{bx:.1}\" y=\"{:.1}\">{}</text>\n",
-            if *on { "#e67e22" } else { "#1f77b4" },
-            escape(name),
-            fmt_psnr(*db),
-            num(*ms),
-            if *on { ", on the frontier" } else { "" },
-            by + 11.0,
-            escape(name)
-        );
-    }
+    plot.points(&timed, &line_labels, &mut s);
     s += "</svg>\n";
     s
+}
+
+/// A label's or a point's box: left, top, right, bottom.
+type LabelBox = (f64, f64, f64, f64);
+
+/// The chart's plotting area: decades of time across, a range of PSNR up.
+struct Plot {
+    /// The first and last decade (log10 of milliseconds) across.
+    dx0: f64,
+    dx1: f64,
+    /// The PSNR at the bottom and the top, and the tick step between.
+    ya: f64,
+    yb: f64,
+    step: f64,
+    /// The plotting area's width and height in pixels.
+    pw: f64,
+    ph: f64,
+}
+
+impl Plot {
+    /// The area that holds every timed point and every untimed row's line.
+    fn new(timed: &[(&str, f64, f64, bool)], lines: &[(&str, f64)]) -> Plot {
+        // x: decades around the timed points (one decade 1..10 ms when there are none).
+        let (mut lx0, mut lx1) = timed.iter().fold((f64::MAX, f64::MIN), |(a, b), t| {
+            (a.min(t.1.log10()), b.max(t.1.log10()))
+        });
+        if timed.is_empty() {
+            (lx0, lx1) = (0.0, 1.0);
+        }
+        let (dx0, mut dx1) = (lx0.floor(), lx1.ceil());
+        if dx1 <= dx0 {
+            dx1 = dx0 + 1.0;
+        }
+        // y: padded range of every PSNR shown, snapped to the tick step.
+        let ys = timed.iter().map(|t| t.2).chain(lines.iter().map(|l| l.1));
+        let (y0, y1) = ys.fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(y), b.max(y)));
+        let step = nice_step((y1 - y0).max(1.0) + 2.0);
+        Plot {
+            dx0,
+            dx1,
+            ya: ((y0 - 1.0) / step).floor() * step,
+            yb: ((y1 + 1.0) / step).ceil() * step,
+            step,
+            pw: CW - LEFT - RIGHT,
+            ph: CH - TOP - BOTTOM,
+        }
+    }
+
+    /// The x of a frame time.
+    fn px(&self, ms: f64) -> f64 {
+        LEFT + (ms.log10() - self.dx0) / (self.dx1 - self.dx0) * self.pw
+    }
+
+    /// The y of a PSNR.
+    fn py(&self, db: f64) -> f64 {
+        TOP + (self.yb - db) / (self.yb - self.ya) * self.ph
+    }
+
+    /// The frame, the ticks and their numbers, and the axes' titles.
+    fn axes(&self) -> String {
+        let (pw, ph) = (self.pw, self.ph);
+        let mut s = format!(
+            "<rect x=\"{LEFT}\" y=\"{TOP}\" width=\"{pw}\" height=\"{ph}\" fill=\"#fff\" stroke=\"#888\"/>\n"
+        );
+        // x ticks: 1, 2, 5 per decade.
+        let mut d = self.dx0;
+        while d <= self.dx1 + 1e-9 {
+            for m in [1.0, 2.0, 5.0] {
+                let ms = m * 10f64.powf(d);
+                if ms.log10() > self.dx1 + 1e-9 {
+                    continue;
+                }
+                let x = self.px(ms);
+                let major = m == 1.0;
+                s += &format!(
+                    "<line x1=\"{x:.1}\" y1=\"{TOP}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"{}\"/>\n<text x=\"{x:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text>\n",
+                    TOP + ph,
+                    if major { "#ccc" } else { "#eee" },
+                    TOP + ph + 16.0,
+                    num(ms)
+                );
+            }
+            d += 1.0;
+        }
+        // y ticks.
+        let mut y = self.ya;
+        while y <= self.yb + 1e-9 {
+            let yy = self.py(y);
+            s += &format!(
+                "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#ddd\"/>\n<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>\n",
+                LEFT + pw,
+                LEFT - 6.0,
+                yy + 4.0,
+                num(y)
+            );
+            y += self.step;
+        }
+        s += &format!(
+            "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">time per frame (ms, log scale)</text>\n<text transform=\"translate(16 {:.1}) rotate(-90)\" text-anchor=\"middle\">PSNR over the covered pixels (dB)</text>\n",
+            LEFT + pw / 2.0,
+            CH - 10.0,
+            TOP + ph / 2.0
+        );
+        s
+    }
+
+    /// The untimed rows' dashed lines with their labels, drawn onto `s`; returns the labels'
+    /// boxes. A label sits just above its line, at the left end, or at the right end (or
+    /// staggered upwards) when an earlier line's label is in the way.
+    fn dashed_lines(&self, lines: &[(&str, f64)], s: &mut String) -> Vec<LabelBox> {
+        let pw = self.pw;
+        let mut line_labels: Vec<LabelBox> = Vec::new();
+        for (name, db) in lines {
+            let yy = self.py(*db);
+            let text = format!("{} ({} dB, no time)", escape(name), fmt_psnr(*db));
+            let tw = 7.0
+                * format!("{name} ({} dB, no time)", fmt_psnr(*db))
+                    .chars()
+                    .count() as f64;
+            let free = |bx: f64, by: f64| {
+                line_labels.iter().all(|&(x0, y0, x1, y1)| {
+                    bx + tw <= x0 || bx >= x1 || by + 14.0 <= y0 || by >= y1
+                })
+            };
+            let (left, right) = (LEFT + 6.0, LEFT + pw - 6.0 - tw);
+            let (bx, by) = (0..4)
+                .flat_map(|k| {
+                    [
+                        (left, yy - 17.0 - 14.0 * k as f64),
+                        (right, yy - 17.0 - 14.0 * k as f64),
+                    ]
+                })
+                .find(|&(bx, by)| free(bx, by))
+                .unwrap_or((left, yy - 17.0));
+            line_labels.push((bx, by, bx + tw, by + 14.0));
+            *s += &format!(
+                "<line x1=\"{LEFT}\" y1=\"{yy:.1}\" x2=\"{:.1}\" y2=\"{yy:.1}\" stroke=\"#c0392b\" stroke-dasharray=\"6 4\"/>\n<text x=\"{bx:.1}\" y=\"{:.1}\" fill=\"#c0392b\">{text}</text>\n",
+                LEFT + pw,
+                by + 12.0,
+            );
+        }
+        line_labels
+    }
+
+    /// The timed rows' points and labels, drawn onto `s`. A label takes the first of four places
+    /// around its point (right-above, right-below, left-above, left-below) that overlaps no point,
+    /// no dashed line's label and no label placed before; text width is estimated at 7 px a
+    /// character.
+    fn points(&self, timed: &[(&str, f64, f64, bool)], line_labels: &[LabelBox], s: &mut String) {
+        let mut placed: Vec<LabelBox> = timed
+            .iter()
+            .map(|t| {
+                let (x, y) = (self.px(t.1), self.py(t.2));
+                (x - 5.0, y - 5.0, x + 5.0, y + 5.0)
+            })
+            .chain(line_labels.iter().copied())
+            .collect();
+        for (name, ms, db, on) in timed {
+            let (x, yy) = (self.px(*ms), self.py(*db));
+            let tw = 7.0 * name.chars().count() as f64;
+            let boxes = [
+                (x + 6.0, yy - 18.0),
+                (x + 6.0, yy + 4.0),
+                (x - 6.0 - tw, yy - 18.0),
+                (x - 6.0 - tw, yy + 4.0),
+            ];
+            let free = |&(bx, by): &(f64, f64)| {
+                placed.iter().all(|&(px0, py0, px1, py1)| {
+                    bx + tw <= px0 || bx >= px1 || by + 14.0 <= py0 || by >= py1
+                })
+            };
+            let (bx, by) = boxes.iter().copied().find(|b| free(b)).unwrap_or(boxes[0]);
+            placed.push((bx, by, bx + tw, by + 14.0));
+            *s += &format!(
+                "<circle cx=\"{x:.1}\" cy=\"{yy:.1}\" r=\"4\" fill=\"{}\"><title>{}: {} dB, {} ms{}</title></circle>\n<text x=\"{bx:.1}\" y=\"{:.1}\">{}</text>\n",
+                if *on { "#e67e22" } else { "#1f77b4" },
+                escape(name),
+                fmt_psnr(*db),
+                num(*ms),
+                if *on { ", on the frontier" } else { "" },
+                by + 11.0,
+                escape(name)
+            );
+        }
+    }
 }
 
 fn img(src: &str, alt: &str) -> String {

@@ -438,23 +438,7 @@ pub fn render_reference_adaptive(
     let mut depth = vec![f32::INFINITY; pixels];
     let mut interrupted = false;
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
-    let exact = if plan.exact {
-        let status = |done: u64, total: u64| {
-            if let Some(p) = progress {
-                p(&ReferenceStatus {
-                    round: 0,
-                    spp: 0,
-                    active: total,
-                    converged: 0.0,
-                    done,
-                    total,
-                });
-            }
-        };
-        Some(render_exact(settings, draws, Some(&status))?)
-    } else {
-        None
-    };
+    let exact = exact_pixels(settings, draws, plan, progress)?;
     with_passes(settings, draws, strata, |pass| {
         // The pixels this round refines, as indices and (after round 0) as the passes' mask;
         // every other pixel has converged or is exact.
@@ -464,13 +448,7 @@ pub fn render_reference_adaptive(
         if indices.is_empty() {
             return Ok(());
         }
-        let mut active: Option<Vec<bool>> = exact.is_some().then(|| {
-            let mut mask = vec![false; pixels];
-            for &i in &indices {
-                mask[i] = true;
-            }
-            mask
-        });
+        let mut active = exact.is_some().then(|| mask_of(&indices, pixels));
         let mut done_passes = 0u32;
         let mut round = 0u32;
         let mut add = first_passes;
@@ -528,11 +506,7 @@ pub fn render_reference_adaptive(
             if indices.is_empty() || add == 0 {
                 break;
             }
-            let mut mask = vec![false; pixels];
-            for &i in &indices {
-                mask[i] = true;
-            }
-            active = Some(mask);
+            active = Some(mask_of(&indices, pixels));
             round += 1;
         }
         Ok(())
@@ -546,6 +520,41 @@ pub fn render_reference_adaptive(
         interrupted,
         exact.as_ref(),
     ))
+}
+
+/// The exact pixels of the plan's image where the plan asks for them, reported to `progress` as
+/// round 0.
+fn exact_pixels(
+    settings: &RenderSettings,
+    draws: &[DrawCall],
+    plan: &ReferencePlan,
+    progress: Option<&(dyn Fn(&ReferenceStatus) + Sync)>,
+) -> Result<Option<ExactImage>, RasterError> {
+    if !plan.exact {
+        return Ok(None);
+    }
+    let status = |done: u64, total: u64| {
+        if let Some(p) = progress {
+            p(&ReferenceStatus {
+                round: 0,
+                spp: 0,
+                active: total,
+                converged: 0.0,
+                done,
+                total,
+            });
+        }
+    };
+    Ok(Some(render_exact(settings, draws, Some(&status))?))
+}
+
+/// A mask of `pixels` pixels, true at `indices`.
+fn mask_of(indices: &[usize], pixels: usize) -> Vec<bool> {
+    let mut mask = vec![false; pixels];
+    for &i in indices {
+        mask[i] = true;
+    }
+    mask
 }
 
 #[cfg(test)]

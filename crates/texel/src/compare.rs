@@ -411,14 +411,9 @@ pub fn compare(
     check_scene(scene, budget)?;
     let enc = crate::encoding(scene.color);
     let frames = job.orbit.map_or(1, |o| o.frames);
-    let stage = Stage::Reference { n: 0, of: frames };
-    if let Some(p) = job.progress {
-        p.stage(stage);
-    }
-    let estimate = reference(scene, job, &scene.scene.camera)?;
-    if let Some(p) = job.progress {
-        p.done(stage);
-    }
+    let estimate = staged(job, Stage::Reference { n: 0, of: frames }, || {
+        reference(scene, job, &scene.scene.camera)
+    })?;
     let reference = &estimate.frame;
     let (w, h) = (reference.width, reference.height);
     let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
@@ -442,38 +437,17 @@ pub fn compare(
     let rows_count = job.filters.len() + job.extras.len();
     let kept = u64::from(w) * u64::from(h) * ROW_BYTES_PER_PIXEL * rows_count as u64;
     budget.take("the rows' images, kept to rank them", kept)?;
-    let crop = horizon_crop_rect(&coverage, (w / 5).max(16), (h / 8).max(8));
-    let scoring = Scoring {
-        reference: ref_image,
-        encoding: enc,
-        coverage,
-        band_rows: default_band_rows(h),
-        crop,
-        dir,
-    };
-    let reference_crop = match (crop, dir) {
-        (Some(rect), Some(dir)) => {
-            crop_enlarge(&scoring.reference, rect, CROP_FACTOR)?
-                .write_png(dir.join("reference-horizon.png"))?;
-            Some("reference-horizon.png".to_string())
-        }
-        _ => None,
-    };
+    let (scoring, reference_crop) = scoring(ref_image, enc, coverage, dir)?;
 
     let mut rows = Vec::new();
     let mut images = Vec::new();
     for &filter in job.filters {
         job.stopped()?;
-        let stage = Stage::Filter(filter.name());
-        if let Some(p) = job.progress {
-            p.stage(stage);
-        }
-        let (row, image) = filter_row(scene, job, filter, &scoring, budget)?;
+        let (row, image) = staged(job, Stage::Filter(filter.name()), || {
+            filter_row(scene, job, filter, &scoring, budget)
+        })?;
         rows.push(row);
         images.push(image);
-        if let Some(p) = job.progress {
-            p.done(stage);
-        }
     }
     let orbit = match job.orbit {
         Some(spec) => Some(orbit_scores(
@@ -491,12 +465,7 @@ pub fn compare(
         rows.push(row);
         images.push(image);
     }
-    let refs: Vec<&Image8> = images.iter().collect();
-    let ties = error.within_noise(&scoring.reference, &refs, Some(&scoring.coverage))?;
-    let names: Vec<String> = rows.iter().map(|r| r.name.clone()).collect();
-    for (row, tied) in rows.iter_mut().zip(ties) {
-        row.within_noise_of = tied.into_iter().map(|j| names[j].clone()).collect();
-    }
+    mark_ties(&mut rows, &images, &error, &scoring)?;
     drop(images);
     budget.release(kept);
 
@@ -505,15 +474,7 @@ pub fn compare(
         width: w,
         height: h,
         spp: job.plan.min_spp,
-        // The colour handling, and the filtering arithmetic where it is not the exact default.
-        color: format!(
-            "{}{}",
-            scene.color.name(),
-            match scene.precision {
-                texel_raster::Precision::Exact => "",
-                texel_raster::Precision::Gpu => ", gpu precision",
-            }
-        ),
+        color: color_label(scene),
         reference_image: "reference.png".to_string(),
         reference_crop,
         band_rows: scoring.band_rows,
@@ -526,6 +487,77 @@ pub fn compare(
         report.write(dir)?;
     }
     Ok(report)
+}
+
+/// What every row is scored against, and the name of the reference's enlarged horizon crop where
+/// one is written.
+fn scoring<'a>(
+    reference: Image8,
+    encoding: Encoding,
+    coverage: Mask,
+    dir: Option<&'a Path>,
+) -> Result<(Scoring<'a>, Option<String>), Error> {
+    let (w, h) = reference.size();
+    let crop = horizon_crop_rect(&coverage, (w / 5).max(16), (h / 8).max(8));
+    let scoring = Scoring {
+        reference,
+        encoding,
+        coverage,
+        band_rows: default_band_rows(h),
+        crop,
+        dir,
+    };
+    let reference_crop = match (crop, dir) {
+        (Some(rect), Some(dir)) => {
+            crop_enlarge(&scoring.reference, rect, CROP_FACTOR)?
+                .write_png(dir.join("reference-horizon.png"))?;
+            Some("reference-horizon.png".to_string())
+        }
+        _ => None,
+    };
+    Ok((scoring, reference_crop))
+}
+
+/// Runs one stage of the job between its progress marks.
+fn staged<T>(
+    job: &CompareJob,
+    stage: Stage,
+    work: impl FnOnce() -> Result<T, Error>,
+) -> Result<T, Error> {
+    if let Some(p) = job.progress {
+        p.stage(stage);
+    }
+    let done = work()?;
+    if let Some(p) = job.progress {
+        p.done(stage);
+    }
+    Ok(done)
+}
+
+/// Names, on each row, the rows whose images are within the reference's noise of its own.
+fn mark_ties(
+    rows: &mut [FilterRow],
+    images: &[Image8],
+    error: &ReferenceError,
+    scoring: &Scoring,
+) -> Result<(), Error> {
+    let refs: Vec<&Image8> = images.iter().collect();
+    let ties = error.within_noise(&scoring.reference, &refs, Some(&scoring.coverage))?;
+    let names: Vec<String> = rows.iter().map(|r| r.name.clone()).collect();
+    for (row, tied) in rows.iter_mut().zip(ties) {
+        row.within_noise_of = tied.into_iter().map(|j| names[j].clone()).collect();
+    }
+    Ok(())
+}
+
+/// The report's colour line: the colour handling, and the filtering arithmetic where it is not
+/// the exact default.
+fn color_label(scene: &PreparedScene) -> String {
+    let precision = match scene.precision {
+        texel_raster::Precision::Exact => "",
+        texel_raster::Precision::Gpu => ", gpu precision",
+    };
+    format!("{}{precision}", scene.color.name())
 }
 
 /// Render the rest of an orbit (frames 1 to `frames - 1`; frame 0 is the comparison's own, its
@@ -551,18 +583,12 @@ fn orbit_scores(
     let mut change = vec![0.0; filters.len()];
     let mut psnr_sum: Vec<f64> = rows.iter().map(|r| r.psnr_all).collect();
     for k in 1..spec.frames {
+        let camera = scene.scene.camera.orbited(spec.step_deg * k as f32);
         let stage = Stage::Reference {
             n: k,
             of: spec.frames,
         };
-        if let Some(p) = job.progress {
-            p.stage(stage);
-        }
-        let camera = scene.scene.camera.orbited(spec.step_deg * k as f32);
-        let reference = reference(scene, job, &camera)?.frame;
-        if let Some(p) = job.progress {
-            p.done(stage);
-        }
+        let reference = staged(job, stage, || reference(scene, job, &camera))?.frame;
         let ref_image = Image8::from_linear(w, h, &reference.color, enc)?;
         let coverage = Mask::new(w, h, reference.coverage())?;
         ref_change += mean_abs_change(&prev_ref, &ref_image, &prev_cov, &coverage)?;

@@ -604,6 +604,45 @@ fn reference_spp(req: &Request) -> [u32; 2] {
         [2, 2]
     }
 }
+/// A student's shader's codes decoded to linear RGBA. The codes are in the texture's own encoding
+/// (the shader filters the codes as they are stored): sRGB codes decode through the sRGB curve,
+/// linear ones by 255; alpha is always linear.
+fn decoded(px: &[[u8; 4]], srgb: bool) -> Vec<[f32; 4]> {
+    let decode = |c: u8| {
+        let v = f32::from(c) / 255.0;
+        if srgb {
+            texel::texture::base::color::srgb_to_linear(v)
+        } else {
+            v
+        }
+    };
+    px.iter()
+        .map(|p| {
+            [
+                decode(p[0]),
+                decode(p[1]),
+                decode(p[2]),
+                f32::from(p[3]) / 255.0,
+            ]
+        })
+        .collect()
+}
+
+/// Adds one reference pass over `band` to the progressive reference. The pass holds means of
+/// `spp[0] x spp[1]` samples: their sums join `sum`, the squared means join `squares`.
+fn add_pass(progress: &mut Progress, pass: &Frame, spp: [u32; 2], band: [u32; 4], w: u32) {
+    let n = (spp[0] * spp[1]) as f32;
+    for_rect(band, w, |k| {
+        let (a, b) = (&mut progress.sum[k], pass.color[k]);
+        for c in 0..4 {
+            a[c] += b[c] * n;
+        }
+        let q = &mut progress.squares[k];
+        for c in 0..3 {
+            q[c] += f64::from(b[c]) * f64::from(b[c]);
+        }
+    });
+}
 
 /// The share of the pixels of `rect` (in a frame `w` wide) whose accumulated reference, `passes`
 /// equal passes in `progress`, has a 95 % interval of its displayed value (sRGB when `srgb`)
@@ -847,30 +886,10 @@ impl FrameContext<'_, '_> {
                 let size = (w, frame.height);
                 let path = self.worker.shader.as_deref();
                 let px = shader_frame(self.shader, path, &draws, &settings, part.clip, size, mode)?;
-                // The shader's codes are in the texture's own encoding (it filters the codes as
-                // they are stored): sRGB codes decode through the sRGB curve, linear ones by 255.
                 let srgb = draws.first().is_some_and(|d| {
                     d.texture.source_format() == texel::texture::Format::Rgba8Srgb
                 });
-                let decode = |c: u8| {
-                    let v = f32::from(c) / 255.0;
-                    if srgb {
-                        texel::texture::base::color::srgb_to_linear(v)
-                    } else {
-                        v
-                    }
-                };
-                let linear: Vec<[f32; 4]> = px
-                    .iter()
-                    .map(|p| {
-                        [
-                            decode(p[0]),
-                            decode(p[1]),
-                            decode(p[2]),
-                            f32::from(p[3]) / 255.0,
-                        ]
-                    })
-                    .collect();
+                let linear = decoded(&px, srgb);
                 copy_rect(&linear, &mut frame.color, w, rect);
                 frame.forget_clear();
             }
@@ -918,19 +937,7 @@ impl FrameContext<'_, '_> {
                         ..settings
                     };
                     let pass = render_reference_strata(&s, &draws, spp, seed, None)?;
-                    // The pass holds means of spp[0] x spp[1] samples: add their sums.
-                    let n = (spp[0] * spp[1]) as f32;
-                    let progress = &mut *self.progress;
-                    for_rect(band, w, |k| {
-                        let (a, b) = (&mut progress.sum[k], pass.color[k]);
-                        for c in 0..4 {
-                            a[c] += b[c] * n;
-                        }
-                        let q = &mut progress.squares[k];
-                        for c in 0..3 {
-                            q[c] += f64::from(b[c]) * f64::from(b[c]);
-                        }
-                    });
+                    add_pass(&mut *self.progress, &pass, spp, band, w);
                 }
             }
         }
