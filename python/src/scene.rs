@@ -453,11 +453,7 @@ pub fn compare<'py>(
     max_memory: Option<u64>,
     exact: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let filters = match filters {
-        // The command line's list syntax: names, or "all".
-        Some(names) => Filter::parse_list(&names.join(",")).map_err(py_err(""))?,
-        None => Filter::ALL.to_vec(),
-    };
+    let filters = filters_of(filters)?;
     let (threads, color) = (threads_of(threads)?, color_named(color)?);
     let options = SceneOptions {
         size: size_of(size)?,
@@ -469,24 +465,40 @@ pub fn compare<'py>(
     let report = run_released(py, move |stop| {
         let loaded = load_py(&arg)?;
         let mut budget = MemoryBudget::limit_or_default(max_memory);
-        let run = |budget: &mut MemoryBudget| -> Result<Report, Error> {
-            let prepared = PreparedScene::new(loaded, &options, budget)?;
-            let (label, stop) = (arg.describe(), Some(stop));
-            let job = CompareJob {
-                threads,
-                stop,
-                ..CompareJob::new(&label, &filters, plan)
-            };
-            job.charge(&prepared, budget)?;
-            texel::compare::compare(&prepared, &job, None, budget)
+        let (label, stop) = (arg.describe(), Some(stop));
+        let job = CompareJob {
+            threads,
+            stop,
+            ..CompareJob::new(&label, &filters, plan)
         };
-        run(&mut budget).map_err(|e| to_py(e, ""))
+        compare_prepared(loaded, &options, &job, &mut budget).map_err(|e| to_py(e, ""))
     })?;
     let out = PyDict::new(py);
     for row in &report.rows {
         out.set_item(&row.name, row_dict(py, row, &report)?)?;
     }
     Ok(out)
+}
+
+/// The filters named by a Python list in the command line's syntax (names, or `"all"`); every
+/// filter when there is no list.
+fn filters_of(filters: Option<Vec<String>>) -> PyResult<Vec<Filter>> {
+    match filters {
+        Some(names) => Filter::parse_list(&names.join(",")).map_err(py_err("")),
+        None => Ok(Filter::ALL.to_vec()),
+    }
+}
+
+/// `job` on `scene` prepared with `options`, its memory charged before the first pixel.
+fn compare_prepared(
+    scene: Scene,
+    options: &SceneOptions,
+    job: &CompareJob,
+    budget: &mut MemoryBudget,
+) -> Result<Report, Error> {
+    let prepared = PreparedScene::new(scene, options, budget)?;
+    job.charge(&prepared, budget)?;
+    texel::compare::compare(&prepared, job, None, budget)
 }
 
 /// One row of a comparison as Python's `compare` returns it.
