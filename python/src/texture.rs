@@ -238,7 +238,7 @@ impl Texture {
 }
 
 /// The derivatives `sample` is given, read and checked against `uv`'s shape, or else the grid
-/// (its width and height) whose neighbours give them; neither for a filter that reads level 0.
+/// (its width and height) whose neighbours give them; a filter that reads level 0 needs no grid.
 #[allow(clippy::type_complexity)]
 fn derivatives<'py>(
     shape: &[usize],
@@ -288,8 +288,9 @@ fn derivatives<'py>(
 struct Points<'a> {
     /// `(u, v)` or `(x, y)` pairs, one per point.
     uv: &'a [f32],
-    /// The given derivatives in x and in y, pairs as `uv`.
+    /// The given derivatives in x, pairs as `uv`.
     dx: Option<&'a [f32]>,
+    /// The given derivatives in y, pairs as `uv`.
     dy: Option<&'a [f32]>,
     /// The grid's width and height, when the derivatives come from its neighbours.
     grid: Option<(usize, usize)>,

@@ -1,6 +1,6 @@
 //! `texel bench`: median frame time per filter.
 //!
-//! What is timed: one call of `texel_raster::draw_into` — setting up, clipping, binning,
+//! What is timed: one call of `texel::raster::draw_into` — setting up, clipping, binning,
 //! rasterizing, sampling and shading every triangle into a frame cleared beforehand — with the
 //! textures, their pyramids and any ripmap or summed-area table built beforehand. The clear
 //! (`Frame::reset`, a fill of the reused buffers) is not timed, as `llvmpipe_bench.py` clears its
@@ -11,7 +11,7 @@
 //!
 //! The clear leaves the frame marked as holding it (`Frame::holds_clear`), as a GPU's fast
 //! clear does, so a frame larger than the last-level cache is drawn tile by tile in scratch and
-//! streamed out without reading the frame (`--streaming`, [`texel_raster::Streaming`]); the report
+//! streamed out without reading the frame (`--streaming`, [`texel::raster::Streaming`]); the report
 //! says whether the timed frames were (`streamed`).
 
 use std::io::Write;
@@ -58,7 +58,7 @@ fn time_gpu(
         let plan = scene.plan(Some(filter), budget)?;
         let draws = plan.draws();
         let mut settings = plan.settings();
-        settings.derivatives = texel_raster::Derivatives::Quad;
+        settings.derivatives = texel::raster::Derivatives::Quad;
         if args.target == TargetArg::Float {
             settings.target = texel::ColorTarget::Float;
         }
@@ -127,8 +127,8 @@ pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
         (parse_list(&args.filters)?, Vec::new())
     };
     let budget = &mut input.budget;
-    texel_raster::limit_level(args.simd.limit());
-    texel_raster::set_streaming(args.streaming);
+    texel::raster::limit_level(args.simd.limit());
+    texel::raster::set_streaming(args.streaming);
     let gpu = if args.gpu {
         Some(texel_gpu::Gpu::new(args.adapter.as_deref())?)
     } else {
@@ -189,7 +189,8 @@ fn time_cpu(
     })?
 }
 
-/// Every filter's frames have the same size and target, so all stream or none does.
+/// Whether the frames streamed (every filter's frames have the same size and target, so all
+/// stream or none does).
 fn streamed(timings: &[Timing]) -> bool {
     timings.iter().any(|t| t.streamed)
 }
@@ -253,7 +254,7 @@ impl Measured<'_> {
         writeln!(
         stdout,
         "texel bench: {} at {}x{}, {threads} threads, {} target, median of {} frames after {} warm-up",
-        texel_io::escape(&args.scene.scene),
+        texel::io::escape(&args.scene.scene),
         scene.width,
         scene.height,
         target_name(args.target),
@@ -316,9 +317,9 @@ fn cpu_model() -> String {
 
 /// The instruction set the rasterizer's tiles and the sampler's batch kernels run on (run-time
 /// dispatch, see
-/// `texel_raster::simd_level`).
+/// `texel::raster::simd_level`).
 fn simd_level() -> String {
-    format!("{}, run-time dispatch", texel_raster::simd_level().name())
+    format!("{}, run-time dispatch", texel::raster::simd_level().name())
 }
 
 /// How the scene's textures are kept, as the bench prints it: `stored`, `float` (8-bit textures

@@ -483,8 +483,9 @@ struct GradedScene<'a> {
     capture: &'a Capture,
     /// The pixels the scene covers.
     mask: Vec<bool>,
-    /// The reference image, and the covered pixels it covers too.
+    /// The reference image.
     reference: Image8,
+    /// The covered pixels the reference covers too.
     ref_mask: Mask,
     /// Whether each pixel is magnified (its level of detail below 0).
     magnified: Vec<bool>,

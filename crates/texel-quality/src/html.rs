@@ -129,15 +129,19 @@ type LabelBox = (f64, f64, f64, f64);
 
 /// The chart's plotting area: decades of time across, a range of PSNR up.
 struct Plot {
-    /// The first and last decade (log10 of milliseconds) across.
+    /// The first decade (log10 of milliseconds) across.
     dx0: f64,
+    /// The last decade across.
     dx1: f64,
-    /// The PSNR at the bottom and the top, and the tick step between.
+    /// The PSNR at the bottom.
     ya: f64,
+    /// The PSNR at the top.
     yb: f64,
+    /// The PSNR between ticks.
     step: f64,
-    /// The plotting area's width and height in pixels.
+    /// The plotting area's width in pixels.
     pw: f64,
+    /// The plotting area's height in pixels.
     ph: f64,
 }
 
