@@ -298,7 +298,7 @@ pub fn scene_files(
             // A mesh file, scene text, or a path that is no UTF-8 string: the same preparation,
             // recorded.
             None => {
-                let (done, files) = texel_io::record_opened(|| -> Result<(), Error> {
+                let (done, files) = texel::io::record_opened(|| -> Result<(), Error> {
                     let scene = load(&arg)?;
                     let mut budget = MemoryBudget::limit_or_default(max_memory);
                     let options = SceneOptions {

@@ -9,7 +9,7 @@ use crate::budget::ByteSize;
 use crate::filters::{filter_parser, Filter};
 
 /// `--tolerance`'s default: half an 8-bit step of the displayed value.
-pub use texel_raster::adaptive::DEFAULT_TOLERANCE_STEPS;
+pub use texel::raster::adaptive::DEFAULT_TOLERANCE_STEPS;
 
 /// texel: texture mapping and texture filtering on the CPU, measured.
 #[derive(Debug, Parser)]
@@ -127,12 +127,12 @@ pub struct SceneArgs {
     /// `shading_samples`: where the shading normal turns from one pixel to the next by more
     /// than the specular lobe is wide, shade up to N x N sub-samples per pixel (1 to 8; 1 is
     /// off) and average them. Lit scenes only; the reference ignores it.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=i64::from(texel_scene::MAX_SHADING_SAMPLES)))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::scene::MAX_SHADING_SAMPLES)))]
     pub shading_samples: Option<u32>,
     /// What every material's height map does, overriding the scene's `displacement` (materials
     /// without a height map are unaffected).
     #[arg(long, value_enum)]
-    pub displacement: Option<texel_scene::Displacement>,
+    pub displacement: Option<texel::scene::Displacement>,
     /// With displacement = tessellate: the longest projected edge kept, in pixels (0.25 to 256;
     /// default 4).
     #[arg(long, value_name = "PX", value_parser = parse_edge_px)]
@@ -140,11 +140,11 @@ pub struct SceneArgs {
     /// Where every layered material blends its layers, overriding the scene's `layer_order`
     /// (e.g. builtin:terrain).
     #[arg(long, value_enum)]
-    pub layer_order: Option<texel_scene::LayerOrder>,
+    pub layer_order: Option<texel::scene::LayerOrder>,
     /// Lay the scene's procedural sky out as this mapping, at about the same texel angle
     /// (e.g. builtin:mirror-plane; a map from files keeps its own layout).
     #[arg(long, value_enum, value_name = "MAPPING")]
-    pub environment_mapping: Option<texel_scene::Mapping>,
+    pub environment_mapping: Option<texel::scene::Mapping>,
     /// Where meshes with a sphere mapping (builtin:sphere, builtin:globe, `sphere_uv` in a scene)
     /// get their uv: exactly at every pixel (the default), or at the vertices, interpolated.
     #[arg(long, value_enum, value_name = "AT")]
@@ -277,14 +277,14 @@ pub struct ReferenceArgs {
     pub spp: u32,
     /// The most samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is wider than
     /// --tolerance get more passes, doubling, up to this (equal to --spp: no pixel gets more).
-    #[arg(long, default_value_t = 65_536, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel_raster::adaptive::MAX_ADAPTIVE_SPP)))]
+    #[arg(long, default_value_t = 65_536, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::raster::adaptive::MAX_ADAPTIVE_SPP)))]
     pub max_spp: u32,
     /// Half-width of a converged pixel's 95 % interval, in 8-bit steps of the displayed value
     /// (clipped to 0..255, sRGB-encoded unless --color raw), 0 to 255.
     #[arg(long, default_value_t = DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
     pub tolerance: f64,
     /// Seed of the jitter; two seeds give independent estimates.
-    #[arg(long, default_value_t = texel_raster::adaptive::DEFAULT_SEED)]
+    #[arg(long, default_value_t = texel::raster::adaptive::DEFAULT_SEED)]
     pub seed: u64,
     /// Compute the box-filtered integral of every pixel whose visible surface is unlit textured
     /// triangles (standard error 0, accurate to about 1e-6 of its value), and sample only the
@@ -336,7 +336,7 @@ pub struct CompareArgs {
     /// The most reference samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is
     /// wider than --tolerance get more passes, doubling, up to this (default: --spp, a fixed
     /// budget; the report says how much of the reference converged and what it can rank).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel_raster::adaptive::MAX_ADAPTIVE_SPP)))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::raster::adaptive::MAX_ADAPTIVE_SPP)))]
     pub max_spp: Option<u32>,
     /// With --max-spp: half-width of a converged reference pixel's 95 % interval, in 8-bit steps
     /// of the displayed value, 0 to 255 (also the converged share the report gives).
@@ -434,7 +434,7 @@ pub struct BenchArgs {
     /// level that ran.
     #[arg(long, value_enum, default_value_t = SimdArg::Best)]
     pub simd: SimdArg,
-    /// How frames are written (`texel_raster::Streaming`): `auto` draws the tiles of a frame
+    /// How frames are written (`texel::raster::Streaming`): `auto` draws the tiles of a frame
     /// larger than the last-level cache in scratch and streams them out with non-temporal
     /// stores (and clears it so); `always` and `never` force either way, to measure the
     /// difference (images are the same).
@@ -454,7 +454,7 @@ pub struct BenchArgs {
 }
 
 /// Which instruction-set copy the tile rasterizer and the sampler's batch kernels run
-/// (`texel_raster::simd_level`).
+/// (`texel::raster::simd_level`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SimdArg {
     /// The best the CPU has.
@@ -469,8 +469,8 @@ pub enum SimdArg {
 
 impl SimdArg {
     /// The highest level this choice allows.
-    pub fn limit(self) -> texel_raster::SimdLevel {
-        use texel_raster::SimdLevel;
+    pub fn limit(self) -> texel::raster::SimdLevel {
+        use texel::raster::SimdLevel;
         match self {
             SimdArg::Best | SimdArg::V4 => SimdLevel::X86_64V4,
             SimdArg::V3 => SimdLevel::X86_64V3,

@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use texel::ao::{bake_ao, protected_levels, AoMap, AoMesh, AoSettings};
 use texel::quality::{Encoding, Image8};
-use texel_scene::{load_gltf_with, load_obj_with, Mesh, Scene};
+use texel::scene::{load_gltf_with, load_obj_with, Mesh, Scene};
 
 use crate::cli::BakeAoArgs;
 use crate::input::{scene_limits, Input};
@@ -64,7 +64,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
             i64::from(protected_levels(m)) - 1
         ),
     };
-    texel_io::stderr_line(format_args!(
+    texel::io::stderr_line(format_args!(
         "texel bake-ao: {} triangles, {size}x{size}: {} texels sampled ({:.1} %), {} filled by the margin, {:.1} M rays in {seconds:.1} s on {} threads ({:.2} M rays/s); margin: {margin}",
         mesh.triangles.len(),
         map.sampled,
@@ -76,7 +76,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
         size = map.size,
     ));
     if map.skipped_triangles > 0 {
-        texel_io::stderr_line(format_args!(
+        texel::io::stderr_line(format_args!(
             "texel bake-ao: warning: {} triangles not baked (zero area in uv or in space, or outside the map's [0, 1] uv square); they still occlude",
             map.skipped_triangles
         ));
@@ -128,7 +128,7 @@ pub struct DemoAo {
 /// frame's width rounded up to a power of two when `size` is smaller, `DEMO_RAYS` rays), then
 /// rendered (trilinear) without and with the map as its material's `occlusion`, and the map.
 pub fn demo_page(dir: &Path, size: (u32, u32), input: &mut Input) -> Result<DemoAo> {
-    use texel_scene::{EncodedImage, TextureSource, TextureSpec};
+    use texel::scene::{EncodedImage, TextureSource, TextureSpec};
 
     let mut scene = Scene::load("builtin:knot")?;
     let side = DEMO_MAP.min(size.0.next_power_of_two().max(32));

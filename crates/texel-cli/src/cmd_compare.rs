@@ -5,12 +5,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use texel::compare::{slug, CompareJob, Extra, OrbitSpec, Stage, TIMED_FRAMES};
+use texel::io::publish_dir;
+use texel::quality::Image8;
+use texel::raster::{Frame, ReferenceStatus, RenderSettings};
 use texel::timing::median;
 use texel::{MemoryBudget, PreparedScene};
 use texel_gpu::GpuFilter;
-use texel_io::publish_dir;
-use texel_quality::Image8;
-use texel_raster::{Frame, ReferenceStatus, RenderSettings};
 
 use crate::cli::CompareArgs;
 use crate::cmd_reference as reference;
@@ -35,11 +35,11 @@ pub fn parse_extra(s: &str) -> Result<(String, PathBuf)> {
 pub fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<()> {
     for (i, (label, _)) in extras.iter().enumerate() {
         // A label is a row of the report (Markdown, HTML, JSON) that a terminal may show.
-        if label.chars().any(texel_io::term::needs_escape) {
+        if label.chars().any(texel::io::term::needs_escape) {
             bail!(
                 "--extra label {} holds control or bidirectional characters: give a label of \
                  printable characters",
-                texel_io::escape(label)
+                texel::io::escape(label)
             );
         }
         if let Some(f) = filters.iter().find(|f| f.name() == label) {
@@ -117,7 +117,7 @@ impl texel::compare::Progress for Bars {
         match (stage, &self.shared) {
             (Stage::Reference { n, of }, None) => {
                 if n > 0 {
-                    texel_io::stderr_line(format_args!("orbit frame {n} of {}", of - 1));
+                    texel::io::stderr_line(format_args!("orbit frame {n} of {}", of - 1));
                 }
                 self.finish();
                 *self.bar() = Some(progress::bar(1, "reference"));
@@ -164,9 +164,9 @@ fn gpu_rows(
     budget: &mut MemoryBudget,
 ) -> Result<Vec<Extra>> {
     let gpu = texel_gpu::Gpu::new(adapter)?;
-    texel_io::stderr_line(format_args!("gpu: {}", gpu.info()));
+    texel::io::stderr_line(format_args!("gpu: {}", gpu.info()));
     let mut settings = scene.settings();
-    settings.derivatives = texel_raster::Derivatives::Quad;
+    settings.derivatives = texel::raster::Derivatives::Quad;
     let mut jobs: Vec<(String, Filter, GpuFilter)> = filters
         .iter()
         .filter_map(|&f| GpuFilter::of(f).map(|g| (format!("gpu-{}", f.name()), f, g)))
@@ -246,7 +246,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         args.max_spp.unwrap_or(args.spp),
         args.tolerance,
         args.scene.color == texel::ColorHandling::Srgb,
-        texel_raster::adaptive::DEFAULT_SEED,
+        texel::raster::adaptive::DEFAULT_SEED,
     )?
     .with_exact(args.exact);
     check_storage(&args.scene, args.gpu)?;
@@ -262,7 +262,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         path: path.clone(),
     }));
     // The scene's name as the report shows it: control and bidirectional characters escaped.
-    let label = texel_io::escape(&args.scene.scene);
+    let label = texel::io::escape(&args.scene.scene);
     let bars = Bars::own(filters.len());
     let job = CompareJob {
         orbit: args.orbit.map(|frames| OrbitSpec {
@@ -288,8 +288,8 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     bars.finish();
     let report =
         report.with_context(|| format!("cannot write the report to {}", args.out.display()))?;
-    texel_io::stdout_text(&report.to_markdown()).context(crate::cmd_render::STDOUT)?;
-    texel_io::stderr_line(format_args!(
+    texel::io::stdout_text(&report.to_markdown()).context(crate::cmd_render::STDOUT)?;
+    texel::io::stderr_line(format_args!(
         "report: {}",
         args.out.join("index.html").display()
     ));

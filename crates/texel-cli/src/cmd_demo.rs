@@ -9,9 +9,9 @@ use std::fmt::Write as _;
 
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
-use texel_io::{publish_dir, write_atomic};
-use texel_quality::html::escape;
-use texel_quality::Report;
+use texel::io::{publish_dir, write_atomic};
+use texel::quality::html::escape;
+use texel::quality::Report;
 
 use crate::cli::DemoArgs;
 use crate::cli::DEFAULT_TOLERANCE_STEPS;
@@ -23,15 +23,15 @@ use crate::input::{load_scene_with, Input};
 use crate::progress;
 use texel::compare::CompareJob;
 use texel::quality::Encoding;
-use texel_raster::{render, ColorTarget, UvEvaluation, View};
+use texel::raster::{render, ColorTarget, UvEvaluation, View};
 
 /// Run `texel demo`: every scene's report is written into one staging directory, published as a
 /// whole at `--out` when all are done. One bar counts every reference and filter image (and the
 /// ambient-occlusion page) with an estimate of the time left.
 pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let started = std::time::Instant::now();
-    let shaded = texel_scene::shaded_builtin_names();
-    let scenes: Vec<&str> = texel_scene::builtin_names()
+    let shaded = texel::scene::shaded_builtin_names();
+    let scenes: Vec<&str> = texel::scene::builtin_names()
         .iter()
         .chain(shaded)
         .copied()
@@ -39,7 +39,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let steps =
         scenes.len() * (Filter::ALL.len() + 1) + GLOBES.len() * (MAPPING_FILTERS.len() + 1) + 1;
     let pb = progress::bar(steps as u64, "demo");
-    let note = |pb: &ProgressBar, line: String| pb.suspend(|| texel_io::stderr_line(line));
+    let note = |pb: &ProgressBar, line: String| pb.suspend(|| texel::io::stderr_line(line));
     let reports = publish_dir(&args.out, &[], |dir| -> Result<Vec<(String, Report)>> {
         let mut reports: Vec<(String, Report)> = Vec::new();
         for name in &scenes {
@@ -93,13 +93,13 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     .with_context(|| format!("cannot write the demo to {}", args.out.display()))?;
     pb.finish_and_clear();
     let index = args.out.join("index.html");
-    texel_io::stdout_line(format_args!(
+    texel::io::stdout_line(format_args!(
         "texel demo: {} scenes in {:.0} s",
         reports.len(),
         started.elapsed().as_secs_f64()
     ))
     .context(crate::cmd_render::STDOUT)?;
-    texel_io::stdout_line(format_args!("open {}", index.display()))
+    texel::io::stdout_line(format_args!("open {}", index.display()))
         .context(crate::cmd_render::STDOUT)?;
     Ok(())
 }
@@ -111,7 +111,7 @@ fn scene_size(args: &DemoArgs, name: &str) -> Result<Option<crate::cli::Size>> {
     if let Some(s) = args.size {
         return Ok(Some(s));
     }
-    let lit = texel_scene::shaded_builtin_names().contains(&name);
+    let lit = texel::scene::shaded_builtin_names().contains(&name);
     let divisor = match (args.full, lit) {
         (true, false) => return Ok(None),
         (true, true) | (false, false) => 2,
@@ -136,7 +136,7 @@ fn report_in(
         spp,
         DEFAULT_TOLERANCE_STEPS,
         true,
-        texel_raster::adaptive::DEFAULT_SEED,
+        texel::raster::adaptive::DEFAULT_SEED,
     )?
     // Unlit textured pixels computed, not sampled; lit ones sampled.
     .with_exact(true);
@@ -297,7 +297,7 @@ fn mapping_html(rows: &[MappingRow]) -> String {
 
 /// The output size of built-in scene `name`, each side divided by `divisor`.
 fn own_size(name: &str, divisor: u32) -> Result<crate::cli::Size> {
-    let o = texel_scene::builtin(name)?.output;
+    let o = texel::scene::builtin(name)?.output;
     Ok(crate::cli::Size {
         width: (o.width / divisor).max(1),
         height: (o.height / divisor).max(1),

@@ -17,7 +17,7 @@ const MAX_SHADER_BYTES: u64 = 1 << 20;
 
 /// The text of a shader file (a regular file of at most 1 MiB, UTF-8).
 pub fn read_source(path: &Path, what: &str) -> Result<String> {
-    let bytes = texel_io::read_regular(path, MAX_SHADER_BYTES)
+    let bytes = texel::io::read_regular(path, MAX_SHADER_BYTES)
         .with_context(|| format!("cannot read the {what} {}", path.display()))?;
     String::from_utf8(bytes)
         .with_context(|| format!("the {what} {} is not UTF-8 text", path.display()))
@@ -86,17 +86,17 @@ pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
         )?;
     }
     for v in lab::source::violations(&job.fragment) {
-        texel_io::stderr_line(format_args!(
+        texel::io::stderr_line(format_args!(
             "texel: warning: line {}: `{}` breaks the lab's rule (texelFetch and textureSize only); the shader is still graded, and marked",
             v.line, v.call
         ));
     }
     for line in lab::source::level_size_queries(&job.fragment) {
-        texel_io::stderr_line(format_args!(
+        texel::io::stderr_line(format_args!(
             "texel: note: line {line} asks textureSize for a per-pixel level; Mesa's llvmpipe answers one size for a whole quad, so use max(textureSize(texSlot, 0) >> level, ivec2(1))"
         ));
     }
-    let shader_name = texel_io::escape(&args.shader.display().to_string()).into_owned();
+    let shader_name = texel::io::escape(&args.shader.display().to_string()).into_owned();
     let options = lab::GradeOptions {
         reference_spp: args.spp,
         threads: args.threads.map(|t| t as usize),
@@ -113,7 +113,7 @@ pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
             .filter(|p| p.extension().is_some()),
     );
     let limit = Duration::from_secs(args.timeout);
-    let report = texel_io::publish_dir(&args.out, &inputs, |dir| {
+    let report = texel::io::publish_dir(&args.out, &inputs, |dir| {
         let work = WorkDir::new(dir)?;
         let job_path = work.0.join("job.json");
         std::fs::write(&job_path, serde_json::to_vec(&job)?)
@@ -146,8 +146,8 @@ pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
             summary.push_str(&format!("    {d}\n"));
         }
     }
-    texel_io::stdout_text(&summary).context(crate::cmd_render::STDOUT)?;
-    texel_io::stderr_line(format_args!(
+    texel::io::stdout_text(&summary).context(crate::cmd_render::STDOUT)?;
+    texel::io::stderr_line(format_args!(
         "report: {}",
         args.out.join("report.html").display()
     ));

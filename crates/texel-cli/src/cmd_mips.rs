@@ -1,14 +1,14 @@
 //! `texel mips`: every level of a texture's pyramid, and one image of the whole chain.
 //!
-//! Memory: the texture loads within what `--max-memory` leaves (see [`texel_texture::Limits`]);
+//! Memory: the texture loads within what `--max-memory` leaves (see [`texel::texture::Limits`]);
 //! then each level is encoded straight from the pyramid to an 8-bit image and written before the
 //! next (4 bytes per pixel plus the encoder's copies, [`ENCODE_BYTES_PER_PIXEL`]), and the chain
-//! likewise. The directory is published as a whole ([`texel_io::publish_dir`]).
+//! likewise. The directory is published as a whole ([`texel::io::publish_dir`]).
 
 use anyhow::{Context, Result};
-use texel_io::publish_dir;
-use texel_quality::{Image8, MAX_SIDE};
-use texel_texture::Texture;
+use texel::io::publish_dir;
+use texel::quality::{Image8, MAX_SIDE};
+use texel::texture::Texture;
 
 use crate::cli::MipsArgs;
 use crate::input::Input;
@@ -80,11 +80,11 @@ pub fn run(args: &MipsArgs, input: &mut Input) -> Result<()> {
     })
     .with_context(|| format!("cannot write the levels to {}", args.out.display()))?;
     if !chain_fits {
-        texel_io::stderr_line(format_args!(
+        texel::io::stderr_line(format_args!(
             "texel mips: chain.png skipped: the chain would be {cw}x{ch}, over {MAX_SIDE} pixels per side"
         ));
     }
-    texel_io::stderr_line(format_args!(
+    texel::io::stderr_line(format_args!(
         "wrote {} levels ({} bytes of pyramid){} to {}",
         levels.len(),
         tex.pyramid_bytes(),

@@ -4,8 +4,8 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use anyhow::Result;
-use texel_quality::{viridis, Image8};
-use texel_raster::{ReferenceEstimate, ReferencePlan, ReferenceStatus};
+use texel::quality::{viridis, Image8};
+use texel::raster::{ReferenceEstimate, ReferencePlan, ReferenceStatus};
 
 use crate::cli::ReferenceArgs;
 use crate::input::{load_scene, Input};
@@ -27,7 +27,7 @@ pub fn plan(
     seed: u64,
 ) -> Result<ReferencePlan> {
     ReferencePlan::new(min_spp, max_spp, tolerance_steps, srgb, seed).map_err(|e| match e {
-        texel_raster::RasterError::MaxSppBelowMin { min_spp, max_spp } => anyhow::anyhow!(
+        texel::raster::RasterError::MaxSppBelowMin { min_spp, max_spp } => anyhow::anyhow!(
             "--max-spp {max_spp} is below --spp {min_spp}: the maximum must be at least the minimum"
         ),
         e => e.into(),
@@ -47,7 +47,7 @@ pub fn show_status(pb: &indicatif::ProgressBar, s: &ReferenceStatus) {
     ));
 }
 
-/// Run `texel reference`: the converging reference (`texel_raster::adaptive`), its summary on
+/// Run `texel reference`: the converging reference (`texel::raster::adaptive`), its summary on
 /// stderr, the image and, with `--error-map`, each pixel's error. Ctrl-C during the passes writes
 /// what is done so far, says so, and exits with status 130.
 pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
@@ -77,7 +77,7 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     let estimate = texel::reference_prepared(&scene, &scene.scene.camera, &run, &mut input.budget)
         .map_err(|e| match e {
             texel::Error::Cancelled => anyhow::Error::new(interrupt::Interrupted(
-                texel_raster::RasterError::Interrupted.to_string(),
+                texel::raster::RasterError::Interrupted.to_string(),
             )),
             e => e.into(),
         })?;
@@ -91,7 +91,7 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     if let Some(path) = &args.error_map {
         write_error_map(path, &estimate, &[])?;
     }
-    texel_io::stderr_line(summary(&estimate, args.tolerance, seconds));
+    texel::io::stderr_line(summary(&estimate, args.tolerance, seconds));
     Ok(())
 }
 
@@ -140,7 +140,7 @@ fn write_partial(args: &ReferenceArgs, e: &ReferenceEstimate, seconds: f64) -> R
         }
         written.push(path.display().to_string());
     }
-    texel_io::stderr_line(summary(e, args.tolerance, seconds));
+    texel::io::stderr_line(summary(e, args.tolerance, seconds));
     let mut message = String::from("interrupted");
     if !written.is_empty() {
         let _ = write!(
@@ -231,7 +231,7 @@ fn write_error_map(
             .iter()
             .map(|s| s.map(|x| if x.is_finite() { x } else { f32::MAX }))
             .collect();
-        let bytes = texel_quality::encode_exr_with_text(w, h, &finite, text)?;
+        let bytes = texel::quality::encode_exr_with_text(w, h, &finite, text)?;
         return crate::output::publish(path, &bytes);
     }
     let pixels: Vec<[u8; 4]> = e

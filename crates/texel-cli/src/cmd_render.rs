@@ -1,8 +1,8 @@
 //! `texel render`: one filter (or a debug view), one PNG.
 
 use anyhow::{bail, Context, Result};
+use texel::raster::{render, ColorTarget, Derivatives, UvEvaluation};
 use texel_gpu::{Gpu, GpuFilter};
-use texel_raster::{render, ColorTarget, Derivatives, UvEvaluation};
 
 use crate::cli::RenderArgs;
 use crate::filters::Filter;
@@ -26,7 +26,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     let mut scene = load_scene(&args.scene, input)?;
     if args.gpu && args.scene.surface_uv.is_none() && scene.maps_uv_per_pixel() {
         // The shader interpolates the vertices' uv: say so rather than refuse the scene.
-        texel_io::stderr_line(
+        texel::io::stderr_line(
             "texel: --gpu interpolates sphere mappings from the vertices (--surface-uv vertex)",
         );
         scene.set_surface_uv(UvEvaluation::PerVertex);
@@ -80,9 +80,9 @@ pub fn gpu_info() -> Result<()> {
         bail!(texel_gpu::GpuError::NoAdapter);
     }
     for a in &all {
-        texel_io::stdout_line(a).context(STDOUT)?;
+        texel::io::stdout_line(a).context(STDOUT)?;
     }
     let gpu = Gpu::new(None)?;
-    texel_io::stdout_line(format_args!("--gpu uses: {}", gpu.info().name)).context(STDOUT)?;
+    texel::io::stdout_line(format_args!("--gpu uses: {}", gpu.info().name)).context(STDOUT)?;
     Ok(())
 }

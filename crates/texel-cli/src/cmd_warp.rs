@@ -6,8 +6,8 @@
 
 use anyhow::{bail, Context, Result};
 use glam::DVec2;
-use texel_raster::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
-use texel_texture::{AddressMode, Sampler, Texture};
+use texel::raster::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
+use texel::texture::{AddressMode, Sampler, Texture};
 
 use crate::cli::WarpArgs;
 use crate::input::Input;
@@ -29,7 +29,7 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
     crate::output::check_outputs(&[("-o", &args.output)])?;
     let cannot = || format!("cannot load image {}", args.input.display());
     let bytes =
-        texel_io::read_regular(&args.input, input.budget.remaining()).with_context(cannot)?;
+        texel::io::read_regular(&args.input, input.budget.remaining()).with_context(cannot)?;
     let (sw, sh, _) = Texture::header(&bytes).with_context(cannot)?;
     let (w, h) = match args.size {
         Some(s) => (s.width, s.height),
@@ -58,7 +58,7 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
     let mut desc = args
         .filter
         .descriptor(AddressMode::ClampToBorder, AddressMode::ClampToBorder);
-    desc.border_color = texel_texture::BorderColor::TransparentBlack;
+    desc.border_color = texel::texture::BorderColor::TransparentBlack;
     let sampler = Sampler::new(desc)?;
     let pixels = warp_perspective(&tex, &sampler, corners, w, h).map_err(|e| {
         let what = match e {

@@ -2,8 +2,8 @@
 //! the tests; one function ([`ViewState::apply`]) from a key press to the new state. No window is
 //! needed here: `--keys` scripts and the window's keyboard both arrive as [`Press`]es.
 
+use texel::raster::{Derivatives, Perspective, View};
 use texel::Filter;
-use texel_raster::{Derivatives, Perspective, View};
 
 /// What one half of the screen (or the whole screen) shows: a filter, or the progressive
 /// supersampled reference.

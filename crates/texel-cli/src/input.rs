@@ -3,10 +3,10 @@
 
 use anyhow::Result;
 use texel::memory::{MESH_BYTES, TRIANGLE_BYTES, VERTEX_BYTES};
+use texel::texture::{ColorSpace, Limits, LoadOptions, TextureError};
 use texel::{MemoryBudget, PreparedScene, Scene, SceneLimits, SceneOptions, TextureStorage};
-use texel_texture::{ColorSpace, Limits, LoadOptions, TextureError};
 
-use texel_raster::SpecularAa;
+use texel::raster::SpecularAa;
 
 use crate::cli::{SceneArgs, Size};
 
@@ -42,10 +42,10 @@ impl Input {
     /// Print a warning when `--sanitize` replaced values of texture `name`.
     pub fn warn_replaced(&self, name: &str, replaced: u64) {
         if replaced > 0 {
-            texel_io::stderr_line(format_args!(
+            texel::io::stderr_line(format_args!(
                 "texel: warning: texture {name:?}: replaced {replaced} NaN, infinite or out-of-range channel values (NaN -> 0, +-inf -> +-{inf}, beyond +-{max:e} -> +-{max:e})",
-                inf = texel_texture::NON_FINITE_CLAMP,
-                max = texel_texture::MAX_TEXEL
+                inf = texel::texture::NON_FINITE_CLAMP,
+                max = texel::texture::MAX_TEXEL
             ));
         }
     }
@@ -111,13 +111,13 @@ pub struct MaterialOverrides {
     /// `--shading-samples`.
     pub shading_samples: Option<u32>,
     /// `--displacement`.
-    pub displacement: Option<texel_scene::Displacement>,
+    pub displacement: Option<texel::scene::Displacement>,
     /// `--edge-px`.
     pub edge_px: Option<f32>,
     /// `--layer-order`.
-    pub layer_order: Option<texel_scene::LayerOrder>,
+    pub layer_order: Option<texel::scene::LayerOrder>,
     /// `--environment-mapping`.
-    pub environment_mapping: Option<texel_scene::Mapping>,
+    pub environment_mapping: Option<texel::scene::Mapping>,
     /// `--surface-uv`.
     pub surface_uv: Option<texel::raster::UvEvaluation>,
     /// `--precision`.
@@ -233,7 +233,7 @@ pub fn load_scene_with(
         input.warn_replaced(name, *n);
     }
     for (name, bytes) in &prepared.kept_stored {
-        texel_io::stderr_line(format_args!(
+        texel::io::stderr_line(format_args!(
             "texel: note: texture {name:?} stays 8-bit: its float copy ({}) does not fit {}",
             texel::memory::mib(*bytes),
             input.budget.name()

@@ -17,10 +17,12 @@ static STOP: AtomicBool = AtomicBool::new(false);
 /// The signal handler.
 pub fn on_signal() {
     if GRACEFUL.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
-        texel_io::stderr_text("\ntexel: stopping at the next pixel row (a second signal aborts)\n");
+        texel::io::stderr_text(
+            "\ntexel: stopping at the next pixel row (a second signal aborts)\n",
+        );
         return;
     }
-    texel_io::remove_pending_and_exit(INTERRUPTED)
+    texel::io::remove_pending_and_exit(INTERRUPTED)
 }
 
 /// While alive, the first signal raises [`Graceful::flag`] instead of exiting.

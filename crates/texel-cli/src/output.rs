@@ -6,10 +6,10 @@ use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use texel_quality::{Encoding, Image8};
+use texel::quality::{Encoding, Image8};
 
+use texel::raster::Frame;
 use texel::ColorHandling;
-use texel_raster::Frame;
 
 /// The 8-bit encoding `--color` asks for: sRGB-encoded RGB, or raw `round(255 x)`.
 pub fn encoding(color: impl Into<ColorHandling>) -> Encoding {
@@ -66,8 +66,8 @@ pub fn png_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
 }
 
 /// Check a command's outputs (each flag with its path) before any work: no two of them can reach
-/// one file or stream, however they are spelled ([`texel_io::same_output`]: `-` and
-/// `/dev/stdout`, a link and its target), and each can be written ([`texel_io::check_output`]).
+/// one file or stream, however they are spelled ([`texel::io::same_output`]: `-` and
+/// `/dev/stdout`, a link and its target), and each can be written ([`texel::io::check_output`]).
 ///
 /// # Errors
 /// The two flags that name one output, or the first output that cannot be written.
@@ -75,14 +75,15 @@ pub fn check_outputs(outputs: &[(&str, &Path)]) -> Result<()> {
     for (i, &(flag, path)) in outputs.iter().enumerate() {
         for &(other_flag, other) in &outputs[..i] {
             anyhow::ensure!(
-                !texel_io::same_output(path, other),
+                !texel::io::same_output(path, other),
                 "{other_flag} {} and {flag} {} name the same file or stream: give each output a \
                  path of its own",
                 other.display(),
                 path.display()
             );
         }
-        texel_io::check_output(path).with_context(|| format!("cannot write {}", path.display()))?;
+        texel::io::check_output(path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
 }
@@ -103,7 +104,7 @@ pub fn write_frame_with_text(
 ) -> Result<()> {
     if is_exr(path) {
         let bytes =
-            texel_quality::encode_exr_with_text(frame.width, frame.height, &frame.linear(), text)?;
+            texel::quality::encode_exr_with_text(frame.width, frame.height, &frame.linear(), text)?;
         return publish(path, &bytes);
     }
     let image = texel::frame_image(frame, encoding)?;
@@ -113,11 +114,11 @@ pub fn write_frame_with_text(
 /// `png` with a `tEXt` chunk for each text entry.
 pub fn with_text(png: Vec<u8>, text: &[(&str, &str)]) -> Vec<u8> {
     text.iter().fold(png, |png, (keyword, value)| {
-        texel_quality::png_with_text(&png, keyword, value)
+        texel::quality::png_with_text(&png, keyword, value)
     })
 }
 
-/// Publish encoded image bytes at `path` ([`texel_io::write_atomic`]), or on standard output for
+/// Publish encoded image bytes at `path` ([`texel::io::write_atomic`]), or on standard output for
 /// `-`.
 pub fn publish(path: &Path, bytes: &[u8]) -> Result<()> {
     if path.as_os_str() == "-" {
@@ -127,7 +128,7 @@ pub fn publish(path: &Path, bytes: &[u8]) -> Result<()> {
             .and_then(|()| out.flush())
             .context("cannot write the PNG to standard output");
     }
-    texel_io::write_atomic(path, bytes).with_context(|| format!("cannot write {}", path.display()))
+    texel::io::write_atomic(path, bytes).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Publish linear RGBA pixels at `path`: OpenEXR for a `.exr` path ([`is_exr`]), else PNG
@@ -146,13 +147,13 @@ pub fn write_linear(
     write_image(path, &image)
 }
 
-/// Publish linear RGBA pixels as OpenEXR at `path` ([`texel_quality::write_exr_atomic`]).
+/// Publish linear RGBA pixels as OpenEXR at `path` ([`texel::quality::write_exr_atomic`]).
 fn write_exr(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<()> {
-    texel_quality::write_exr_atomic(path, width, height, pixels)
+    texel::quality::write_exr_atomic(path, width, height, pixels)
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Publish an 8-bit image as PNG at `path` ([`texel_io::write_atomic`]: atomically over a
+/// Publish an 8-bit image as PNG at `path` ([`texel::io::write_atomic`]: atomically over a
 /// regular file or a new path, through to a device or FIFO), or on standard output for `-`.
 pub fn write_image(path: &Path, image: &Image8) -> Result<()> {
     if is_exr(path) {

@@ -1,6 +1,6 @@
 //! `texel compare`: the report agrees with the images it wrote; the filter ranking on the ground plane.
 
-use texel_quality::{
+use texel::quality::{
     block_psnr, psnr, psnr_band, ssim, Encoding, Image8, Mask, Report, DEFAULT_BLOCK, OUTSIDE,
 };
 

@@ -1,6 +1,6 @@
 //! `texel demo` and `texel bench`.
 
-use texel_quality::Report;
+use texel::quality::Report;
 
 use crate::util::*;
 
@@ -157,7 +157,7 @@ fn bench_json_has_the_llvmpipe_shape() {
 }
 
 /// `--streaming always|never` forces either way of writing the frame, and the report says which
-/// ran (`texel_raster::Streaming`).
+/// ran (`texel::raster::Streaming`).
 #[test]
 fn bench_streaming_is_reported() {
     let bench = |filter: &str, policy: &str, json: bool| {

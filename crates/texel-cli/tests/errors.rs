@@ -1,6 +1,6 @@
 //! Usage and input errors: exit code, the key part of the one-line message, never a panic.
 
-use texel_quality::Image8;
+use texel::quality::Image8;
 
 use crate::util::*;
 

@@ -1,7 +1,7 @@
 //! `render --gpu` and `gpu-info`. The rendering tests need a Vulkan adapter (Mesa's lavapipe:
 //! `apt-get install mesa-vulkan-drivers`); without one they print why and pass, unless `CI=true`.
 
-use texel_quality::Image8;
+use texel::quality::Image8;
 
 use crate::util::*;
 
@@ -196,7 +196,7 @@ fn compare_gpu_scores_shader_and_hardware_rows() {
         let (cpu, gpu) = (psnr(f), psnr(&format!("gpu-{f} (extra)")));
         assert!((cpu - gpu).abs() < 0.25, "{f}: cpu {cpu} gpu {gpu}");
         let image = |name: &str| load(d.join("report").join(format!("{name}.png")));
-        let apart = texel_quality::psnr(&image(f), &image(&format!("gpu-{f}")), None).unwrap();
+        let apart = texel::quality::psnr(&image(f), &image(&format!("gpu-{f}")), None).unwrap();
         assert!(apart > 35.0, "{f}: cpu and gpu images {apart} dB apart");
     }
     assert!(psnr("hw-trilinear (extra)") > 0.0 && psnr("hw-aniso16 (extra)") > 0.0);

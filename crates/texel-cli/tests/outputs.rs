@@ -104,7 +104,7 @@ fn exr_outputs_keep_the_linear_colour_unclamped() {
             .fold(0.0, f32::max);
         assert!(brightest > 1.5, "{cmd}: highlight {brightest}");
         let encoded =
-            texel_quality::Image8::from_linear(w, h, &px, texel_quality::Encoding::Srgb).unwrap();
+            texel::quality::Image8::from_linear(w, h, &px, texel::quality::Encoding::Srgb).unwrap();
         assert_eq!(encoded.pixels(), load(&png).pixels(), "{cmd}");
     }
 }

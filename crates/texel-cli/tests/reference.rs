@@ -242,7 +242,7 @@ fn refinement_adds_samples_only_where_needed() {
 
 /// The display value (8-bit steps, clipped, sRGB) of a linear value.
 fn display(x: f32) -> f64 {
-    texel_texture::base::color::displayed(f64::from(x), true) * 255.0
+    texel::texture::base::color::displayed(f64::from(x), true) * 255.0
 }
 
 /// Glints (`scenes/glints.toml`: a sharp lobe on a bumpy plane under a grazing light) at 48 x 27:
@@ -475,7 +475,7 @@ fn exact_reference_of_the_ground_and_of_a_lit_scene() {
         &report,
     ]);
     let json = std::fs::read_to_string(d.join("report").join("report.json")).unwrap();
-    let parsed = texel_quality::Report::from_json(&json).unwrap();
+    let parsed = texel::quality::Report::from_json(&json).unwrap();
     let e = parsed.reference_error.expect("the reference's figures");
     assert_eq!(e.exact, 1.0);
     assert!(e.noise_floor.is_infinite(), "{e:?}");

@@ -1,6 +1,6 @@
 //! Lit scenes with materials through the command line: the glossy normal-mapped plane.
 
-use texel_quality::psnr;
+use texel::quality::psnr;
 
 use crate::util::*;
 
@@ -104,7 +104,7 @@ fn an_orbit_reports_flicker_and_aliasing_flickers_most() {
         &d.arg("report"),
     ]);
     let json = std::fs::read_to_string(d.join("report/report.json")).unwrap();
-    let report = texel_quality::Report::from_json(&json).unwrap();
+    let report = texel::quality::Report::from_json(&json).unwrap();
     let orbit = report.orbit.as_ref().expect("an orbit in the report");
     assert_eq!((orbit.frames, orbit.step_deg), (3, 0.1));
     assert!(orbit.reference_flicker > 0.0);
@@ -167,7 +167,7 @@ fn shading_sub_samples_lower_lean_flicker_on_the_glossy_orbit() {
         ]);
         let json =
             std::fs::read_to_string(d.join(&format!("report-{samples}/report.json"))).unwrap();
-        let report = texel_quality::Report::from_json(&json).unwrap();
+        let report = texel::quality::Report::from_json(&json).unwrap();
         let row = &report.rows[0];
         (row.psnr_all, row.flicker.unwrap())
     };

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use texel_quality::Image8;
+use texel::quality::Image8;
 
 // ---------------------------------------------------------------------------------------------
 // Helpers

@@ -7,7 +7,7 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 
-use texel_quality::{psnr, Image8};
+use texel::quality::{psnr, Image8};
 
 use crate::util::*;
 

@@ -1,6 +1,6 @@
 //! `texel warp`: identity, size, and shrinking a fine checkerboard without aliasing.
 
-use texel_quality::Image8;
+use texel::quality::Image8;
 
 use crate::util::*;
 

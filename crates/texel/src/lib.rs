@@ -30,6 +30,7 @@ pub mod compare;
 mod entry;
 pub mod timing;
 
+pub use texel_io as io;
 pub use texel_lab as lab;
 pub use texel_quality as quality;
 pub use texel_raster as raster;

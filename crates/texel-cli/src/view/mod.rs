@@ -110,7 +110,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     shared.quit();
     let _ = thread.join();
     ran.context("the window's event loop failed")?;
-    texel_io::stderr_line(app.summary());
+    texel::io::stderr_line(app.summary());
     match app.failure {
         Some(e) => Err(e),
         None => Ok(()),

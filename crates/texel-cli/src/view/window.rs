@@ -244,7 +244,7 @@ impl App {
             .iter()
             .map(|&p| [(p >> 16) as u8, (p >> 8) as u8, p as u8, 255])
             .collect();
-        let image = texel_quality::Image8::new(w, h, pixels)?;
+        let image = texel::quality::Image8::new(w, h, pixels)?;
         crate::output::write_image(path, &image)
     }
 
@@ -356,12 +356,12 @@ impl App {
             "view {}  {}  {} derivatives  lod bias {:+.1}  {}  fov {:.0}",
             view_name(self.state.view),
             match self.state.perspective {
-                texel_raster::Perspective::Correct => "perspective-correct",
-                texel_raster::Perspective::Affine => "affine",
+                texel::raster::Perspective::Correct => "perspective-correct",
+                texel::raster::Perspective::Affine => "affine",
             },
             match self.state.derivatives {
-                texel_raster::Derivatives::Analytic => "analytic",
-                texel_raster::Derivatives::Quad => "quad",
+                texel::raster::Derivatives::Analytic => "analytic",
+                texel::raster::Derivatives::Quad => "quad",
             },
             self.state.lod_bias,
             match self.state.color {

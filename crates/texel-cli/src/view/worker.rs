@@ -2,7 +2,7 @@
 //! event loop, so input is handled every frame however slow the filter.
 //!
 //! - **One frame** renders each half (or the whole screen) through a scissor rectangle
-//!   ([`texel_raster::RenderSettings::scissor`]), so a split screen costs one frame, and each half
+//!   ([`texel::raster::RenderSettings::scissor`]), so a split screen costs one frame, and each half
 //!   is bit for bit what `texel render` gives that filter.
 //! - **Never freeze**: while the camera moves, a frame whose measured cost (ms per pixel, per
 //!   mode) would exceed [`BUDGET_MS`] is rendered at 1/s resolution (`s` up to 8) and shown
@@ -23,13 +23,13 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 use texel::lab::gl::{Gl, GlScene, Names, ShaderDraws};
+use texel::quality::Encoding;
+use texel::raster::{
+    draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, RenderSettings, View,
+};
 use texel::scene::Camera;
 use texel::{Filter, PreparedScene, Sampler, SamplerDescriptor};
 use texel_gpu::{Gpu, GpuDraws, GpuFilter};
-use texel_quality::Encoding;
-use texel_raster::{
-    draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, RenderSettings, View,
-};
 
 use crate::controls::{Mode, ViewState};
 
@@ -141,7 +141,7 @@ pub struct PartInfo {
     pub samples: Option<u32>,
     /// For a still reference of at least two passes: the share of its pixels whose displayed
     /// value's 95 % interval, from the spread of the passes, is within half an 8-bit step
-    /// ([`texel_raster::adaptive::display_half_width`]).
+    /// ([`texel::raster::adaptive::display_half_width`]).
     pub within: Option<f64>,
     /// Mean texels read per covered pixel and the lod range (min, max) over covered pixels,
     /// once measured for this image.
@@ -647,7 +647,7 @@ fn add_pass(progress: &mut Progress, pass: &Frame, spp: [u32; 2], band: [u32; 4]
 /// The share of the pixels of `rect` (in a frame `w` wide) whose accumulated reference, `passes`
 /// equal passes in `progress`, has a 95 % interval of its displayed value (sRGB when `srgb`)
 /// within half an 8-bit step: each pass mean is one independent estimate
-/// ([`texel_raster::adaptive::pass_std_error`]).
+/// ([`texel::raster::adaptive::pass_std_error`]).
 fn share_within(progress: &Progress, rect: [u32; 4], w: u32, passes: u32, srgb: bool) -> f64 {
     let n = f64::from(passes);
     let tolerance = crate::cli::DEFAULT_TOLERANCE_STEPS / 255.0;
@@ -657,9 +657,9 @@ fn share_within(progress: &Progress, rect: [u32; 4], w: u32, passes: u32, srgb: 
         let mean: [f64; 3] =
             std::array::from_fn(|c| f64::from(sum[c]) / f64::from(progress.samples));
         let se = std::array::from_fn(|c| {
-            texel_raster::adaptive::pass_std_error(squares[c] - n * mean[c] * mean[c], passes)
+            texel::raster::adaptive::pass_std_error(squares[c] - n * mean[c] * mean[c], passes)
         });
-        texel_raster::adaptive::display_half_width(mean, se, passes, srgb) <= tolerance
+        texel::raster::adaptive::display_half_width(mean, se, passes, srgb) <= tolerance
     };
     let [x0, y0, x1, y1] = rect;
     // Rows in parallel: each pixel's interval takes a few sRGB encodes.
@@ -904,7 +904,7 @@ impl FrameContext<'_, '_> {
                 g.set_clip_from_world(part.clip);
                 let out = g.render(&RenderSettings {
                     scissor: Some(rect),
-                    derivatives: texel_raster::Derivatives::Quad,
+                    derivatives: texel::raster::Derivatives::Quad,
                     ..settings
                 })?;
                 copy_rect(&out.color, &mut frame.color, w, rect);
@@ -1046,7 +1046,7 @@ impl FrameContext<'_, '_> {
                 capture_footprints: true,
                 ..settings
             };
-            let counted = texel_raster::render(&s, &draws)?;
+            let counted = texel::raster::render(&s, &draws)?;
             let (mut texels, mut covered) = (0u64, 0u64);
             for_rect(rect, s.width, |k| {
                 if counted.covered(k) {
@@ -1104,7 +1104,7 @@ pub fn lod_range(
         let f = if groups.len() == 1 {
             frame
         } else {
-            alone = texel_raster::render(settings, &members)?;
+            alone = texel::raster::render(settings, &members)?;
             &alone
         };
         let d = &members[0];
@@ -1440,7 +1440,7 @@ mod tests {
                         .sum();
                     (ss / (n - 1.0) / n).sqrt()
                 });
-                let half = texel_raster::adaptive::display_half_width(mean, se, passes, true);
+                let half = texel::raster::adaptive::display_half_width(mean, se, passes, true);
                 half <= 0.5 / 255.0
             })
             .count();
