@@ -263,164 +263,69 @@ fn the_graph_sees_paths_in_code_and_a_cycle() {
     fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `text` with comments, string literals and character literals blanked to spaces (newlines
-/// kept), so that the braces left are the code's own.
-fn code_only(text: &str) -> String {
-    let c: Vec<char> = text.chars().collect();
-    let mut out = String::with_capacity(text.len());
-    let blank = |ch: char| if ch == '\n' { '\n' } else { ' ' };
-    let mut i = 0;
-    while i < c.len() {
-        let next = c.get(i + 1).copied();
-        if c[i] == '/' && next == Some('/') {
-            while i < c.len() && c[i] != '\n' {
-                out.push(' ');
-                i += 1;
-            }
-        } else if c[i] == '/' && next == Some('*') {
-            let mut depth = 0;
-            loop {
-                if i >= c.len() {
-                    break;
-                }
-                if c[i] == '/' && c.get(i + 1) == Some(&'*') {
-                    depth += 1;
-                    out.push_str("  ");
-                    i += 2;
-                } else if c[i] == '*' && c.get(i + 1) == Some(&'/') {
-                    depth -= 1;
-                    out.push_str("  ");
-                    i += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    out.push(blank(c[i]));
-                    i += 1;
-                }
-            }
-        } else if c[i] == 'r'
-            && matches!(next, Some('"') | Some('#'))
-            && (i == 0 || !(c[i - 1].is_alphanumeric() || c[i - 1] == '_'))
-        {
-            // A raw string: r"..." or r#"..."#.
-            let mut j = i + 1;
-            while c.get(j) == Some(&'#') {
-                j += 1;
-            }
-            if c.get(j) != Some(&'"') {
-                out.push(c[i]);
-                i += 1;
-                continue;
-            }
-            let hashes = j - i - 1;
-            let close: Vec<char> = std::iter::once('"')
-                .chain(std::iter::repeat_n('#', hashes))
-                .collect();
-            let mut k = j + 1;
-            while k < c.len() && !c[k..].starts_with(&close) {
-                k += 1;
-            }
-            let end = (k + close.len()).min(c.len());
-            out.extend(c[i..end].iter().map(|&ch| blank(ch)));
-            i = end;
-        } else if c[i] == '"' {
-            out.push(' ');
-            i += 1;
-            while i < c.len() && c[i] != '"' {
-                if c[i] == '\\' {
-                    out.push(' ');
-                    i += 1;
-                }
-                if i < c.len() {
-                    out.push(blank(c[i]));
-                    i += 1;
-                }
-            }
-            out.push(' ');
-            i += 1;
-        } else if c[i] == '\'' {
-            // A character literal ('x', '\n', '\u{..}'), or a lifetime, which stays.
-            let end = if next == Some('\\') {
-                (i + 2..c.len()).find(|&k| c[k] == '\'')
-            } else if c.get(i + 2) == Some(&'\'') {
-                Some(i + 2)
-            } else {
-                None
-            };
-            match end {
-                Some(e) => {
-                    out.extend(c[i..=e].iter().map(|&ch| blank(ch)));
-                    i = e + 1;
-                }
-                None => {
-                    out.push('\'');
-                    i += 1;
-                }
-            }
-        } else {
-            out.push(c[i]);
-            i += 1;
-        }
-    }
-    out
-}
-
-/// The name of the function a line of code starts, if it starts one.
-fn fn_name(line: &str) -> Option<&str> {
-    let mut rest = line.trim_start();
-    for word in [
-        "pub(crate) ",
-        "pub(super) ",
-        "pub ",
-        "const ",
-        "async ",
-        "unsafe ",
-    ] {
-        rest = rest.strip_prefix(word).unwrap_or(rest);
-    }
-    let rest = rest.strip_prefix("fn ")?;
-    let end = rest
-        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
-        .unwrap_or(rest.len());
-    (end > 0).then(|| &rest[..end])
-}
-
-/// Every function with a body in `code` (as [`code_only`] leaves it): its name and its length in
+/// Every function with a body in `file` (unit-test modules aside): its name and its length in
 /// lines, from the `fn` line to the closing brace.
-fn function_lengths(code: &str) -> Vec<(String, usize)> {
-    let lines: Vec<&str> = code.lines().collect();
-    let mut out = Vec::new();
-    for (start, line) in lines.iter().enumerate() {
-        let Some(name) = fn_name(line) else { continue };
-        let mut depth = 0usize;
-        let mut opened = false;
-        'scan: for (k, l) in lines[start..].iter().enumerate() {
-            for ch in l.chars() {
-                match ch {
-                    ';' if !opened => break 'scan,
-                    '{' => {
-                        depth += 1;
-                        opened = true;
-                    }
-                    '}' => {
-                        depth = depth.saturating_sub(1);
-                        if opened && depth == 0 {
-                            out.push((name.to_string(), k + 1));
-                            break 'scan;
-                        }
-                    }
-                    _ => {}
-                }
-            }
+fn function_lengths(file: &syn::File) -> Vec<(String, usize)> {
+    use syn::spanned::Spanned;
+    use syn::visit::Visit;
+    struct Lengths(Vec<(String, usize)>);
+    impl Lengths {
+        fn add(&mut self, sig: &syn::Signature, block: &syn::Block) {
+            let first = sig.fn_token.span.start().line;
+            let last = block.span().end().line;
+            self.0.push((sig.ident.to_string(), last + 1 - first));
         }
     }
-    out
+    impl<'a> Visit<'a> for Lengths {
+        fn visit_item_mod(&mut self, m: &'a syn::ItemMod) {
+            let test = m.attrs.iter().any(|a| {
+                a.path().is_ident("cfg") && a.parse_args::<syn::Ident>().is_ok_and(|i| i == "test")
+            });
+            if !test {
+                syn::visit::visit_item_mod(self, m);
+            }
+        }
+        fn visit_item_fn(&mut self, f: &'a syn::ItemFn) {
+            self.add(&f.sig, &f.block);
+            syn::visit::visit_item_fn(self, f);
+        }
+        fn visit_impl_item_fn(&mut self, f: &'a syn::ImplItemFn) {
+            self.add(&f.sig, &f.block);
+            syn::visit::visit_impl_item_fn(self, f);
+        }
+        fn visit_trait_item_fn(&mut self, f: &'a syn::TraitItemFn) {
+            if let Some(block) = &f.default {
+                self.add(&f.sig, block);
+            }
+            syn::visit::visit_trait_item_fn(self, f);
+        }
+    }
+    let mut lengths = Lengths(Vec::new());
+    lengths.visit_file(file);
+    lengths.0
 }
 
-/// The library functions allowed over 100 lines, each as (file, name, the reason it stays whole).
-/// None is: every long job reads as named steps.
-const LONG_FUNCTIONS: &[(&str, &str, &str)] = &[];
+/// The library functions allowed over 100 lines: (file, name, the reason it stays whole).
+const LONG_FUNCTIONS: [(&str, &str, &str); 3] = [
+    (
+        "crates/texel-texture/src/engine/batch.rs",
+        "anisotropic",
+        "the anisotropic batch loop, inlined into each kernel's copy; its probe batches and scratch \
+         live across the stages, and a split is a frame-time measurement, not a refactor",
+    ),
+    (
+        "crates/texel-texture/src/engine/batch.rs",
+        "run_in",
+        "the trilinear batch loop, inlined per chunk size; as anisotropic, its stages share \
+         chunk-local state on the hottest path",
+    ),
+    (
+        "crates/texel-raster/src/relief.rs",
+        "shading_normal",
+        "a fragment's normal-map and bump-map branches with their specular antialiasing, which \
+         share one tangent frame and roughness rule",
+    ),
+];
 
 #[test]
 fn library_functions_are_at_most_100_lines() {
@@ -433,49 +338,51 @@ fn library_functions_are_at_most_100_lines() {
         }
     }
     rust_files(&root.join("python/src"), &mut files);
-    let mut long = BTreeSet::new();
+    let listed: BTreeSet<(&str, &str)> = LONG_FUNCTIONS.iter().map(|&(f, n, _)| (f, n)).collect();
+    let (mut unlisted, mut long) = (Vec::new(), BTreeSet::new());
     let mut counted = 0;
     for file in &files {
         let text = fs::read_to_string(file).unwrap();
-        let library = text.split("#[cfg(test)]\nmod ").next().unwrap();
+        let syntax = syn::parse_file(&text).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         let rel = file
             .strip_prefix(&root)
             .unwrap()
             .to_string_lossy()
             .into_owned();
-        for (name, lines) in function_lengths(&code_only(library)) {
+        for (name, lines) in function_lengths(&syntax) {
             counted += 1;
-            if lines > 100 {
-                long.insert((rel.clone(), name, lines));
+            if lines <= 100 {
+                continue;
             }
+            if !listed.contains(&(rel.as_str(), name.as_str())) {
+                unlisted.push(format!("{rel}: {name} has {lines} lines"));
+            }
+            long.insert((rel.clone(), name));
         }
     }
     assert!(counted > 1000, "found {counted} functions");
-    let listed: BTreeSet<(&str, &str)> = LONG_FUNCTIONS.iter().map(|&(f, n, _)| (f, n)).collect();
-    let unlisted: Vec<String> = long
-        .iter()
-        .filter(|(f, n, _)| !listed.contains(&(f.as_str(), n.as_str())))
-        .map(|(f, n, l)| format!("{f}: {n} has {l} lines"))
-        .collect();
-    assert!(unlisted.is_empty(), "split these:\n{}", unlisted.join("\n"));
-    let found: BTreeSet<(&str, &str)> = long
-        .iter()
-        .map(|(f, n, _)| (f.as_str(), n.as_str()))
-        .collect();
-    let stale: Vec<_> = listed.difference(&found).collect();
     assert!(
-        stale.is_empty(),
-        "listed but at most 100 lines now: {stale:?}"
+        unlisted.is_empty(),
+        "split these into named steps:\n{}",
+        unlisted.join("\n")
     );
+    let stale: Vec<_> = listed
+        .iter()
+        .filter(|(f, n)| !long.contains(&(f.to_string(), n.to_string())))
+        .collect();
+    assert!(stale.is_empty(), "listed but at most 100 lines: {stale:?}");
 }
 
 #[test]
-fn function_lengths_see_code_not_strings_or_comments() {
-    let code = code_only(
-        "pub fn a() {\n    let s = \"}}{\";\n    // }\n    let c = '}';\n}\nfn b<'x>(v: &'x str);\nfn c() {\n    /* { */\n    let r = r#\"}\"#;\n}\n",
-    );
+fn function_lengths_count_from_fn_to_the_closing_brace() {
+    let file = syn::parse_file(
+        "/// Doc.\n#[inline]\npub fn a() {\n    let s = \"}}{\";\n    // }\n    let c = '}';\n}\n\
+         trait T {\n    fn b(&self);\n    fn c(&self) {\n        let r = r#\"}\"#;\n    }\n}\n\
+         #[cfg(test)]\nmod tests {\n    fn d() {}\n}\n",
+    )
+    .unwrap();
     assert_eq!(
-        function_lengths(&code),
-        vec![("a".to_string(), 5), ("c".to_string(), 4)]
+        function_lengths(&file),
+        vec![("a".to_string(), 5), ("c".to_string(), 3)]
     );
 }
