@@ -478,7 +478,7 @@ impl Texture {
     /// `map_coordinates`, whose centres are at integers). `duv_dx` and `duv_dy`, of the same
     /// shape and units, are the footprint: how the coordinates change from one output pixel to
     /// the next in x and in y. The filters that read mip levels or footprints (mip-nearest,
-    /// trilinear, aniso2-16, ewa, ripmap, sat) need them; when both are left out and `uv` is a
+    /// trilinear, aniso2-16, ewa, ewa-probes, ripmap, sat) need them; when both are left out and `uv` is a
     /// grid `(..., H, W, 2)`, they are derived from its neighbours as a GPU's 2 x 2 quads derive
     /// them: within each quad, the forward difference of the two points of its row (for x) or
     /// column (for y), the same for both points; the last row or column of an odd side takes the

@@ -209,7 +209,8 @@ fn bench_gpu_times_shaders_and_the_hardware_sampler() {
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("--gpu has no sat filter") && err.contains("ewa, hw-trilinear, hw-aniso16)"),
+        err.contains("--gpu has no sat filter")
+            && err.contains("ewa, ewa-probes, hw-trilinear, hw-aniso16)"),
         "{err}"
     );
     // `all` only alone; an unknown name gets the GPU's own list.

@@ -11,7 +11,7 @@ use texel::quality::Image8;
 // ---------------------------------------------------------------------------------------------
 
 /// Every filter name, in the CLI's order (the library's one list).
-pub(crate) const FILTERS: [&str; 12] = texel::Filter::NAMES;
+pub(crate) const FILTERS: [&str; 13] = texel::Filter::NAMES;
 
 /// The built-in scenes the demo covers.
 pub(crate) const BUILTINS: [&str; 14] = [

@@ -30,9 +30,11 @@ override CONVENTION: u32 = 0u;
 @group(0) @binding(1) var tex: texture_2d<f32>;
 @group(0) @binding(2) var<storage, read> srgb: array<f32, 256>;
 @group(0) @binding(3) var hw: sampler;
-// EWA's Gaussian weight table, the CPU's (texel_texture::ewa::weight_lut): LUT[k] for r^2 in
-// [k / 128, (k + 1) / 128).
-@group(0) @binding(4) var<storage, read> ewa_lut: array<f32, 128>;
+// The CPU's tables: EWA's Gaussian weights (texel_texture::ewa::weight_lut), LUT[k] for r^2 in
+// [k / 128, (k + 1) / 128), at 0..128; then EWA from probes' table
+// (texel_texture::ewa_probes::probe_table) for n probes: positions at 128 + 16 (n - 1) + i,
+// weights at 384 + 16 (n - 1) + i, spacing at 640 + n - 1.
+@group(0) @binding(4) var<storage, read> ewa_lut: array<f32, 656>;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -426,6 +428,69 @@ fn ewa(uv: vec2<f32>, px: vec2<f32>, py: vec2<f32>, iso_lod: f32) -> vec4<f32> {
     return ewa_at(uv, s, i32(floor(d)));
 }
 
+// ---- EWA from trilinear probes (texel_texture::technique::ewa_probes) -----------------------------
+
+const PROBES_MAX: i32 = 16;
+const PROBES_SPACING: f32 = 3.0;
+const PROBES_LOD_OFFSET: f32 = 0.25;
+const PROBES_ONE: f32 = 0.1;
+
+// The lod whose trilinear sample has per-axis variance `v` (level-0 texels^2): level k where
+// v_k = (3 4^k - 1) / 12 <= v < v_(k+1), plus the share of the way to v_(k+1); 0 up to 1/6.
+fn lod_of_variance(v: f32) -> f32 {
+    if !(v > 1.0 / 6.0) {
+        return 0.0;
+    }
+    let k = max(floor(log2((12.0 * v + 1.0) / 3.0) * 0.5), 0.0);
+    let p = exp2(2.0 * k);
+    return k + clamp((v - (3.0 * p - 1.0) / 12.0) / (0.75 * p), 0.0, 1.0);
+}
+
+// The reference's covariance C = (S + 2 I) / 12 from N Gaussian-weighted trilinear probes along
+// the ellipse's major axis: one probe's variance is the minor eigenvalue (its lod a quarter
+// level coarser), the probes' positions carry the rest of the major one.
+fn ewa_probes(uv: vec2<f32>, px: vec2<f32>, py: vec2<f32>, iso_lod: f32) -> vec4<f32> {
+    if !(all(abs(px) < vec2<f32>(3.4e38)) && all(abs(py) < vec2<f32>(3.4e38))) {
+        return trilinear(uv, iso_lod);
+    }
+    let s = ellipse(px, py, f32(params.mode.z));
+    let half = (s.x - s.z) * 0.5;
+    let r1 = (s.x + s.z) * 0.5 + sqrt(half * half + s.y * s.y);
+    let v = select(vec2<f32>(s.y, r1 - s.x), vec2<f32>(r1 - s.z, s.y), s.x >= s.z);
+    let len = length(v);
+    let e1 = select(vec2<f32>(1.0, 0.0), v / len, len > 0.0 && len < 3.4e38);
+    let l1 = (r1 + 2.0) / 12.0;
+    let l2 = (s.w * s.w + 2.0) / 12.0;
+    var n = 1;
+    var var_p = l2;
+    if l1 > (1.0 + PROBES_ONE) * l2 {
+        let rs = sqrt(l1 - l2);
+        n = 2;
+        loop {
+            if n >= PROBES_MAX || ewa_lut[640 + n - 1] * rs <= PROBES_SPACING * sqrt(l2) {
+                break;
+            }
+            n++;
+        }
+        if ewa_lut[640 + n - 1] * rs > PROBES_SPACING * sqrt(l2) {
+            let g2 = ewa_lut[640 + PROBES_MAX - 1] * ewa_lut[640 + PROBES_MAX - 1];
+            var_p = max(g2 * l1 / (PROBES_SPACING * PROBES_SPACING + g2), l2);
+        }
+    }
+    let lod = clamp(lod_of_variance(var_p) + PROBES_LOD_OFFSET + params.lod.x, params.lod.y,
+                    params.lod.z);
+    if n == 1 {
+        return trilinear(uv, lod);
+    }
+    let axis = e1 * sqrt(max(l1 - var_p, 0.0)) / size_of(0);
+    var sum = vec4<f32>(0.0);
+    for (var i = 0; i < n; i++) {
+        let t = ewa_lut[128 + 16 * (n - 1) + i];
+        sum += trilinear(uv + t * axis, lod) * ewa_lut[384 + 16 * (n - 1) + i];
+    }
+    return sum;
+}
+
 // ---- The fragment shader -------------------------------------------------------------------------
 
 // Both targets hold f32 bit patterns in unsigned-integer formats (`Rgba32Uint`, `R32Uint`): every
@@ -461,6 +526,8 @@ fn fs_main(in: VertexOut) -> FragmentOut {
         c = bicubic(in.uv, 0);
     } else if mode == 10u && lod > 0.0 {
         c = ewa(in.uv, px, py, lod);
+    } else if mode == 11u && lod > 0.0 {
+        c = ewa_probes(in.uv, px, py, lod);
     } else if mode == 2u || lod <= 0.0 {
         // Bilinear without mips, and magnification for modes 3-8 (their mag filter is linear).
         c = bilinear(in.uv, 0);

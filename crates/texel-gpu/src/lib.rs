@@ -106,7 +106,7 @@ pub enum GpuFilter {
 /// mip-nearest, 4 trilinear, 5-8 anisotropic 2x-16x, 9 bicubic, 10 EWA; `None` where the shader
 /// has no such filter.
 pub fn shader_mode(d: &SamplerDescriptor) -> Option<(u32, u32)> {
-    use FilterMode::{Cubic, Ewa, Linear, Nearest};
+    use FilterMode::{Cubic, Ewa, EwaProbes, Linear, Nearest};
     use MipmapFilterMode as Mip;
     let aniso = u32::from(d.anisotropy_clamp);
     let mode = match (d.min_filter, d.mipmap_filter, aniso) {
@@ -117,6 +117,7 @@ pub fn shader_mode(d: &SamplerDescriptor) -> Option<(u32, u32)> {
         (Linear, Mip::Linear, 2 | 4 | 8 | 16) => 4 + aniso.trailing_zeros(),
         (Cubic(_), Mip::None, 1) => 9,
         (Ewa, _, _) => 10,
+        (EwaProbes, _, _) => 11,
         _ => return None,
     };
     Some((mode, aniso))
@@ -322,7 +323,7 @@ impl Gpu {
             .flat_map(|x| x.to_le_bytes())
             .collect();
         let srgb = buffer(&device, &queue, &table, wgpu::BufferUsages::STORAGE);
-        let lut: Vec<u8> = texel_texture::technique::ewa::weight_lut()
+        let lut: Vec<u8> = shader_tables()
             .iter()
             .flat_map(|x| x.to_le_bytes())
             .collect();
@@ -404,6 +405,19 @@ fn convention_of(
             "the lab convention with a filter other than the lab's eight modes",
         )),
     }
+}
+
+/// The tables the shader reads from its storage buffer (binding 4): EWA's weight table, then
+/// EWA from probes' positions, weights and spacings, each row padded to its 16 probes.
+fn shader_tables() -> Vec<f32> {
+    use texel_texture::technique::ewa_probes::{probe_table, MAX_PROBES};
+    let t = probe_table();
+    let mut out = texel_texture::technique::ewa::weight_lut().to_vec();
+    out.extend(t.positions.iter().flatten());
+    out.extend(t.weights.iter().flatten());
+    out.extend(t.spacing.iter().map(|&x| x.min(f64::from(f32::MAX)) as f32));
+    debug_assert_eq!(out.len(), 128 + 2 * MAX_PROBES * MAX_PROBES + MAX_PROBES);
+    out
 }
 
 /// The pipeline of one shader mode (`MODE`) under one convention (`CONVENTION`), both pipeline
@@ -1184,6 +1198,7 @@ mod tests {
             (Filter::Aniso8, Some((7, 8))),
             (Filter::Aniso16, Some((8, 16))),
             (Filter::Ewa, Some((10, 16))),
+            (Filter::EwaProbes, Some((11, 16))),
             (Filter::Ripmap, None),
             (Filter::Sat, None),
         ];

@@ -34,19 +34,21 @@ fn technique(name: &str) -> SamplerDescriptor {
         "aniso8" => SamplerDescriptor::lab_mode(7).unwrap(),
         "aniso16" => SamplerDescriptor::lab_mode(8).unwrap(),
         "ewa" => SamplerDescriptor::minification(FilterMode::Ewa),
+        "ewa-probes" => SamplerDescriptor::minification(FilterMode::EwaProbes),
         "ripmap" => SamplerDescriptor::minification(FilterMode::Ripmap),
         "sat" => SamplerDescriptor::minification(FilterMode::SummedArea),
         _ => unreachable!("unknown technique {name}"),
     }
 }
 
-const TECHNIQUES: [&str; 8] = [
+const TECHNIQUES: [&str; 9] = [
     "trilinear",
     "aniso2",
     "aniso4",
     "aniso8",
     "aniso16",
     "ewa",
+    "ewa-probes",
     "ripmap",
     "sat",
 ];
@@ -579,13 +581,13 @@ fn ewa_weights_have_the_pixel_boxs_covariance() {
 fn ewa_and_aniso_beat_trilinear_against_brute_force_gaussian() {
     let n = 256;
     let tex = noise_texture(n, n, Format::Rgba32Float, 1234);
-    let names = ["trilinear", "aniso16", "ewa"];
+    let names = ["trilinear", "aniso16", "ewa", "ewa-probes"];
     let samplers: Vec<Sampler> = names
         .iter()
         .map(|name| sampler(name, AddressMode::Repeat))
         .collect();
-    let mut err2 = [0.0f64; 3];
-    let mut reads = [0u64; 3];
+    let mut err2 = [0.0f64; 4];
+    let mut reads = [0u64; 4];
     let mut rng = Rng::new(99);
     let count = 300;
     for _ in 0..count {
@@ -613,7 +615,7 @@ fn ewa_and_aniso_beat_trilinear_against_brute_force_gaussian() {
         .iter()
         .map(|e| (e / (3 * count) as f64).sqrt())
         .collect();
-    for k in 0..3 {
+    for k in 0..4 {
         println!(
             "{:>10}: RMS error {:.4}, texels read per sample {:.1}",
             names[k],
@@ -629,6 +631,75 @@ fn ewa_and_aniso_beat_trilinear_against_brute_force_gaussian() {
     );
     assert!(rms[2] < rms[0], "EWA {} vs trilinear {}", rms[2], rms[0]);
     assert!(rms[2] < rms[1], "EWA {} vs aniso16 {}", rms[2], rms[1]);
+    assert!(
+        rms[3] < rms[1],
+        "EWA from probes {} vs aniso16 {}",
+        rms[3],
+        rms[1]
+    );
+}
+
+/// EWA from probes puts the reference's covariance `C = (S + 2 I) / 12` on its probes: the
+/// weighted positions' covariance plus one trilinear probe's variance at the matched lod (the
+/// plan's lod less `LOD_OFFSET`) is `C` (exact, up to rounding), for footprints of 1 to 40
+/// texels, ratios 1 to 16, any angle. Where the probes run out, the probes' kernel has grown:
+/// the major axis still carries `lambda_1`, the minor axis more than `lambda_2`.
+#[test]
+fn ewa_probes_carry_the_reference_covariance() {
+    use texel_texture::technique::ewa_probes::{
+        plan, probe_table, variance_of_lod, LOD_OFFSET, MAX_PROBES,
+    };
+    let table = probe_table();
+    let mut rng = Rng::new(31);
+    let (mut capped, mut exact) = (0, 0);
+    for _ in 0..2000 {
+        let minor = 1.0 + 39.0 * rng.next_f32();
+        let ratio = 1.0 + 15.0 * rng.next_f32();
+        let (px, py) = axes(minor, ratio, rng.next_f32() * std::f32::consts::TAU);
+        let size = (512, 256);
+        let e = Ellipse::from_axes(px, py, 16.0).unwrap();
+        let c = [(e.s00 + 2.0) / 12.0, e.s01 / 12.0, (e.s11 + 2.0) / 12.0];
+        let pl = plan(px, py, size, 16.0).unwrap();
+        let probe = variance_of_lod(pl.lod - LOD_OFFSET);
+        let a = pl.axis_texels;
+        let (mut xx, mut xy, mut yy) = (0.0, 0.0, 0.0);
+        for i in 0..pl.n {
+            let (w, t) = (
+                f64::from(table.weights[pl.n - 1][i]),
+                f64::from(table.positions[pl.n - 1][i]),
+            );
+            xx += w * t * t * a.x * a.x;
+            xy += w * t * t * a.x * a.y;
+            yy += w * t * t * a.y * a.y;
+        }
+        let got = [xx + probe, xy, yy + probe];
+        let scale = c[0].max(c[2]);
+        let l1 = (e.major * e.major + 2.0) / 12.0;
+        let l2 = (e.minor * e.minor + 2.0) / 12.0;
+        // The uv axis is the texel axis over the level's size.
+        assert!((pl.axis_uv.x * 512.0 - a.x).abs() <= 1e-9 * a.length().max(1.0));
+        assert!((pl.axis_uv.y * 256.0 - a.y).abs() <= 1e-9 * a.length().max(1.0));
+        if pl.n == 1 {
+            // A near-circle: one probe with the minor variance, within `ONE_PROBE` of `C`.
+            assert!(l1 <= 1.1 * l2 + 1e-12 && (probe - l2).abs() < 1e-9 * l2);
+            continue;
+        }
+        if pl.n == MAX_PROBES && probe > l2 * (1.0 + 1e-9) {
+            capped += 1;
+            // Along the major axis the total is lambda_1; across, the grown probe variance.
+            let major = (got[0] * a.x * a.x + 2.0 * got[1] * a.x * a.y + got[2] * a.y * a.y)
+                / a.length_squared();
+            assert!((major - l1).abs() < 1e-6 * l1, "{major} vs {l1}");
+            continue;
+        }
+        exact += 1;
+        let err = (0..3)
+            .map(|k| (got[k] - c[k]).abs() / scale)
+            .fold(0.0, f64::max);
+        assert!(err < 1e-5, "{got:?} vs {c:?} ({px}, {py}), {} probes", pl.n);
+    }
+    println!("EWA from probes: {exact} footprints matched exactly, {capped} at the probe limit");
+    assert!(exact > 1000 && capped > 10, "{exact} {capped}");
 }
 
 // ---------------------------------------------------------------------------------------------

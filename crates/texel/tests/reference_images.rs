@@ -2,7 +2,7 @@
 //! pixels, compared byte for byte with the PNGs under `tests/images/`.
 //!
 //! One contact sheet per scene (`tests/images/NAME.png`), a grid of [`TILE`]-sized tiles in the
-//! order of [`tiles`]: the twelve filters in sRGB; the six debug views; the four core filters
+//! order of [`tiles`]: the thirteen filters in sRGB; the six debug views; the four core filters
 //! with `--precision gpu` (8-bit fixed-point weights), trilinear with quad derivatives, nearest
 //! and trilinear in raw colour; a 16-sample reference. Tiles are rendered as `texel render`
 //! renders them (the scene prepared at the tile's size, a debug view into an sRGB target) and

@@ -14,6 +14,9 @@ pub enum FilterMode {
     /// Elliptically weighted average (Heckbert 1989, pbrt-v4 structure) over the footprint's
     /// ellipse in two pyramid levels; `min_filter` only. See [`crate::technique::ewa`].
     Ewa,
+    /// EWA's Gaussian from Gaussian-weighted trilinear probes along the ellipse's major axis
+    /// (Mavridis and Papaioannou 2011); `min_filter` only. See [`crate::technique::ewa_probes`].
+    EwaProbes,
     /// Anisotropically reduced images `(W >> a) x (H >> b)` chosen from the footprint's
     /// axis-aligned bounding box, four blended; `min_filter` only. See [`crate::technique::ripmap`].
     Ripmap,
@@ -23,11 +26,12 @@ pub enum FilterMode {
 }
 
 impl FilterMode {
-    /// Whether this filter is valid only as `min_filter` (`Ewa`, `Ripmap`, `SummedArea`).
+    /// Whether this filter is valid only as `min_filter` (`Ewa`, `EwaProbes`, `Ripmap`,
+    /// `SummedArea`).
     pub fn is_minification_only(self) -> bool {
         matches!(
             self,
-            FilterMode::Ewa | FilterMode::Ripmap | FilterMode::SummedArea
+            FilterMode::Ewa | FilterMode::EwaProbes | FilterMode::Ripmap | FilterMode::SummedArea
         )
     }
 }

@@ -32,6 +32,9 @@ pub enum Filter {
     Aniso16,
     /// Elliptical weighted average (Heckbert 1989), eccentricity clamped at 16.
     Ewa,
+    /// EWA's Gaussian from up to 16 Gaussian-weighted trilinear probes (Mavridis and
+    /// Papaioannou 2011).
+    EwaProbes,
     /// Ripmap: anisotropically reduced images, four neighbours blended.
     Ripmap,
     /// Summed-area table: box mean over the footprint's bounding rectangle.
@@ -40,7 +43,7 @@ pub enum Filter {
 
 impl Filter {
     /// Every filter, cheapest first.
-    pub const ALL: [Filter; 12] = [
+    pub const ALL: [Filter; 13] = [
         Filter::Nearest,
         Filter::Bilinear,
         Filter::Bicubic,
@@ -51,12 +54,13 @@ impl Filter {
         Filter::Aniso8,
         Filter::Aniso16,
         Filter::Ewa,
+        Filter::EwaProbes,
         Filter::Ripmap,
         Filter::Sat,
     ];
 
     /// Every filter's name, in the order of [`Filter::ALL`].
-    pub const NAMES: [&'static str; 12] = [
+    pub const NAMES: [&'static str; 13] = [
         "nearest",
         "bilinear",
         "bicubic",
@@ -67,6 +71,7 @@ impl Filter {
         "aniso8",
         "aniso16",
         "ewa",
+        "ewa-probes",
         "ripmap",
         "sat",
     ];
@@ -134,6 +139,7 @@ impl Filter {
             Filter::Aniso8 => base(Linear, Linear, MipmapFilterMode::Linear, 8),
             Filter::Aniso16 => base(Linear, Linear, MipmapFilterMode::Linear, 16),
             Filter::Ewa => minification(FilterMode::Ewa),
+            Filter::EwaProbes => minification(FilterMode::EwaProbes),
             Filter::Ripmap => minification(FilterMode::Ripmap),
             Filter::Sat => minification(FilterMode::SummedArea),
         }

@@ -24,6 +24,7 @@ use crate::storage::view::{codes_of, with_pyramid, Counted, Pyramid};
 use crate::technique::aniso::Probes;
 use crate::technique::aniso::{anisotropic, filter_planned, plan_chunk, Plan};
 use crate::technique::ewa::ewa;
+use crate::technique::ewa_probes::ewa_probes;
 use crate::technique::lab::Rules;
 use crate::technique::mip::{mip_nearest, trilinear};
 use crate::technique::ripmap::ripmap;
@@ -288,6 +289,23 @@ impl Sampler {
             }
             return;
         }
+        if let Technique::EwaProbes(max) = self.technique {
+            // The probes' scratch made once, as for the anisotropic probes.
+            let mut probes = Probes::new(self.params.addr);
+            for (fps, outs) in parts {
+                batch::queries(self, size, fps, &mut chunk);
+                for (k, o) in outs.iter_mut().enumerate() {
+                    let q = chunk.query(k);
+                    *o = if q.lod > 0.0 {
+                        ewa_probes(p, &self.params, &q, max, &mut probes)
+                    } else {
+                        self.filter(p, &q)
+                    }
+                    .to_array();
+                }
+            }
+            return;
+        }
         for (fps, outs) in parts {
             batch::queries(self, size, fps, &mut chunk);
             for (k, o) in outs.iter_mut().enumerate() {
@@ -355,6 +373,9 @@ impl Sampler {
             },
             Technique::Anisotropic => anisotropic(p, &self.params, q),
             Technique::Ewa(max) => ewa(p, &self.params, q, max),
+            Technique::EwaProbes(max) => {
+                ewa_probes(p, &self.params, q, max, &mut Probes::new(self.params.addr))
+            }
             Technique::Ripmap => match p.texture().ripmap() {
                 Ok(r) => ripmap(p, r, &self.params, q),
                 Err(_) => trilinear(p, Bilinear, addr, q),

@@ -8,16 +8,17 @@
 //! `lod > 0` uses `min_filter` with `mipmap_filter` choosing the level(s). `lod` is
 //! `log2(rho) + lod_bias` clamped to `[lod_min_clamp, lod_max_clamp]` (see [`crate::base::footprint`]).
 //!
-//! Beyond the core filters, four anisotropic techniques are selected through the same descriptor:
+//! Beyond the core filters, five anisotropic techniques are selected through the same descriptor:
 //!
 //! | technique | descriptor | module |
 //! |---|---|---|
 //! | hardware-style N x anisotropic | mag, min and mipmap filters `Linear`, `anisotropy_clamp` 2..=16 (up to 64 accepted); [`SamplerDescriptor::lab_mode`] 5-8 | [`crate::technique::aniso`] |
 //! | EWA | `min_filter: FilterMode::Ewa` | [`crate::technique::ewa`] |
+//! | EWA from weighted trilinear probes | `min_filter: FilterMode::EwaProbes` | [`crate::technique::ewa_probes`] |
 //! | ripmap | `min_filter: FilterMode::Ripmap` | [`crate::technique::ripmap`] |
 //! | summed-area table | `min_filter: FilterMode::SummedArea` | [`crate::technique::sat`] |
 //!
-//! Decisions for the three minification-only filters (`Ewa`, `Ripmap`, `SummedArea`):
+//! Decisions for the four minification-only filters (`Ewa`, `EwaProbes`, `Ripmap`, `SummedArea`):
 //! - magnification works as on a GPU: when the isotropic `lod` (from `rho`, the longer axis) is
 //!   `<= 0`, `mag_filter` runs at level 0. Using one of them as `mag_filter` is rejected with
 //!   [`TextureError::MinificationOnlyFilter`];
@@ -74,6 +75,8 @@ pub(super) enum Technique {
     Anisotropic,
     /// EWA with this eccentricity clamp (1..=64).
     Ewa(f32),
+    /// EWA from weighted trilinear probes, with this eccentricity clamp (1..=64).
+    EwaProbes(f32),
     /// Ripmap.
     Ripmap,
     /// Summed-area table.
@@ -130,12 +133,14 @@ impl Sampler {
             return Err(TextureError::MinificationOnlyFilter(desc.mag_filter));
         }
         let clamp = desc.anisotropy_clamp;
+        let ewa_clamp = f32::from(if clamp == 1 {
+            EWA_DEFAULT_ANISOTROPY
+        } else {
+            clamp
+        });
         let technique = match desc.min_filter {
-            FilterMode::Ewa => Technique::Ewa(f32::from(if clamp == 1 {
-                EWA_DEFAULT_ANISOTROPY
-            } else {
-                clamp
-            })),
+            FilterMode::Ewa => Technique::Ewa(ewa_clamp),
+            FilterMode::EwaProbes => Technique::EwaProbes(ewa_clamp),
             FilterMode::Ripmap => Technique::Ripmap,
             FilterMode::SummedArea => Technique::SummedArea,
             _ if clamp > 1 => {

@@ -32,9 +32,11 @@ pub(crate) fn filter_level<F: Fetch>(
     match mode {
         FilterMode::Nearest => nearest(level, addr, uv),
         FilterMode::Cubic(c) => bicubic(level, addr, c, uv),
-        FilterMode::Linear | FilterMode::Ewa | FilterMode::Ripmap | FilterMode::SummedArea => {
-            bilinear(level, addr, uv)
-        }
+        FilterMode::Linear
+        | FilterMode::Ewa
+        | FilterMode::EwaProbes
+        | FilterMode::Ripmap
+        | FilterMode::SummedArea => bilinear(level, addr, uv),
     }
 }
 

@@ -1,11 +1,12 @@
 //! Techniques: how a footprint becomes kernel reads across levels or tables. Mipmapping
-//! ([`mip`]), the hardware-style anisotropic probes ([`aniso`]), EWA ([`ewa`]), ripmaps
+//! ([`mip`]), the hardware-style anisotropic probes ([`aniso`]), EWA ([`ewa`]) and its approximation by weighted probes ([`ewa_probes`]), ripmaps
 //! ([`ripmap`]) and summed-area tables ([`sat`]); the lab's eight modes under either convention
 //! ([`lab`]). Each takes the pyramid, a query and the small
 //! parameter set it needs, never the whole sampler.
 
 pub mod aniso;
 pub mod ewa;
+pub mod ewa_probes;
 pub mod lab;
 pub mod mip;
 pub mod ripmap;
