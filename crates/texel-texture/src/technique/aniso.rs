@@ -223,7 +223,32 @@ impl Probes {
     /// as in [`mip::trilinear`]): stages 2 and 3 of [`run`] with every probe in the same levels,
     /// so their views are made once. Bit for bit the sum of [`mip::trilinear`] per probe, in order.
     #[inline(always)]
-    pub(crate) fn trilinear_sum<P: Pyramid>(&mut self, p: &P, (k, delta): (usize, f32)) -> Vec4 {
+    pub(crate) fn trilinear_sum<P: Pyramid>(&mut self, p: &P, levels: (usize, f32)) -> Vec4 {
+        self.sum_by(p, levels, |_, t| t)
+    }
+
+    /// [`Probes::trilinear_sum`] with probe `i` weighed by `weights[i]` (one weight per probe
+    /// at `self.at`): `sum w_i trilinear_i`, in order.
+    #[inline(always)]
+    pub(crate) fn trilinear_weighted_sum<P: Pyramid>(
+        &mut self,
+        p: &P,
+        levels: (usize, f32),
+        weights: &[f32],
+    ) -> Vec4 {
+        debug_assert!(weights.len() >= self.at.n.min(CHUNK));
+        self.sum_by(p, levels, |i, t| t * weights[i])
+    }
+
+    /// The sum over the probes at `self.at` of `term(i, trilinear_i)`, in order, with every
+    /// probe's trilinear sample in `levels`.
+    #[inline(always)]
+    fn sum_by<P: Pyramid>(
+        &mut self,
+        p: &P,
+        (k, delta): (usize, f32),
+        term: impl Fn(usize, Vec4) -> Vec4,
+    ) -> Vec4 {
         let last = p.level_count() - 1;
         let coarse = delta > 0.0 && k < last;
         let n = self.at.n.min(CHUNK);
@@ -244,50 +269,14 @@ impl Probes {
         for i in 0..n {
             let uv = self.at.uv(i);
             let a = self.fine.filtered(&fine_level, i, uv);
-            sum += if coarse {
-                lerp(a, self.next.filtered(&next_level, i, uv), delta)
-            } else {
-                a
-            };
-        }
-        sum
-    }
-
-    /// [`Probes::trilinear_sum`] with probe `i` weighed by `weights[i]` (one weight per probe
-    /// at `self.at`): `sum w_i trilinear_i`, in order.
-    #[inline(always)]
-    pub(crate) fn trilinear_weighted_sum<P: Pyramid>(
-        &mut self,
-        p: &P,
-        (k, delta): (usize, f32),
-        weights: &[f32],
-    ) -> Vec4 {
-        let last = p.level_count() - 1;
-        let coarse = delta > 0.0 && k < last;
-        let n = self.at.n.min(CHUNK).min(weights.len());
-        let fine_level = p.level(k);
-        let next_level = p.level(if coarse { k + 1 } else { k });
-        let size_of = |level: &P::Level<'_>| {
-            let (w, h) = level.size();
-            (w as f32, h as f32)
-        };
-        let fine_size = size_of(&fine_level);
-        let (us, vs) = (&self.at.u[..n], &self.at.v[..n]);
-        self.fine.coordinates(|_| fine_size, us, vs);
-        if coarse {
-            let next_size = size_of(&next_level);
-            self.next.coordinates(|_| next_size, us, vs);
-        }
-        let mut sum = Vec4::ZERO;
-        for (i, &w) in weights[..n].iter().enumerate() {
-            let uv = self.at.uv(i);
-            let a = self.fine.filtered(&fine_level, i, uv);
-            let t = if coarse {
-                lerp(a, self.next.filtered(&next_level, i, uv), delta)
-            } else {
-                a
-            };
-            sum += t * w;
+            sum += term(
+                i,
+                if coarse {
+                    lerp(a, self.next.filtered(&next_level, i, uv), delta)
+                } else {
+                    a
+                },
+            );
         }
         sum
     }

@@ -167,6 +167,8 @@ pub struct Ellipse {
     pub major: f64,
     /// Minor semi-axis length `r2 >= major / max_anisotropy` after the clamp.
     pub minor: f64,
+    /// The major semi-axis's unit direction `e1` (`(1, 0)` for a circle).
+    pub e1: DVec2,
 }
 
 impl Ellipse {
@@ -195,10 +197,9 @@ impl Ellipse {
         } else {
             0.0
         };
-        // The major axis e1, the eigenvector of l1, without trigonometry (three libm calls per
-        // sample before): `(l1 - c, b)` when `a >= c`, else `(b, l1 - a)`, whichever has the
-        // larger, cancellation-free first or second entry; a circle (`a = c`, `b = 0`) takes
-        // `(1, 0)` as `atan2(0, 0) = 0` did.
+        // The major axis e1, the eigenvector of l1, without trigonometry: `(l1 - c, b)` when
+        // `a >= c`, else `(b, l1 - a)`, whichever has the larger, cancellation-free first or
+        // second entry; a circle (`a = c`, `b = 0`) takes `(1, 0)`.
         let v = if a >= c {
             DVec2::new(l1 - c, b)
         } else {
@@ -221,6 +222,7 @@ impl Ellipse {
             s11: q1 * e1.y * e1.y + q2 * e1.x * e1.x,
             major,
             minor,
+            e1,
         })
     }
 

@@ -178,7 +178,6 @@ pub fn plan(px: Vec2, py: Vec2, size: (u32, u32), max_anisotropy: f32) -> Option
     // The reference's covariance `C = (S + 2 I) / 12`: eigenvalues from the clamped semi-axes.
     let l1 = (e.major * e.major + 2.0) / 12.0;
     let l2 = (e.minor * e.minor + 2.0) / 12.0;
-    let e1 = major_direction(&e);
     let table = probe_table();
     let (n, var) = if l1 <= (1.0 + ONE_PROBE) * l2 {
         (1, l2)
@@ -198,7 +197,7 @@ pub fn plan(px: Vec2, py: Vec2, size: (u32, u32), max_anisotropy: f32) -> Option
     } else {
         (l1 - var).max(0.0).sqrt()
     };
-    let axis_texels = e1 * residual;
+    let axis_texels = e.e1 * residual;
     let (w, h) = (f64::from(size.0), f64::from(size.1));
     Some(ProbePlan {
         n,
@@ -206,24 +205,6 @@ pub fn plan(px: Vec2, py: Vec2, size: (u32, u32), max_anisotropy: f32) -> Option
         axis_uv: DVec2::new(axis_texels.x / w, axis_texels.y / h),
         axis_texels,
     })
-}
-
-/// The unit eigenvector of the ellipse's larger eigenvalue (its shape matrix `S`); `(1, 0)` for
-/// a circle.
-fn major_direction(e: &Ellipse) -> DVec2 {
-    let (a, b, c) = (e.s00, e.s01, e.s11);
-    let l1 = e.major * e.major;
-    let v = if a >= c {
-        DVec2::new(l1 - c, b)
-    } else {
-        DVec2::new(b, l1 - a)
-    };
-    let len = v.length();
-    if len > 0.0 && len.is_finite() {
-        v / len
-    } else {
-        DVec2::X
-    }
 }
 
 /// EWA from trilinear probes of query `q` (whose isotropic lod is `> 0`) under `s`, with the
