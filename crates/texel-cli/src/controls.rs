@@ -85,8 +85,8 @@ pub const KEYS: &[KeyHelp] = &[
         action: "EWA / the reference (accumulates up to 512 samples per pixel while still)",
     },
     KeyHelp {
-        keys: "B M T",
-        action: "bicubic, ripmap, summed-area table",
+        keys: "E B M T",
+        action: "EWA from weighted probes, bicubic, ripmap, summed-area table",
     },
     KeyHelp {
         keys: "Shift+key",
@@ -339,6 +339,7 @@ fn mode_of(key: Key) -> Option<Mode> {
         Key::Digit(d @ 1..=8) => Mode::Filter(Filter::from_lab_mode(d).ok()?),
         Key::Digit(9) => Mode::Filter(Filter::Ewa),
         Key::Digit(0) => Mode::Reference,
+        Key::Letter('e') => Mode::Filter(Filter::EwaProbes),
         Key::Letter('b') => Mode::Filter(Filter::Bicubic),
         Key::Letter('m') => Mode::Filter(Filter::Ripmap),
         Key::Letter('t') => Mode::Filter(Filter::Sat),
@@ -416,6 +417,7 @@ mod tests {
         let cases = [
             (Key::Digit(9), Mode::Filter(Filter::Ewa)),
             (Key::Digit(0), Mode::Reference),
+            (Key::Letter('e'), Mode::Filter(Filter::EwaProbes)),
             (Key::Letter('b'), Mode::Filter(Filter::Bicubic)),
             (Key::Letter('m'), Mode::Filter(Filter::Ripmap)),
             (Key::Letter('t'), Mode::Filter(Filter::Sat)),
@@ -516,8 +518,8 @@ mod tests {
     fn the_help_table_names_every_key_the_state_handles() {
         let table = key_table();
         for name in [
-            "1-8", "9 / 0", "B M T", "Shift", "Tab", "V", "P", "Q", "[ ]", "C", "H", "F12", "Esc",
-            "WASD", "R",
+            "1-8", "9 / 0", "E B M T", "Shift", "Tab", "V", "P", "Q", "[ ]", "C", "H", "F12",
+            "Esc", "WASD", "R",
         ] {
             assert!(table.contains(name), "{name} missing from\n{table}");
         }

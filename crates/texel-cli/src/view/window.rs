@@ -445,6 +445,7 @@ pub fn key_of(code: KeyCode) -> Option<Key> {
         C::KeyB => Key::Letter('b'),
         C::KeyC => Key::Letter('c'),
         C::KeyD => Key::Letter('d'),
+        C::KeyE => Key::Letter('e'),
         C::KeyH => Key::Letter('h'),
         C::KeyM => Key::Letter('m'),
         C::KeyP => Key::Letter('p'),
