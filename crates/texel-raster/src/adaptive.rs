@@ -252,16 +252,19 @@ pub fn pass_layout(min_spp: u32) -> (u32, [u32; 2]) {
         .unwrap_or((min_spp, [1, 1]))
 }
 
-/// Per-pixel running statistics of the pass means (Welford's update, in f64).
-#[derive(Clone, Copy, Default)]
-struct Stats {
+/// One pixel's running statistics of its independent pass means (Welford's update, in f64): the
+/// mean, its standard error and its interval on the display. The adaptive reference and the
+/// viewer's progressive reference keep one per pixel.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PassStats {
     n: u32,
     mean: [f64; 4],
     m2: [f64; 4],
 }
 
-impl Stats {
-    fn add(&mut self, x: [f32; 4]) {
+impl PassStats {
+    /// Adds one pass's mean (linear RGBA).
+    pub fn add(&mut self, x: [f32; 4]) {
         self.n += 1;
         let n = f64::from(self.n);
         for c in 0..4 {
@@ -272,13 +275,24 @@ impl Stats {
         }
     }
 
-    fn std_error(&self) -> [f64; 4] {
+    /// The passes added so far.
+    pub fn passes(&self) -> u32 {
+        self.n
+    }
+
+    /// The mean of the passes (linear RGBA; zero before the first).
+    pub fn mean(&self) -> [f32; 4] {
+        self.mean.map(|m| m as f32)
+    }
+
+    /// The standard error of [`PassStats::mean`] per channel ([`pass_std_error`]).
+    pub fn std_error(&self) -> [f64; 4] {
         self.m2.map(|m2| pass_std_error(m2, self.n))
     }
 
     /// The largest distance over R, G, B between the displayed mean and the displayed ends of the
-    /// 95 % interval ([`display_half_width`]).
-    fn display_half_width(&self, srgb: bool) -> f64 {
+    /// 95 % interval ([`display_half_width`]); infinite below two passes.
+    pub fn display_half_width(&self, srgb: bool) -> f64 {
         if self.n < 2 {
             return f64::INFINITY;
         }
@@ -346,7 +360,7 @@ fn check_plan(plan: &ReferencePlan) -> Result<(), RasterError> {
 /// half-width on the display, samples and whether it converged.
 fn estimate(
     settings: &RenderSettings,
-    stats: &[Stats],
+    stats: &[PassStats],
     mut depth: Vec<f32>,
     plan: &ReferencePlan,
     per_pass: u32,
@@ -434,7 +448,7 @@ pub fn render_reference_adaptive(
     let per_pass = strata[0] * strata[1];
     let max_passes = plan.max_spp / per_pass;
     let pixels = settings.width as usize * settings.height as usize;
-    let mut stats = vec![Stats::default(); pixels];
+    let mut stats = vec![PassStats::default(); pixels];
     let mut depth = vec![f32::INFINITY; pixels];
     let mut interrupted = false;
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
@@ -584,7 +598,7 @@ mod tests {
     #[test]
     fn welford_matches_the_two_pass_formulas() {
         let xs = [0.25f32, 0.5, 1.75, 0.0, 3.0];
-        let mut s = Stats::default();
+        let mut s = PassStats::default();
         for x in xs {
             s.add([x; 4]);
         }
@@ -597,7 +611,7 @@ mod tests {
             / (n - 1.0);
         assert!((s.mean[0] - mean).abs() < 1e-12);
         assert!((s.std_error()[0] - (var / n).sqrt()).abs() < 1e-12);
-        // From a sum of squares, as the viewer keeps its passes: the same error.
+        // From a sum of squares: the same error.
         let squares: f64 = xs.iter().map(|&x| f64::from(x).powi(2)).sum();
         let se = pass_std_error(squares - n * mean * mean, xs.len() as u32);
         assert!((se - (var / n).sqrt()).abs() < 1e-12);
@@ -608,13 +622,13 @@ mod tests {
     #[test]
     fn the_display_clips_and_encodes() {
         // An interval wholly above 1 shows as 1 at both ends: width zero.
-        let mut s = Stats::default();
+        let mut s = PassStats::default();
         for x in [5.0f32, 9.0, 7.0] {
             s.add([x, x, x, 1.0]);
         }
         assert_eq!(s.display_half_width(true), 0.0);
         // Linear display: the half-width is t * s / sqrt(n) while the interval stays in [0, 1].
-        let mut s = Stats::default();
+        let mut s = PassStats::default();
         for x in [0.4f32, 0.5, 0.6] {
             s.add([x, x, x, 1.0]);
         }
@@ -622,7 +636,7 @@ mod tests {
         assert!((s.display_half_width(false) - expected).abs() < 1e-6);
         // sRGB is steeper than linear below mid-grey.
         assert!(s.display_half_width(true) > 0.0);
-        let mut one = Stats::default();
+        let mut one = PassStats::default();
         one.add([0.5; 4]);
         assert!(one.display_half_width(true).is_infinite());
     }

@@ -24,6 +24,7 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 use texel::lab::gl::{Gl, GlScene, Names, ShaderDraws};
 use texel::quality::Encoding;
+use texel::raster::adaptive::PassStats;
 use texel::raster::{
     draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, RenderSettings, View,
 };
@@ -420,11 +421,9 @@ impl ShaderThread {
 struct Progress {
     /// The request the accumulation and statistics belong to.
     image: Option<Request>,
-    /// Reference sums (linear RGBA) and samples per pixel.
-    sum: Vec<[f32; 4]>,
-    /// Per pixel, the sum of the squared pass means (linear RGB): with `sum`, the spread of the
-    /// passes, hence the reference's standard error.
-    squares: Vec<[f64; 3]>,
+    /// Per pixel, the statistics of the reference's passes: their mean and its standard error.
+    pixels: Vec<PassStats>,
+    /// Samples per pixel so far.
     samples: u32,
     passes: u64,
     stats: Option<Vec<Option<Stats>>>,
@@ -628,39 +627,18 @@ fn decoded(px: &[[u8; 4]], srgb: bool) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// Adds one reference pass over `band` to the progressive reference. The pass holds means of
-/// `spp[0] x spp[1]` samples: their sums join `sum`, the squared means join `squares`.
-fn add_pass(progress: &mut Progress, pass: &Frame, spp: [u32; 2], band: [u32; 4], w: u32) {
-    let n = (spp[0] * spp[1]) as f32;
-    for_rect(band, w, |k| {
-        let (a, b) = (&mut progress.sum[k], pass.color[k]);
-        for c in 0..4 {
-            a[c] += b[c] * n;
-        }
-        let q = &mut progress.squares[k];
-        for c in 0..3 {
-            q[c] += f64::from(b[c]) * f64::from(b[c]);
-        }
-    });
+/// Adds one reference pass over `band` (each pixel the mean of its strata) to the progressive
+/// reference.
+fn add_pass(progress: &mut Progress, pass: &Frame, band: [u32; 4], w: u32) {
+    for_rect(band, w, |k| progress.pixels[k].add(pass.color[k]));
 }
 
-/// The share of the pixels of `rect` (in a frame `w` wide) whose accumulated reference, `passes`
-/// equal passes in `progress`, has a 95 % interval of its displayed value (sRGB when `srgb`)
-/// within half an 8-bit step: each pass mean is one independent estimate
-/// ([`texel::raster::adaptive::pass_std_error`]).
-fn share_within(progress: &Progress, rect: [u32; 4], w: u32, passes: u32, srgb: bool) -> f64 {
-    let n = f64::from(passes);
+/// The share of the pixels of `rect` (in a frame `w` wide) whose accumulated reference has a
+/// 95 % interval of its displayed value (sRGB when `srgb`) within half an 8-bit step: each pass
+/// mean is one independent estimate ([`PassStats::display_half_width`]).
+fn share_within(progress: &Progress, rect: [u32; 4], w: u32, srgb: bool) -> f64 {
     let tolerance = crate::cli::DEFAULT_TOLERANCE_STEPS / 255.0;
-    let within = |k: usize| {
-        let (sum, squares) = (progress.sum[k], progress.squares[k]);
-        // `sum` holds every sample; the pass means' mean is the same mean.
-        let mean: [f64; 3] =
-            std::array::from_fn(|c| f64::from(sum[c]) / f64::from(progress.samples));
-        let se = std::array::from_fn(|c| {
-            texel::raster::adaptive::pass_std_error(squares[c] - n * mean[c] * mean[c], passes)
-        });
-        texel::raster::adaptive::display_half_width(mean, se, passes, srgb) <= tolerance
-    };
+    let within = |k: usize| progress.pixels[k].display_half_width(srgb) <= tolerance;
     let [x0, y0, x1, y1] = rect;
     // Rows in parallel: each pixel's interval takes a few sRGB encodes.
     let inside: usize = (y0..y1)
@@ -751,9 +729,8 @@ impl FrameContext<'_, '_> {
             }
             _ => Frame::new(&settings),
         };
-        if self.progress.sum.len() != frame.color.len() {
-            self.progress.sum = vec![[0.0; 4]; frame.color.len()];
-            self.progress.squares = vec![[0.0; 3]; frame.color.len()];
+        if self.progress.pixels.len() != frame.color.len() {
+            self.progress.pixels = vec![PassStats::default(); frame.color.len()];
         }
         let t0 = Instant::now();
         let mut parts = Vec::new();
@@ -937,7 +914,7 @@ impl FrameContext<'_, '_> {
                         ..settings
                     };
                     let pass = render_reference_strata(&s, &draws, spp, seed, None)?;
-                    add_pass(&mut *self.progress, &pass, spp, band, w);
+                    add_pass(&mut *self.progress, &pass, band, w);
                 }
             }
         }
@@ -965,12 +942,9 @@ impl FrameContext<'_, '_> {
         for (part, &rect) in parts.iter_mut().zip(rects) {
             if part.mode == Mode::Reference {
                 part.samples = Some(samples);
-                let inv = 1.0 / samples as f32;
-                for_rect(rect, w, |k| {
-                    frame.color[k] = self.progress.sum[k].map(|c| c * inv);
-                });
+                for_rect(rect, w, |k| frame.color[k] = self.progress.pixels[k].mean());
                 if !req.moving && passes >= 2 {
-                    part.within = Some(share_within(&*self.progress, rect, w, passes, srgb));
+                    part.within = Some(share_within(&*self.progress, rect, w, srgb));
                 }
             }
         }
@@ -1376,24 +1350,24 @@ mod tests {
             assert_eq!(r.parts[0].samples, Some(4 * k));
             last = r.pixels;
         }
-        // The mean of 12 samples equals the reference renderer's passes averaged.
+        // The mean of 12 samples equals the reference renderer's three passes averaged (in f64).
         let scene = h.worker.scenes[0].as_ref().unwrap();
         let samplers = scene.samplers(Filter::Trilinear).unwrap();
         let draws = scene.draws(&samplers);
-        let mut sum = vec![[0.0f32; 4]; 64 * 36];
+        let mut sum = vec![[0.0f64; 4]; 64 * 36];
         for seed in 1..=3 {
             let pass =
                 render_reference_strata(&scene.settings(), &draws, [2, 2], seed, None).unwrap();
             for (s, c) in sum.iter_mut().zip(&pass.color) {
                 for i in 0..4 {
-                    s[i] += c[i] * 4.0;
+                    s[i] += f64::from(c[i]);
                 }
             }
         }
         let want: Vec<u32> = sum
             .iter()
             .map(|s| {
-                let [r, g, b, _] = Encoding::Srgb.encode(s.map(|c| c * (1.0 / 12.0)));
+                let [r, g, b, _] = Encoding::Srgb.encode(s.map(|c| (c / 3.0) as f32));
                 u32::from(r) << 16 | u32::from(g) << 8 | u32::from(b)
             })
             .collect();
@@ -1445,7 +1419,8 @@ mod tests {
             })
             .count();
         let want = within as f64 / (64.0 * 36.0);
-        // The sums differ from the two-pass form in the last bits of a few pixels at most.
+        // Welford's update differs from the two-pass form in the last bits of a few pixels at
+        // most.
         assert!(
             (got - want).abs() <= 2.0 / (64.0 * 36.0),
             "{got} against {want}"
