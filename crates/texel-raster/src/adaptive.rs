@@ -306,6 +306,92 @@ impl PassStats {
     }
 }
 
+/// A reference that converges while it is shown: each pixel of a `width` x `height` frame keeps
+/// the [`PassStats`] of the independent passes added to it, so that a viewer draws their mean and
+/// reports the share of pixels whose interval on the display is within the plan's tolerance (the
+/// rule [`render_reference_adaptive`] stops refining a pixel by).
+#[derive(Clone, Debug, Default)]
+pub struct ProgressiveReference {
+    width: u32,
+    height: u32,
+    tolerance: f64,
+    srgb_display: bool,
+    pixels: Vec<PassStats>,
+}
+
+impl ProgressiveReference {
+    /// An empty reference of `width` x `height` pixels judged by `plan`'s tolerance and display
+    /// encoding.
+    pub fn new(width: u32, height: u32, plan: &ReferencePlan) -> Self {
+        ProgressiveReference {
+            width,
+            height,
+            tolerance: plan.tolerance,
+            srgb_display: plan.srgb_display,
+            pixels: vec![PassStats::default(); width as usize * height as usize],
+        }
+    }
+
+    /// Whether this reference is `width` x `height` pixels judged as `plan` says.
+    pub fn fits(&self, width: u32, height: u32, plan: &ReferencePlan) -> bool {
+        (self.width, self.height, self.tolerance, self.srgb_display)
+            == (width, height, plan.tolerance, plan.srgb_display)
+    }
+
+    /// Adds the pixels of `rect` (`[x0, y0, x1, y1]`) of one pass (each pixel the mean of its
+    /// strata, linear RGBA), a frame of this reference's size.
+    ///
+    /// # Panics
+    /// If `rect` reaches outside the frame or `pass` is of another size (a programming error).
+    pub fn add(&mut self, pass: &Frame, rect: [u32; 4]) {
+        assert_eq!(pass.color.len(), self.pixels.len(), "pass of another size");
+        for k in self.indices(rect) {
+            self.pixels[k].add(pass.color[k]);
+        }
+    }
+
+    /// Writes the mean of every pixel of `rect` into `color` (a frame's colour of this size).
+    pub fn mean_into(&self, rect: [u32; 4], color: &mut [[f32; 4]]) {
+        for k in self.indices(rect) {
+            color[k] = self.pixels[k].mean();
+        }
+    }
+
+    /// The share of the pixels of `rect` whose 95 % interval on the display is within the
+    /// tolerance ([`PassStats::display_half_width`]); 0 for an empty `rect`.
+    pub fn share_within(&self, rect: [u32; 4]) -> f64 {
+        use rayon::prelude::*;
+        let [x0, y0, x1, y1] = rect;
+        let within =
+            |k: usize| self.pixels[k].display_half_width(self.srgb_display) <= self.tolerance;
+        // Rows in parallel: each pixel's interval takes a few sRGB encodes.
+        let inside: usize = (y0..y1)
+            .into_par_iter()
+            .map(|y| {
+                let row = y as usize * self.width as usize;
+                (x0..x1).filter(|&x| within(row + x as usize)).count()
+            })
+            .sum();
+        let n = u64::from(x1.saturating_sub(x0)) * u64::from(y1.saturating_sub(y0));
+        if n == 0 {
+            0.0
+        } else {
+            inside as f64 / n as f64
+        }
+    }
+
+    /// The indices of `rect`'s pixels, row by row.
+    fn indices(&self, rect: [u32; 4]) -> impl Iterator<Item = usize> {
+        let [x0, y0, x1, y1] = rect;
+        assert!(
+            x1 <= self.width && y1 <= self.height,
+            "rect outside the frame"
+        );
+        let w = self.width as usize;
+        (y0..y1).flat_map(move |y| (x0..x1).map(move |x| y as usize * w + x as usize))
+    }
+}
+
 /// The standard error of the mean of `n` independent pass means whose squared deviations from
 /// their mean sum to `m2` (the passes' sample deviation over `sqrt(n)`); infinite below two
 /// passes. A negative `m2` (rounding in a caller's `sum x^2 - n mean^2`) counts as 0.
@@ -617,6 +703,42 @@ mod tests {
         assert!((se - (var / n).sqrt()).abs() < 1e-12);
         assert!(pass_std_error(0.0, 1).is_infinite());
         assert_eq!(pass_std_error(-1e-18, 3), 0.0);
+    }
+
+    /// A progressive reference holds each pixel's passes apart: the rect a pass covers gets its
+    /// mean, and a pixel is within the tolerance when its passes agree.
+    #[test]
+    fn a_progressive_reference_adds_passes_per_rect() {
+        let settings = RenderSettings {
+            width: 4,
+            height: 2,
+            ..RenderSettings::default()
+        };
+        let plan = ReferencePlan {
+            srgb_display: false,
+            ..ReferencePlan::default()
+        };
+        let mut r = ProgressiveReference::new(4, 2, &plan);
+        assert!(r.fits(4, 2, &plan) && !r.fits(2, 4, &plan));
+        let mut pass = Frame::new(&settings);
+        // Three passes: the left half constant, the right half spread by 0.1.
+        for v in [0.4f32, 0.5, 0.6] {
+            for (k, c) in pass.color.iter_mut().enumerate() {
+                *c = if k % 4 < 2 { [0.25; 4] } else { [v; 4] };
+            }
+            r.add(&pass, [0, 0, 4, 2]);
+        }
+        // A fourth pass over the top-left pixel only.
+        pass.color[0] = [0.25; 4];
+        r.add(&pass, [0, 0, 1, 1]);
+        let mut color = vec![[0.0; 4]; 8];
+        r.mean_into([0, 0, 4, 2], &mut color);
+        assert_eq!(color[0], [0.25; 4]);
+        assert!((color[3][0] - 0.5).abs() < 1e-6);
+        assert_eq!(r.share_within([0, 0, 2, 2]), 1.0);
+        assert_eq!(r.share_within([2, 0, 4, 2]), 0.0);
+        assert_eq!(r.share_within([0, 0, 4, 2]), 0.5);
+        assert_eq!(r.share_within([1, 1, 1, 2]), 0.0, "an empty rect");
     }
 
     #[test]

@@ -60,7 +60,10 @@ pub mod tile;
 pub mod views;
 pub mod warp;
 
-pub use adaptive::{render_reference_adaptive, ReferenceEstimate, ReferencePlan, ReferenceStatus};
+pub use adaptive::{
+    render_reference_adaptive, ProgressiveReference, ReferenceEstimate, ReferencePlan,
+    ReferenceStatus,
+};
 pub use draw::{DrawCall, UvEvaluation, UvMapping, Vertex};
 pub use error::RasterError;
 pub use exact::{render_exact, ExactImage};

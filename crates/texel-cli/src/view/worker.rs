@@ -24,9 +24,9 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 use texel::lab::gl::{Gl, GlScene, Names, ShaderDraws};
 use texel::quality::Encoding;
-use texel::raster::adaptive::PassStats;
 use texel::raster::{
-    draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, RenderSettings, View,
+    draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, ProgressiveReference,
+    ReferencePlan, RenderSettings, View,
 };
 use texel::scene::Camera;
 use texel::{Filter, PreparedScene, Sampler, SamplerDescriptor};
@@ -421,8 +421,8 @@ impl ShaderThread {
 struct Progress {
     /// The request the accumulation and statistics belong to.
     image: Option<Request>,
-    /// Per pixel, the statistics of the reference's passes: their mean and its standard error.
-    pixels: Vec<PassStats>,
+    /// The reference's passes so far, per pixel.
+    reference: ProgressiveReference,
     /// Samples per pixel so far.
     samples: u32,
     passes: u64,
@@ -627,31 +627,6 @@ fn decoded(px: &[[u8; 4]], srgb: bool) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// Adds one reference pass over `band` (each pixel the mean of its strata) to the progressive
-/// reference.
-fn add_pass(progress: &mut Progress, pass: &Frame, band: [u32; 4], w: u32) {
-    for_rect(band, w, |k| progress.pixels[k].add(pass.color[k]));
-}
-
-/// The share of the pixels of `rect` (in a frame `w` wide) whose accumulated reference has a
-/// 95 % interval of its displayed value (sRGB when `srgb`) within half an 8-bit step: each pass
-/// mean is one independent estimate ([`PassStats::display_half_width`]).
-fn share_within(progress: &Progress, rect: [u32; 4], w: u32, srgb: bool) -> f64 {
-    let tolerance = crate::cli::DEFAULT_TOLERANCE_STEPS / 255.0;
-    let within = |k: usize| progress.pixels[k].display_half_width(srgb) <= tolerance;
-    let [x0, y0, x1, y1] = rect;
-    // Rows in parallel: each pixel's interval takes a few sRGB encodes.
-    let inside: usize = (y0..y1)
-        .into_par_iter()
-        .map(|y| {
-            let row = y as usize * w as usize;
-            (x0..x1).filter(|&x| within(row + x as usize)).count()
-        })
-        .sum();
-    let all = (x1 - x0) as usize * (y1 - y0) as usize;
-    inside as f64 / all.max(1) as f64
-}
-
 /// The scene's settings for a `w x h` frame of `state`'s view, perspective and derivatives, on
 /// every thread, into linear floats (progressive passes accumulate them).
 fn view_settings(
@@ -729,8 +704,12 @@ impl FrameContext<'_, '_> {
             }
             _ => Frame::new(&settings),
         };
-        if self.progress.pixels.len() != frame.color.len() {
-            self.progress.pixels = vec![PassStats::default(); frame.color.len()];
+        let plan = ReferencePlan {
+            srgb_display: req.state.color == texel::ColorHandling::Srgb,
+            ..ReferencePlan::default()
+        };
+        if !self.progress.reference.fits(w, h, &plan) {
+            self.progress.reference = ProgressiveReference::new(w, h, &plan);
         }
         let t0 = Instant::now();
         let mut parts = Vec::new();
@@ -914,7 +893,7 @@ impl FrameContext<'_, '_> {
                         ..settings
                     };
                     let pass = render_reference_strata(&s, &draws, spp, seed, None)?;
-                    add_pass(&mut *self.progress, &pass, band, w);
+                    self.progress.reference.add(&pass, band);
                 }
             }
         }
@@ -935,16 +914,14 @@ impl FrameContext<'_, '_> {
             self.progress.samples += a * b;
         }
         let samples = self.progress.samples;
-        let w = frame.width;
         let [a, b] = reference_spp(req);
         let passes = samples / (a * b);
-        let srgb = req.state.color == texel::ColorHandling::Srgb;
         for (part, &rect) in parts.iter_mut().zip(rects) {
             if part.mode == Mode::Reference {
                 part.samples = Some(samples);
-                for_rect(rect, w, |k| frame.color[k] = self.progress.pixels[k].mean());
+                self.progress.reference.mean_into(rect, &mut frame.color);
                 if !req.moving && passes >= 2 {
-                    part.within = Some(share_within(&*self.progress, rect, w, srgb));
+                    part.within = Some(self.progress.reference.share_within(rect));
                 }
             }
         }
