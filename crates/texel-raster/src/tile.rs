@@ -62,7 +62,7 @@ use texel_texture::base::color::{
     rgba_to_unorm8, rgba_to_unorm8_slice, srgb8_encoder, unorm8_table, Srgb8Encoder,
 };
 use texel_texture::engine::dispatch::{self, Kernel, StreamElement};
-use texel_texture::{Footprint, FootprintLanes, Lanes};
+use texel_texture::{BoundSampler, Footprint, FootprintLanes, Lanes, SpanKind, Wants};
 
 use crate::draw::DrawCall;
 use crate::environment::{Environment, ViewRays};
@@ -177,7 +177,7 @@ struct Context<'a> {
     /// The environment's camera rays, when it is the background of a colour view.
     background: Option<(Environment<'a>, ViewRays)>,
     /// Per draw: how its colour-view fragments are sampled ([`Route::of`]).
-    routes: Vec<Route>,
+    routes: Vec<Route<'a>>,
     /// The frame's clear (colour as the target stores it, depth `+inf`) when its tiles are drawn
     /// in scratch and streamed out ([`Frame::draw_streams`]); `None` to draw in place.
     stream: Option<Clear>,
@@ -193,38 +193,32 @@ impl Context<'_> {
     }
 }
 
-/// How a draw's colour-view fragments get their texture colour.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Route {
-    /// [`texel_texture::Sampler::sample_batch`], `f32`, then shaded and encoded.
-    Float,
-    /// The stored bytes of the texel each reads, written as they are ([`Route::of`]).
-    Stored,
-    /// [`texel_texture::Sampler::sample_batch_fixed8`] under [`Precision::Gpu`]: written as
-    /// they are (`copy`: unshaded, into a unorm8 target), else decoded (`b / 255`) and shaded.
-    Fixed8 { copy: bool },
+/// How a draw's colour-view fragments get their texture colour: its sampler bound to its
+/// texture for the frame, and whether the bytes a span gets are written as they are.
+struct Route<'a> {
+    bound: BoundSampler<'a>,
+    copy: bool,
 }
 
-impl Route {
+impl<'a> Route<'a> {
     /// Draw `dc`'s route in a frame of `settings` (lit or not) with colour target `target`.
     ///
     /// Its samples may be written as they are (`copy`) when nothing changes them — the colour
     /// view, no lights, no material, white vertex colours ([`DrawContext::unshaded`]) — and the
     /// target stores colour as the texture stores texels: the target's encoder then gives back
-    /// the texture's bytes for every code, so copying them leaves the image unchanged. A
-    /// sampler that reads one texel copies the texel's stored bytes
-    /// ([`texel_texture::Sampler::sample_batch_stored`]).
-    fn of(settings: &RenderSettings, lit: bool, target: ColorTarget, dc: &DrawContext) -> Route {
-        if settings.view != View::Color {
-            return Route::Float;
-        }
-        let copy = !lit && dc.unshaded() && target.stores_like(dc.texture.format());
-        if copy && dc.sampler.reads_one_texel() {
-            Route::Stored
-        } else if settings.precision == Precision::Gpu && dc.sampler.filters_fixed8(dc.texture) {
-            Route::Fixed8 { copy }
-        } else {
-            Route::Float
+    /// the texture's bytes for every code, so copying them leaves the image unchanged. The
+    /// sampler then hands over the stored bytes where it reads one texel, and under
+    /// [`Precision::Gpu`] its fixed-point codes where they apply ([`texel_texture::Sampler::bind`]).
+    fn of(settings: &RenderSettings, lit: bool, target: ColorTarget, dc: &DrawContext<'a>) -> Self {
+        let color = settings.view == View::Color;
+        let copy = color && !lit && dc.unshaded() && target.stores_like(dc.texture.format());
+        let wants = Wants {
+            stored_bytes: copy,
+            fixed8: color && settings.precision == Precision::Gpu,
+        };
+        Route {
+            bound: dc.sampler.bind(dc.texture, wants),
+            copy,
         }
     }
 }
@@ -983,24 +977,20 @@ fn flush_span(
         }
     }
     let fps = Span::footprints((n, span.deriv), &span.u, &span.v, &span.d);
-    let bytes = &mut span.bytes[..n];
-    match ctx.routes[t.draw as usize] {
-        Route::Stored if dc.sampler.sample_batch_stored(dc.texture, fps, bytes) => {
+    let route = &ctx.routes[t.draw as usize];
+    let (texs, bytes) = (&mut span.texs[..n], &mut span.bytes[..n]);
+    match route.bound.sample_span(span.lanes, fps, texs, bytes) {
+        SpanKind::Float => shade_span(ctx, tile, t, dc, span),
+        SpanKind::Fixed8 if !route.copy => {
+            for (t, b) in span.texs[..n].iter_mut().zip(&span.bytes[..n]) {
+                *t = decode_unorm8(*b);
+            }
+            shade_span(ctx, tile, t, dc, span);
+        }
+        SpanKind::Stored | SpanKind::Fixed8 => {
             let (color8, depth) = (&mut tile.color8, &mut tile.depth);
             write_rows(span, &span.bytes, color8, depth, Copied);
         }
-        Route::Fixed8 { copy } if dc.sampler.sample_batch_fixed8(dc.texture, fps, bytes) => {
-            if copy {
-                let (color8, depth) = (&mut tile.color8, &mut tile.depth);
-                write_rows(span, &span.bytes, color8, depth, Copied);
-            } else {
-                for (t, b) in span.texs[..n].iter_mut().zip(&span.bytes[..n]) {
-                    *t = decode_unorm8(*b);
-                }
-                shade_span(ctx, tile, t, dc, span, false);
-            }
-        }
-        _ => shade_span(ctx, tile, t, dc, span, true),
     }
     if ctx.capture {
         for k in 0..n {
@@ -1011,8 +1001,7 @@ fn flush_span(
     span.runs = 0;
 }
 
-/// Sample (when `sample`; else `span.texs` holds the samples), shade and write the span's
-/// fragments whose footprints are ready.
+/// Shade and write the span's fragments, whose samples `span.texs` holds.
 #[inline(always)]
 fn shade_span(
     ctx: &Context,
@@ -1020,14 +1009,8 @@ fn shade_span(
     t: &TriangleSetup,
     dc: &DrawContext,
     span: &mut Span,
-    sample: bool,
 ) {
     let n = span.n;
-    if sample {
-        let fps = Span::footprints((n, span.deriv), &span.u, &span.v, &span.d);
-        dc.sampler
-            .sample_batch_lanes(span.lanes, dc.texture, fps, &mut span.texs[..n]);
-    }
     let verts = dc.vertices(t);
     // An unshaded, unlit draw's colour is its sample (`shade` returns `tex` unchanged).
     let shader = Shader {
@@ -1232,8 +1215,11 @@ fn write_fragment(
     // Under `Precision::Gpu` the colour is the fixed-point sample (of the same texels, so the
     // counts are the exact sampler's).
     let mut code = [[0u8; 4]];
-    let fixed = matches!(ctx.routes[t.draw as usize], Route::Fixed8 { .. })
-        && dc.sampler.sample_batch_fixed8(dc.texture, &[fp], &mut code);
+    let bound = &ctx.routes[t.draw as usize].bound;
+    let fixed = bound.kind() == SpanKind::Fixed8;
+    if fixed {
+        bound.sample_span(Lanes::scalar(), &[fp], &mut [], &mut code);
+    }
     let (mut tex, count) = if ctx.counting {
         dc.sampler.sample_counted(dc.texture, &fp)
     } else if ctx.settings.view == View::Color && !fixed {

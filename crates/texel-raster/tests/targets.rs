@@ -143,7 +143,7 @@ fn drawing_on_top_of_an_eight_bit_frame_keeps_the_nearer_fragments() {
 }
 
 /// Nearest samplers write unshaded texels into an 8-bit target of the texture's own format as
-/// stored bytes (`Sampler::sample_batch_stored`): the frame must still be the float frame's
+/// stored bytes (`SpanKind::Stored`): the frame must still be the float frame's
 /// encoding, texel for texel and at the border, and the other pairings (the other format, vertex
 /// colours) must take the shading path to the same result.
 #[test]
@@ -205,7 +205,11 @@ fn copied_texels_are_the_encoded_float_frame() {
     for tex in &textures {
         let ground = Ground::with_texture(w, h, noise(tex.format()));
         for s in &samplers {
-            assert!(s.reads_one_texel());
+            let wants = texel_texture::Wants {
+                stored_bytes: true,
+                fixed8: false,
+            };
+            assert_eq!(s.bind(tex, wants).kind(), texel_texture::SpanKind::Stored);
             for target in [ColorTarget::Srgb8, ColorTarget::Unorm8] {
                 let draws = [
                     ("ground", ground.draw(s)),

@@ -12,8 +12,8 @@
 //! bilinear walk alone, with every coordinate computed beforehand (nothing a sampler could skip).
 //!
 //! The `fixed8/*` group compares, on a unorm copy of the texture, the exact `f32` path
-//! (`sample_batch`) with the GPU-style fixed-point one (`sample_batch_fixed8`, unorm8 codes out).
-//! The batched rows (`sample_batch`, `sample_batch_fixed8`) run the best instruction-set copy
+//! (`sample_batch`) with the GPU-style fixed-point one (a sampler bound for `SpanKind::Fixed8`, unorm8 codes out).
+//! The batched rows (`sample_batch`, the fixed-point span) run the best instruction-set copy
 //! the CPU has (`texel_texture::dispatch`, as in the rasterizer); the
 //! `bound/decode-and-blend-only/bilinear` loop is baseline code.
 
@@ -23,8 +23,8 @@ use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criteri
 use glam::Vec4;
 use texel_texture::base::color::{srgb_table, unorm8_table};
 use texel_texture::{
-    AddressMode, Cubic, FilterMode, Footprint, Format, Limits, MipmapFilterMode, Sampler,
-    SamplerDescriptor, Texture,
+    AddressMode, Cubic, FilterMode, Footprint, Format, Lanes, Limits, MipmapFilterMode, Sampler,
+    SamplerDescriptor, SpanKind, Texture, Wants,
 };
 
 /// The benchmark texture's texel `(i, j)` in linear RGBA.
@@ -213,9 +213,16 @@ fn fixed8(c: &mut Criterion) {
             })
         });
         let mut codes = vec![[0u8; 4]; fps.len()];
+        let wants = Wants {
+            stored_bytes: false,
+            fixed8: true,
+        };
+        let bound = s.bind(&unorm, wants);
+        assert_eq!(bound.kind(), SpanKind::Fixed8);
+        let lanes = Lanes::detect();
         group.bench_function(format!("{label}/{name}/gpu"), |b| {
             b.iter(|| {
-                assert!(s.sample_batch_fixed8(&unorm, black_box(&fps), &mut codes));
+                bound.sample_span(lanes, black_box(&fps), &mut [], &mut codes);
                 black_box(&codes);
             })
         });

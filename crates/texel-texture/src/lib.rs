@@ -45,6 +45,7 @@ pub use base::footprint::{Axes, Footprint};
 pub use base::footprint_batch::{FootprintBatch, FootprintLanes};
 pub use base::named::Filter;
 pub use engine::sampler::Sampler;
+pub use engine::span::{BoundSampler, SpanKind, Wants};
 pub use storage::lanes::Lanes;
 pub use storage::tables::{Ripmap, SummedAreaTable};
 pub use storage::texture::{

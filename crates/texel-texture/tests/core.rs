@@ -3,9 +3,42 @@
 
 use proptest::prelude::*;
 use texel_texture::{
-    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, FootprintLanes,
-    Format, Lanes, Limits, MipmapFilterMode, Sampler, SamplerDescriptor, Texture, TextureError,
+    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, FootprintBatch,
+    FootprintLanes, Format, Lanes, Limits, MipmapFilterMode, Sampler, SamplerDescriptor, SpanKind,
+    Texture, TextureError, Wants,
 };
+
+/// The bytes `s` bound to `tex` gives for `wants`, into `out`, when its spans are `kind`;
+/// `false`, writing nothing, when they are another kind.
+fn span_bytes(
+    s: &Sampler,
+    tex: &Texture,
+    wants: Wants,
+    kind: SpanKind,
+    fps: impl FootprintBatch,
+    out: &mut [[u8; 4]],
+) -> bool {
+    let bound = s.bind(tex, wants);
+    bound.kind() == kind && bound.sample_span(Lanes::scalar(), fps, &mut [], out) == kind
+}
+
+/// The texel's stored bytes (`SpanKind::Stored`), where the sampler reads one texel.
+fn stored_bytes(s: &Sampler, tex: &Texture, fps: impl FootprintBatch, out: &mut [[u8; 4]]) -> bool {
+    let wants = Wants {
+        stored_bytes: true,
+        fixed8: false,
+    };
+    span_bytes(s, tex, wants, SpanKind::Stored, fps, out)
+}
+
+/// The fixed-point codes (`SpanKind::Fixed8`), where they apply.
+fn fixed8_codes(s: &Sampler, tex: &Texture, fps: impl FootprintBatch, out: &mut [[u8; 4]]) -> bool {
+    let wants = Wants {
+        stored_bytes: false,
+        fixed8: true,
+    };
+    span_bytes(s, tex, wants, SpanKind::Fixed8, fps, out)
+}
 
 const ADDRESS_MODES: [AddressMode; 5] = [
     AddressMode::ClampToEdge,
@@ -1354,7 +1387,7 @@ fn jpeg_completeness_walks_the_segments() {
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(32))]
-    /// `sample_batch_stored` returns, for every single-texel sampler (nearest, with no or nearest
+    /// The stored-bytes span (`SpanKind::Stored`) is, for every single-texel sampler (nearest, with no or nearest
     /// mipmaps) under every address mode and border colour, the bytes the texture's own format
     /// encodes `sample` to, and for texels inside the texture a code whose decoding is `sample`
     /// bit for bit. Other samplers and float textures are refused with nothing written.
@@ -1382,9 +1415,8 @@ proptest! {
                     let one = d.min_filter == FilterMode::Nearest
                         && d.mag_filter == FilterMode::Nearest
                         && d.mipmap_filter != MipmapFilterMode::Linear;
-                    prop_assert_eq!(s.reads_one_texel(), one);
                     out.fill([7; 4]);
-                    let took = s.sample_batch_stored(&tex, &fps, &mut out);
+                    let took = stored_bytes(&s, &tex, &fps, &mut out);
                     prop_assert_eq!(took, one && format != Format::Rgba32Float);
                     if !took {
                         prop_assert!(out.iter().all(|&o| o == [7; 4]));
@@ -1417,7 +1449,7 @@ proptest! {
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(32))]
-    /// `sample_batch_fixed8` (GPU-style 8-bit weights, one rounding per blend) stays within a
+    /// The fixed-point span (`SpanKind::Fixed8`, GPU-style 8-bit weights, one rounding per blend) stays within a
     /// stated distance of the exact sample's unorm8 encoding: nearest without mip blending is
     /// exact, one bilinear level at most 2 codes (each weight's quantisation moves the value by
     /// at most half a code, the rounding by another half, the exact path's encoding by half),
@@ -1435,9 +1467,9 @@ proptest! {
                     let d = *s.descriptor();
                     let core = matches!(d.min_filter, FilterMode::Nearest | FilterMode::Linear);
                     let applies = core && format == Format::Rgba8Unorm;
-                    prop_assert_eq!(s.filters_fixed8(&tex), applies);
+                    prop_assert_eq!(s.bind(&tex, Wants { fixed8: true, ..Wants::default() }).kind() == SpanKind::Fixed8, applies);
                     out.fill([7; 4]);
-                    prop_assert_eq!(s.sample_batch_fixed8(&tex, &fps, &mut out), applies);
+                    prop_assert_eq!(fixed8_codes(&s, &tex, &fps, &mut out), applies);
                     if !applies {
                         prop_assert!(out.iter().all(|&o| o == [7; 4]));
                         continue;
@@ -1465,7 +1497,7 @@ proptest! {
 /// min_filter`) no sampling path reads a footprint's derivative fields, so a caller may leave any
 /// values there (or, as lanes, give none). Footprints whose
 /// derivatives are NaN, infinite, huge or tiny sample bit for bit as with zero derivatives, through
-/// `sample`, `sample_batch` (both quad kernels), `sample_batch_stored` and `sample_batch_fixed8`,
+/// `sample`, `sample_batch` (both quad kernels), the stored-bytes and fixed-point spans,
 /// for every such sampler (nearest, bilinear and the cubic filters, every address mode) on every
 /// texel format. Samplers that do use derivatives are checked to be told apart.
 #[test]
@@ -1519,12 +1551,12 @@ fn lod_free_samplers_never_read_derivatives() {
             }
             let mut a = vec![[0u8; 4]; zeroed.len()];
             let mut b = a.clone();
-            let took = s.sample_batch_stored(&tex, &zeroed, &mut a);
-            assert_eq!(took, s.sample_batch_stored(&tex, &junked, &mut b), "{case}");
-            assert_eq!(a, b, "sample_batch_stored {case}");
-            let took = s.sample_batch_fixed8(&tex, &zeroed, &mut a);
-            assert_eq!(took, s.sample_batch_fixed8(&tex, &junked, &mut b), "{case}");
-            assert_eq!(a, b, "sample_batch_fixed8 {case}");
+            let took = stored_bytes(&s, &tex, &zeroed, &mut a);
+            assert_eq!(took, stored_bytes(&s, &tex, &junked, &mut b), "{case}");
+            assert_eq!(a, b, "stored bytes {case}");
+            let took = fixed8_codes(&s, &tex, &zeroed, &mut a);
+            assert_eq!(took, fixed8_codes(&s, &tex, &junked, &mut b), "{case}");
+            assert_eq!(a, b, "fixed8 {case}");
         }
     }
     // Nearest, bilinear and three cubic filters under five address modes, three formats.
@@ -1532,8 +1564,8 @@ fn lod_free_samplers_never_read_derivatives() {
 }
 
 /// Footprints given as lanes ([`FootprintLanes`]) sample as the same footprints given as structs,
-/// through every batched entry (`sample_batch`, both quad kernels, `sample_batch_stored`,
-/// `sample_batch_fixed8`), for every sampler (the core filters under every address mode, and the
+/// through every batched entry (`sample_batch`, both quad kernels, the stored-bytes and
+/// fixed-point spans), for every sampler (the core filters under every address mode, and the
 /// anisotropic, EWA, ripmap and summed-area filters) on every texel format, over several chunks
 /// and a short tail (150 footprints); and lanes without derivatives
 /// ([`FootprintLanes::points`]) as structs with zero derivatives.
@@ -1583,23 +1615,15 @@ fn lanes_sample_as_structs() {
             for (structs, as_lanes) in [(&fps, lanes), (&points, point_lanes)] {
                 let mut a = vec![[0u8; 4]; n];
                 let mut b = vec![[1u8; 4]; n];
-                let took = s.sample_batch_stored(&tex, structs, &mut a);
-                assert_eq!(
-                    took,
-                    s.sample_batch_stored(&tex, as_lanes, &mut b),
-                    "{case}"
-                );
+                let took = stored_bytes(&s, &tex, structs, &mut a);
+                assert_eq!(took, stored_bytes(&s, &tex, as_lanes, &mut b), "{case}");
                 if took {
-                    assert_eq!(a, b, "sample_batch_stored {case}");
+                    assert_eq!(a, b, "stored bytes {case}");
                 }
-                let took = s.sample_batch_fixed8(&tex, structs, &mut a);
-                assert_eq!(
-                    took,
-                    s.sample_batch_fixed8(&tex, as_lanes, &mut b),
-                    "{case}"
-                );
+                let took = fixed8_codes(&s, &tex, structs, &mut a);
+                assert_eq!(took, fixed8_codes(&s, &tex, as_lanes, &mut b), "{case}");
                 if took {
-                    assert_eq!(a, b, "sample_batch_fixed8 {case}");
+                    assert_eq!(a, b, "fixed8 {case}");
                 }
             }
         }

@@ -163,7 +163,7 @@ impl Decode for Unorm8 {
 }
 
 /// 8-bit texels as their stored code values, `0.0..=255.0` per channel (exact in `f32`), with
-/// no transfer function: the stored-bytes path ([`crate::Sampler::sample_batch_stored`]) runs the
+/// no transfer function: the stored-bytes path ([`crate::SpanKind::Stored`]) runs the
 /// same single-texel kernels on these and converts the results back to bytes, bit for bit the
 /// texels the decoding views read.
 #[derive(Clone, Copy)]
