@@ -1615,13 +1615,13 @@ fn lanes_sample_as_structs() {
             for (structs, as_lanes) in [(&fps, lanes), (&points, point_lanes)] {
                 let mut a = vec![[0u8; 4]; n];
                 let mut b = vec![[1u8; 4]; n];
-                let took = stored_bytes(&s, &tex, structs, &mut a);
-                assert_eq!(took, stored_bytes(&s, &tex, as_lanes, &mut b), "{case}");
+                let took = stored_bytes(s, &tex, structs, &mut a);
+                assert_eq!(took, stored_bytes(s, &tex, as_lanes, &mut b), "{case}");
                 if took {
                     assert_eq!(a, b, "stored bytes {case}");
                 }
-                let took = fixed8_codes(&s, &tex, structs, &mut a);
-                assert_eq!(took, fixed8_codes(&s, &tex, as_lanes, &mut b), "{case}");
+                let took = fixed8_codes(s, &tex, structs, &mut a);
+                assert_eq!(took, fixed8_codes(s, &tex, as_lanes, &mut b), "{case}");
                 if took {
                     assert_eq!(a, b, "fixed8 {case}");
                 }
