@@ -1,13 +1,8 @@
-//! `texel bench`: median frame time per filter.
-//!
-//! What is timed: one call of `texel::raster::draw_into` — setting up, clipping, binning,
-//! rasterizing, sampling and shading every triangle into a frame cleared beforehand — with the
-//! textures, their pyramids and any ripmap or summed-area table built beforehand. The clear
-//! (`Frame::reset`, a fill of the reused buffers) is not timed, as `llvmpipe_bench.py` clears its
-//! framebuffer and calls `glFinish` before starting the clock; its cost is reported separately
-//! (`clear ms`). No file I/O, no PNG encoding. The median of `--frames` timed frames after
-//! `--warmup` untimed ones (lasting at least [`MIN_WARMUP`] unless `--warmup 0`), on a pool of
-//! `--threads` workers built once.
+//! `texel bench`: median frame time per filter, measured by [`texel::timing::time_filters`]
+//! (what is timed: [`texel::timing`]), with the clear's cost reported apart (`clear ms`), as
+//! `llvmpipe_bench.py` clears its framebuffer and calls `glFinish` before starting the clock.
+//! The median of `--frames` timed frames after `--warmup` untimed ones (lasting at least
+//! [`MIN_WARMUP`] unless `--warmup 0`), on a pool of `--threads` workers built once.
 //!
 //! The clear leaves the frame marked as holding it (`Frame::holds_clear`), as a GPU's fast
 //! clear does, so a frame larger than the last-level cache is drawn tile by tile in scratch and
@@ -18,30 +13,13 @@ use std::io::Write;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use texel::timing::{median, time_frames, warm_up, MIN_WARMUP};
+use texel::timing::{time_filters, warm_up, BenchPlan, FilterTiming, MIN_WARMUP};
 use texel::{Filter, MemoryBudget, PreparedScene};
 
 use crate::cli::{BenchArgs, TargetArg};
 use crate::filters::{parse_gpu_list, parse_list, GpuJob};
 use crate::input::{check_storage, load_scene, Input};
 use crate::threads::{thread_count, workers};
-
-/// One filter's timings in milliseconds.
-pub struct Timing {
-    /// Filter name.
-    pub filter: &'static str,
-    /// Median of the timed frames.
-    pub median_ms: f64,
-    /// Fastest timed frame.
-    pub min_ms: f64,
-    /// Slowest timed frame.
-    pub max_ms: f64,
-    /// Median of the untimed clears before the timed frames.
-    pub clear_ms: f64,
-    /// Whether the timed frames were drawn in scratch and streamed out
-    /// (`Frame::draw_streams`).
-    pub streamed: bool,
-}
 
 /// `--gpu`: per job, upload once, then time whole frames (render and read back) on the device,
 /// and where the adapter has timestamp queries the device time of as many render passes recorded
@@ -52,7 +30,7 @@ fn time_gpu(
     scene: &PreparedScene,
     jobs: &[GpuJob],
     budget: &mut MemoryBudget,
-) -> Result<Vec<Timing>> {
+) -> Result<Vec<FilterTiming>> {
     let mut out = Vec::new();
     for &(label, filter, gpu_filter) in jobs {
         let plan = scene.plan(Some(filter), budget)?;
@@ -90,26 +68,12 @@ fn time_gpu(
                 prepared.pass_times(&settings, batch).map(drop)
             })?;
         }
-        let mut device = prepared
+        let device = prepared
             .pass_times(&settings, args.frames)?
             .unwrap_or_default();
-        let (min_ms, max_ms) = times
-            .iter()
-            .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
-        out.push(Timing {
-            filter: label,
-            median_ms: median(&mut times),
-            min_ms,
-            max_ms,
-            // For the GPU the second column is the render pass's device time (0 without
-            // timestamp queries).
-            clear_ms: if device.is_empty() {
-                0.0
-            } else {
-                median(&mut device)
-            },
-            streamed: false,
-        });
+        // For the GPU the second column is the render pass's device time (0 without timestamp
+        // queries).
+        out.push(FilterTiming::of(label, times, device, false));
         drop(prepared);
         budget.release(held);
     }
@@ -161,37 +125,19 @@ fn time_cpu(
     scene: &PreparedScene,
     filters: &[Filter],
     budget: &mut MemoryBudget,
-) -> Result<Vec<Timing>> {
-    texel::raster::on_threads(workers(args.threads), || -> Result<Vec<Timing>> {
-        let mut out = Vec::new();
-        for filter in filters {
-            let plan = scene.plan(Some(*filter), budget)?;
-            let draws = plan.draws();
-            let mut settings = plan.settings();
-            if args.target == TargetArg::Float {
-                settings.target = texel::ColorTarget::Float;
-            }
-            let mut times = time_frames(&settings, &draws, args.warmup, MIN_WARMUP, args.frames)?;
-            let (min_ms, max_ms) = times
-                .draw_ms
-                .iter()
-                .fold((f64::MAX, 0f64), |(a, b), &t| (a.min(t), b.max(t)));
-            out.push(Timing {
-                filter: filter.name(),
-                median_ms: median(&mut times.draw_ms),
-                min_ms,
-                max_ms,
-                clear_ms: median(&mut times.clear_ms),
-                streamed: times.streamed,
-            });
-        }
-        Ok(out)
-    })?
+) -> Result<Vec<FilterTiming>> {
+    let plan = BenchPlan {
+        warmup: args.warmup,
+        frames: args.frames,
+        float_target: args.target == TargetArg::Float,
+        threads: workers(args.threads),
+    };
+    Ok(time_filters(scene, filters, &plan, budget)?)
 }
 
 /// Whether the frames streamed (every filter's frames have the same size and target, so all
 /// stream or none does).
-fn streamed(timings: &[Timing]) -> bool {
+fn streamed(timings: &[FilterTiming]) -> bool {
     timings.iter().any(|t| t.streamed)
 }
 
@@ -200,7 +146,7 @@ struct Measured<'a> {
     args: &'a BenchArgs,
     scene: &'a PreparedScene,
     gpu: Option<&'a texel_gpu::Gpu>,
-    timings: &'a [Timing],
+    timings: &'a [FilterTiming],
     threads: usize,
     streamed: bool,
 }
@@ -220,7 +166,7 @@ impl Measured<'_> {
                 serde_json::Value::from(g.info().to_string())
             )
         });
-        let entries = |value: fn(&Timing) -> f64| {
+        let entries = |value: fn(&FilterTiming) -> f64| {
             timings
                 .iter()
                 .map(|t| format!("  \"{}\": {:.3}", t.filter, value(t)))
@@ -233,15 +179,15 @@ impl Measured<'_> {
         serde_json::Value::from(cpu_model()),
         simd_level(),
         target_name(args.target),
-        precision_name(args.scene.precision),
-        storage_name(scene),
+        args.scene.precision.name(),
+        scene.storage_name(),
         args.streaming.name(),
         streamed,
         scene.width,
         scene.height,
         args.frames,
         entries(|t| t.median_ms),
-        entries(|t| t.clear_ms)
+        entries(|t| t.second_ms)
     )
     .context("cannot write to stdout")?;
         Ok(())
@@ -266,8 +212,8 @@ impl Measured<'_> {
             "cpu: {}; simd: {}; precision: {}; textures: {}; streaming: {} ({})",
             cpu_model(),
             simd_level(),
-            precision_name(args.scene.precision),
-            storage_name(scene),
+            args.scene.precision.name(),
+            scene.storage_name(),
             args.streaming.name(),
             if streamed { "streamed" } else { "in place" }
         )?;
@@ -287,7 +233,7 @@ impl Measured<'_> {
             writeln!(
                 stdout,
                 "{:<12} {:>10.3} {:>10.3} {:>10.3} {:>10.3}",
-                t.filter, t.median_ms, t.min_ms, t.max_ms, t.clear_ms
+                t.filter, t.median_ms, t.min_ms, t.max_ms, t.second_ms
             )?;
         }
         Ok(())
@@ -320,26 +266,4 @@ fn cpu_model() -> String {
 /// `texel::raster::simd_level`).
 fn simd_level() -> String {
     format!("{}, run-time dispatch", texel::raster::simd_level().name())
-}
-
-/// How the scene's textures are kept, as the bench prints it: `stored`, `float` (8-bit textures
-/// decoded to float), or `float, N stored` when N of them did not fit the budget as float.
-fn storage_name(scene: &texel::PreparedScene) -> String {
-    let decoded = scene
-        .textures
-        .values()
-        .any(|t| t.format() != t.source_format());
-    match (decoded, scene.kept_stored.len()) {
-        (false, 0) => "stored".into(),
-        (true, 0) => "float".into(),
-        (_, n) => format!("float, {n} stored"),
-    }
-}
-
-/// `--precision`'s value as the bench prints it.
-fn precision_name(p: texel::raster::Precision) -> &'static str {
-    match p {
-        texel::raster::Precision::Exact => "exact",
-        texel::raster::Precision::Gpu => "gpu",
-    }
 }

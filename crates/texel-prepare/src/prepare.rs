@@ -311,6 +311,20 @@ fn environment_maps(
 }
 
 impl PreparedScene {
+    /// How the scene's textures are kept, as reports write it: `stored`, `float` (8-bit textures
+    /// decoded to float), or `float, N stored` when `N` of them did not fit the budget as float.
+    pub fn storage_name(&self) -> String {
+        let decoded = self
+            .textures
+            .values()
+            .any(|t| t.format() != t.source_format());
+        match (decoded, self.kept_stored.len()) {
+            (false, 0) => "stored".into(),
+            (true, 0) => "float".into(),
+            (_, n) => format!("float, {n} stored"),
+        }
+    }
+
     /// Prepare `scene` (already validated, as [`Scene::load`] returns it): charge `budget` for
     /// the meshes and one frame of the output size, then load every texture the meshes use
     /// within what is left, charging each one's pyramid.

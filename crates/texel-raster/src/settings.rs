@@ -109,6 +109,16 @@ pub enum Precision {
     Gpu,
 }
 
+impl Precision {
+    /// The name the command line and reports use: `exact` or `gpu`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::Exact => "exact",
+            Precision::Gpu => "gpu",
+        }
+    }
+}
+
 /// The colour render target's format: what [`crate::Frame`] stores per pixel, as a GPU's colour
 /// attachment format. Fragments are encoded as they are written, so an 8-bit target's bytes are
 /// exactly what [`crate::Frame::to_srgb8`] or [`crate::Frame::to_raw8`] make of a
