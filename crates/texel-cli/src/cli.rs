@@ -721,3 +721,25 @@ pub fn parse_modes(s: &str) -> Result<ModeList, String> {
     }
     Ok(ModeList(out))
 }
+
+/// A reference plan from the command line's numbers ([`texel::raster::ReferencePlan::new`]), its errors worded
+/// with the flags' names.
+///
+/// # Errors
+/// A maximum below the minimum, and the plan's other checks.
+pub fn reference_plan(
+    min_spp: u32,
+    max_spp: u32,
+    tolerance_steps: f64,
+    srgb: bool,
+    seed: u64,
+) -> anyhow::Result<texel::raster::ReferencePlan> {
+    texel::raster::ReferencePlan::new(min_spp, max_spp, tolerance_steps, srgb, seed).map_err(|e| {
+        match e {
+            texel::raster::RasterError::MaxSppBelowMin { min_spp, max_spp } => anyhow::anyhow!(
+            "--max-spp {max_spp} is below --spp {min_spp}: the maximum must be at least the minimum"
+        ),
+            e => e.into(),
+        }
+    })
+}

@@ -6,8 +6,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use texel::ao::{bake_ao, protected_levels, AoMap, AoMesh, AoSettings};
-use texel::quality::{Encoding, Image8};
+use texel::ao::{bake_ao, protected_levels, AoMesh, AoSettings};
 use texel::scene::{load_gltf_with, load_obj_with, Mesh, Scene};
 
 use crate::cli::BakeAoArgs;
@@ -54,7 +53,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
             texel::ColorHandling::Raw,
         )?;
     } else {
-        write_image(&args.output, &map_image(&map)?)?;
+        write_image(&args.output, &map.image()?)?;
     }
     let texels = u64::from(map.size) * u64::from(map.size);
     let margin = match args.margin {
@@ -84,17 +83,6 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
     Ok(())
 }
 
-/// A baked map as the image `bake-ao` writes: grey, linear (`round(255 a)`), opaque.
-fn map_image(map: &AoMap) -> Result<Image8> {
-    let pixels: Vec<[f32; 4]> = map.values.iter().map(|&v| [v, v, v, 1.0]).collect();
-    Ok(Image8::from_linear(
-        map.size,
-        map.size,
-        &pixels,
-        Encoding::Linear,
-    )?)
-}
-
 /// The meshes of `arg`: an OBJ or glTF file by its extension, else a scene (a TOML file or
 /// `builtin:NAME`).
 fn load_meshes(arg: &str, input: &Input) -> Result<Vec<Mesh>> {
@@ -110,73 +98,4 @@ fn load_meshes(arg: &str, input: &Input) -> Result<Vec<Mesh>> {
         _ => Scene::load_with(arg, &limits).map(|s| s.meshes),
     };
     meshes.with_context(|| format!("cannot load the mesh {arg}"))
-}
-
-/// Side of the demo's map; its rays per texel.
-const DEMO_MAP: u32 = 512;
-const DEMO_RAYS: u32 = 128;
-
-/// What the demo's ambient occlusion page shows: the lecture's three pictures.
-pub struct DemoAo {
-    /// The knot without its occlusion map, with it, and the map (file names in the page's directory).
-    pub images: [&'static str; 3],
-    /// One line on the bake.
-    pub summary: String,
-}
-
-/// The demo's ambient occlusion page in `dir`: `builtin:knot` baked (a `DEMO_MAP` map, or the
-/// frame's width rounded up to a power of two when `size` is smaller, `DEMO_RAYS` rays), then
-/// rendered (trilinear) without and with the map as its material's `occlusion`, and the map.
-pub fn demo_page(dir: &Path, size: (u32, u32), input: &mut Input) -> Result<DemoAo> {
-    use texel::scene::{EncodedImage, TextureSource, TextureSpec};
-
-    let mut scene = Scene::load("builtin:knot")?;
-    let side = DEMO_MAP.min(size.0.next_power_of_two().max(32));
-    let settings = AoSettings {
-        size: side,
-        rays: DEMO_RAYS,
-        ..AoSettings::default()
-    };
-    let started = Instant::now();
-    let map = bake_ao(
-        &AoMesh::from_meshes(&scene.meshes),
-        &settings,
-        &mut input.budget,
-        &|_| {},
-        &AtomicBool::new(false),
-    )?;
-    let seconds = started.elapsed().as_secs_f64();
-    let ao = map_image(&map)?;
-    ao.write_png(dir.join("ao-map.png"))?;
-    let options = texel::RenderOptions {
-        filter: Some(texel::Filter::Trilinear),
-        size: Some(size),
-        max_memory: Some(input.budget.remaining()),
-        ..Default::default()
-    };
-    let plain = texel::render_scene(&scene, &options)?;
-    texel::frame_image(&plain, Encoding::Srgb)?.write_png(dir.join("plain.png"))?;
-    scene.textures.insert(
-        "ao".into(),
-        TextureSpec::new(
-            TextureSource::Encoded(EncodedImage {
-                bytes: ao.to_png()?.into(),
-                origin: "the baked ambient occlusion".into(),
-            }),
-            texel::texture::ColorSpace::Linear,
-        ),
-    );
-    for m in scene.materials.values_mut() {
-        m.occlusion = Some("ao".into());
-    }
-    let lit = texel::render_scene(&scene, &options)?;
-    texel::frame_image(&lit, Encoding::Srgb)?.write_png(dir.join("with-ao.png"))?;
-    Ok(DemoAo {
-        images: ["plain.png", "with-ao.png", "ao-map.png"],
-        summary: format!(
-            "builtin:knot, {} triangles, baked at {side}x{side} with {DEMO_RAYS} rays per texel ({:.1} M rays) in {seconds:.1} s",
-            scene.meshes.iter().map(|m| m.triangles.len()).sum::<usize>(),
-            map.rays as f64 / 1e6
-        ),
-    })
 }

@@ -4,16 +4,15 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use texel::compare::{slug, CompareJob, Extra, OrbitSpec, Stage, TIMED_FRAMES};
+use texel::compare::{slug, CompareJob, Extra, OrbitSpec, TIMED_FRAMES};
 use texel::io::publish_dir;
 use texel::quality::Image8;
-use texel::raster::{Frame, ReferenceStatus, RenderSettings};
+use texel::raster::{Frame, RenderSettings};
 use texel::timing::median;
 use texel::{MemoryBudget, PreparedScene};
 use texel_gpu::GpuFilter;
 
 use crate::cli::CompareArgs;
-use crate::cmd_reference as reference;
 use crate::filters::{parse_list, Filter};
 use crate::input::{check_storage, load_scene, Input};
 use crate::progress;
@@ -64,95 +63,6 @@ pub fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<
         }
     }
     Ok(())
-}
-
-/// Progress bars for a comparison: its own (a bar for each reference's rounds, then one over the
-/// filters) or, where a caller shows one bar over several comparisons (`texel demo`), that bar,
-/// counting the reference and each filter.
-pub struct Bars {
-    shared: Option<(indicatif::ProgressBar, String)>,
-    filters: usize,
-    /// The bar drawn now, of the comparison's own.
-    own: std::sync::Mutex<Option<indicatif::ProgressBar>>,
-}
-
-impl Bars {
-    /// The comparison's own bars, over `filters` filters.
-    pub fn own(filters: usize) -> Self {
-        Bars {
-            shared: None,
-            filters,
-            own: std::sync::Mutex::new(None),
-        }
-    }
-
-    /// `shared`, its messages prefixed by the scene's `label`.
-    pub fn shared(shared: indicatif::ProgressBar, label: &str) -> Self {
-        Bars {
-            shared: Some((shared, label.to_string())),
-            filters: 0,
-            own: std::sync::Mutex::new(None),
-        }
-    }
-
-    /// Clear the bar the comparison drew last.
-    pub fn finish(&self) {
-        if let Some(pb) = self.bar().take() {
-            pb.finish_and_clear();
-        }
-    }
-
-    fn bar(&self) -> std::sync::MutexGuard<'_, Option<indicatif::ProgressBar>> {
-        self.own.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    /// The own bar, made as `make` says unless one is drawn.
-    fn own_bar(&self, make: impl FnOnce() -> indicatif::ProgressBar) -> indicatif::ProgressBar {
-        self.bar().get_or_insert_with(make).clone()
-    }
-}
-
-impl texel::compare::Progress for Bars {
-    fn stage(&self, stage: Stage<'_>) {
-        match (stage, &self.shared) {
-            (Stage::Reference { n, of }, None) => {
-                if n > 0 {
-                    texel::io::stderr_line(format_args!("orbit frame {n} of {}", of - 1));
-                }
-                self.finish();
-                *self.bar() = Some(progress::bar(1, "reference"));
-            }
-            (Stage::Reference { .. }, Some((pb, label))) => {
-                pb.set_message(format!("{label}: reference"));
-            }
-            (Stage::Filter(name), None) => self
-                .own_bar(|| progress::bar(self.filters as u64, "filters"))
-                .set_message(name.to_string()),
-            (Stage::Filter(name), Some((pb, label))) => pb.set_message(format!("{label}: {name}")),
-        }
-    }
-
-    fn reference(&self, s: &ReferenceStatus) {
-        if self.shared.is_none() {
-            if let Some(pb) = self.bar().as_ref() {
-                reference::show_status(pb, s);
-            }
-        }
-    }
-
-    fn done(&self, stage: Stage<'_>) {
-        match (stage, &self.shared) {
-            (Stage::Reference { n: 0, .. }, Some((pb, _))) => pb.inc(1),
-            (Stage::Reference { .. }, None) => self.finish(),
-            (Stage::Reference { .. }, Some(_)) => {}
-            (Stage::Filter(_), Some((pb, _))) => pb.inc(1),
-            (Stage::Filter(_), None) => {
-                if let Some(pb) = self.bar().as_ref() {
-                    pb.inc(1);
-                }
-            }
-        }
-    }
 }
 
 /// Render `filters` (those the GPU path has) with texel's shaders and the device's own sampler:
@@ -241,7 +151,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         .map(|e| parse_extra(e))
         .collect::<Result<Vec<_>>>()?;
     check_extras(&files, &filters)?;
-    let plan = reference::plan(
+    let plan = crate::cli::reference_plan(
         args.spp,
         args.max_spp.unwrap_or(args.spp),
         args.tolerance,
@@ -263,7 +173,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     }));
     // The scene's name as the report shows it: control and bidirectional characters escaped.
     let label = texel::io::escape(&args.scene.scene);
-    let bars = Bars::own(filters.len());
+    let bars = progress::Bars::own(filters.len());
     let job = CompareJob {
         orbit: args.orbit.map(|frames| OrbitSpec {
             frames,

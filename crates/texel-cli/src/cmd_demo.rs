@@ -6,6 +6,9 @@
 //! them.
 
 use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
 
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
@@ -15,12 +18,9 @@ use texel::quality::Report;
 
 use crate::cli::DemoArgs;
 use crate::cli::DEFAULT_TOLERANCE_STEPS;
-use crate::cmd_bake_ao::{demo_page, DemoAo};
-use crate::cmd_compare::Bars;
-use crate::cmd_reference::plan;
 use crate::filters::Filter;
 use crate::input::{load_scene_with, Input};
-use crate::progress;
+use crate::progress::{self, Bars};
 use texel::compare::CompareJob;
 use texel::quality::Encoding;
 use texel::raster::{render, ColorTarget, UvEvaluation, View};
@@ -131,7 +131,7 @@ fn report_in(
     pb: &ProgressBar,
     input: &mut Input,
 ) -> Result<Report> {
-    let plan = plan(
+    let plan = crate::cli::reference_plan(
         spp,
         spp,
         DEFAULT_TOLERANCE_STEPS,
@@ -385,4 +385,74 @@ fn index_html(
         escape(&ao.summary)
     );
     s
+}
+
+/// Side of the demo's map; its rays per texel.
+const DEMO_MAP: u32 = 512;
+const DEMO_RAYS: u32 = 128;
+
+/// What the demo's ambient occlusion page shows: the lecture's three pictures.
+struct DemoAo {
+    /// The knot without its occlusion map, with it, and the map (file names in the page's directory).
+    pub images: [&'static str; 3],
+    /// One line on the bake.
+    pub summary: String,
+}
+
+/// The demo's ambient occlusion page in `dir`: `builtin:knot` baked (a `DEMO_MAP` map, or the
+/// frame's width rounded up to a power of two when `size` is smaller, `DEMO_RAYS` rays), then
+/// rendered (trilinear) without and with the map as its material's `occlusion`, and the map.
+fn demo_page(dir: &Path, size: (u32, u32), input: &mut Input) -> Result<DemoAo> {
+    use texel::ao::{bake_ao, AoMesh, AoSettings};
+    use texel::scene::{EncodedImage, Scene, TextureSource, TextureSpec};
+
+    let mut scene = Scene::load("builtin:knot")?;
+    let side = DEMO_MAP.min(size.0.next_power_of_two().max(32));
+    let settings = AoSettings {
+        size: side,
+        rays: DEMO_RAYS,
+        ..AoSettings::default()
+    };
+    let started = Instant::now();
+    let map = bake_ao(
+        &AoMesh::from_meshes(&scene.meshes),
+        &settings,
+        &mut input.budget,
+        &|_| {},
+        &AtomicBool::new(false),
+    )?;
+    let seconds = started.elapsed().as_secs_f64();
+    let ao = map.image()?;
+    ao.write_png(dir.join("ao-map.png"))?;
+    let options = texel::RenderOptions {
+        filter: Some(texel::Filter::Trilinear),
+        size: Some(size),
+        max_memory: Some(input.budget.remaining()),
+        ..Default::default()
+    };
+    let plain = texel::render_scene(&scene, &options)?;
+    texel::frame_image(&plain, Encoding::Srgb)?.write_png(dir.join("plain.png"))?;
+    scene.textures.insert(
+        "ao".into(),
+        TextureSpec::new(
+            TextureSource::Encoded(EncodedImage {
+                bytes: ao.to_png()?.into(),
+                origin: "the baked ambient occlusion".into(),
+            }),
+            texel::texture::ColorSpace::Linear,
+        ),
+    );
+    for m in scene.materials.values_mut() {
+        m.occlusion = Some("ao".into());
+    }
+    let lit = texel::render_scene(&scene, &options)?;
+    texel::frame_image(&lit, Encoding::Srgb)?.write_png(dir.join("with-ao.png"))?;
+    Ok(DemoAo {
+        images: ["plain.png", "with-ao.png", "ao-map.png"],
+        summary: format!(
+            "builtin:knot, {} triangles, baked at {side}x{side} with {DEMO_RAYS} rays per texel ({:.1} M rays) in {seconds:.1} s",
+            scene.meshes.iter().map(|m| m.triangles.len()).sum::<usize>(),
+            map.rays as f64 / 1e6
+        ),
+    })
 }

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use texel::quality::{viridis, Image8};
-use texel::raster::{ReferenceEstimate, ReferencePlan, ReferenceStatus};
+use texel::raster::{ReferenceEstimate, ReferenceStatus};
 
 use crate::cli::ReferenceArgs;
 use crate::input::{load_scene, Input};
@@ -14,44 +14,11 @@ use crate::output::{check_outputs, encoding, write_frame, write_image};
 use crate::progress;
 use crate::threads::workers;
 
-/// A reference plan from the command line's numbers ([`ReferencePlan::new`]), its errors worded
-/// with the flags' names.
-///
-/// # Errors
-/// A maximum below the minimum, and the plan's other checks.
-pub fn plan(
-    min_spp: u32,
-    max_spp: u32,
-    tolerance_steps: f64,
-    srgb: bool,
-    seed: u64,
-) -> Result<ReferencePlan> {
-    ReferencePlan::new(min_spp, max_spp, tolerance_steps, srgb, seed).map_err(|e| match e {
-        texel::raster::RasterError::MaxSppBelowMin { min_spp, max_spp } => anyhow::anyhow!(
-            "--max-spp {max_spp} is below --spp {min_spp}: the maximum must be at least the minimum"
-        ),
-        e => e.into(),
-    })
-}
-
-/// Show a reference's round on `pb`.
-pub fn show_status(pb: &indicatif::ProgressBar, s: &ReferenceStatus) {
-    pb.set_length(s.total.max(1));
-    pb.set_position(s.done);
-    pb.set_message(format!(
-        "round {} ({} pixels to {} spp, {:.1} % converged)",
-        s.round,
-        s.active,
-        s.spp,
-        100.0 * s.converged
-    ));
-}
-
 /// Run `texel reference`: the converging reference (`texel::raster::adaptive`), its summary on
 /// stderr, the image and, with `--error-map`, each pixel's error. Ctrl-C during the passes writes
 /// what is done so far, says so, and exits with status 130.
 pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
-    let plan = plan(
+    let plan = crate::cli::reference_plan(
         args.spp,
         args.max_spp,
         args.tolerance,
@@ -66,7 +33,7 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     let started = Instant::now();
     let pb = progress::bar(1, "reference");
     let graceful = interrupt::Graceful::begin();
-    let status = |s: &ReferenceStatus| show_status(&pb, s);
+    let status = |s: &ReferenceStatus| crate::progress::show_status(&pb, s);
     let run = texel::ReferenceRun {
         plan,
         threads: workers(args.threads),

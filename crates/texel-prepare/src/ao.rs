@@ -172,6 +172,22 @@ pub struct AoMap {
     pub skipped_triangles: usize,
 }
 
+impl AoMap {
+    /// The map as the 8-bit linear grey image `texel bake-ao` writes (alpha opaque).
+    ///
+    /// # Errors
+    /// [`Error::Quality`] for a map whose side the image type refuses.
+    pub fn image(&self) -> Result<texel_quality::Image8, Error> {
+        let pixels: Vec<[f32; 4]> = self.values.iter().map(|&v| [v, v, v, 1.0]).collect();
+        Ok(texel_quality::Image8::from_linear(
+            self.size,
+            self.size,
+            &pixels,
+            texel_quality::Encoding::Linear,
+        )?)
+    }
+}
+
 /// A texel's surface point: triangle `tri` at barycentrics `(1 - b1 - b2, b1, b2)`, `d2` the
 /// squared distance (texels) from the texel's centre.
 #[derive(Clone, Copy, Debug)]
