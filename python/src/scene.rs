@@ -9,7 +9,6 @@
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use clap::ValueEnum;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -221,25 +220,12 @@ fn color_named(name: &str) -> PyResult<ColorHandling> {
 
 /// A debug view by its command-line name.
 fn view_named(name: &str) -> PyResult<View> {
-    View::from_str(name, false).map_err(|_| {
-        let names: Vec<String> = View::value_variants()
-            .iter()
-            .filter_map(|v| v.to_possible_value().map(|p| p.get_name().to_string()))
-            .collect();
-        PyValueError::new_err(format!(
-            "unknown view {name:?}: valid views are {}",
-            names.join(", ")
-        ))
-    })
+    name.parse().map_err(PyValueError::new_err)
 }
 
 /// How 8-bit textures are kept, by its command-line name (`--texture-storage`).
 fn storage_named(name: &str) -> PyResult<TextureStorage> {
-    TextureStorage::from_str(name, false).map_err(|_| {
-        PyValueError::new_err(format!(
-            "unknown texture_storage {name:?}: valid values are stored, float"
-        ))
-    })
+    name.parse().map_err(PyValueError::new_err)
 }
 
 /// Output size from Python, checked for zero sides.

@@ -743,3 +743,40 @@ pub fn reference_plan(
         }
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use clap::ValueEnum;
+
+    /// The names clap offers for an option enum (its `ValueEnum`).
+    fn clap_names<T: ValueEnum>() -> Vec<String> {
+        T::value_variants()
+            .iter()
+            .map(|v| v.to_possible_value().unwrap().get_name().to_string())
+            .collect()
+    }
+
+    /// The command line offers exactly the names the libraries parse and print (which Python and
+    /// the reports use), in the same order, and each parses back to its value.
+    #[test]
+    fn the_command_line_and_the_libraries_name_options_alike() {
+        use texel::raster::{Precision, View};
+        use texel::{ColorHandling, TextureStorage};
+        let views: Vec<String> = View::ALL.iter().map(|v| v.to_string()).collect();
+        assert_eq!(clap_names::<View>(), views);
+        for v in View::ALL {
+            assert_eq!(v.name().parse::<View>(), Ok(v));
+        }
+        let storage: Vec<String> = TextureStorage::ALL.iter().map(|t| t.to_string()).collect();
+        assert_eq!(clap_names::<TextureStorage>(), storage);
+        for t in TextureStorage::ALL {
+            assert_eq!(t.name().to_uppercase().parse::<TextureStorage>(), Ok(t));
+        }
+        let colors: Vec<String> = ColorHandling::ALL.iter().map(|c| c.to_string()).collect();
+        assert_eq!(clap_names::<ColorHandling>(), colors);
+        let precisions = [Precision::Exact, Precision::Gpu].map(|p| p.name().to_string());
+        assert_eq!(clap_names::<Precision>(), precisions);
+        let err = "sideways".parse::<View>().unwrap_err();
+        assert!(err.contains("valid views are color, uv, mip"), "{err}");
+    }
+}

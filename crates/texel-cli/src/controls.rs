@@ -183,28 +183,7 @@ pub struct ViewState {
 pub const MAX_BIAS: f32 = 8.0;
 
 /// The views V cycles through, in order.
-pub const VIEWS: [View; 7] = [
-    View::Color,
-    View::Uv,
-    View::Mip,
-    View::Lod,
-    View::Aniso,
-    View::Fetches,
-    View::Barycentric,
-];
-
-/// A view's short name.
-pub fn view_name(v: View) -> &'static str {
-    match v {
-        View::Color => "color",
-        View::Uv => "uv",
-        View::Mip => "mip",
-        View::Lod => "lod",
-        View::Aniso => "aniso",
-        View::Fetches => "fetches",
-        View::Barycentric => "barycentric",
-    }
-}
+pub const VIEWS: [View; 7] = View::ALL;
 
 /// What a key press asks of the viewer besides a new state.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -315,7 +294,7 @@ impl ViewState {
             s.push_str(&format!("-vs-{}", self.right.name()));
         }
         s.push('-');
-        s.push_str(view_name(self.view));
+        s.push_str(self.view.name());
         if self.perspective == Perspective::Affine {
             s.push_str("-affine");
         }

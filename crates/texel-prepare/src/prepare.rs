@@ -111,6 +111,37 @@ pub enum TextureStorage {
     Float,
 }
 
+impl TextureStorage {
+    /// Every way, in the order help lists them.
+    pub const ALL: [TextureStorage; 2] = [TextureStorage::Stored, TextureStorage::Float];
+
+    /// The name the command line, Python and reports use: `stored` or `float`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TextureStorage::Stored => "stored",
+            TextureStorage::Float => "float",
+        }
+    }
+}
+
+impl std::fmt::Display for TextureStorage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for TextureStorage {
+    type Err = String;
+
+    /// `stored` or `float`, case ignored.
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|t| t.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| format!("unknown texture storage {s:?}: valid are stored, float"))
+    }
+}
+
 /// How a scene is prepared.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SceneOptions {

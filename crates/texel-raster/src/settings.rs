@@ -90,6 +90,53 @@ pub enum View {
     Barycentric,
 }
 
+impl View {
+    /// Every view, in the order help lists them.
+    pub const ALL: [View; 7] = [
+        View::Color,
+        View::Uv,
+        View::Mip,
+        View::Lod,
+        View::Aniso,
+        View::Fetches,
+        View::Barycentric,
+    ];
+
+    /// The name the command line (`--view`), the viewer and Python use.
+    pub fn name(self) -> &'static str {
+        match self {
+            View::Color => "color",
+            View::Uv => "uv",
+            View::Mip => "mip",
+            View::Lod => "lod",
+            View::Aniso => "aniso",
+            View::Fetches => "fetches",
+            View::Barycentric => "barycentric",
+        }
+    }
+}
+
+impl std::fmt::Display for View {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for View {
+    type Err = String;
+
+    /// A view's name, case ignored.
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|v| v.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|v| v.name()).collect();
+                format!("unknown view {s:?}: valid views are {}", names.join(", "))
+            })
+    }
+}
+
 /// How the colour view filters textures stored as 8-bit unorm (`Rgba8Unorm`) with the core
 /// filters (nearest or bilinear within a level, any mipmap filter).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

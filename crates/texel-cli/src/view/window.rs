@@ -20,7 +20,7 @@ use winit::window::{Window, WindowId};
 use super::fly::{Fly, Motion};
 use super::hud::{scale_for, Canvas};
 use super::worker::{part_rects, Rendered, Request, Shared, MAX_REFERENCE_SAMPLES};
-use crate::controls::{key_table, view_name, Effect, Key, Mode, Press, ViewState};
+use crate::controls::{key_table, Effect, Key, Mode, Press, ViewState};
 
 /// How long after the last movement the camera counts as still (then frames refine).
 const SETTLE: Duration = Duration::from_millis(200);
@@ -354,7 +354,7 @@ impl App {
         lines.push(timing);
         lines.push(format!(
             "view {}  {}  {} derivatives  lod bias {:+.1}  {}  fov {:.0}",
-            view_name(self.state.view),
+            self.state.view.name(),
             match self.state.perspective {
                 texel::raster::Perspective::Correct => "perspective-correct",
                 texel::raster::Perspective::Affine => "affine",
