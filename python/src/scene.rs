@@ -220,12 +220,14 @@ fn color_named(name: &str) -> PyResult<ColorHandling> {
 
 /// A debug view by its command-line name.
 fn view_named(name: &str) -> PyResult<View> {
-    name.parse().map_err(PyValueError::new_err)
+    name.parse()
+        .map_err(|e| PyValueError::new_err(format!("view: {e}")))
 }
 
 /// How 8-bit textures are kept, by its command-line name (`--texture-storage`).
 fn storage_named(name: &str) -> PyResult<TextureStorage> {
-    name.parse().map_err(PyValueError::new_err)
+    name.parse()
+        .map_err(|e| PyValueError::new_err(format!("texture_storage: {e}")))
 }
 
 /// Output size from Python, checked for zero sides.
