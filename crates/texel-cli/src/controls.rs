@@ -182,9 +182,6 @@ pub struct ViewState {
 /// The largest lod bias `[` and `]` reach, in levels.
 pub const MAX_BIAS: f32 = 8.0;
 
-/// The views V cycles through, in order.
-pub const VIEWS: [View; 7] = View::ALL;
-
 /// What a key press asks of the viewer besides a new state.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Effect {
@@ -242,9 +239,9 @@ impl ViewState {
         match press.key {
             Key::Tab => self.split = !self.split,
             Key::Letter('v') => {
-                let k = VIEWS.iter().position(|&v| v == self.view).unwrap_or(0);
-                let n = VIEWS.len();
-                self.view = VIEWS[if press.shift {
+                let k = View::ALL.iter().position(|&v| v == self.view).unwrap_or(0);
+                let n = View::ALL.len();
+                self.view = View::ALL[if press.shift {
                     (k + n - 1) % n
                 } else {
                     (k + 1) % n
@@ -427,11 +424,11 @@ mod tests {
     fn v_cycles_every_view_both_ways() {
         let mut s = ViewState::new(Mode::Reference, texel::ColorHandling::Srgb);
         let mut seen = vec![s.view];
-        for _ in 0..VIEWS.len() - 1 {
+        for _ in 0..View::ALL.len() - 1 {
             s.apply(press(Key::Letter('v')));
             seen.push(s.view);
         }
-        assert_eq!(seen, VIEWS.to_vec());
+        assert_eq!(seen, View::ALL.to_vec());
         s.apply(press(Key::Letter('v')));
         assert_eq!(s.view, View::Color);
         s.apply(shift(Key::Letter('v')));

@@ -91,7 +91,7 @@ pub enum View {
 }
 
 impl View {
-    /// Every view, in the order help lists them.
+    /// Every view, in the order help lists them and the viewer's V key cycles through them.
     pub const ALL: [View; 7] = [
         View::Color,
         View::Uv,

@@ -15,15 +15,7 @@ fn one_and_two_threads_give_identical_frames() {
     let (w, h) = (300, 170); // not multiples of the tile size
     let scene = Ground::new(w, h);
     let sampler = lab_sampler(4);
-    for view in [
-        View::Color,
-        View::Uv,
-        View::Mip,
-        View::Lod,
-        View::Aniso,
-        View::Fetches,
-        View::Barycentric,
-    ] {
+    for view in View::ALL {
         for derivatives in [Derivatives::Analytic, Derivatives::Quad] {
             let settings = |threads| RenderSettings {
                 view,
