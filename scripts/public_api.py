@@ -8,7 +8,9 @@ target/public-api), then walks the facade's modules from the root: every public 
 `pub use` re-exports (single names and globs) into the other crates' JSON. It prints, by kind, the
 items reached (modules, structs, enums, traits, functions, constants, type aliases; fields and
 variants are not counted), both as paths (an item re-exported at two paths counts twice) and as
-distinct items, and the public inherent methods and trait items of the types reached.
+distinct items, and the public inherent methods and trait items of the types reached. It also
+lists the texel types a user meets in the signatures, public fields and variants of what it
+reaches but cannot name through the facade (`--unnamed`).
 """
 import argparse
 import collections
@@ -50,6 +52,8 @@ class Surface:
         self.distinct = collections.Counter()
         self.methods = 0
         self.listed = []
+        # Items whose signatures, fields and variants are read for the types they mention.
+        self.mentioning = []
 
     def resolve(self, d, target_id):
         tid = str(target_id)
@@ -98,6 +102,7 @@ class Surface:
         self.items.add(ident)
         if first:
             self.distinct[k] += 1
+            self.mentioning.append((d, it, "::".join(path)))
         if k == "module":
             self.module(d, it, path)
         elif k in ("struct", "enum", "union") and first:
@@ -110,14 +115,73 @@ class Surface:
                     m = d["index"].get(str(mid))
                     if m and m.get("visibility") == "public":
                         self.methods += 1
+                        self.mentioning.append((d, m, "::".join(path + [m["name"]])))
                         self.listed.append(("method", "::".join(path + [m["name"]])))
         elif k == "trait" and first:
             self.methods += len(it["inner"]["trait"]["items"])
 
 
+    def members(self, d, it):
+        """The public fields and the variants (with their fields) of a struct or enum."""
+        k = kind_of(it)
+        ids = []
+        if k == "struct":
+            kind = it["inner"]["struct"]["kind"]
+            if isinstance(kind, dict):
+                body = kind.get("plain") or {}
+                ids = body.get("fields", []) if isinstance(body, dict) else []
+                ids += [f for f in kind.get("tuple", []) or [] if f is not None]
+        elif k == "enum":
+            ids = list(it["inner"]["enum"]["variants"])
+        out = []
+        for i in ids:
+            m = d["index"].get(str(i))
+            if m is None:
+                continue
+            if kind_of(m) == "variant":
+                out.append(m)
+                vk = m["inner"]["variant"]["kind"]
+                if isinstance(vk, dict):
+                    fs = (vk.get("struct") or {}).get("fields", []) + [
+                        f for f in vk.get("tuple", []) or [] if f is not None]
+                    out += [d["index"][str(f)] for f in fs if str(f) in d["index"]]
+            elif m.get("visibility") == "public":
+                out.append(m)
+        return out
+
+    def unnamed(self):
+        """Texel types mentioned by what is reached that the facade does not reach: (type, where)."""
+        found = {}
+
+        def walk(d, node, where):
+            if isinstance(node, dict):
+                rp = node.get("resolved_path")
+                if isinstance(rp, dict) and rp.get("id") is not None:
+                    d2, target = self.resolve(d, rp["id"])
+                    if target is not None:
+                        ident = (d2["index"][str(d2["root"])]["name"], target["id"])
+                        if ident not in self.items:
+                            q = d2["paths"].get(str(target["id"]))
+                            name = "::".join(q["path"]) if q else f"{ident[0]}::{target.get('name')}"
+                            found.setdefault(name, where)
+                for v in node.values():
+                    walk(d, v, where)
+            elif isinstance(node, list):
+                for v in node:
+                    walk(d, v, where)
+
+        for d, it, where in self.mentioning:
+            parts = [it] + self.members(d, it)
+            for part in parts:
+                walk(d, part["inner"], where)
+        return sorted(found.items())
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--list", help="write every path reached, one a line, to this file")
+    ap.add_argument("--unnamed", action="store_true",
+                    help="list the texel types met in signatures that the facade does not name")
     ap.add_argument("--target", default="target/public-api", help="cargo's target directory")
     args = ap.parse_args()
     s = Surface(build(args.target))
@@ -127,6 +191,11 @@ def main():
     print(f"public paths: {sum(s.kinds.values())} ({s.kinds['module']} modules)")
     print(f"distinct items: {sum(s.distinct.values())} ({s.distinct['module']} modules)")
     print(f"public inherent methods and trait items of the types reached: {s.methods}")
+    unnamed = s.unnamed()
+    print(f"texel types met in signatures, fields and variants but not named: {len(unnamed)}")
+    if args.unnamed:
+        for name, where in unnamed:
+            print(f"  {name}  (in {where})")
     if args.list:
         with open(args.list, "w") as fh:
             fh.write("\n".join(f"{k} {p}" for k, p in sorted(s.listed)) + "\n")

@@ -48,15 +48,6 @@ impl ImageView<'_> {
         matches!(self.data, ViewData::F32(_))
     }
 
-    /// Bytes of one RGBA texel of the texture it makes: 4 for `uint8`, 16 for `float32`.
-    pub(crate) fn texel_bytes(&self) -> u64 {
-        if self.is_float() {
-            16
-        } else {
-            4
-        }
-    }
-
     /// The texels widened to RGBA (a copy; charge it first).
     pub(crate) fn texels(&self) -> PyResult<ImageIn> {
         let texels = match &self.data {

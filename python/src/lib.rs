@@ -101,6 +101,6 @@ fn _texel(m: &Bound<'_, PyModule>) -> PyResult<()> {
         .copied()
         .collect();
     m.add("BUILTIN_SCENES", builtins)?;
-    m.add("DEFAULT_SEED", texel::raster::adaptive::DEFAULT_SEED)?;
+    m.add("DEFAULT_SEED", texel::raster::DEFAULT_SEED)?;
     Ok(())
 }

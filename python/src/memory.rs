@@ -6,13 +6,10 @@
 //! call never dies of a failed allocation.
 
 use pyo3::PyResult;
-use texel::texture::storage::pyramid::pyramid_texels;
+use texel::texture::{Format, Limits};
 use texel::MemoryBudget;
 
 use crate::errors::to_py;
-
-/// Bytes of the linear `f32` scratch a pyramid build holds per texel below level 0.
-const PYRAMID_SCRATCH_PER_TEXEL: u64 = 16;
 
 /// The budget of one call: `max_memory` bytes (held to what the machine and the process limits
 /// allow), else the process's default.
@@ -30,14 +27,16 @@ pub(crate) fn bytes_of(n: u64, size: usize) -> u64 {
     n.saturating_mul(size as u64)
 }
 
-/// What making a `width x height` texture of `texel_bytes`-byte texels holds at its peak: the
-/// RGBA copy of the array, the whole pyramid (the copy grows into it, both held while it moves),
-/// and the linear scratch of the levels below 0.
-pub(crate) fn texture_bytes(width: u32, height: u32, texel_bytes: u64) -> u64 {
-    let level0 = u64::from(width) * u64::from(height);
-    let all = pyramid_texels(width, height);
-    level0
-        .saturating_add(all)
-        .saturating_mul(texel_bytes)
-        .saturating_add((all - level0).saturating_mul(PYRAMID_SCRATCH_PER_TEXEL))
+/// What making a `width x height` texture from an array of `float` or 8-bit texels holds at its
+/// peak: the RGBA copy of the array and the texture as it is built ([`Limits::texture_bytes`]:
+/// the whole pyramid, which the copy grows into while both are held, and the linear scratch of
+/// the levels below 0).
+pub(crate) fn texture_bytes(width: u32, height: u32, float: bool) -> u64 {
+    let format = if float {
+        Format::Rgba32Float
+    } else {
+        Format::Rgba8Unorm
+    };
+    let copy = u64::from(width) * u64::from(height) * format.texel_bytes();
+    copy.saturating_add(Limits::texture_bytes(width, height, format))
 }

@@ -245,7 +245,7 @@ fn size_of(size: Option<(u32, u32)>) -> PyResult<Option<(u32, u32)>> {
 /// The size a scene renders at: `size`, else the scene's own (640 x 480 for a mesh file).
 #[pyfunction]
 #[pyo3(signature = (scene, size = None))]
-pub fn scene_size(
+pub(crate) fn scene_size(
     py: Python<'_>,
     scene: &Bound<'_, PyAny>,
     size: Option<(u32, u32)>,
@@ -264,7 +264,7 @@ pub fn scene_size(
 /// builtin scene reads none.
 #[pyfunction]
 #[pyo3(signature = (scene, max_memory = None))]
-pub fn scene_files(
+pub(crate) fn scene_files(
     py: Python<'_>,
     scene: &Bound<'_, PyAny>,
     max_memory: Option<u64>,
@@ -286,7 +286,7 @@ pub fn scene_files(
             // A mesh file, scene text, or a path that is no UTF-8 string: the same preparation,
             // recorded.
             None => {
-                let (done, files) = texel::io::record_opened(|| -> Result<(), Error> {
+                let (done, files) = texel_io::record_opened(|| -> Result<(), Error> {
                     let scene = load(&arg)?;
                     let mut budget = MemoryBudget::limit_or_default(max_memory);
                     let options = SceneOptions {
@@ -317,7 +317,7 @@ pub fn scene_files(
 #[pyfunction]
 #[pyo3(signature = (scene, filter = Some("trilinear"), size = None, color = "srgb", view = "color", threads = None, max_memory = None, texture_storage = "stored"))]
 #[allow(clippy::too_many_arguments)]
-pub fn render<'py>(
+pub(crate) fn render<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     filter: Option<&str>,
@@ -354,9 +354,9 @@ pub fn render<'py>(
 /// visible surface is unlit textured triangles is computed, not sampled (standard error 0, no
 /// samples).
 #[pyfunction]
-#[pyo3(signature = (scene, spp = 256, max_spp = 65536, tolerance = 0.5, seed = texel::raster::adaptive::DEFAULT_SEED, size = None, color = "srgb", threads = None, scissor = None, max_memory = None, exact = false))]
+#[pyo3(signature = (scene, spp = 256, max_spp = 65536, tolerance = 0.5, seed = texel::raster::DEFAULT_SEED, size = None, color = "srgb", threads = None, scissor = None, max_memory = None, exact = false))]
 #[allow(clippy::too_many_arguments)]
-pub fn reference_estimate<'py>(
+pub(crate) fn reference_estimate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     spp: u32,
@@ -425,9 +425,9 @@ pub fn reference_estimate<'py>(
 /// `texel reference --exact`'s (unlit textured pixels computed, the others sampled); with
 /// `exact=False` it is sampled everywhere (`--sampled-reference`).
 #[pyfunction]
-#[pyo3(signature = (scene, filters = None, spp = 256, max_spp = None, tolerance = 0.5, seed = texel::raster::adaptive::DEFAULT_SEED, size = None, color = "srgb", threads = None, max_memory = None, exact = true))]
+#[pyo3(signature = (scene, filters = None, spp = 256, max_spp = None, tolerance = 0.5, seed = texel::raster::DEFAULT_SEED, size = None, color = "srgb", threads = None, max_memory = None, exact = true))]
 #[allow(clippy::too_many_arguments)]
-pub fn compare<'py>(
+pub(crate) fn compare<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     filters: Option<Vec<String>>,

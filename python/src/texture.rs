@@ -11,9 +11,8 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use rayon::prelude::*;
-use texel::memory::RIPMAP_SCRATCH_PER_TEXEL;
 use texel::quality::Encoding;
-use texel::raster::warp::warp_perspective;
+use texel::raster::warp_perspective;
 use texel::texture::{
     AddressMode, BorderColor, ColorSpace, FilterMode, Footprint, LevelTexels, Limits, Sampler,
     SamplerDescriptor,
@@ -140,7 +139,7 @@ fn texture_input(view: &ImageView<'_>, budget: &mut MemoryBudget) -> PyResult<(I
     take(
         budget,
         &format!("a {w}x{h} {storage} texture (its texels and mip pyramid)"),
-        texture_bytes(w, h, view.texel_bytes()),
+        texture_bytes(w, h, view.is_float()),
     )?;
     Ok((view.texels()?, limits))
 }
@@ -212,10 +211,6 @@ impl Texture {
         let slot = Self::structure_slot(desc.min_filter);
         if let Some(k) = slot.filter(|&k| !self.built[k].load(Ordering::Acquire)) {
             let t = &self.texture;
-            let scratch = match k {
-                0 => u64::from(t.width()) * u64::from(t.height()) * RIPMAP_SCRATCH_PER_TEXEL,
-                _ => 0,
-            };
             let structure = if k == 0 {
                 "ripmap"
             } else {
@@ -230,7 +225,7 @@ impl Texture {
                 ),
                 t.structure_bytes(desc)
                     .saturating_sub(t.pyramid_bytes())
-                    .saturating_add(scratch),
+                    .saturating_add(t.build_scratch_bytes(desc)),
             )?;
         }
         Ok(slot)
@@ -631,7 +626,7 @@ impl Texture {
 #[pyfunction]
 #[pyo3(signature = (image, corners, size = None, filter = "ewa", color = "linear", max_memory = None))]
 #[allow(clippy::too_many_arguments)]
-pub fn warp<'py>(
+pub(crate) fn warp<'py>(
     py: Python<'py>,
     image: &Bound<'py, PyAny>,
     corners: &Bound<'py, PyAny>,
@@ -718,7 +713,7 @@ pub(crate) fn encoding_of(srgb: bool) -> Encoding {
 /// charged to `max_memory`, else the process's memory limit.
 #[pyfunction]
 #[pyo3(signature = (linear, color = "linear", max_memory = None))]
-pub fn encode<'py>(
+pub(crate) fn encode<'py>(
     py: Python<'py>,
     linear: &Bound<'py, PyAny>,
     color: &str,

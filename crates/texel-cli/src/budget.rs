@@ -7,7 +7,7 @@ use texel::MemoryBudget;
 /// A byte count from the command line: a number (decimals allowed, `170.8M`) with an optional
 /// unit K, M, G, T (powers of 1024; `KiB`, `MB`, ... are read the same way), at least 1 MiB.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ByteSize(pub u64);
+pub(crate) struct ByteSize(pub u64);
 
 impl std::str::FromStr for ByteSize {
     type Err = String;
@@ -62,7 +62,7 @@ impl std::str::FromStr for ByteSize {
 /// allocation, not an error), else for the process's default ([`texel::memory::default_limit`]:
 /// the smallest of half the machine's memory, the cgroup's limit and what `ulimit -v`/`-d`
 /// leave); errors name the flag.
-pub fn budget(max_memory: Option<ByteSize>) -> MemoryBudget {
+pub(crate) fn budget(max_memory: Option<ByteSize>) -> MemoryBudget {
     match max_memory {
         Some(ByteSize(b)) => MemoryBudget::explicit(b, &format!("--max-memory {}", mib(b))),
         None => {

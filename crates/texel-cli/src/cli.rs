@@ -9,12 +9,12 @@ use crate::budget::ByteSize;
 use crate::filters::{filter_parser, Filter};
 
 /// `--tolerance`'s default: half an 8-bit step of the displayed value.
-pub use texel::raster::adaptive::DEFAULT_TOLERANCE_STEPS;
+pub(crate) use texel::raster::DEFAULT_TOLERANCE_STEPS;
 
 /// texel: texture mapping and texture filtering on the CPU, measured.
 #[derive(Debug, Parser)]
 #[command(name = "texel", version, about, long_about = None, propagate_version = true)]
-pub struct Cli {
+pub(crate) struct Cli {
     /// The command to run.
     #[command(subcommand)]
     pub command: Command,
@@ -33,7 +33,7 @@ pub struct Cli {
 
 /// The commands.
 #[derive(Debug, Subcommand)]
-pub enum Command {
+pub(crate) enum Command {
     /// Render a scene with one texture filter (or a debug view) to a PNG.
     ///
     /// Example: texel render builtin:ground --filter trilinear -o ground.png
@@ -105,7 +105,7 @@ pub enum Command {
 
 /// The scene and colour options every rendering command shares.
 #[derive(Debug, Args)]
-pub struct SceneArgs {
+pub(crate) struct SceneArgs {
     /// Scene file (TOML) or built-in scene (builtin:ground, builtin:ground-rotated, builtin:zoneplate,
     /// builtin:cube, builtin:sphere, builtin:globe, builtin:globe-equirect, builtin:triangle,
     /// builtin:glossy, builtin:bricks, builtin:terrain, builtin:knot, builtin:mirror-spheres,
@@ -191,7 +191,7 @@ fn parse_edge_px(s: &str) -> Result<f32, String> {
 
 /// `texel render`.
 #[derive(Debug, Args)]
-pub struct RenderArgs {
+pub(crate) struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Texture filter for every mesh (default: a glTF mesh's own sampler filters, else trilinear).
@@ -229,7 +229,7 @@ pub struct RenderArgs {
 
 /// `texel view`.
 #[derive(Debug, Args)]
-pub struct ViewArgs {
+pub(crate) struct ViewArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Worker threads for rendering, 1 to 1024 (default: all cores).
@@ -268,7 +268,7 @@ pub struct ViewArgs {
 
 /// `texel reference`.
 #[derive(Debug, Args)]
-pub struct ReferenceArgs {
+pub(crate) struct ReferenceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Samples every pixel gets, 1 to 4096, in at least 8 independent passes (one per sample below
@@ -277,14 +277,14 @@ pub struct ReferenceArgs {
     pub spp: u32,
     /// The most samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is wider than
     /// --tolerance get more passes, doubling, up to this (equal to --spp: no pixel gets more).
-    #[arg(long, default_value_t = 65_536, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::raster::adaptive::MAX_ADAPTIVE_SPP)))]
+    #[arg(long, default_value_t = 65_536, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::raster::MAX_ADAPTIVE_SPP)))]
     pub max_spp: u32,
     /// Half-width of a converged pixel's 95 % interval, in 8-bit steps of the displayed value
     /// (clipped to 0..255, sRGB-encoded unless --color raw), 0 to 255.
     #[arg(long, default_value_t = DEFAULT_TOLERANCE_STEPS, value_parser = tolerance())]
     pub tolerance: f64,
     /// Seed of the jitter; two seeds give independent estimates.
-    #[arg(long, default_value_t = texel::raster::adaptive::DEFAULT_SEED)]
+    #[arg(long, default_value_t = texel::raster::DEFAULT_SEED)]
     pub seed: u64,
     /// Compute the box-filtered integral of every pixel whose visible surface is unlit textured
     /// triangles (standard error 0, accurate to about 1e-6 of its value), and sample only the
@@ -323,7 +323,7 @@ fn tolerance() -> impl clap::builder::TypedValueParser<Value = f64> {
 
 /// `texel compare`.
 #[derive(Debug, Args)]
-pub struct CompareArgs {
+pub(crate) struct CompareArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Filters to compare: comma-separated names, or all.
@@ -336,7 +336,7 @@ pub struct CompareArgs {
     /// The most reference samples a pixel gets, --spp to 1048576: pixels whose 95 % interval is
     /// wider than --tolerance get more passes, doubling, up to this (default: --spp, a fixed
     /// budget; the report says how much of the reference converged and what it can rank).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::raster::adaptive::MAX_ADAPTIVE_SPP)))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(texel::raster::MAX_ADAPTIVE_SPP)))]
     pub max_spp: Option<u32>,
     /// With --max-spp: half-width of a converged reference pixel's 95 % interval, in 8-bit steps
     /// of the displayed value, 0 to 255 (also the converged share the report gives).
@@ -382,7 +382,7 @@ fn parse_orbit_step(s: &str) -> Result<f32, String> {
 
 /// `texel demo`.
 #[derive(Debug, Args)]
-pub struct DemoArgs {
+pub(crate) struct DemoArgs {
     /// Output directory: created, or replaced as a whole if texel wrote it before.
     #[arg(long, default_value = "texel-demo")]
     pub out: PathBuf,
@@ -403,7 +403,7 @@ pub struct DemoArgs {
 
 /// `texel bench`.
 #[derive(Debug, Args)]
-pub struct BenchArgs {
+pub(crate) struct BenchArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Filters to time: comma-separated names, or all.
@@ -456,7 +456,7 @@ pub struct BenchArgs {
 /// Which instruction-set copy the tile rasterizer and the sampler's batch kernels run
 /// (`texel::raster::simd_level`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SimdArg {
+pub(crate) enum SimdArg {
     /// The best the CPU has.
     Best,
     /// At most the x86-64-v4 (AVX-512) copy.
@@ -469,7 +469,7 @@ pub enum SimdArg {
 
 impl SimdArg {
     /// The highest level this choice allows.
-    pub fn limit(self) -> texel::raster::SimdLevel {
+    pub(crate) fn limit(self) -> texel::raster::SimdLevel {
         use texel::raster::SimdLevel;
         match self {
             SimdArg::Best | SimdArg::V4 => SimdLevel::X86_64V4,
@@ -481,7 +481,7 @@ impl SimdArg {
 
 /// A colour render target ([`texel::ColorTarget`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum TargetArg {
+pub(crate) enum TargetArg {
     /// RGBA8 in the output's encoding (sRGB, or unorm with `--color raw`): what `texel render`
     /// writes, 4 bytes a pixel.
     Rgba8,
@@ -491,7 +491,7 @@ pub enum TargetArg {
 
 /// Output size `WIDTHxHEIGHT`, each side 1 to 16384.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Size {
+pub(crate) struct Size {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
@@ -499,10 +499,10 @@ pub struct Size {
 }
 
 /// Most reference samples per pixel: 64 x 64, the rasterizer's largest stratification.
-pub const MAX_SPP: i64 = 4096;
+pub(crate) const MAX_SPP: i64 = 4096;
 
 /// Largest output side accepted (pixels).
-pub const MAX_SIDE: u32 = 16384;
+pub(crate) const MAX_SIDE: u32 = 16384;
 
 impl std::str::FromStr for Size {
     type Err = String;
@@ -534,7 +534,7 @@ impl std::str::FromStr for Size {
 /// One value rather than clap's `value_delimiter` with `num_args = 8`: clap counts the 8 values
 /// before splitting at commas, so it rejected the documented `--corners 0,0,4000,300,...`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Corners(pub [f64; 8]);
+pub(crate) struct Corners(pub [f64; 8]);
 
 impl std::str::FromStr for Corners {
     type Err = String;
@@ -560,7 +560,7 @@ impl std::str::FromStr for Corners {
 
 /// `texel warp`.
 #[derive(Debug, Args)]
-pub struct WarpArgs {
+pub(crate) struct WarpArgs {
     /// Source image (PNG, JPEG or OpenEXR).
     pub input: PathBuf,
     /// Source pixel positions shown at the output's top-left, top-right, bottom-right and
@@ -584,7 +584,7 @@ pub struct WarpArgs {
 
 /// `texel mips`.
 #[derive(Debug, Args)]
-pub struct MipsArgs {
+pub(crate) struct MipsArgs {
     /// The texture (PNG, JPEG or OpenEXR).
     pub texture: PathBuf,
     /// Colour handling: srgb averages in linear light, raw averages the bytes.
@@ -597,7 +597,7 @@ pub struct MipsArgs {
 
 /// `texel bake-ao`.
 #[derive(Debug, Args)]
-pub struct BakeAoArgs {
+pub(crate) struct BakeAoArgs {
     /// The mesh: an OBJ or glTF (.gltf, .glb) file, or a scene (TOML file or builtin:NAME) whose
     /// meshes all bake into the one map. Its uvs must not overlap where they are to differ.
     #[arg(default_value = "builtin:knot")]
@@ -648,7 +648,7 @@ fn png_output() -> impl TypedValueParser<Value = PathBuf> {
 
 /// `texel lab`'s arguments.
 #[derive(Debug, Args)]
-pub struct LabArgs {
+pub(crate) struct LabArgs {
     /// The student's fragment shader (GLSL, any version the driver accepts).
     pub shader: PathBuf,
     /// The student's vertex shader; it gets the attributes `position` (vec3, world space) and
@@ -695,9 +695,9 @@ pub struct LabArgs {
 
 /// `texel lab --modes`: modes 1-8, in order, without repeats.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ModeList(pub Vec<u8>);
+pub(crate) struct ModeList(pub Vec<u8>);
 
-pub fn parse_modes(s: &str) -> Result<ModeList, String> {
+pub(crate) fn parse_modes(s: &str) -> Result<ModeList, String> {
     let mut out = Vec::new();
     for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
         let (a, b) = part.split_once('-').unwrap_or((part, part));
@@ -727,7 +727,7 @@ pub fn parse_modes(s: &str) -> Result<ModeList, String> {
 ///
 /// # Errors
 /// A maximum below the minimum, and the plan's other checks.
-pub fn reference_plan(
+pub(crate) fn reference_plan(
     min_spp: u32,
     max_spp: u32,
     tolerance_steps: f64,

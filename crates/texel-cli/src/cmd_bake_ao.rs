@@ -10,13 +10,13 @@ use texel::ao::{bake_ao, protected_levels, AoMesh, AoSettings};
 use texel::scene::{load_gltf_with, load_obj_with, Mesh, Scene};
 
 use crate::cli::BakeAoArgs;
-use crate::input::{scene_limits, Input};
+use crate::input::Input;
 use crate::output::{is_exr, write_image, write_linear};
 use crate::progress;
 use crate::threads::{thread_count, workers};
 
 /// Run `texel bake-ao`.
-pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
     crate::output::check_outputs(&[("-o", &args.output)])?;
     let meshes = load_meshes(&args.mesh, input)?;
     let mesh = AoMesh::from_meshes(&meshes);
@@ -63,7 +63,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
             i64::from(protected_levels(m)) - 1
         ),
     };
-    texel::io::stderr_line(format_args!(
+    texel_io::stderr_line(format_args!(
         "texel bake-ao: {} triangles, {size}x{size}: {} texels sampled ({:.1} %), {} filled by the margin, {:.1} M rays in {seconds:.1} s on {} threads ({:.2} M rays/s); margin: {margin}",
         mesh.triangles.len(),
         map.sampled,
@@ -75,7 +75,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
         size = map.size,
     ));
     if map.skipped_triangles > 0 {
-        texel::io::stderr_line(format_args!(
+        texel_io::stderr_line(format_args!(
             "texel bake-ao: warning: {} triangles not baked (zero area in uv or in space, or outside the map's [0, 1] uv square); they still occlude",
             map.skipped_triangles
         ));
@@ -86,7 +86,7 @@ pub fn run(args: &BakeAoArgs, input: &mut Input) -> Result<()> {
 /// The meshes of `arg`: an OBJ or glTF file by its extension, else a scene (a TOML file or
 /// `builtin:NAME`).
 fn load_meshes(arg: &str, input: &Input) -> Result<Vec<Mesh>> {
-    let limits = scene_limits(input.budget.remaining());
+    let limits = input.budget.scene_limits();
     let path = Path::new(arg);
     let ext = path
         .extension()

@@ -2,7 +2,7 @@
 //! (what is timed: [`texel::timing`]), with the clear's cost reported apart (`clear ms`), as
 //! `llvmpipe_bench.py` clears its framebuffer and calls `glFinish` before starting the clock.
 //! The median of `--frames` timed frames after `--warmup` untimed ones (lasting at least
-//! [`MIN_WARMUP`] unless `--warmup 0`), on a pool of `--threads` workers built once.
+//! 200 ms unless `--warmup 0`), on a pool of `--threads` workers built once.
 //!
 //! The clear leaves the frame marked as holding it (`Frame::holds_clear`), as a GPU's fast
 //! clear does, so a frame larger than the last-level cache is drawn tile by tile in scratch and
@@ -13,7 +13,7 @@ use std::io::Write;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use texel::timing::{time_filters, warm_up, BenchPlan, FilterTiming, MIN_WARMUP};
+use texel::timing::{time_filters, warm_up, BenchPlan, FilterTiming};
 use texel::{Filter, MemoryBudget, PreparedScene};
 
 use crate::cli::{BenchArgs, TargetArg};
@@ -48,7 +48,7 @@ fn time_gpu(
             held,
         )?;
         let prepared = gpu.prepare(&draws, gpu_filter)?;
-        warm_up(args.warmup, MIN_WARMUP, 1, || {
+        warm_up(args.warmup, 1, || {
             std::hint::black_box(prepared.render(&settings)?);
             Ok::<_, texel_gpu::GpuError>(())
         })?;
@@ -61,10 +61,10 @@ fn time_gpu(
         // Device time of as many passes, back to back: between read-back frames the device
         // idles and may clock down (docs/guide/gpu.md), so warm-up passes run
         // back to back first, as the frames' warm-up does (`--warmup` of them and at least
-        // MIN_WARMUP unless 0).
+        // 200 ms unless 0).
         if gpu.has_timestamps() {
             let batch = args.warmup.min(texel_gpu::PASSES_PER_SUBMIT);
-            warm_up(args.warmup, MIN_WARMUP, batch, || {
+            warm_up(args.warmup, batch, || {
                 prepared.pass_times(&settings, batch).map(drop)
             })?;
         }
@@ -81,7 +81,7 @@ fn time_gpu(
 }
 
 /// Run `texel bench`.
-pub fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &BenchArgs, input: &mut Input) -> Result<()> {
     check_storage(&args.scene, args.gpu)?;
     let scene = load_scene(&args.scene, input)?;
     // The GPU's rows are checked before the (slower) adapter start; the CPU's list as before.
@@ -200,7 +200,7 @@ impl Measured<'_> {
         writeln!(
         stdout,
         "texel bench: {} at {}x{}, {threads} threads, {} target, median of {} frames after {} warm-up",
-        texel::io::escape(&args.scene.scene),
+        texel_io::escape(&args.scene.scene),
         scene.width,
         scene.height,
         target_name(args.target),

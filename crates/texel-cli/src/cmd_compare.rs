@@ -5,12 +5,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use texel::compare::{slug, CompareJob, Extra, OrbitSpec, TIMED_FRAMES};
-use texel::io::publish_dir;
 use texel::quality::Image8;
 use texel::raster::{Frame, RenderSettings};
 use texel::timing::median;
 use texel::{MemoryBudget, PreparedScene};
 use texel_gpu::GpuFilter;
+use texel_io::publish_dir;
 
 use crate::cli::CompareArgs;
 use crate::filters::{parse_list, Filter};
@@ -18,7 +18,7 @@ use crate::input::{check_storage, load_scene, Input};
 use crate::progress;
 
 /// Parse `LABEL=PATH`.
-pub fn parse_extra(s: &str) -> Result<(String, PathBuf)> {
+pub(crate) fn parse_extra(s: &str) -> Result<(String, PathBuf)> {
     match s.split_once('=') {
         Some((label, path)) if !label.trim().is_empty() && !path.is_empty() => {
             Ok((label.trim().to_string(), PathBuf::from(path)))
@@ -31,14 +31,14 @@ pub fn parse_extra(s: &str) -> Result<(String, PathBuf)> {
 /// file, so two labels that are equal, or whose file names would be equal, or a label equal to a
 /// compared filter's name, are refused, and so is a label holding control or bidirectional
 /// characters (it is a row of the report).
-pub fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<()> {
+pub(crate) fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<()> {
     for (i, (label, _)) in extras.iter().enumerate() {
         // A label is a row of the report (Markdown, HTML, JSON) that a terminal may show.
-        if label.chars().any(texel::io::term::needs_escape) {
+        if label.chars().any(texel_io::term::needs_escape) {
             bail!(
                 "--extra label {} holds control or bidirectional characters: give a label of \
                  printable characters",
-                texel::io::escape(label)
+                texel_io::escape(label)
             );
         }
         if let Some(f) = filters.iter().find(|f| f.name() == label) {
@@ -74,7 +74,7 @@ fn gpu_rows(
     budget: &mut MemoryBudget,
 ) -> Result<Vec<Extra>> {
     let gpu = texel_gpu::Gpu::new(adapter)?;
-    texel::io::stderr_line(format_args!("gpu: {}", gpu.info()));
+    texel_io::stderr_line(format_args!("gpu: {}", gpu.info()));
     let mut settings = scene.settings();
     settings.derivatives = texel::raster::Derivatives::Quad;
     let mut jobs: Vec<(String, Filter, GpuFilter)> = filters
@@ -143,7 +143,7 @@ fn check_before_work(
 }
 
 /// Run `texel compare`.
-pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     let filters = parse_list(&args.filters)?;
     let files = args
         .extra
@@ -156,7 +156,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         args.max_spp.unwrap_or(args.spp),
         args.tolerance,
         args.scene.color == texel::ColorHandling::Srgb,
-        texel::raster::adaptive::DEFAULT_SEED,
+        texel::raster::DEFAULT_SEED,
     )?
     .with_exact(args.exact);
     check_storage(&args.scene, args.gpu)?;
@@ -172,7 +172,7 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         path: path.clone(),
     }));
     // The scene's name as the report shows it: control and bidirectional characters escaped.
-    let label = texel::io::escape(&args.scene.scene);
+    let label = texel_io::escape(&args.scene.scene);
     let bars = progress::Bars::own(filters.len());
     let job = CompareJob {
         orbit: args.orbit.map(|frames| OrbitSpec {
@@ -198,8 +198,8 @@ pub fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
     bars.finish();
     let report =
         report.with_context(|| format!("cannot write the report to {}", args.out.display()))?;
-    texel::io::stdout_text(&report.to_markdown()).context(crate::cmd_render::STDOUT)?;
-    texel::io::stderr_line(format_args!(
+    texel_io::stdout_text(&report.to_markdown()).context(crate::cmd_render::STDOUT)?;
+    texel_io::stderr_line(format_args!(
         "report: {}",
         args.out.join("index.html").display()
     ));

@@ -12,9 +12,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
-use texel::io::{publish_dir, write_atomic};
-use texel::quality::html::escape;
+use texel::quality::html_escape as escape;
 use texel::quality::Report;
+use texel_io::{publish_dir, write_atomic};
 
 use crate::cli::DemoArgs;
 use crate::cli::DEFAULT_TOLERANCE_STEPS;
@@ -28,7 +28,7 @@ use texel::raster::{render, ColorTarget, UvEvaluation, View};
 /// Run `texel demo`: every scene's report is written into one staging directory, published as a
 /// whole at `--out` when all are done. One bar counts every reference and filter image (and the
 /// ambient-occlusion page) with an estimate of the time left.
-pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let started = std::time::Instant::now();
     let shaded = texel::scene::shaded_builtin_names();
     let scenes: Vec<&str> = texel::scene::builtin_names()
@@ -39,7 +39,7 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     let steps =
         scenes.len() * (Filter::ALL.len() + 1) + GLOBES.len() * (MAPPING_FILTERS.len() + 1) + 1;
     let pb = progress::bar(steps as u64, "demo");
-    let note = |pb: &ProgressBar, line: String| pb.suspend(|| texel::io::stderr_line(line));
+    let note = |pb: &ProgressBar, line: String| pb.suspend(|| texel_io::stderr_line(line));
     let reports = publish_dir(&args.out, &[], |dir| -> Result<Vec<(String, Report)>> {
         let mut reports: Vec<(String, Report)> = Vec::new();
         for name in &scenes {
@@ -93,13 +93,13 @@ pub fn run(args: &DemoArgs, input: &mut Input) -> Result<()> {
     .with_context(|| format!("cannot write the demo to {}", args.out.display()))?;
     pb.finish_and_clear();
     let index = args.out.join("index.html");
-    texel::io::stdout_line(format_args!(
+    texel_io::stdout_line(format_args!(
         "texel demo: {} scenes in {:.0} s",
         reports.len(),
         started.elapsed().as_secs_f64()
     ))
     .context(crate::cmd_render::STDOUT)?;
-    texel::io::stdout_line(format_args!("open {}", index.display()))
+    texel_io::stdout_line(format_args!("open {}", index.display()))
         .context(crate::cmd_render::STDOUT)?;
     Ok(())
 }
@@ -136,7 +136,7 @@ fn report_in(
         spp,
         DEFAULT_TOLERANCE_STEPS,
         true,
-        texel::raster::adaptive::DEFAULT_SEED,
+        texel::raster::DEFAULT_SEED,
     )?
     // Unlit textured pixels computed, not sampled; lit ones sampled.
     .with_exact(true);

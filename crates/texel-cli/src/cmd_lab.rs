@@ -16,8 +16,8 @@ use crate::input::Input;
 const MAX_SHADER_BYTES: u64 = 1 << 20;
 
 /// The text of a shader file (a regular file of at most 1 MiB, UTF-8).
-pub fn read_source(path: &Path, what: &str) -> Result<String> {
-    let bytes = texel::io::read_regular(path, MAX_SHADER_BYTES)
+pub(crate) fn read_source(path: &Path, what: &str) -> Result<String> {
+    let bytes = texel_io::read_regular(path, MAX_SHADER_BYTES)
         .with_context(|| format!("cannot read the {what} {}", path.display()))?;
     String::from_utf8(bytes)
         .with_context(|| format!("the {what} {} is not UTF-8 text", path.display()))
@@ -56,7 +56,7 @@ fn scene_bytes(w: u32, h: u32, modes: usize) -> u64 {
 }
 
 /// Run `texel lab`.
-pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
     let fragment = read_source(&args.shader, "fragment shader")?;
     let vertex = match &args.vertex {
         Some(p) => Some(read_source(p, "vertex shader")?),
@@ -85,18 +85,18 @@ pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
             scene_bytes(w, h, job.modes.len()),
         )?;
     }
-    for v in lab::source::violations(&job.fragment) {
-        texel::io::stderr_line(format_args!(
+    for v in lab::violations(&job.fragment) {
+        texel_io::stderr_line(format_args!(
             "texel: warning: line {}: `{}` breaks the lab's rule (texelFetch and textureSize only); the shader is still graded, and marked",
             v.line, v.call
         ));
     }
-    for line in lab::source::level_size_queries(&job.fragment) {
-        texel::io::stderr_line(format_args!(
+    for line in lab::level_size_queries(&job.fragment) {
+        texel_io::stderr_line(format_args!(
             "texel: note: line {line} asks textureSize for a per-pixel level; Mesa's llvmpipe answers one size for a whole quad, so use max(textureSize(texSlot, 0) >> level, ivec2(1))"
         ));
     }
-    let shader_name = texel::io::escape(&args.shader.display().to_string()).into_owned();
+    let shader_name = texel_io::escape(&args.shader.display().to_string()).into_owned();
     let options = lab::GradeOptions {
         reference_spp: args.spp,
         threads: args.threads.map(|t| t as usize),
@@ -113,7 +113,7 @@ pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
             .filter(|p| p.extension().is_some()),
     );
     let limit = Duration::from_secs(args.timeout);
-    let report = texel::io::publish_dir(&args.out, &inputs, |dir| {
+    let report = texel_io::publish_dir(&args.out, &inputs, |dir| {
         let work = WorkDir::new(dir)?;
         let job_path = work.0.join("job.json");
         std::fs::write(&job_path, serde_json::to_vec(&job)?)
@@ -123,7 +123,7 @@ pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
             lab::grade(&job, &shader_name, &work.0, &options)
         })??;
         drop(work);
-        lab::report::write(&report, &images, dir)?;
+        lab::write_report(&report, &images, dir)?;
         Ok::<_, anyhow::Error>(report)
     })
     .with_context(|| format!("cannot write the report to {}", args.out.display()))?;
@@ -146,8 +146,8 @@ pub fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
             summary.push_str(&format!("    {d}\n"));
         }
     }
-    texel::io::stdout_text(&summary).context(crate::cmd_render::STDOUT)?;
-    texel::io::stderr_line(format_args!(
+    texel_io::stdout_text(&summary).context(crate::cmd_render::STDOUT)?;
+    texel_io::stderr_line(format_args!(
         "report: {}",
         args.out.join("report.html").display()
     ));
@@ -213,7 +213,7 @@ fn device_in_child(dir: &Path, limit: Duration) -> Result<()> {
 
 /// `texel lab-device DIR`: render the job in `DIR/job.json` into `DIR`; on failure write the
 /// message to `DIR/error.txt`.
-pub fn device(dir: &Path) -> Result<()> {
+pub(crate) fn device(dir: &Path) -> Result<()> {
     let text = std::fs::read_to_string(dir.join("job.json"))
         .with_context(|| format!("cannot read {}", dir.join("job.json").display()))?;
     let job: Job = serde_json::from_str(&text).context("the job file is not valid")?;

@@ -3,23 +3,23 @@
 //! Memory: the texture loads within what `--max-memory` leaves (see [`texel::texture::Limits`]);
 //! then each level is encoded straight from the pyramid to an 8-bit image and written before the
 //! next (4 bytes per pixel plus the encoder's copies, [`ENCODE_BYTES_PER_PIXEL`]), and the chain
-//! likewise. The directory is published as a whole ([`texel::io::publish_dir`]).
+//! likewise. The directory is published as a whole ([`texel_io::publish_dir`]).
 
 use anyhow::{Context, Result};
-use texel::io::publish_dir;
 use texel::quality::{Image8, MAX_SIDE};
 use texel::texture::Texture;
+use texel_io::publish_dir;
 
 use crate::cli::MipsArgs;
 use crate::input::Input;
-use crate::output::{encoding, write_image};
+use crate::output::write_image;
 
 /// What writing one image holds per pixel: the 8-bit image (4), its RGBA bytes for the encoder
 /// (4) and the PNG (at most about 4 plus headers), rounded up.
-pub const ENCODE_BYTES_PER_PIXEL: u64 = 16;
+pub(crate) const ENCODE_BYTES_PER_PIXEL: u64 = 16;
 
 /// Run `texel mips`.
-pub fn run(args: &MipsArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &MipsArgs, input: &mut Input) -> Result<()> {
     let options = input.texture_options(args.color);
     let loaded = Texture::load_with(&args.texture, &options)
         .map_err(|e| input.explain(e.into()))
@@ -43,7 +43,7 @@ pub fn run(args: &MipsArgs, input: &mut Input) -> Result<()> {
     input
         .budget
         .take("encoding the levels", largest * ENCODE_BYTES_PER_PIXEL)?;
-    let enc = encoding(args.color);
+    let enc = args.color.encoding();
     publish_dir(&args.out, &[args.texture.as_path()], |dir| -> Result<()> {
         for (k, l) in levels.iter().enumerate() {
             let image = Image8::from_fn(l.width, l.height, |i, j| {
@@ -80,11 +80,11 @@ pub fn run(args: &MipsArgs, input: &mut Input) -> Result<()> {
     })
     .with_context(|| format!("cannot write the levels to {}", args.out.display()))?;
     if !chain_fits {
-        texel::io::stderr_line(format_args!(
+        texel_io::stderr_line(format_args!(
             "texel mips: chain.png skipped: the chain would be {cw}x{ch}, over {MAX_SIDE} pixels per side"
         ));
     }
-    texel::io::stderr_line(format_args!(
+    texel_io::stderr_line(format_args!(
         "wrote {} levels ({} bytes of pyramid){} to {}",
         levels.len(),
         tex.pyramid_bytes(),

@@ -10,14 +10,14 @@ use texel::raster::{ReferenceEstimate, ReferenceStatus};
 use crate::cli::ReferenceArgs;
 use crate::input::{load_scene, Input};
 use crate::interrupt;
-use crate::output::{check_outputs, encoding, write_frame, write_image};
+use crate::output::{check_outputs, write_frame, write_image};
 use crate::progress;
 use crate::threads::workers;
 
-/// Run `texel reference`: the converging reference (`texel::raster::adaptive`), its summary on
+/// Run `texel reference`: the converging reference (`texel::raster::ReferencePlan`), its summary on
 /// stderr, the image and, with `--error-map`, each pixel's error. Ctrl-C during the passes writes
 /// what is done so far, says so, and exits with status 130.
-pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     let plan = crate::cli::reference_plan(
         args.spp,
         args.max_spp,
@@ -54,17 +54,17 @@ pub fn run(args: &ReferenceArgs, input: &mut Input) -> Result<()> {
     if estimate.interrupted {
         return write_partial(args, &estimate, seconds);
     }
-    write_frame(&args.output, &estimate.frame, encoding(args.scene.color))?;
+    write_frame(&args.output, &estimate.frame, args.scene.color.encoding())?;
     if let Some(path) = &args.error_map {
         write_error_map(path, &estimate, &[])?;
     }
-    texel::io::stderr_line(summary(&estimate, args.tolerance, seconds));
+    texel_io::stderr_line(summary(&estimate, args.tolerance, seconds));
     Ok(())
 }
 
 /// The keyword of the text entry (PNG `tEXt` chunk, OpenEXR attribute) that marks an interrupted
 /// reference.
-pub const PARTIAL_KEYWORD: &str = "texel:partial";
+pub(crate) const PARTIAL_KEYWORD: &str = "texel:partial";
 
 /// The outputs of an interrupted reference: each one that does not exist yet (or, with
 /// `--keep-partial`, every one) gets the estimate so far, marked [`PARTIAL_KEYWORD`] with the
@@ -101,13 +101,13 @@ fn write_partial(args: &ReferenceArgs, e: &ReferenceEstimate, seconds: f64) -> R
             crate::output::write_frame_with_text(
                 path,
                 &e.frame,
-                encoding(args.scene.color),
+                args.scene.color.encoding(),
                 &text,
             )?;
         }
         written.push(path.display().to_string());
     }
-    texel::io::stderr_line(summary(e, args.tolerance, seconds));
+    texel_io::stderr_line(summary(e, args.tolerance, seconds));
     let mut message = String::from("interrupted");
     if !written.is_empty() {
         let _ = write!(
@@ -134,7 +134,7 @@ fn write_partial(args: &ReferenceArgs, e: &ReferenceEstimate, seconds: f64) -> R
 }
 
 /// One line: the share converged, the samples taken and the time.
-pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> String {
+pub(crate) fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> String {
     let min = e.spp.iter().copied().min().unwrap_or(0);
     let max = e.spp.iter().copied().max().unwrap_or(0);
     let unconverged = e.converged.iter().filter(|&&c| !c).count();
@@ -183,7 +183,7 @@ pub fn summary(e: &ReferenceEstimate, tolerance_steps: f64, seconds: f64) -> Str
 }
 
 /// Top of the error picture's colour ramp, in 8-bit steps.
-pub const ERROR_MAP_MAX_STEPS: f32 = 4.0;
+pub(crate) const ERROR_MAP_MAX_STEPS: f32 = 4.0;
 
 /// Write `--error-map`: the standard errors as OpenEXR, or their picture as PNG.
 fn write_error_map(

@@ -11,7 +11,7 @@ use crate::output::{is_exr, write_frame};
 use crate::threads::workers;
 
 /// Run `texel render`.
-pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     let filter = match args.lab_mode {
         Some(m) => Some(Filter::from_lab_mode(m)?),
         None => args.filter,
@@ -26,7 +26,7 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
     let mut scene = load_scene(&args.scene, input)?;
     if args.gpu && args.scene.surface_uv.is_none() && scene.maps_uv_per_pixel() {
         // The shader interpolates the vertices' uv: say so rather than refuse the scene.
-        texel::io::stderr_line(
+        texel_io::stderr_line(
             "texel: --gpu interpolates sphere mappings from the vertices (--surface-uv vertex)",
         );
         scene.set_surface_uv(UvEvaluation::PerVertex);
@@ -71,18 +71,18 @@ pub fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
 }
 
 /// The context of a failed write of a result to standard output.
-pub const STDOUT: &str = "cannot write to standard output";
+pub(crate) const STDOUT: &str = "cannot write to standard output";
 
 /// Run `texel gpu-info`: every adapter, and which one `--gpu` would pick.
-pub fn gpu_info() -> Result<()> {
+pub(crate) fn gpu_info() -> Result<()> {
     let all = texel_gpu::adapters();
     if all.is_empty() {
         bail!(texel_gpu::GpuError::NoAdapter);
     }
     for a in &all {
-        texel::io::stdout_line(a).context(STDOUT)?;
+        texel_io::stdout_line(a).context(STDOUT)?;
     }
     let gpu = Gpu::new(None)?;
-    texel::io::stdout_line(format_args!("--gpu uses: {}", gpu.info().name)).context(STDOUT)?;
+    texel_io::stdout_line(format_args!("--gpu uses: {}", gpu.info().name)).context(STDOUT)?;
     Ok(())
 }

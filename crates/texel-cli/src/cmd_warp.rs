@@ -6,7 +6,7 @@
 
 use anyhow::{bail, Context, Result};
 use glam::DVec2;
-use texel::raster::warp::{warp_perspective, WarpError, MAX_WARP_PIXELS};
+use texel::raster::{warp_perspective, WarpError, MAX_WARP_PIXELS};
 use texel::texture::{AddressMode, Sampler, Texture};
 
 use crate::cli::WarpArgs;
@@ -15,7 +15,7 @@ use crate::output::write_linear;
 use texel::memory::FRAME_BYTES_PER_PIXEL;
 
 /// Run `texel warp`.
-pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
+pub(crate) fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
     if let Some(s) = args.size {
         let pixels = u64::from(s.width) * u64::from(s.height);
         if pixels > MAX_WARP_PIXELS {
@@ -29,7 +29,7 @@ pub fn run(args: &WarpArgs, input: &mut Input) -> Result<()> {
     crate::output::check_outputs(&[("-o", &args.output)])?;
     let cannot = || format!("cannot load image {}", args.input.display());
     let bytes =
-        texel::io::read_regular(&args.input, input.budget.remaining()).with_context(cannot)?;
+        texel_io::read_regular(&args.input, input.budget.remaining()).with_context(cannot)?;
     let (sw, sh, _) = Texture::header(&bytes).with_context(cannot)?;
     let (w, h) = match args.size {
         Some(s) => (s.width, s.height),

@@ -8,7 +8,7 @@ use texel::Filter;
 /// What one half of the screen (or the whole screen) shows: a filter, or the progressive
 /// supersampled reference.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Mode {
+pub(crate) enum Mode {
     /// Texture filter for every mesh.
     Filter(Filter),
     /// The reference: jittered level-0 sub-samples accumulated while the camera is still.
@@ -17,7 +17,7 @@ pub enum Mode {
 
 impl Mode {
     /// Short name for the HUD and file names.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Mode::Filter(f) => f.name(),
             Mode::Reference => "reference",
@@ -28,7 +28,7 @@ impl Mode {
 /// A key, independent of the keyboard layout (winit's physical keys map onto it) and of where it
 /// came from (the window or a `--keys` script).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Key {
+pub(crate) enum Key {
     /// `0` to `9`.
     Digit(u8),
     /// `a` to `z` (lower case).
@@ -59,7 +59,7 @@ pub enum Key {
 
 /// A key press with the state of Shift.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Press {
+pub(crate) struct Press {
     /// The key.
     pub key: Key,
     /// Whether Shift was held.
@@ -67,7 +67,7 @@ pub struct Press {
 }
 
 /// One row of the key table: the keys, what they do.
-pub struct KeyHelp {
+pub(crate) struct KeyHelp {
     /// The keys as the user types them.
     pub keys: &'static str,
     /// What they do.
@@ -75,7 +75,7 @@ pub struct KeyHelp {
 }
 
 /// Every key of `texel view`, as `--help` and the overlay (H) show them.
-pub const KEYS: &[KeyHelp] = &[
+pub(crate) const KEYS: &[KeyHelp] = &[
     KeyHelp {
         keys: "1-8",
         action: "the lab's modes: nearest, bilinear, mip-nearest, trilinear, aniso2-16",
@@ -143,7 +143,7 @@ pub const KEYS: &[KeyHelp] = &[
 ];
 
 /// The key table as plain text, one row a line (for `--help`).
-pub fn key_table() -> String {
+pub(crate) fn key_table() -> String {
     let width = KEYS.iter().map(|k| k.keys.len()).max().unwrap_or(0);
     let mut s = String::from("Keys:\n");
     for k in KEYS {
@@ -154,7 +154,7 @@ pub fn key_table() -> String {
 
 /// Every state a frame depends on except the camera.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ViewState {
+pub(crate) struct ViewState {
     /// The whole screen's mode, or the left half's in split screen.
     pub left: Mode,
     /// The right half's mode in split screen.
@@ -180,11 +180,11 @@ pub struct ViewState {
 }
 
 /// The largest lod bias `[` and `]` reach, in levels.
-pub const MAX_BIAS: f32 = 8.0;
+pub(crate) const MAX_BIAS: f32 = 8.0;
 
 /// What a key press asks of the viewer besides a new state.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Effect {
+pub(crate) enum Effect {
     /// Nothing (or only the state changed).
     None,
     /// Write a screenshot.
@@ -200,7 +200,7 @@ pub enum Effect {
 impl ViewState {
     /// The start: `mode` on the whole screen (trilinear on the right when split), colour view,
     /// perspective-correct, analytic derivatives, no bias, HUD on.
-    pub fn new(mode: Mode, color: texel::ColorHandling) -> ViewState {
+    pub(crate) fn new(mode: Mode, color: texel::ColorHandling) -> ViewState {
         ViewState {
             left: mode,
             right: Mode::Filter(Filter::Trilinear),
@@ -217,7 +217,7 @@ impl ViewState {
     }
 
     /// The modes on screen: one, or left and right in split screen.
-    pub fn modes(&self) -> Vec<Mode> {
+    pub(crate) fn modes(&self) -> Vec<Mode> {
         if self.split {
             vec![self.left, self.right]
         } else {
@@ -226,7 +226,7 @@ impl ViewState {
     }
 
     /// Apply one key press; see [`KEYS`].
-    pub fn apply(&mut self, press: Press) -> Effect {
+    pub(crate) fn apply(&mut self, press: Press) -> Effect {
         if let Some(mode) = mode_of(press.key) {
             if press.shift {
                 self.right = mode;
@@ -285,7 +285,7 @@ impl ViewState {
 
     /// A file name that says the state: `texel-aniso16-color.png`,
     /// `texel-trilinear-vs-ewa-mip-affine-quad-bias+1.0-raw.png`; non-default settings only.
-    pub fn file_name(&self) -> String {
+    pub(crate) fn file_name(&self) -> String {
         let mut s = format!("texel-{}", self.left.name());
         if self.split {
             s.push_str(&format!("-vs-{}", self.right.name()));
@@ -329,7 +329,7 @@ fn mode_of(key: Key) -> Option<Mode> {
 ///
 /// # Errors
 /// The first token that is not a key, with the list of names.
-pub fn parse_keys(script: &str) -> Result<Vec<Press>, String> {
+pub(crate) fn parse_keys(script: &str) -> Result<Vec<Press>, String> {
     let mut out = Vec::new();
     for token in script.split(',').map(str::trim).filter(|t| !t.is_empty()) {
         let (mut shift, name) = match token.get(..6) {

@@ -3,26 +3,26 @@
 
 use anyhow::Result;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
-pub use texel::Filter;
+pub(crate) use texel::Filter;
 use texel_gpu::GpuFilter;
 
 /// One row `--gpu` renders: its label, the texel filter whose samplers and pyramid it is given,
 /// and the GPU mode.
-pub type GpuJob = (&'static str, Filter, GpuFilter);
+pub(crate) type GpuJob = (&'static str, Filter, GpuFilter);
 
 /// Parses one filter name for clap, listing [`Filter::NAMES`] in `--help` and in usage errors.
-pub fn filter_parser() -> impl TypedValueParser<Value = Filter> {
+pub(crate) fn filter_parser() -> impl TypedValueParser<Value = Filter> {
     PossibleValuesParser::new(Filter::NAMES).map(|s| s.parse::<Filter>().expect("a listed name"))
 }
 
 /// Parse a filter list: `all`, or comma-separated names ([`Filter::parse_list`]).
-pub fn parse_list(list: &str) -> Result<Vec<Filter>> {
+pub(crate) fn parse_list(list: &str) -> Result<Vec<Filter>> {
     Ok(Filter::parse_list(list)?)
 }
 
 /// The device's own sampler as `texel bench --gpu` and `texel compare --gpu` name it: label, the
 /// texel filter whose samplers and pyramid it is given, and the GPU mode.
-pub const HARDWARE_ROWS: [GpuJob; 2] = [
+pub(crate) const HARDWARE_ROWS: [GpuJob; 2] = [
     ("hw-trilinear", Filter::Trilinear, GpuFilter::HwTrilinear),
     ("hw-aniso16", Filter::Trilinear, GpuFilter::HwAniso16),
 ];
@@ -31,7 +31,7 @@ pub const HARDWARE_ROWS: [GpuJob; 2] = [
 /// the device's own sampler for `hw-trilinear` and `hw-aniso16`, names' case ignored, in the
 /// list's order, each once. `all` alone is every filter the GPU path has and both hardware rows.
 /// An error names an unknown name, or a filter the GPU path lacks, with what it has.
-pub fn parse_gpu_list(list: &str) -> Result<Vec<GpuJob>> {
+pub(crate) fn parse_gpu_list(list: &str) -> Result<Vec<GpuJob>> {
     if list.trim() == "all" {
         let mut jobs: Vec<_> = GpuFilter::filters()
             .filter_map(|f| GpuFilter::of(f).map(|g| (f.name(), f, g)))

@@ -2,8 +2,7 @@
 //! `--sanitize` policy and error wording.
 
 use anyhow::Result;
-use texel::memory::{MESH_BYTES, TRIANGLE_BYTES, VERTEX_BYTES};
-use texel::texture::{ColorSpace, Limits, LoadOptions, TextureError};
+use texel::texture::{Limits, LoadOptions, TextureError};
 use texel::{MemoryBudget, PreparedScene, Scene, SceneLimits, SceneOptions, TextureStorage};
 
 use texel::raster::SpecularAa;
@@ -12,7 +11,7 @@ use crate::cli::{SceneArgs, Size};
 
 /// How a command reads its inputs: the memory account and the policy for non-finite and
 /// out-of-range texels.
-pub struct Input {
+pub(crate) struct Input {
     /// The `--max-memory` account.
     pub budget: MemoryBudget,
     /// `--sanitize`: replace NaN, infinite and out-of-range texels instead of refusing them.
@@ -22,11 +21,8 @@ pub struct Input {
 impl Input {
     /// How a command-line image is read: `color` for 8-bit data, `--sanitize`, and a memory limit
     /// of what the account has left.
-    pub fn texture_options(&self, color: texel::ColorHandling) -> LoadOptions {
-        let color = match color {
-            texel::ColorHandling::Srgb => ColorSpace::Srgb,
-            texel::ColorHandling::Raw => ColorSpace::Linear,
-        };
+    pub(crate) fn texture_options(&self, color: texel::ColorHandling) -> LoadOptions {
+        let color = color.color_space();
         LoadOptions {
             replace_non_finite: self.sanitize,
             ..LoadOptions::new(
@@ -40,9 +36,9 @@ impl Input {
     }
 
     /// Print a warning when `--sanitize` replaced values of texture `name`.
-    pub fn warn_replaced(&self, name: &str, replaced: u64) {
+    pub(crate) fn warn_replaced(&self, name: &str, replaced: u64) {
         if replaced > 0 {
-            texel::io::stderr_line(format_args!(
+            texel_io::stderr_line(format_args!(
                 "texel: warning: texture {name:?}: replaced {replaced} NaN, infinite or out-of-range channel values (NaN -> 0, +-inf -> +-{inf}, beyond +-{max:e} -> +-{max:e})",
                 inf = texel::texture::NON_FINITE_CLAMP,
                 max = texel::texture::MAX_TEXEL
@@ -51,7 +47,7 @@ impl Input {
     }
 
     /// Add to a texture's memory-limit error which flag sets the limit.
-    pub fn explain(&self, e: anyhow::Error) -> anyhow::Error {
+    pub(crate) fn explain(&self, e: anyhow::Error) -> anyhow::Error {
         let over = e.chain().any(|c| {
             matches!(
                 c.downcast_ref::<TextureError>(),
@@ -72,28 +68,8 @@ impl Input {
     }
 }
 
-/// The scene limits that fit in `remaining` bytes: [`SceneLimits::default`], lowered where the
-/// account is smaller. Allowances read off the loaders, not measured peaks: a glTF/GLB file is held
-/// up to three times while it loads (the file, its binary chunk, the buffers) and an OBJ file about
-/// as often with `tobj`'s vectors, so files get a quarter of what is left; the TOML parser's tables
-/// get a sixteenth for the text; a triangle may bring three vertices of its own and needs at least
-/// one rasterizer set-up and bin entry (about 700 bytes; `texel::memory::raster_bytes` counts them
-/// exactly once the mesh is loaded).
-pub fn scene_limits(remaining: u64) -> SceneLimits {
-    let d = SceneLimits::default();
-    SceneLimits {
-        max_scene_bytes: d.max_scene_bytes.min(remaining / 16),
-        max_mesh_file_bytes: d.max_mesh_file_bytes.min(remaining / 4),
-        max_triangles: d
-            .max_triangles
-            .min(remaining / (TRIANGLE_BYTES + 3 * VERTEX_BYTES + 700)),
-        max_vertices: d.max_vertices.min(remaining / VERTEX_BYTES),
-        max_meshes: d.max_meshes.min(remaining / MESH_BYTES),
-    }
-}
-
 /// Load the scene of a command's [`SceneArgs`] within `input`'s account.
-pub fn load_scene(args: &SceneArgs, input: &mut Input) -> Result<PreparedScene> {
+pub(crate) fn load_scene(args: &SceneArgs, input: &mut Input) -> Result<PreparedScene> {
     load_scene_with(
         &args.scene,
         args.color,
@@ -105,7 +81,7 @@ pub fn load_scene(args: &SceneArgs, input: &mut Input) -> Result<PreparedScene> 
 
 /// What the CLI overrides in every material (`--specular-aa`, `--displacement`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct MaterialOverrides {
+pub(crate) struct MaterialOverrides {
     /// `--specular-aa`.
     pub specular_aa: Option<SpecularAa>,
     /// `--shading-samples`.
@@ -130,7 +106,7 @@ pub struct MaterialOverrides {
 
 impl MaterialOverrides {
     /// The overrides a command's [`SceneArgs`] give.
-    pub fn of(args: &SceneArgs) -> Self {
+    pub(crate) fn of(args: &SceneArgs) -> Self {
         MaterialOverrides {
             specular_aa: args.specular_aa,
             shading_samples: args.shading_samples,
@@ -150,7 +126,7 @@ impl MaterialOverrides {
 /// `--texture-storage` when given, else `preferred`. The GPU path uploads the texels as stored
 /// and the fixed-point path (`--precision gpu`) reads 8-bit codes, so with either `float` is
 /// refused when asked for and not chosen by default.
-pub fn texture_storage(
+pub(crate) fn texture_storage(
     args: &SceneArgs,
     gpu: bool,
     preferred: TextureStorage,
@@ -173,20 +149,20 @@ pub fn texture_storage(
 }
 
 /// [`texture_storage`]'s refusals for a command whose default is stored.
-pub fn check_storage(args: &SceneArgs, gpu: bool) -> Result<()> {
+pub(crate) fn check_storage(args: &SceneArgs, gpu: bool) -> Result<()> {
     texture_storage(args, gpu, TextureStorage::Stored).map(drop)
 }
 
 /// Load `scene` (a path or `builtin:NAME`) and its textures within `input`'s account, with
 /// `color` handling, an output `size` and the material `overrides`.
-pub fn load_scene_with(
+pub(crate) fn load_scene_with(
     scene: &str,
     color: texel::ColorHandling,
     size: Option<Size>,
     overrides: MaterialOverrides,
     input: &mut Input,
 ) -> Result<PreparedScene> {
-    let limits = scene_limits(input.budget.remaining());
+    let limits = input.budget.scene_limits();
     let d = SceneLimits::default();
     // The limits lowered to fit the account, as the errors print them.
     let lowered: Vec<String> = [
@@ -233,7 +209,7 @@ pub fn load_scene_with(
         input.warn_replaced(name, *n);
     }
     for (name, bytes) in &prepared.kept_stored {
-        texel::io::stderr_line(format_args!(
+        texel_io::stderr_line(format_args!(
             "texel: note: texture {name:?} stays 8-bit: its float copy ({}) does not fit {}",
             texel::memory::mib(*bytes),
             input.budget.name()

@@ -6,7 +6,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Exit status after SIGINT, SIGTERM or SIGHUP (128 + SIGINT, as shells report an interrupt).
-pub const INTERRUPTED: i32 = 130;
+pub(crate) const INTERRUPTED: i32 = 130;
 
 /// Whether a [`Graceful`] guard is held.
 static GRACEFUL: AtomicBool = AtomicBool::new(false);
@@ -15,29 +15,27 @@ static GRACEFUL: AtomicBool = AtomicBool::new(false);
 static STOP: AtomicBool = AtomicBool::new(false);
 
 /// The signal handler.
-pub fn on_signal() {
+pub(crate) fn on_signal() {
     if GRACEFUL.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
-        texel::io::stderr_text(
-            "\ntexel: stopping at the next pixel row (a second signal aborts)\n",
-        );
+        texel_io::stderr_text("\ntexel: stopping at the next pixel row (a second signal aborts)\n");
         return;
     }
-    texel::io::remove_pending_and_exit(INTERRUPTED)
+    texel_io::remove_pending_and_exit(INTERRUPTED)
 }
 
 /// While alive, the first signal raises [`Graceful::flag`] instead of exiting.
-pub struct Graceful(());
+pub(crate) struct Graceful(());
 
 impl Graceful {
     /// Start handling signals gracefully.
-    pub fn begin() -> Graceful {
+    pub(crate) fn begin() -> Graceful {
         STOP.store(false, Ordering::SeqCst);
         GRACEFUL.store(true, Ordering::SeqCst);
         Graceful(())
     }
 
     /// The flag the first signal raises.
-    pub fn flag(&self) -> &'static AtomicBool {
+    pub(crate) fn flag(&self) -> &'static AtomicBool {
         &STOP
     }
 }
@@ -52,4 +50,4 @@ impl Drop for Graceful {
 /// and exits with [`INTERRUPTED`].
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
-pub struct Interrupted(pub String);
+pub(crate) struct Interrupted(pub String);

@@ -35,17 +35,17 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return clap_exit(&e),
     };
-    // A decoder panic that texel::io::guarded turns into an error is not reported as a
+    // A decoder panic that texel_io::guarded turns into an error is not reported as a
     // panic; every other panic is.
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        if !texel::io::in_guarded_decode() {
+        if !texel_io::in_guarded_decode() {
             default_hook(info);
         }
     }));
     // An interrupted run deletes its unpublished temporary files and staging directories.
     if let Err(e) = ctrlc::set_handler(interrupt::on_signal) {
-        texel::io::stderr_line(format_args!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files"));
+        texel_io::stderr_line(format_args!("texel: warning: cannot handle interrupts ({e}); an interrupted run may leave hidden .texel-*.tmp files"));
     }
     let mut input = input::Input {
         budget: budget::budget(cli.max_memory),
@@ -76,7 +76,7 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             // One line whatever the paths and names in it hold.
-            texel::io::stderr_line(format_args!("texel: error: {}", chain_line(&err)));
+            texel_io::stderr_line(format_args!("texel: error: {}", chain_line(&err)));
             if err.downcast_ref::<interrupt::Interrupted>().is_some() {
                 return ExitCode::from(interrupt::INTERRUPTED as u8);
             }
@@ -93,12 +93,12 @@ fn clap_exit(e: &clap::Error) -> ExitCode {
     let hostile: Vec<String> = std::env::args_os()
         .skip(1)
         .map(|a| a.to_string_lossy().into_owned())
-        .filter(|a| a.chars().any(texel::io::term::needs_escape))
+        .filter(|a| a.chars().any(texel_io::term::needs_escape))
         .collect();
     if !e.use_stderr() {
         if let Err(err) = e.print() {
             if err.kind() != std::io::ErrorKind::BrokenPipe {
-                texel::io::stderr_line(format_args!(
+                texel_io::stderr_line(format_args!(
                     "texel: error: cannot write to standard output: {err}"
                 ));
                 return ExitCode::FAILURE;
@@ -112,12 +112,12 @@ fn clap_exit(e: &clap::Error) -> ExitCode {
         for a in &hostile {
             // The whole argument, and the value after its `=` that clap may quote alone.
             for part in std::iter::once(a.as_str()).chain(a.split_once('=').map(|(_, v)| v)) {
-                text = text.replace(part, &texel::io::escape(part));
+                text = text.replace(part, &texel_io::escape(part));
             }
         }
         // Without the styles (plain text, as clap prints when colour is off).
         let plain = clap::builder::StyledStr::from(text).to_string();
-        texel::io::stderr_text(&plain);
+        texel_io::stderr_text(&plain);
     }
     ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
 }

@@ -9,20 +9,11 @@ use anyhow::{Context, Result};
 use texel::quality::{Encoding, Image8};
 
 use texel::raster::Frame;
-use texel::ColorHandling;
-
-/// The 8-bit encoding `--color` asks for: sRGB-encoded RGB, or raw `round(255 x)`.
-pub fn encoding(color: impl Into<ColorHandling>) -> Encoding {
-    match color.into() {
-        ColorHandling::Srgb => Encoding::Srgb,
-        ColorHandling::Raw => Encoding::Linear,
-    }
-}
 
 /// Whether `path` names an OpenEXR file (extension `exr`, in any case). Such outputs hold the
 /// frame's linear colour as 32-bit floats, unclamped (radiance above 1 is kept), whatever
 /// `--color` says about encoding.
-pub fn is_exr(path: &Path) -> bool {
+pub(crate) fn is_exr(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
@@ -34,7 +25,7 @@ pub fn is_exr(path: &Path) -> bool {
 ///
 /// # Errors
 /// A message naming the extension and the formats texel writes.
-pub fn image_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
+pub(crate) fn image_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
     let path = std::path::PathBuf::from(s);
     let s = path.display().to_string();
     if let Some(ext) = path.extension().and_then(|e| e.to_str()) {
@@ -54,7 +45,7 @@ pub fn image_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String>
 ///
 /// # Errors
 /// As [`image_output`].
-pub fn png_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
+pub(crate) fn png_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
     let path = image_output(s)?;
     let s = path.display().to_string();
     if is_exr(&path) {
@@ -66,37 +57,36 @@ pub fn png_output(s: std::ffi::OsString) -> Result<std::path::PathBuf, String> {
 }
 
 /// Check a command's outputs (each flag with its path) before any work: no two of them can reach
-/// one file or stream, however they are spelled ([`texel::io::same_output`]: `-` and
-/// `/dev/stdout`, a link and its target), and each can be written ([`texel::io::check_output`]).
+/// one file or stream, however they are spelled ([`texel_io::same_output`]: `-` and
+/// `/dev/stdout`, a link and its target), and each can be written ([`texel_io::check_output`]).
 ///
 /// # Errors
 /// The two flags that name one output, or the first output that cannot be written.
-pub fn check_outputs(outputs: &[(&str, &Path)]) -> Result<()> {
+pub(crate) fn check_outputs(outputs: &[(&str, &Path)]) -> Result<()> {
     for (i, &(flag, path)) in outputs.iter().enumerate() {
         for &(other_flag, other) in &outputs[..i] {
             anyhow::ensure!(
-                !texel::io::same_output(path, other),
+                !texel_io::same_output(path, other),
                 "{other_flag} {} and {flag} {} name the same file or stream: give each output a \
                  path of its own",
                 other.display(),
                 path.display()
             );
         }
-        texel::io::check_output(path)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        texel_io::check_output(path).with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
 }
 
 /// Publish `frame` at `path`: OpenEXR of its linear colour ([`is_exr`]; a float frame is
 /// written as it is, an 8-bit one decoded), else PNG encoded as `encoding` ([`write_image`]).
-pub fn write_frame(path: &Path, frame: &Frame, encoding: Encoding) -> Result<()> {
+pub(crate) fn write_frame(path: &Path, frame: &Frame, encoding: Encoding) -> Result<()> {
     write_frame_with_text(path, frame, encoding, &[])
 }
 
 /// [`write_frame`] with text entries (`keyword`, `text`): a PNG `tEXt` chunk or an OpenEXR
 /// header attribute each.
-pub fn write_frame_with_text(
+pub(crate) fn write_frame_with_text(
     path: &Path,
     frame: &Frame,
     encoding: Encoding,
@@ -112,15 +102,15 @@ pub fn write_frame_with_text(
 }
 
 /// `png` with a `tEXt` chunk for each text entry.
-pub fn with_text(png: Vec<u8>, text: &[(&str, &str)]) -> Vec<u8> {
+pub(crate) fn with_text(png: Vec<u8>, text: &[(&str, &str)]) -> Vec<u8> {
     text.iter().fold(png, |png, (keyword, value)| {
         texel::quality::png_with_text(&png, keyword, value)
     })
 }
 
-/// Publish encoded image bytes at `path` ([`texel::io::write_atomic`]), or on standard output for
+/// Publish encoded image bytes at `path` ([`texel_io::write_atomic`]), or on standard output for
 /// `-`.
-pub fn publish(path: &Path, bytes: &[u8]) -> Result<()> {
+pub(crate) fn publish(path: &Path, bytes: &[u8]) -> Result<()> {
     if path.as_os_str() == "-" {
         let mut out = std::io::stdout().lock();
         return out
@@ -128,12 +118,12 @@ pub fn publish(path: &Path, bytes: &[u8]) -> Result<()> {
             .and_then(|()| out.flush())
             .context("cannot write the PNG to standard output");
     }
-    texel::io::write_atomic(path, bytes).with_context(|| format!("cannot write {}", path.display()))
+    texel_io::write_atomic(path, bytes).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Publish linear RGBA pixels at `path`: OpenEXR for a `.exr` path ([`is_exr`]), else PNG
 /// encoded as `color` says ([`write_image`]).
-pub fn write_linear(
+pub(crate) fn write_linear(
     path: &Path,
     width: u32,
     height: u32,
@@ -143,7 +133,7 @@ pub fn write_linear(
     if is_exr(path) {
         return write_exr(path, width, height, pixels);
     }
-    let image = Image8::from_linear(width, height, pixels, encoding(color))?;
+    let image = Image8::from_linear(width, height, pixels, color.encoding())?;
     write_image(path, &image)
 }
 
@@ -153,9 +143,9 @@ fn write_exr(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]]) -> Resul
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Publish an 8-bit image as PNG at `path` ([`texel::io::write_atomic`]: atomically over a
+/// Publish an 8-bit image as PNG at `path` ([`texel_io::write_atomic`]: atomically over a
 /// regular file or a new path, through to a device or FIFO), or on standard output for `-`.
-pub fn write_image(path: &Path, image: &Image8) -> Result<()> {
+pub(crate) fn write_image(path: &Path, image: &Image8) -> Result<()> {
     if is_exr(path) {
         anyhow::bail!(
             "cannot write {}: this image is 8-bit, written as PNG only (use a .png name)",

@@ -5,7 +5,7 @@ use texel::compare::Stage;
 use texel::raster::ReferenceStatus;
 
 /// A bar counting `total` units of `what`, drawn on stderr only if it is a terminal.
-pub fn bar(total: u64, what: &str) -> ProgressBar {
+pub(crate) fn bar(total: u64, what: &str) -> ProgressBar {
     let pb = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
     pb.set_style(
         ProgressStyle::with_template(
@@ -19,7 +19,7 @@ pub fn bar(total: u64, what: &str) -> ProgressBar {
 }
 
 /// Show a reference's round on `pb`.
-pub fn show_status(pb: &indicatif::ProgressBar, s: &ReferenceStatus) {
+pub(crate) fn show_status(pb: &indicatif::ProgressBar, s: &ReferenceStatus) {
     pb.set_length(s.total.max(1));
     pb.set_position(s.done);
     pb.set_message(format!(
@@ -34,7 +34,7 @@ pub fn show_status(pb: &indicatif::ProgressBar, s: &ReferenceStatus) {
 /// Progress bars for a comparison: its own (a bar for each reference's rounds, then one over the
 /// filters) or, where a caller shows one bar over several comparisons (`texel demo`), that bar,
 /// counting the reference and each filter.
-pub struct Bars {
+pub(crate) struct Bars {
     shared: Option<(indicatif::ProgressBar, String)>,
     filters: usize,
     /// The bar drawn now, of the comparison's own.
@@ -43,7 +43,7 @@ pub struct Bars {
 
 impl Bars {
     /// The comparison's own bars, over `filters` filters.
-    pub fn own(filters: usize) -> Self {
+    pub(crate) fn own(filters: usize) -> Self {
         Bars {
             shared: None,
             filters,
@@ -52,7 +52,7 @@ impl Bars {
     }
 
     /// `shared`, its messages prefixed by the scene's `label`.
-    pub fn shared(shared: indicatif::ProgressBar, label: &str) -> Self {
+    pub(crate) fn shared(shared: indicatif::ProgressBar, label: &str) -> Self {
         Bars {
             shared: Some((shared, label.to_string())),
             filters: 0,
@@ -61,7 +61,7 @@ impl Bars {
     }
 
     /// Clear the bar the comparison drew last.
-    pub fn finish(&self) {
+    pub(crate) fn finish(&self) {
         if let Some(pb) = self.bar().take() {
             pb.finish_and_clear();
         }
@@ -82,7 +82,7 @@ impl texel::compare::Progress for Bars {
         match (stage, &self.shared) {
             (Stage::Reference { n, of }, None) => {
                 if n > 0 {
-                    texel::io::stderr_line(format_args!("orbit frame {n} of {}", of - 1));
+                    texel_io::stderr_line(format_args!("orbit frame {n} of {}", of - 1));
                 }
                 self.finish();
                 *self.bar() = Some(bar(1, "reference"));

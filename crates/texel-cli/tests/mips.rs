@@ -23,7 +23,7 @@ fn mips_writes_every_level_and_the_chain() {
         .map(|(k, (w, h))| format!("level-{k:02}-{w}x{h}.png"))
         .collect();
     expected.push("chain.png".to_string());
-    expected.push(texel::io::OUTPUT_MARKER.to_string());
+    expected.push(texel_io::OUTPUT_MARKER.to_string());
     expected.sort();
     assert_eq!(files, expected);
     for (k, &(w, h)) in sizes.iter().enumerate() {

@@ -242,7 +242,7 @@ fn refinement_adds_samples_only_where_needed() {
 
 /// The display value (8-bit steps, clipped, sRGB) of a linear value.
 fn display(x: f32) -> f64 {
-    texel::texture::base::color::displayed(f64::from(x), true) * 255.0
+    texel::texture::displayed(f64::from(x), true) * 255.0
 }
 
 /// Glints (`scenes/glints.toml`: a sharp lobe on a bumpy plane under a grazing light) at 48 x 27:

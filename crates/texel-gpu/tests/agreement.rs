@@ -40,7 +40,7 @@ fn gpu() -> Option<Gpu> {
 /// PSNR (dB) of the 8-bit sRGB encodings of `a` and `b` over pixels both cover, and the largest
 /// difference of one 8-bit channel.
 fn psnr(a: &texel::Frame, b: &texel::Frame) -> (f64, u8, usize) {
-    let enc = |x: f32| texel::texture::base::color::linear_to_srgb8(x);
+    let enc = |x: f32| texel::texture::linear_to_srgb8(x);
     let (mut sum, mut n, mut worst) = (0.0f64, 0usize, 0u8);
     for k in 0..a.color.len() {
         if !(a.covered(k) && b.covered(k)) {

@@ -3,7 +3,7 @@
 //! `texCoord`, texture access through `texelFetch` and `textureSize` only); texel runs it unchanged
 //! on OpenGL ([`gl`], through EGL: Mesa's llvmpipe without a GPU), checks the access rule
 //! ([`source`]), and grades every mode on every scene against its own mode under the OpenGL rules
-//! and under the handout's formulas ([`mod@grade`]), with the supersampled reference beside it.
+//! and under the handout's formulas ([`grading`]), with the supersampled reference beside it.
 //!
 //! The work is split in two so that a shader that never finishes cannot hang the grader:
 //! [`run_device`] renders (the CLI runs it in a child process with a time limit) and writes what
@@ -12,7 +12,7 @@
 //! through it.
 
 pub mod gl;
-pub mod grade;
+pub mod grading;
 pub mod report;
 pub mod scene;
 pub mod source;
@@ -26,7 +26,7 @@ use texel_raster::ReferencePlan;
 use texel_texture::Convention;
 
 pub use gl::{Capture, Gl, GlError, Names};
-pub use grade::Verdict;
+pub use grading::Verdict;
 pub use scene::{LabScene, LAB_SCENES};
 pub use source::Violation;
 
@@ -171,7 +171,7 @@ pub struct ModeResult {
     pub scene: String,
     /// `gl`, `lab` or `neither`.
     pub verdict: Verdict,
-    /// Share of covered pixels within [`grade::AGREE_CODES`] of texel's mode under GL's rules.
+    /// Share of covered pixels within [`grading::AGREE_CODES`] of texel's mode under GL's rules.
     pub agreement_gl: f64,
     /// The same under the lab's formulas.
     pub agreement_lab: f64,
@@ -364,7 +364,7 @@ pub fn grade(
         let (w, h) = scene.size();
         let n = (w as usize) * (h as usize);
         let capture = read_capture(&capture_path(dir, k), n)?;
-        let mask = grade::covered(&capture);
+        let mask = grading::covered(&capture);
         let (reference, ref_covered) = reference(&scene, options)?;
         let ref_mask: Vec<bool> = mask
             .iter()
@@ -414,7 +414,7 @@ pub fn grade(
             rule_violations: source::violations(&job.fragment),
             comment_lines: source::comment_lines(&job.fragment),
             level_size_queries: source::level_size_queries(&job.fragment),
-            agreement_measure: (grade::AGREE_CODES, grade::AGREE_SHARE),
+            agreement_measure: (grading::AGREE_CODES, grading::AGREE_SHARE),
             modes,
             rubric,
             score,
@@ -505,11 +505,12 @@ impl GradedScene<'_> {
     ) -> Result<ModeResult, Error> {
         let (scene, capture, mask) = (self.scene, self.capture, &self.mask[..]);
         let (w, h) = scene.size();
-        let gl = grade::convention_match(scene, capture, mode, Convention::Gl, &shader_px, mask);
-        let lab = grade::convention_match(scene, capture, mode, Convention::Lab, &shader_px, mask);
-        let verdict = grade::verdict(gl.agreement, lab.agreement);
+        let gl = grading::convention_match(scene, capture, mode, Convention::Gl, &shader_px, mask);
+        let lab =
+            grading::convention_match(scene, capture, mode, Convention::Lab, &shader_px, mask);
+        let verdict = grading::verdict(gl.agreement, lab.agreement);
         let diagnosis = if verdict == Verdict::Neither {
-            grade::diagnose(scene, capture, mode, &shader_px, mask, (&gl, &lab))
+            grading::diagnose(scene, capture, mode, &shader_px, mask, (&gl, &lab))
         } else {
             Vec::new()
         };

@@ -11,6 +11,7 @@
 //! limits set from what the budget had left ([`MemoryBudget::texture_limits`]) is restated so
 //! ([`MemoryBudget::restate`]).
 
+use texel_scene::SceneLimits;
 use texel_texture::{Limits, TextureError};
 
 use crate::Error;
@@ -29,11 +30,6 @@ pub const VERTEX_BYTES: u64 = 48 + std::mem::size_of::<texel_raster::Vertex>() a
 /// What a scene keeps per mesh beyond its vertices and triangles, as an allowance: the mesh's
 /// record and names, its vectors' allocations, and the renderer's per-draw state.
 pub const MESH_BYTES: u64 = 4096;
-
-/// What building a ripmap holds per level-0 texel while it runs, beyond the ripmap itself: the
-/// `f32` scratch of texel-texture's ripmap build (the decoded level 0, an x-reduced image and a
-/// y chain), which the texture's own limit counts too.
-pub const RIPMAP_SCRATCH_PER_TEXEL: u64 = 40;
 
 /// What a scene keeps per triangle: its indices (12 bytes). The rasterizer's per-frame set-up and
 /// tile bins depend on where the triangle lands on screen: [`raster_bytes`].
@@ -392,6 +388,27 @@ impl MemoryBudget {
         Limits {
             max_bytes: self.remaining(),
             ..Limits::default()
+        }
+    }
+
+    /// The scene limits of loading within what is left: [`SceneLimits::default`], lowered where
+    /// [`MemoryBudget::remaining`] is smaller. Allowances read off the loaders, not measured peaks:
+    /// a glTF/GLB file is held up to three times while it loads (the file, its binary chunk, the
+    /// buffers) and an OBJ file about as often with `tobj`'s vectors, so files get a quarter of
+    /// what is left; the TOML parser's tables get a sixteenth for the text; a triangle may bring
+    /// three vertices of its own and needs at least one rasterizer set-up and bin entry (about 700
+    /// bytes; [`raster_bytes`] counts them exactly once the mesh is loaded).
+    pub fn scene_limits(&self) -> SceneLimits {
+        let remaining = self.remaining();
+        let d = SceneLimits::default();
+        SceneLimits {
+            max_scene_bytes: d.max_scene_bytes.min(remaining / 16),
+            max_mesh_file_bytes: d.max_mesh_file_bytes.min(remaining / 4),
+            max_triangles: d
+                .max_triangles
+                .min(remaining / (TRIANGLE_BYTES + 3 * VERTEX_BYTES + 700)),
+            max_vertices: d.max_vertices.min(remaining / VERTEX_BYTES),
+            max_meshes: d.max_meshes.min(remaining / MESH_BYTES),
         }
     }
 

@@ -21,9 +21,7 @@ use texel_texture::base::color::srgb_to_linear;
 use texel_texture::{AddressMode, ColorSpace, Convention, Format, Limits, Sampler, Texture};
 
 use crate::bake::{self, Composite};
-use crate::memory::{
-    raster_bytes, FRAME_BYTES_PER_PIXEL, RIPMAP_SCRATCH_PER_TEXEL, TRIANGLE_BYTES, VERTEX_BYTES,
-};
+use crate::memory::{raster_bytes, FRAME_BYTES_PER_PIXEL, TRIANGLE_BYTES, VERTEX_BYTES};
 use crate::tessellate::Tessellated;
 use crate::{Error, Filter, MemoryBudget};
 
@@ -63,6 +61,22 @@ impl ColorHandling {
         match self {
             ColorHandling::Srgb => "srgb",
             ColorHandling::Raw => "raw",
+        }
+    }
+
+    /// The 8-bit encoding of frames and images: sRGB-encoded RGB, or raw `round(255 x)`.
+    pub fn encoding(self) -> texel_quality::Encoding {
+        match self {
+            ColorHandling::Srgb => texel_quality::Encoding::Srgb,
+            ColorHandling::Raw => texel_quality::Encoding::Linear,
+        }
+    }
+
+    /// How an 8-bit image read under this handling decodes: as sRGB, or as raw linear values.
+    pub fn color_space(self) -> ColorSpace {
+        match self {
+            ColorHandling::Srgb => ColorSpace::Srgb,
+            ColorHandling::Raw => ColorSpace::Linear,
         }
     }
 }
@@ -194,7 +208,7 @@ pub struct SceneOptions {
 /// # Errors
 /// [`texel_scene::SceneError::Environment`] for a map from files in another mapping: their
 /// layout is their own.
-pub fn relay_sky(
+pub(crate) fn relay_sky(
     spec: &texel_scene::EnvironmentSpec,
     mapping: Option<texel_scene::Mapping>,
 ) -> Result<texel_scene::EnvironmentSpec, texel_scene::SceneError> {
@@ -577,7 +591,7 @@ impl PreparedScene {
     /// [`PreparedScene::build_structures`], charging `budget` for each ripmap and summed-area
     /// table before it is built (once per texture and kind, names that share a texture sharing
     /// its structures: they are kept for later frames), and for a ripmap's build scratch while
-    /// it is built ([`crate::memory::RIPMAP_SCRATCH_PER_TEXEL`]).
+    /// it is built ([`Texture::build_scratch_bytes`]).
     ///
     /// # Errors
     /// [`Error::OverBudget`], for the budget's refusal and for a texture's own (its limits were
@@ -589,10 +603,9 @@ impl PreparedScene {
         budget: &mut MemoryBudget,
     ) -> Result<u64, Error> {
         for (mesh, sampler) in self.scene.meshes.iter().zip(samplers) {
-            // The structure, and what its build holds per level-0 texel while it runs.
-            let (kind, scratch_per_texel) = match sampler.descriptor().min_filter {
-                texel_texture::FilterMode::Ripmap => ("ripmap", RIPMAP_SCRATCH_PER_TEXEL),
-                texel_texture::FilterMode::SummedArea => ("summed-area table", 0),
+            let kind = match sampler.descriptor().min_filter {
+                texel_texture::FilterMode::Ripmap => "ripmap",
+                texel_texture::FilterMode::SummedArea => "summed-area table",
                 _ => continue,
             };
             let tex = &self.textures[&mesh.texture];
@@ -602,7 +615,7 @@ impl PreparedScene {
                 continue;
             }
             let extra = tex.structure_bytes(sampler.descriptor()) - tex.pyramid_bytes();
-            let scratch = u64::from(tex.width()) * u64::from(tex.height()) * scratch_per_texel;
+            let scratch = tex.build_scratch_bytes(sampler.descriptor());
             let with = if scratch > 0 {
                 " with its build scratch"
             } else {
@@ -1506,7 +1519,7 @@ fn layers_of<'a>(
 
 /// The most triangles a tessellated mesh may have: 2^25, the scene's own default limit. The
 /// reference's geometry of `builtin:bricks` at 1280 x 720 (0.75-pixel edges) has 9.3 million.
-pub const MAX_TESSELLATED_TRIANGLES: usize = 1 << 25;
+pub(crate) const MAX_TESSELLATED_TRIANGLES: usize = 1 << 25;
 
 /// The displacement a material gets: `overridden` (the CLI's `--displacement`) or its own.
 fn displacement(
@@ -1537,7 +1550,7 @@ fn texel_vertices(mesh: &texel_scene::Mesh) -> Vec<Vertex> {
 /// A light direction as the shading normalises it: unchanged where its length squared is a normal
 /// f32, else the unit vector of the same direction found in f64 (a direction of `[3e38, 3e38,
 /// 3e38]` overflows f32's length and one of `1e-30` underflows it; both name a direction).
-pub fn shading_direction(direction: glam::Vec3) -> glam::Vec3 {
+pub(crate) fn shading_direction(direction: glam::Vec3) -> glam::Vec3 {
     let l = direction.length_squared();
     if l.is_normal() && l.is_finite() {
         return direction;

@@ -177,7 +177,7 @@ impl FilterRow {
 mod inf_f64 {
     use serde::{Deserialize, Deserializer, Serializer};
 
-    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+    pub(super) fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
         if *v == f64::INFINITY {
             s.serialize_str("inf")
         } else if *v == f64::NEG_INFINITY {
@@ -194,7 +194,7 @@ mod inf_f64 {
         Str(String),
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
         match Repr::deserialize(d)? {
             Repr::Num(v) => Ok(v),
             Repr::Str(s) if s == "inf" => Ok(f64::INFINITY),
@@ -216,11 +216,11 @@ mod opt_inf_f64 {
     #[derive(Deserialize)]
     struct De(#[serde(with = "super::inf_f64")] f64);
 
-    pub fn serialize<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    pub(super) fn serialize<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
         v.map(Ser).serialize(s)
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
         Ok(Option::<De>::deserialize(d)?.map(|De(v)| v))
     }
 }

@@ -149,7 +149,7 @@ impl UvPlanes {
     /// j_hi]`, inclusive) under `perspective`, with the address modes' `period`s (0: none). The
     /// anchor is the pixel of the range's centre and corners where `r` is largest (the nearest,
     /// most magnified part, where accuracy matters most; all of them are equal when affine).
-    pub fn new(
+    pub(crate) fn new(
         t: &TriangleSetup,
         uvs: [DVec2; 3],
         perspective: Perspective,
@@ -216,20 +216,20 @@ impl UvPlanes {
 
     /// `1 / r` at `(dx, dy)` pixels from the anchor.
     #[inline(always)]
-    pub fn inv_r(&self, dx: f32, dy: f32) -> f32 {
+    pub(crate) fn inv_r(&self, dx: f32, dy: f32) -> f32 {
         1.0 / (self.r[0] + self.r[1] * dx + self.r[2] * dy)
     }
 
     /// `u'` (`c = 0`) or `v'` (`c = 1`) at `(dx, dy)` pixels from the anchor, given `1 / r` there.
     #[inline(always)]
-    pub fn value(&self, c: usize, dx: f32, dy: f32, inv_r: f32) -> f32 {
+    pub(crate) fn value(&self, c: usize, dx: f32, dy: f32, inv_r: f32) -> f32 {
         let p = if c == 0 { &self.u } else { &self.v };
         (p[0] + p[1] * dx + p[2] * dy) * inv_r
     }
 
     /// `(d/dx, d/dy)` of `u'` (`c = 0`) or `v'` (`c = 1`), given its value and `1 / r`.
     #[inline(always)]
-    pub fn derivatives(&self, c: usize, value: f32, inv_r: f32) -> (f32, f32) {
+    pub(crate) fn derivatives(&self, c: usize, value: f32, inv_r: f32) -> (f32, f32) {
         let p = if c == 0 { &self.u } else { &self.v };
         (
             (p[1] - value * self.r[1]) * inv_r,
@@ -239,7 +239,7 @@ impl UvPlanes {
 
     /// The offset of pixel `(i, j)` from the anchor, in pixels (exact: both are below `2^24`).
     #[inline(always)]
-    pub fn offset(&self, i: u32, j: u32) -> (f32, f32) {
+    pub(crate) fn offset(&self, i: u32, j: u32) -> (f32, f32) {
         (
             (i as i32 - self.anchor[0] as i32) as f32,
             (j as i32 - self.anchor[1] as i32) as f32,
@@ -249,7 +249,7 @@ impl UvPlanes {
     /// The footprint at pixel `(i, j)`: `uv` reduced and its analytic derivatives. The span
     /// stages in `tile.rs` perform the same operations in the same order over many pixels.
     #[inline(always)]
-    pub fn footprint(&self, i: u32, j: u32) -> Footprint {
+    pub(crate) fn footprint(&self, i: u32, j: u32) -> Footprint {
         let (dx, dy) = self.offset(i, j);
         let inv = self.inv_r(dx, dy);
         let (u, v) = (self.value(0, dx, dy, inv), self.value(1, dx, dy, inv));
@@ -269,7 +269,7 @@ impl UvPlanes {
     /// [`quad_differences`]' order: `uv'` at the four pixels, derivatives as its differences
     /// within the quad (before the reduction, which would break them at a period's edge).
     #[inline(always)]
-    pub fn quad_footprints(&self, qi: u32, qj: u32) -> [Footprint; 4] {
+    pub(crate) fn quad_footprints(&self, qi: u32, qj: u32) -> [Footprint; 4] {
         let uv: [[f32; 2]; 4] = std::array::from_fn(|k| {
             let (dx, dy) = self.offset(qi + (k as u32 & 1), qj + (k as u32 >> 1));
             let inv = self.inv_r(dx, dy);
@@ -300,7 +300,7 @@ impl UvPlanes {
     /// `x` (a `u'` for `c = 0`, a `v'` for `c = 1`) reduced into `[0, period]` by whole periods
     /// (unchanged without a period, or for `|x / period| >= 2^22`, beyond the staged floor).
     #[inline(always)]
-    pub fn reduce(&self, c: usize, x: f32) -> f32 {
+    pub(crate) fn reduce(&self, c: usize, x: f32) -> f32 {
         let (p, inv_p) = (self.period[c], self.inv_period[c]);
         let t = x * inv_p;
         let q = texel_texture::base::floor::floor_staged(t);

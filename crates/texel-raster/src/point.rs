@@ -26,7 +26,7 @@ pub(crate) struct ShadingPoint<'v> {
 impl ShadingPoint<'_> {
     /// The barycentrics in `f32`, as vertex attributes are interpolated.
     #[inline(always)]
-    pub fn l(&self) -> Vec3 {
+    pub(crate) fn l(&self) -> Vec3 {
         self.lambda.as_vec3()
     }
 }

@@ -19,7 +19,7 @@ use crate::point::ShadingPoint;
 
 /// The fewest and the most linear steps of the parallax march (at normal incidence and at
 /// grazing angles; Tatarchuk 2006 interpolates between them by `n.v`).
-pub const POM_STEPS: (u32, u32) = (8, 64);
+pub(crate) const POM_STEPS: (u32, u32) = (8, 64);
 
 /// The specular lobe a shading normal is read for: the antialiasing method and the perceptual
 /// roughness before it.

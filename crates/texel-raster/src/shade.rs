@@ -112,7 +112,7 @@ fn eye_of(draw: &DrawCall) -> Vec3 {
 }
 
 impl<'a> DrawContext<'a> {
-    pub fn new(draw: &DrawCall<'a>) -> Self {
+    pub(crate) fn new(draw: &DrawCall<'a>) -> Self {
         let d = draw.sampler.descriptor();
         DrawContext {
             texture: draw.texture,
@@ -133,7 +133,7 @@ impl<'a> DrawContext<'a> {
     /// Triangle `t` ready for its per-pixel sphere mapping ([`MappedTriangle`]); `None` when
     /// the draw interpolates the vertices' `uv`.
     #[inline(always)]
-    pub fn mapped(&self, t: &TriangleSetup) -> Option<MappedTriangle> {
+    pub(crate) fn mapped(&self, t: &TriangleSetup) -> Option<MappedTriangle> {
         let (projection, centre) = self.surface?;
         Some(MappedTriangle {
             projection,
@@ -144,26 +144,26 @@ impl<'a> DrawContext<'a> {
     /// Whether an unlit fragment's colour is the texture sample unchanged: no material (no
     /// factor, no layers) and every vertex colour opaque white ([`shade`] without lighting then
     /// returns its `tex`).
-    pub fn unshaded(&self) -> bool {
+    pub(crate) fn unshaded(&self) -> bool {
         !self.colored && self.material.is_none()
     }
 
     /// The triangle's vertices.
     #[inline(always)]
-    pub fn vertices(&self, t: &TriangleSetup) -> [&'a Vertex; 3] {
+    pub(crate) fn vertices(&self, t: &TriangleSetup) -> [&'a Vertex; 3] {
         t.indices.map(|k| &self.vertices[k as usize])
     }
 
     /// The triangle's texture coordinates in `f64`.
     #[inline(always)]
-    pub fn uvs(&self, t: &TriangleSetup) -> [DVec2; 3] {
+    pub(crate) fn uvs(&self, t: &TriangleSetup) -> [DVec2; 3] {
         self.vertices(t).map(|v| v.uv.as_dvec2())
     }
 
     /// How triangle `t`'s fragments in the pixels `range` of one tile get their `uv`: its
     /// sphere mapping, or [`UvPlanes`] anchored there.
     #[inline(always)]
-    pub fn uv_source(
+    pub(crate) fn uv_source(
         &self,
         t: &TriangleSetup,
         perspective: Perspective,
@@ -183,7 +183,7 @@ impl<'a> DrawContext<'a> {
 
     /// The footprint for the sampler: `uv` reduced by whole periods, derivatives as given.
     #[inline(always)]
-    pub fn footprint(&self, uv: DVec2, duv_dx: DVec2, duv_dy: DVec2) -> Footprint {
+    pub(crate) fn footprint(&self, uv: DVec2, duv_dx: DVec2, duv_dy: DVec2) -> Footprint {
         Footprint {
             u: reduce(uv.x, self.period.x, self.inv_period.x) as f32,
             v: reduce(uv.y, self.period.y, self.inv_period.y) as f32,
@@ -218,7 +218,7 @@ impl MappedTriangle {
     /// down) its screen derivatives: the projection's Jacobian applied to the position's (zero
     /// without).
     #[inline(always)]
-    pub fn uv(&self, lambda: DVec3, dlambda: Option<[DVec3; 2]>) -> (DVec2, DVec2, DVec2) {
+    pub(crate) fn uv(&self, lambda: DVec3, dlambda: Option<[DVec3; 2]>) -> (DVec2, DVec2, DVec2) {
         let p = &self.p;
         let at = |l: DVec3| p[0] * l.x + p[1] * l.y + p[2] * l.z;
         let d = at(lambda);
@@ -246,7 +246,7 @@ pub(crate) struct Lighting<'a> {
 impl<'a> Lighting<'a> {
     /// The lights of `settings`, or `None` for an unlit frame; `reference` for the reference
     /// renderer's samples.
-    pub fn of(settings: &RenderSettings<'a>, reference: bool) -> Option<Self> {
+    pub(crate) fn of(settings: &RenderSettings<'a>, reference: bool) -> Option<Self> {
         settings.is_lit().then(|| {
             let lights: Vec<Light> = settings.active_lights().copied().collect();
             let ambient = settings.environment.is_some()

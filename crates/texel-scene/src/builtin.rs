@@ -25,9 +25,9 @@ pub const TRIANGLE_TOML: &str = include_str!("builtin/triangle.toml");
 /// The glossy normal-mapped plane's TOML.
 pub const GLOSSY_TOML: &str = include_str!("builtin/glossy.toml");
 /// The brick wall's TOML.
-pub const BRICKS_TOML: &str = include_str!("builtin/bricks.toml");
+pub(crate) const BRICKS_TOML: &str = include_str!("builtin/bricks.toml");
 /// The layered terrain's TOML.
-pub const TERRAIN_TOML: &str = include_str!("builtin/terrain.toml");
+pub(crate) const TERRAIN_TOML: &str = include_str!("builtin/terrain.toml");
 
 /// Angle by which `ground-rotated` turns the ground's uvs, in degrees.
 pub const GROUND_ROTATION_DEG: f32 = 30.0;
@@ -428,7 +428,8 @@ fn mirror_spheres() -> Scene {
 
 /// The ripples of [`mirror_plane_mesh`]: (wave vector `(k_x, k_z)` in radians per unit,
 /// amplitude in units) of `h(x, z) = sum a sin(k_x x + k_z z)`.
-pub const RIPPLES: [(f32, f32, f32); 3] = [(0.35, 1.3, 0.1), (-0.9, 0.8, 0.06), (1.6, 0.5, 0.03)];
+pub(crate) const RIPPLES: [(f32, f32, f32); 3] =
+    [(0.35, 1.3, 0.1), (-0.9, 0.8, 0.06), (1.6, 0.5, 0.03)];
 
 /// The floor of `mirror-plane`: flat at `y = 0`, from `x = -60` to `60` and `z = 1` (behind the
 /// eye at the origin) to `z = -300`, whose normals are those of the ripples [`RIPPLES`]
@@ -439,7 +440,7 @@ pub const RIPPLES: [(f32, f32, f32); 3] = [(0.35, 1.3, 0.1), (-0.9, 0.8, 0.06), 
 /// geometrically with distance (2.2 % per row, 0.05 units at the eye), so every row of
 /// triangles covers about the same number of screen rows and the ripples are resolved by the
 /// vertices (two a wavelength) to about 100 units away.
-pub fn mirror_plane_mesh() -> Mesh {
+pub(crate) fn mirror_plane_mesh() -> Mesh {
     let mut mesh = empty_mesh("white");
     mesh.address_mode_u = AddressMode::Repeat;
     mesh.address_mode_v = AddressMode::Repeat;

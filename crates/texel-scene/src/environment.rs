@@ -31,10 +31,10 @@ use crate::error::SceneError;
 
 /// The sun's angular radius in radians (about 1.15 degrees, four times the real sun's, so that a
 /// 1024-wide map resolves it over several texels).
-pub const SUN_RADIUS: f64 = 0.02;
+pub(crate) const SUN_RADIUS: f64 = 0.02;
 
 /// The sun disc's radiance (linear, per channel, times the sky's warm tint).
-pub const SUN_RADIANCE: f64 = 30.0;
+pub(crate) const SUN_RADIANCE: f64 = 30.0;
 
 /// The largest sky width (its height is half), face side or square side.
 pub const MAX_SKY_WIDTH: u32 = 8192;

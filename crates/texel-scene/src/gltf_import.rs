@@ -51,7 +51,7 @@ fn wrap(m: WrappingMode) -> AddressMode {
 }
 
 /// The [`MeshFilters`] for a glTF sampler's `magFilter` and `minFilter`.
-pub fn filters(mag: Option<MagFilter>, min: Option<MinFilter>) -> MeshFilters {
+pub(crate) fn filters(mag: Option<MagFilter>, min: Option<MinFilter>) -> MeshFilters {
     use FilterMode::{Linear, Nearest};
     let (min_filter, mipmap_filter) = match min {
         None => (None, None),

@@ -399,9 +399,9 @@ impl Procedural {
 }
 
 /// Radius, degrees on the sphere, of [`Procedural::Globe`]'s discs.
-pub const GLOBE_DISC_DEG: f64 = 6.0;
+pub(crate) const GLOBE_DISC_DEG: f64 = 6.0;
 /// Width, degrees on the sphere, of [`Procedural::Globe`]'s lines.
-pub const GLOBE_LINE_DEG: f64 = 0.5;
+pub(crate) const GLOBE_LINE_DEG: f64 = 0.5;
 
 impl Procedural {
     /// The projection a [`Procedural::Globe`] map is drawn in (`None` for other kinds): equirect,
@@ -586,7 +586,7 @@ pub enum NoiseKind {
 }
 
 /// The octaves of [`Procedural::Noise`].
-pub const NOISE_OCTAVES: u32 = 5;
+pub(crate) const NOISE_OCTAVES: u32 = 5;
 
 /// [`Procedural::Noise`]'s fractal value noise at texel `(i, j)` of a `size`-texel square.
 fn noise(size: u32, cells: u32, seed: u32, i: u32, j: u32) -> f64 {

@@ -38,17 +38,17 @@ use texel_raster::{render, Frame, ReferenceEstimate, ReferencePlan, ReferenceSta
 use texel_scene::Camera;
 use texel_texture::Filter;
 
+use crate::entry::REFERENCE_BYTES_PER_PIXEL;
 use crate::timing::{median, time_frames};
-use crate::REFERENCE_BYTES_PER_PIXEL;
 
 /// Timed frames per filter in a comparison.
 pub const TIMED_FRAMES: u32 = 3;
 
 /// Error (8-bit units) at the top of the heat maps' colour ramp.
-pub const HEAT_MAP_MAX: f32 = 64.0;
+pub(crate) const HEAT_MAP_MAX: f32 = 64.0;
 
 /// Enlargement of the horizon crops (nearest neighbour).
-pub const CROP_FACTOR: u32 = 4;
+pub(crate) const CROP_FACTOR: u32 = 4;
 
 /// What a comparison holds per pixel besides the prepared scene's one frame: the reference frame
 /// ([`FRAME_BYTES_PER_PIXEL`]) and its statistics ([`REFERENCE_BYTES_PER_PIXEL`]), the coverage
@@ -56,14 +56,15 @@ pub const CROP_FACTOR: u32 = 4;
 /// copies (8), rounded up; each row's 8-bit image is kept besides ([`ROW_BYTES_PER_PIXEL`]) to rank
 /// the rows against each other. An extra image, checked against the comparison's size from its
 /// header first, adds [`EXTRA_BYTES_PER_PIXEL`] while it is decoded and scored.
-pub const COMPARE_BYTES_PER_PIXEL: u64 = FRAME_BYTES_PER_PIXEL + REFERENCE_BYTES_PER_PIXEL + 32;
+pub(crate) const COMPARE_BYTES_PER_PIXEL: u64 =
+    FRAME_BYTES_PER_PIXEL + REFERENCE_BYTES_PER_PIXEL + 32;
 
 /// Each row's 8-bit image, kept until the rows are ranked.
-pub const ROW_BYTES_PER_PIXEL: u64 = 4;
+pub(crate) const ROW_BYTES_PER_PIXEL: u64 = 4;
 
 /// An extra image while it is decoded (the decoder's buffer, up to 16-bit RGBA: 8) and held as
 /// 8-bit RGBA (4), rounded up; one at a time.
-pub const EXTRA_BYTES_PER_PIXEL: u64 = 16;
+pub(crate) const EXTRA_BYTES_PER_PIXEL: u64 = 16;
 
 /// A camera orbit to measure flicker over.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -156,8 +157,9 @@ impl<'a> CompareJob<'a> {
         }
     }
 
-    /// Charge `budget` for what a comparison of `scene` holds besides the scene:
-    /// [`COMPARE_BYTES_PER_PIXEL`] (and [`EXTRA_BYTES_PER_PIXEL`] with an extra image file), and
+    /// Charge `budget` for what a comparison of `scene` holds besides the scene: per pixel the
+    /// reference's frame and statistics, the coverage mask, the 8-bit images, the heat map and
+    /// the encoder's copies (264 bytes; 16 more with an extra image file), and
     /// with an orbit the previous frame's 8-bit images (the reference and one per filter) and
     /// coverage. The rows' images are charged while they are kept, in [`compare`].
     ///
@@ -409,7 +411,7 @@ pub fn compare(
     budget: &mut MemoryBudget,
 ) -> Result<Report, Error> {
     check_scene(scene, budget)?;
-    let enc = crate::encoding(scene.color);
+    let enc = scene.color.encoding();
     let frames = job.orbit.map_or(1, |o| o.frames);
     let estimate = staged(job, Stage::Reference { n: 0, of: frames }, || {
         reference(scene, job, &scene.scene.camera)

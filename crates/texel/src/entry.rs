@@ -13,11 +13,11 @@ use texel_raster::{
 use texel_scene::{Camera, Scene};
 use texel_texture::Filter;
 
-use crate::quality;
+use texel_quality as quality;
 
 /// Bytes per pixel a converging reference holds besides its frame: its running statistics,
 /// masks and results.
-pub const REFERENCE_BYTES_PER_PIXEL: u64 = 192;
+pub(crate) const REFERENCE_BYTES_PER_PIXEL: u64 = 192;
 
 /// How [`render_scene`] renders.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -103,14 +103,6 @@ pub fn frame_image(
     quality::Image8::from_rgba_bytes(frame.width, frame.height, &frame.to_8bit(target))
 }
 
-/// The 8-bit encoding of `color`: sRGB, or the raw values.
-pub fn encoding(color: ColorHandling) -> quality::Encoding {
-    match color {
-        ColorHandling::Srgb => quality::Encoding::Srgb,
-        ColorHandling::Raw => quality::Encoding::Linear,
-    }
-}
-
 /// Render `scene` as the options say: load its textures, build the samplers (and any ripmap or
 /// summed-area table) and draw every mesh. The frame's colour target is the 8-bit one the
 /// colour handling encodes to ([`PreparedScene::settings`]); a debug view's, whose values are
@@ -146,7 +138,7 @@ pub fn show_view(
 ) -> quality::Encoding {
     settings.view = view;
     if view == View::Color {
-        encoding(color)
+        color.encoding()
     } else {
         settings.target = ColorTarget::Srgb8;
         quality::Encoding::Srgb
@@ -182,7 +174,7 @@ pub struct ReferenceOptions {
 }
 
 /// The converging reference of `scene` as `texel reference` makes it: the scene prepared as the
-/// options say, [`REFERENCE_BYTES_PER_PIXEL`] charged for the statistics, then
+/// options say, 192 bytes a pixel charged for the statistics, then
 /// [`PreparedScene::reference`] from the scene's camera. `stop`, once set, ends it after the
 /// current pass (the estimate says it was interrupted).
 ///
@@ -216,7 +208,7 @@ pub fn reference_scene(
 }
 
 /// The converging reference of a prepared scene seen by `camera`, as `texel reference` and
-/// [`reference_scene`] make it: [`REFERENCE_BYTES_PER_PIXEL`] charged to `budget` for its
+/// [`reference_scene`] make it: 192 bytes a pixel charged to `budget` for its
 /// statistics (and kept: the estimate holds them), then [`PreparedScene::reference`]. A stop before the first pass is
 /// [`Error::Cancelled`]; one after it returns the estimate so far, marked interrupted.
 ///

@@ -14,7 +14,7 @@ use texel_texture::Filter;
 
 /// Times of one filter's frames in milliseconds.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct FrameTimes {
+pub(crate) struct FrameTimes {
     /// The draw of each timed frame ([`draw_into`] after an untimed clear).
     pub draw_ms: Vec<f64>,
     /// The clear ([`Frame::reset`]) before each timed frame.
@@ -25,18 +25,28 @@ pub struct FrameTimes {
 
 /// Shortest warm-up when any is asked for: fast frames run measurably slower while they are all
 /// the machine has run (decisions.md), so warm-up lasts at least this long.
-pub const MIN_WARMUP: Duration = Duration::from_millis(200);
+pub(crate) const MIN_WARMUP: Duration = Duration::from_millis(200);
 
 /// Most warm-up frames [`MIN_WARMUP`] can add (a bound for very fast frames).
 const MAX_WARMUP_FRAMES: u32 = 10_000;
 
 /// Untimed warm-up: call `step`, which does `per_call` units of work (frames, passes), until at
-/// least `warmup` units are done and, unless `warmup` is 0, until `min_warmup` has passed or
-/// ten thousand units are done.
+/// least `warmup` units are done and, unless `warmup` is 0, until 200 ms have passed or ten
+/// thousand units are done (fast frames run measurably slower while they are all the machine has
+/// run).
 ///
 /// # Errors
 /// The first error of `step`.
 pub fn warm_up<E>(
+    warmup: u32,
+    per_call: u32,
+    step: impl FnMut() -> Result<(), E>,
+) -> Result<(), E> {
+    warm_up_for(warmup, MIN_WARMUP, per_call, step)
+}
+
+/// [`warm_up`] for at least `min_warmup` instead of [`MIN_WARMUP`].
+fn warm_up_for<E>(
     warmup: u32,
     min_warmup: Duration,
     per_call: u32,
@@ -57,7 +67,7 @@ pub fn warm_up<E>(
 ///
 /// # Errors
 /// The draw's errors ([`draw_into`]).
-pub fn time_frames(
+pub(crate) fn time_frames(
     settings: &RenderSettings,
     draws: &[DrawCall],
     warmup: u32,
@@ -66,7 +76,7 @@ pub fn time_frames(
 ) -> Result<FrameTimes, RasterError> {
     let mut frame = Frame::new(settings);
     let mut times = FrameTimes::default();
-    warm_up(warmup, min_warmup, 1, || {
+    warm_up_for(warmup, min_warmup, 1, || {
         frame.reset(settings);
         draw_into(settings, draws, &mut frame)?;
         std::hint::black_box(&frame);
@@ -141,7 +151,7 @@ impl FilterTiming {
 /// How [`time_filters`] times each filter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BenchPlan {
-    /// Untimed frames first (and while more than 0, at least [`MIN_WARMUP`] of them).
+    /// Untimed frames first (and while more than 0, at least 200 ms of them).
     pub warmup: u32,
     /// Timed frames.
     pub frames: u32,
@@ -152,8 +162,8 @@ pub struct BenchPlan {
 }
 
 /// Each filter's frame times on the CPU, as `texel bench` measures them: per filter its
-/// samplers and tables built (and charged to `budget`), then [`time_frames`] on a pool of
-/// `plan.threads` built once.
+/// samplers and tables built (and charged to `budget`), then its warm-up and timed frames
+/// (each cleared, then drawn into one reused frame) on a pool of `plan.threads` built once.
 ///
 /// # Errors
 /// The plan's errors ([`PreparedScene::plan`]: the memory budget), the draw's, and a thread pool

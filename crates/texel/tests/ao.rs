@@ -5,9 +5,9 @@ use std::sync::atomic::AtomicBool;
 
 use glam::{Vec2, Vec3};
 use texel::ao::{bake_ao, AoMap, AoMesh, AoSettings};
-use texel::bvh::hits_triangle;
-use texel::texture::base::rng::SplitMix64;
 use texel::{Error, MemoryBudget, Scene};
+use texel_prepare::bvh::hits_triangle;
+use texel_texture::base::rng::SplitMix64;
 
 /// A 4 x 4 plane at `y = 0` (uv = `((x + 2) / 4, (z + 2) / 4)`) with a unit box standing on it at
 /// the centre. The box's uvs lie outside the map: it occludes but is not baked.

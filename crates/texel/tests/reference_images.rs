@@ -172,7 +172,7 @@ fn render_tile(scene: &mut Prepared, tile: &Tile) -> Image8 {
             ..ReferenceRun::default()
         };
         let estimate = prepared.reference(&prepared.scene.camera, &run).unwrap();
-        return texel::frame_image(&estimate.frame, texel::encoding(tile.color)).unwrap();
+        return texel::frame_image(&estimate.frame, tile.color.encoding()).unwrap();
     }
     let mut budget = MemoryBudget::limit_or_default(None);
     let plan = prepared.plan(tile.filter, &mut budget).unwrap();

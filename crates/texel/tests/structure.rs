@@ -4,7 +4,8 @@
 //!   other through `crate::` paths in a circle;
 //! - texel-texture's floors only look down: every `crate::floor::file` path names a file on the
 //!   same floor or a lower one, paths name modules rather than the root's re-exports, and its
-//!   files import each other in no circle.
+//!   files import each other in no circle;
+//! - the facade names its surface item by item: no `pub use` of a whole crate or a glob.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -384,5 +385,53 @@ fn function_lengths_count_from_fn_to_the_closing_brace() {
     assert_eq!(
         function_lengths(&file),
         vec![("a".to_string(), 5), ("c".to_string(), 3)]
+    );
+}
+
+/// The `pub use` trees of `items` (modules included) that re-export a whole crate (`pub use
+/// texel_x;`, `pub use texel_x as y;`) or a glob, written as `path` strings.
+fn wholesale_reexports(items: &[syn::Item]) -> Vec<String> {
+    fn walk(tree: &syn::UseTree, prefix: &str, out: &mut Vec<String>) {
+        match tree {
+            syn::UseTree::Path(p) => walk(&p.tree, &format!("{prefix}{}::", p.ident), out),
+            syn::UseTree::Group(g) => g.items.iter().for_each(|t| walk(t, prefix, out)),
+            syn::UseTree::Glob(_) => out.push(format!("{prefix}*")),
+            syn::UseTree::Name(n) if prefix.is_empty() => out.push(n.ident.to_string()),
+            syn::UseTree::Rename(r) if prefix.is_empty() => out.push(r.ident.to_string()),
+            syn::UseTree::Name(_) | syn::UseTree::Rename(_) => {}
+        }
+    }
+    let mut out = Vec::new();
+    for item in items {
+        match item {
+            syn::Item::Use(u) if matches!(u.vis, syn::Visibility::Public(_)) => {
+                walk(&u.tree, "", &mut out)
+            }
+            syn::Item::Mod(m) => {
+                if let Some((_, inner)) = &m.content {
+                    out.extend(wholesale_reexports(inner));
+                }
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+#[test]
+fn the_facade_names_its_surface_item_by_item() {
+    let lib = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/lib.rs");
+    let file = syn::parse_file(&fs::read_to_string(lib).unwrap()).unwrap();
+    assert_eq!(wholesale_reexports(&file.items), Vec::<String>::new());
+    // The checker sees each wholesale form, in a module too, and passes named items.
+    let sample = syn::parse_file(
+        "pub use texel_io as io;\npub use texel_raster;\nuse texel_scene as private;\n\
+         pub mod m { pub use texel_quality::{psnr, html::*}; }\npub use texel_texture::{Sampler, \
+         base::color::displayed as shown};\n",
+    )
+    .unwrap();
+    assert_eq!(
+        wholesale_reexports(&sample.items),
+        vec!["texel_io", "texel_raster", "texel_quality::html::*"]
     );
 }

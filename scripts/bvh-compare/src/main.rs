@@ -10,8 +10,8 @@ use bvh::aabb::{Aabb, Bounded};
 use bvh::bounding_hierarchy::BHShape;
 use glam::Vec3;
 use nalgebra::{Point3, Vector3};
-use texel::bvh::{hits_triangle, Bvh};
-use texel::texture::rng::SplitMix64;
+use texel_prepare::bvh::{hits_triangle, Bvh};
+use texel_texture::base::rng::SplitMix64;
 
 struct Shape {
     tri: [u32; 3],
@@ -107,7 +107,7 @@ fn main() {
     println!("| BVH | build ms | M rays/s |");
     println!("|---|--:|--:|");
     println!(
-        "| texel::bvh | {:.0} | {:.2} |",
+        "| texel_prepare::bvh | {:.0} | {:.2} |",
         build_ours * 1e3,
         n_rays as f64 / trace_ours / 1e6
     );

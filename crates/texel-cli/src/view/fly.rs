@@ -9,11 +9,11 @@ use texel::scene::Camera;
 const MAX_PITCH_DEG: f32 = 89.0;
 
 /// Field-of-view range of the scroll wheel, degrees.
-pub const FOV_RANGE: (f32, f32) = (5.0, 150.0);
+pub(crate) const FOV_RANGE: (f32, f32) = (5.0, 150.0);
 
 /// A camera the viewer moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Fly {
+pub(crate) struct Fly {
     /// The camera as it is now.
     pub camera: Camera,
     /// World units per second of movement.
@@ -23,7 +23,7 @@ pub struct Fly {
 /// Movement in camera axes: `forward` along the view, `right`, `up` along the scene's up; each
 /// `-1`, `0` or `1` (keys held), scaled by speed and time.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Motion {
+pub(crate) struct Motion {
     /// Forward (+) or back (-).
     pub forward: f32,
     /// Right (+) or left (-).
@@ -34,14 +34,14 @@ pub struct Motion {
 
 impl Motion {
     /// Whether any direction is held.
-    pub fn is_moving(&self) -> bool {
+    pub(crate) fn is_moving(&self) -> bool {
         self.forward != 0.0 || self.right != 0.0 || self.up != 0.0
     }
 }
 
 impl Fly {
     /// Start at `camera`, moving `speed` world units per second.
-    pub fn new(camera: Camera, speed: f32) -> Fly {
+    pub(crate) fn new(camera: Camera, speed: f32) -> Fly {
         Fly { camera, speed }
     }
 
@@ -54,7 +54,7 @@ impl Fly {
     }
 
     /// Move for `seconds` with `motion` (times 4 with `fast`): eye and target move together.
-    pub fn step(&mut self, motion: Motion, seconds: f32, fast: bool) {
+    pub(crate) fn step(&mut self, motion: Motion, seconds: f32, fast: bool) {
         let forward = self.forward();
         let up = self.up();
         let right = forward.cross(up).normalize_or(Vec3::X);
@@ -68,7 +68,7 @@ impl Fly {
 
     /// Turn by `yaw` degrees about the scene's up (positive turns right) and `pitch` degrees
     /// (positive looks up), keeping the pitch within 89 degrees of the horizon.
-    pub fn look(&mut self, yaw_deg: f32, pitch_deg: f32) {
+    pub(crate) fn look(&mut self, yaw_deg: f32, pitch_deg: f32) {
         let up = self.up();
         let to_target = self.camera.target - self.camera.eye;
         let dist = to_target.length().max(1e-3);
@@ -85,7 +85,7 @@ impl Fly {
     }
 
     /// Change the vertical field of view by `delta` degrees, within [`FOV_RANGE`].
-    pub fn zoom(&mut self, delta_deg: f32) {
+    pub(crate) fn zoom(&mut self, delta_deg: f32) {
         self.camera.fovy_deg = (self.camera.fovy_deg + delta_deg).clamp(FOV_RANGE.0, FOV_RANGE.1);
     }
 }

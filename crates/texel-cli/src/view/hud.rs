@@ -5,7 +5,7 @@
 use font8x8::legacy::BASIC_LEGACY;
 
 /// A `0x00RRGGBB` pixel buffer of `width x height`, row-major.
-pub struct Canvas<'a> {
+pub(crate) struct Canvas<'a> {
     /// Pixels.
     pub pixels: &'a mut [u32],
     /// Width in pixels.
@@ -15,12 +15,12 @@ pub struct Canvas<'a> {
 }
 
 /// Glyph cell side before scaling, pixels.
-pub const GLYPH: u32 = 8;
+pub(crate) const GLYPH: u32 = 8;
 
 impl Canvas<'_> {
     /// Darken the rectangle `[x0, x0 + w) x [y0, y0 + h)` (clipped to the canvas) to a quarter of
     /// its brightness, so text over it reads on any image.
-    pub fn shade(&mut self, x0: u32, y0: u32, w: u32, h: u32) {
+    pub(crate) fn shade(&mut self, x0: u32, y0: u32, w: u32, h: u32) {
         for y in y0..(y0 + h).min(self.height) {
             for x in x0..(x0 + w).min(self.width) {
                 let p = &mut self.pixels[(y * self.width + x) as usize];
@@ -31,7 +31,7 @@ impl Canvas<'_> {
 
     /// Draw `text` with its top-left corner at `(x, y)`, each glyph pixel `scale x scale`, in
     /// `color`; characters outside basic Latin show as `?`. Clipped to the canvas.
-    pub fn text(&mut self, x: u32, y: u32, text: &str, color: u32, scale: u32) {
+    pub(crate) fn text(&mut self, x: u32, y: u32, text: &str, color: u32, scale: u32) {
         let mut cx = x;
         for ch in text.chars() {
             let code = if ch.is_ascii() {
@@ -61,7 +61,7 @@ impl Canvas<'_> {
     }
 
     /// Draw `lines` in a shaded box at `(x, y)`; returns the box's height.
-    pub fn panel(&mut self, x: u32, y: u32, lines: &[String], scale: u32) -> u32 {
+    pub(crate) fn panel(&mut self, x: u32, y: u32, lines: &[String], scale: u32) -> u32 {
         let pad = 4 * scale;
         let line_h = (GLYPH + 2) * scale;
         let chars = lines.iter().map(|l| l.chars().count()).max().unwrap_or(0) as u32;
@@ -83,7 +83,7 @@ impl Canvas<'_> {
     }
 
     /// A vertical line at column `x`, `color`.
-    pub fn vline(&mut self, x: u32, color: u32) {
+    pub(crate) fn vline(&mut self, x: u32, color: u32) {
         if x < self.width {
             for y in 0..self.height {
                 self.pixels[(y * self.width + x) as usize] = color;
@@ -93,7 +93,7 @@ impl Canvas<'_> {
 }
 
 /// The text scale for a window `height` pixels tall: 1 below 900 pixels, then 2.
-pub fn scale_for(height: u32) -> u32 {
+pub(crate) fn scale_for(height: u32) -> u32 {
     if height >= 900 {
         2
     } else {

@@ -7,10 +7,10 @@
 //!   the accumulating reference, HUD statistics);
 //! - [`window`]: winit's event loop and softbuffer's surface.
 
-pub mod fly;
-pub mod hud;
-pub mod window;
-pub mod worker;
+pub(crate) mod fly;
+pub(crate) mod hud;
+pub(crate) mod window;
+pub(crate) mod worker;
 
 use std::sync::Arc;
 
@@ -27,7 +27,7 @@ use window::{App, Options};
 use worker::{Rendered, Shared, Worker};
 
 /// Run `texel view`.
-pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
+pub(crate) fn run(args: &ViewArgs, input: Input) -> Result<()> {
     let presses =
         parse_keys(args.keys.as_deref().unwrap_or("")).map_err(|e| anyhow!("--keys: {e}"))?;
     let mut input = input;
@@ -49,12 +49,8 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
         // later edits that do not compile are shown in the window.
         let source = crate::cmd_lab::read_source(path, "shader")?;
         let gl = texel::lab::Gl::new()?;
-        let empty = texel::lab::scene::device_scene(
-            &[],
-            (2, 2),
-            [0; 4],
-            glam::Mat4::IDENTITY.to_cols_array(),
-        );
+        let empty =
+            texel::lab::device_scene(&[], (2, 2), [0; 4], glam::Mat4::IDENTITY.to_cols_array());
         gl.prepare(&source, None, &texel::lab::Names::default(), &empty)
             .with_context(|| format!("the shader {}", path.display()))?;
     }
@@ -110,7 +106,7 @@ pub fn run(args: &ViewArgs, input: Input) -> Result<()> {
     shared.quit();
     let _ = thread.join();
     ran.context("the window's event loop failed")?;
-    texel::io::stderr_line(app.summary());
+    texel_io::stderr_line(app.summary());
     match app.failure {
         Some(e) => Err(e),
         None => Ok(()),

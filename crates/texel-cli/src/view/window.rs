@@ -29,10 +29,10 @@ const SETTLE: Duration = Duration::from_millis(200);
 const LOOK_DEG_PER_PIXEL: f32 = 0.2;
 
 /// Seconds of movement one scripted movement key stands for.
-pub const SCRIPTED_STEP_S: f32 = 0.25;
+pub(crate) const SCRIPTED_STEP_S: f32 = 0.25;
 
 /// Options fixed for the window's life.
-pub struct Options {
+pub(crate) struct Options {
     /// Window title.
     pub title: String,
     /// Initial inner size, pixels.
@@ -44,7 +44,7 @@ pub struct Options {
 }
 
 /// The window's state.
-pub struct App {
+pub(crate) struct App {
     options: Options,
     state: ViewState,
     fly: Fly,
@@ -84,7 +84,7 @@ enum Drag {
 
 impl App {
     /// A window showing `state` through `fly`, asking `shared`'s render thread for frames.
-    pub fn new(options: Options, state: ViewState, fly: Fly, shared: Arc<Shared>) -> App {
+    pub(crate) fn new(options: Options, state: ViewState, fly: Fly, shared: Arc<Shared>) -> App {
         App {
             options,
             state,
@@ -118,7 +118,7 @@ impl App {
     /// Apply a `--keys` script before the first frame: state keys as typed, movement keys as
     /// [`SCRIPTED_STEP_S`] seconds of movement, F12 as a screenshot at exit, Esc as exit after
     /// the first frame.
-    pub fn script(&mut self, presses: &[Press]) {
+    pub(crate) fn script(&mut self, presses: &[Press]) {
         for &p in presses {
             match self.state.apply(p) {
                 Effect::Quit => self.options.max_frames = Some(1),
@@ -136,7 +136,7 @@ impl App {
 
     /// One line on what was shown: frames, the median render time of the full-resolution ones
     /// and frames per second of wall time between the first and the last frame shown.
-    pub fn summary(&self) -> String {
+    pub(crate) fn summary(&self) -> String {
         let mut ms = self.full_ms.clone();
         ms.sort_by(f64::total_cmp);
         let median = ms.get(ms.len() / 2).copied().unwrap_or(f64::NAN);
@@ -154,7 +154,7 @@ impl App {
     }
 
     /// Start with the HUD and the divider line hidden (`--no-hud`).
-    pub fn hide_hud(&mut self) {
+    pub(crate) fn hide_hud(&mut self) {
         self.state.hud = false;
     }
 
@@ -428,7 +428,7 @@ fn unique_name(name: &str) -> PathBuf {
 }
 
 /// The viewer's key for a physical key.
-pub fn key_of(code: KeyCode) -> Option<Key> {
+pub(crate) fn key_of(code: KeyCode) -> Option<Key> {
     use KeyCode as C;
     Some(match code {
         C::Digit0 | C::Numpad0 => Key::Digit(0),

@@ -22,7 +22,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use rayon::prelude::*;
-use texel::lab::gl::{Gl, GlScene, Names, ShaderDraws};
+use texel::lab::{Gl, GlScene, Names, ShaderDraws};
 use texel::quality::Encoding;
 use texel::raster::{
     draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, ProgressiveReference,
@@ -35,20 +35,19 @@ use texel_gpu::{Gpu, GpuDraws, GpuFilter};
 use crate::controls::{Mode, ViewState};
 
 use crate::input::{load_scene_with, Input};
-use crate::output::encoding;
 
 /// Time one frame (or one band of rows) should take, milliseconds.
-pub const BUDGET_MS: f64 = 40.0;
+pub(crate) const BUDGET_MS: f64 = 40.0;
 
 /// Samples per pixel at which the reference stops refining.
-pub const MAX_REFERENCE_SAMPLES: u32 = 512;
+pub(crate) const MAX_REFERENCE_SAMPLES: u32 = 512;
 
 /// Largest reduction of resolution while moving.
 const MAX_SCALE: u32 = 8;
 
 /// What the window asks the render thread for.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Request {
+pub(crate) struct Request {
     /// Increases with every request.
     pub generation: u64,
     /// Filters, view and modes.
@@ -65,7 +64,7 @@ pub struct Request {
 
 impl Request {
     /// Whether two requests give the same image (the HUD, help and the moving flag aside).
-    pub fn same_image(&self, other: &Request) -> bool {
+    pub(crate) fn same_image(&self, other: &Request) -> bool {
         let strip = |s: &ViewState| ViewState {
             hud: false,
             help: false,
@@ -79,7 +78,7 @@ impl Request {
 
 /// The mailbox between the window and the render thread: the newest request wins.
 #[derive(Default)]
-pub struct Shared {
+pub(crate) struct Shared {
     slot: Mutex<Slot>,
     wake: Condvar,
 }
@@ -93,7 +92,7 @@ struct Slot {
 
 impl Shared {
     /// Hand the render thread a new request (replacing one it has not started).
-    pub fn submit(&self, request: Request) {
+    pub(crate) fn submit(&self, request: Request) {
         let mut slot = self.slot.lock().unwrap_or_else(|e| e.into_inner());
         slot.newest = request.generation;
         slot.request = Some(request);
@@ -101,7 +100,7 @@ impl Shared {
     }
 
     /// Ask the render thread to stop.
-    pub fn quit(&self) {
+    pub(crate) fn quit(&self) {
         self.slot.lock().unwrap_or_else(|e| e.into_inner()).quit = true;
         self.wake.notify_all();
     }
@@ -133,7 +132,7 @@ impl Shared {
 
 /// What the HUD says about one half of the screen.
 #[derive(Clone, Debug, PartialEq)]
-pub struct PartInfo {
+pub(crate) struct PartInfo {
     /// The mode shown.
     pub mode: Mode,
     /// `"gpu"` when texel-gpu rendered it, `"cpu"` otherwise.
@@ -142,7 +141,7 @@ pub struct PartInfo {
     pub samples: Option<u32>,
     /// For a still reference of at least two passes: the share of its pixels whose displayed
     /// value's 95 % interval, from the spread of the passes, is within half an 8-bit step
-    /// ([`texel::raster::adaptive::display_half_width`]).
+    /// ([`texel::raster::display_half_width`]).
     pub within: Option<f64>,
     /// Mean texels read per covered pixel and the lod range (min, max) over covered pixels,
     /// once measured for this image.
@@ -151,7 +150,7 @@ pub struct PartInfo {
 
 /// Measured texel reads and lods of one half.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Stats {
+pub(crate) struct Stats {
     /// Mean texels read per covered pixel.
     pub texels_mean: f64,
     /// Smallest and largest lod over covered pixels (see [`lod_range`]).
@@ -159,7 +158,7 @@ pub struct Stats {
 }
 
 /// One frame for the window.
-pub struct Rendered {
+pub(crate) struct Rendered {
     /// The request's generation.
     pub generation: u64,
     /// Window-sized `0x00RRGGBB` pixels.
@@ -182,7 +181,7 @@ pub struct Rendered {
 }
 
 /// What the render thread owns.
-pub struct Worker {
+pub(crate) struct Worker {
     /// The scene argument (a path or `builtin:NAME`), reloaded for the other colour handling.
     pub scene_spec: String,
     /// `--size`, passed on to reloads.
@@ -257,7 +256,7 @@ fn shader_frame(
         let bg = settings
             .background
             .map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
-        let scene = texel::lab::scene::device_scene(draws, size, bg, clip.to_cols_array());
+        let scene = texel::lab::device_scene(draws, size, bg, clip.to_cols_array());
         let source = crate::cmd_lab::read_source(path, "shader");
         let built = match source {
             Ok(source) => match ask(state, ShaderJob::Build(source, scene)) {
@@ -434,7 +433,7 @@ struct Progress {
 type SamplerKey = (Filter, u32, usize);
 
 /// Run the render thread until [`Shared::quit`] or until `send` reports the window gone.
-pub fn run(mut worker: Worker, shared: Arc<Shared>, send: impl Fn(Rendered) -> bool) {
+pub(crate) fn run(mut worker: Worker, shared: Arc<Shared>, send: impl Fn(Rendered) -> bool) {
     let pool = match worker.threads {
         Some(n) => match rayon::ThreadPoolBuilder::new()
             .num_threads(n as usize)
@@ -573,7 +572,7 @@ fn with_environment<'a>(
 }
 
 /// The pixel rectangles `[x0, y0, x1, y1]` of the modes on screen at `w x h`.
-pub fn part_rects(state: &ViewState, w: u32, h: u32) -> Vec<[u32; 4]> {
+pub(crate) fn part_rects(state: &ViewState, w: u32, h: u32) -> Vec<[u32; 4]> {
     if state.split && w >= 2 {
         let d = ((state.divider * w as f32).round() as u32).clamp(1, w - 1);
         vec![[0, 0, d, h], [d, 0, w, h]]
@@ -610,7 +609,7 @@ fn decoded(px: &[[u8; 4]], srgb: bool) -> Vec<[f32; 4]> {
     let decode = |c: u8| {
         let v = f32::from(c) / 255.0;
         if srgb {
-            texel::texture::base::color::srgb_to_linear(v)
+            texel::texture::srgb_to_linear(v)
         } else {
             v
         }
@@ -1020,7 +1019,7 @@ impl FrameContext<'_, '_> {
 /// has the same texture size and lod settings the answer is exact from `frame`; otherwise each
 /// group of draws that share them is rendered alone and its own covered pixels counted (pixels
 /// hidden behind another group then count too).
-pub fn lod_range(
+pub(crate) fn lod_range(
     settings: &RenderSettings,
     draws: &[DrawCall],
     frame: &Frame,
@@ -1117,7 +1116,7 @@ fn display(
 ) -> Vec<u32> {
     let enc_for = |m: Mode| -> Encoding {
         if state.view == View::Color || m == Mode::Reference {
-            encoding(state.color)
+            state.color.encoding()
         } else {
             Encoding::Srgb
         }
@@ -1391,7 +1390,7 @@ mod tests {
                         .sum();
                     (ss / (n - 1.0) / n).sqrt()
                 });
-                let half = texel::raster::adaptive::display_half_width(mean, se, passes, true);
+                let half = texel::raster::display_half_width(mean, se, passes, true);
                 half <= 0.5 / 255.0
             })
             .count();

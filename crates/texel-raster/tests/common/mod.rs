@@ -6,11 +6,11 @@ use texel_raster::{camera, DrawCall, Vertex};
 use texel_texture::{AddressMode, ColorSpace, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
 /// The ground scene's camera.
-pub const EYE: Vec3 = Vec3::new(0.0, 1.0, 0.0);
-pub const TARGET: Vec3 = Vec3::new(0.0, 0.75, -10.0);
+pub(crate) const EYE: Vec3 = Vec3::new(0.0, 1.0, 0.0);
+pub(crate) const TARGET: Vec3 = Vec3::new(0.0, 0.75, -10.0);
 
 /// A `size x size` checker of `checks x checks` squares; texel (0, 0) lies in a black check. sRGB.
-pub fn checker(size: u32, checks: u32) -> Texture {
+pub(crate) fn checker(size: u32, checks: u32) -> Texture {
     let cell = size / checks;
     let texels = (0..size * size)
         .map(|k| {
@@ -26,7 +26,7 @@ pub fn checker(size: u32, checks: u32) -> Texture {
 }
 
 /// A Repeat sampler from a lab mode (1 nearest, 2 bilinear, 3 mip nearest, 4 trilinear).
-pub fn lab_sampler(mode: u8) -> Sampler {
+pub(crate) fn lab_sampler(mode: u8) -> Sampler {
     Sampler::new(
         SamplerDescriptor::lab_mode(mode)
             .unwrap()
@@ -36,7 +36,7 @@ pub fn lab_sampler(mode: u8) -> Sampler {
 }
 
 /// The ground scene's geometry and camera for a `width x height` frame.
-pub struct Ground {
+pub(crate) struct Ground {
     pub vertices: Vec<Vertex>,
     pub triangles: Vec<[u32; 3]>,
     pub texture: Texture,
@@ -44,11 +44,11 @@ pub struct Ground {
 }
 
 impl Ground {
-    pub fn new(width: u32, height: u32) -> Self {
+    pub(crate) fn new(width: u32, height: u32) -> Self {
         Self::with_texture(width, height, checker(1024, 8))
     }
 
-    pub fn with_texture(width: u32, height: u32, texture: Texture) -> Self {
+    pub(crate) fn with_texture(width: u32, height: u32, texture: Texture) -> Self {
         let positions = [
             [-500.0, 0.0, 1.0],
             [500.0, 0.0, 1.0],
@@ -80,7 +80,7 @@ impl Ground {
         }
     }
 
-    pub fn draw<'a>(&'a self, sampler: &'a Sampler) -> DrawCall<'a> {
+    pub(crate) fn draw<'a>(&'a self, sampler: &'a Sampler) -> DrawCall<'a> {
         DrawCall {
             vertices: &self.vertices,
             triangles: &self.triangles,
@@ -94,7 +94,7 @@ impl Ground {
 
     /// The exact uv where the ray through pixel coordinates `(x, y)` meets the ground plane `y = 0`
     /// (`u = X / 2`, `v = -Z / 2` from the scene's positions and uvs), or `None` above the horizon.
-    pub fn analytic_uv(&self, x: f64, y: f64, width: u32, height: u32) -> Option<DVec2> {
+    pub(crate) fn analytic_uv(&self, x: f64, y: f64, width: u32, height: u32) -> Option<DVec2> {
         let world_from_clip: DMat4 = self.clip_from_world.as_dmat4().inverse();
         let x_ndc = 2.0 * x / f64::from(width) - 1.0;
         let y_ndc = 1.0 - 2.0 * y / f64::from(height);
@@ -112,10 +112,10 @@ impl Ground {
 }
 
 /// The project's deterministic generator (SplitMix64), for test geometry.
-pub use texel_texture::base::rng::SplitMix64 as Rng;
+pub(crate) use texel_texture::base::rng::SplitMix64 as Rng;
 
 /// A vertex given in pixel coordinates of a `width x height` frame, for `clip_from_world = I`.
-pub fn screen_vertex(x: f64, y: f64, width: u32, height: u32) -> Vertex {
+pub(crate) fn screen_vertex(x: f64, y: f64, width: u32, height: u32) -> Vertex {
     let xn = 2.0 * x / f64::from(width) - 1.0;
     let yn = 1.0 - 2.0 * y / f64::from(height);
     Vertex::new(
@@ -128,7 +128,7 @@ pub fn screen_vertex(x: f64, y: f64, width: u32, height: u32) -> Vertex {
 }
 
 /// A 1x1 white texture and a nearest sampler.
-pub fn white() -> (Texture, Sampler) {
+pub(crate) fn white() -> (Texture, Sampler) {
     (
         Texture::from_fn(
             1,
@@ -145,7 +145,12 @@ pub fn white() -> (Texture, Sampler) {
 /// The benchmarks' mesh: an `nx x ny` grid of cells over a `w x h` frame, two triangles per cell
 /// (224 x 224 cells give 100 352 triangles of about 9 pixels each at 1280 x 720), and a 64 x 64
 /// gradient texture to map on it with an identity `clip_from_world`.
-pub fn screen_grid(w: u32, h: u32, nx: u32, ny: u32) -> (Vec<Vertex>, Vec<[u32; 3]>, Texture) {
+pub(crate) fn screen_grid(
+    w: u32,
+    h: u32,
+    nx: u32,
+    ny: u32,
+) -> (Vec<Vertex>, Vec<[u32; 3]>, Texture) {
     let vertices = (0..=ny)
         .flat_map(|b| {
             (0..=nx).map(move |a| {

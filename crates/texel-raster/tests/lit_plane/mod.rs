@@ -6,13 +6,13 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use texel_raster::{camera, Vertex};
 
 /// Frame width, pixels.
-pub const W: u32 = 96;
+pub(crate) const W: u32 = 96;
 /// Frame height, pixels.
-pub const H: u32 = 64;
+pub(crate) const H: u32 = 64;
 
 /// The square `[-1, 1]^2` in z = 0 facing +z, u along +x, v down (-y) (2 world units per unit of
 /// u and of v), tangent +x with `w = 1` (`cross(z, x) = +y`, up the image).
-pub fn plane() -> Vec<Vertex> {
+pub(crate) fn plane() -> Vec<Vertex> {
     [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
         .iter()
         .map(|&(x, y)| {
@@ -28,10 +28,10 @@ pub fn plane() -> Vec<Vertex> {
 }
 
 /// The two counter-clockwise triangles of [`plane`].
-pub const PLANE_TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+pub(crate) const PLANE_TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
 
 /// The camera: `clip_from_world` and the eye.
-pub fn view() -> (Mat4, Vec3) {
+pub(crate) fn view() -> (Mat4, Vec3) {
     let eye = Vec3::new(0.4, 0.3, 3.0);
     let m = camera::perspective(50f32.to_radians(), W as f32 / H as f32, 0.1, 10.0)
         * camera::look_at(eye, Vec3::ZERO, Vec3::Y);

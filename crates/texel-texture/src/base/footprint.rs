@@ -160,7 +160,7 @@ pub(crate) struct Query {
 impl Query {
     /// The sample point, normalised (finite).
     #[inline(always)]
-    pub fn uv(&self) -> Vec2 {
+    pub(crate) fn uv(&self) -> Vec2 {
         Vec2::new(self.fp.u, self.fp.v)
     }
 }

@@ -250,6 +250,21 @@ impl Texture {
         }
     }
 
+    /// Bytes a build of the structures `desc` reads holds while it runs, beyond the structures
+    /// themselves: for [`FilterMode::Ripmap`], the `f32` scratch of the ripmap build (the decoded
+    /// level 0, an x-reduced image and a y chain, 40 bytes per level-0 texel), which the
+    /// texture's own limit counts too; nothing otherwise.
+    pub fn build_scratch_bytes(&self, desc: &SamplerDescriptor) -> u64 {
+        match desc.min_filter {
+            FilterMode::Ripmap => {
+                u64::from(self.width())
+                    * u64::from(self.height())
+                    * crate::technique::ripmap::SCRATCH_BYTES_PER_TEXEL
+            }
+            _ => 0,
+        }
+    }
+
     /// Bytes of the structures a sampler configured by `desc` reads: the mip pyramid
     /// ([`Texture::pyramid_bytes`]), plus the ripmap ([`Ripmap::bytes_for`]) for
     /// [`FilterMode::Ripmap`] or the summed-area table ([`SummedAreaTable::bytes_for`]) for

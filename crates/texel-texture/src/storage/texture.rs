@@ -114,13 +114,18 @@ impl Limits {
                 max: self.max_dimension,
             });
         }
+        self.check_bytes(width, height, Self::texture_bytes(width, height, format))
+    }
+
+    /// The bytes a `width x height` texture of `format` holds while it is built: its whole mip
+    /// pyramid, and the linear `f32` scratch of the levels below 0. Saturates at `u64::MAX`.
+    pub fn texture_bytes(width: u32, height: u32, format: Format) -> u64 {
         let texels = pyramid::pyramid_texels(width, height);
         let level0 = u64::from(width) * u64::from(height);
-        let bytes = texels
+        texels
             .checked_mul(format.texel_bytes())
             .and_then(|b| b.checked_add((texels - level0).checked_mul(16)?))
-            .unwrap_or(u64::MAX);
-        self.check_bytes(width, height, bytes)
+            .unwrap_or(u64::MAX)
     }
 }
 

@@ -72,7 +72,7 @@ fn axis_total(n: u32) -> u64 {
 
 /// `f32` scratch bytes per level-0 texel while building (decoded level 0, an x-reduced image and a
 /// y chain): 2.5 images of 16 bytes.
-const SCRATCH_BYTES_PER_TEXEL: u64 = 40;
+pub(crate) const SCRATCH_BYTES_PER_TEXEL: u64 = 40;
 
 impl Ripmap {
     /// Texels a ripmap of a `width x height` texture stores (excluding image `(0, 0)`, which is
