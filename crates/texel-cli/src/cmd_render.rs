@@ -1,7 +1,8 @@
 //! `texel render`: one filter (or a debug view), one PNG.
 
 use anyhow::{bail, Context, Result};
-use texel::raster::{render, ColorTarget, Derivatives, UvEvaluation};
+use texel::raster::{Derivatives, UvEvaluation};
+use texel::FrameOptions;
 use texel_gpu::{Gpu, GpuFilter};
 
 use crate::cli::RenderArgs;
@@ -32,17 +33,18 @@ pub(crate) fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
         scene.set_surface_uv(UvEvaluation::PerVertex);
     }
     let plan = scene.plan(filter, &mut input.budget)?;
-    let mut settings = plan.settings();
-    settings.derivatives = args.derivatives;
-    settings.perspective = args.perspective;
-    // The frame is rendered into the 8-bit target the PNG holds; a debug view into sRGB.
-    let encoding = texel::show_view(&mut settings, args.view, args.scene.color);
-    if is_exr(&args.output) {
-        // OpenEXR keeps the colour in float, unclamped.
-        settings.target = ColorTarget::Float;
-    }
-    let draws = plan.draws();
-    let frame = if args.gpu {
+    // The frame is rendered into the 8-bit target the PNG holds (a debug view into sRGB);
+    // OpenEXR keeps the colour in float, unclamped.
+    let options = FrameOptions {
+        view: args.view,
+        derivatives: args.derivatives,
+        perspective: args.perspective,
+        float: is_exr(&args.output),
+        threads: workers(args.threads),
+    };
+    let (frame, encoding) = if args.gpu {
+        let (mut settings, encoding) = plan.settings_with(&options);
+        let draws = plan.draws();
         let filter = filter.unwrap_or(Filter::Trilinear);
         let Some(gpu_filter) = GpuFilter::of(filter) else {
             let names: Vec<&str> = GpuFilter::filters().map(Filter::name).collect();
@@ -62,10 +64,9 @@ pub(crate) fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
             texel_gpu::frame_bytes(settings.width, settings.height),
         )?;
         let gpu = Gpu::new(args.adapter.as_deref())?;
-        texel_gpu::render(&gpu, &settings, &draws, gpu_filter)?
+        (texel_gpu::render(&gpu, &settings, &draws, gpu_filter)?, encoding)
     } else {
-        settings.threads = workers(args.threads);
-        render(&settings, &draws)?
+        plan.render(&options)?
     };
     write_frame(&args.output, &frame, encoding)
 }

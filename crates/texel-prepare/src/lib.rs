@@ -19,7 +19,7 @@ pub mod tessellate;
 
 pub use error::Error;
 pub use memory::MemoryBudget;
-pub use plan::FramePlan;
+pub use plan::{FrameOptions, FramePlan};
 pub use prepare::{ColorHandling, PreparedScene, SceneOptions, TextureStorage};
 pub use reference::ReferenceRun;
 

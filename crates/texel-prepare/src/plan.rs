@@ -1,12 +1,58 @@
 //! One frame of a prepared scene for one filter: [`PreparedScene::plan`] makes the samplers,
 //! builds and charges what they need, and hands out the settings and draw calls every renderer
-//! (CPU, reference, GPU) takes.
+//! (CPU, reference, GPU) takes; [`FrameOptions`] says how the frame is drawn and
+//! [`FramePlan::render`] draws it.
 
-use texel_raster::{DrawCall, RenderSettings};
+use texel_quality::Encoding;
+use texel_raster::{
+    render, ColorTarget, Derivatives, DrawCall, Frame, Perspective, RenderSettings, View,
+};
 use texel_scene::Camera;
 use texel_texture::Sampler;
 
-use crate::{Error, Filter, MemoryBudget, PreparedScene};
+use crate::{ColorHandling, Error, Filter, MemoryBudget, PreparedScene};
+
+/// How one frame is drawn beyond what the scene says: what each pixel shows, how derivatives
+/// and attributes are computed, the colour target and the threads. The same rules for
+/// `texel render`, [`FramePlan::render`], the facade's `render_scene` and the viewer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameOptions {
+    /// What each pixel shows: the textured colour, or a debug view.
+    pub view: View,
+    /// How the sampler's screen derivatives are computed.
+    pub derivatives: Derivatives,
+    /// How attributes are interpolated across a triangle.
+    pub perspective: Perspective,
+    /// Draw into linear floats, unclamped (an OpenEXR output, or passes to accumulate), rather
+    /// than the 8-bit target of the image.
+    pub float: bool,
+    /// Worker threads; `None`: all cores.
+    pub threads: Option<usize>,
+}
+
+impl FrameOptions {
+    /// Set `settings` (a scene's, whose target the colour handling `color` chose) to draw as
+    /// these options say, and say how the frame's 8-bit image is encoded: the textured colour as
+    /// `color` says; a debug view, whose values are meant for display, into an sRGB target and
+    /// encoded sRGB whatever `color` is. With [`FrameOptions::float`] the target is
+    /// [`ColorTarget::Float`] whatever the view.
+    pub fn apply(&self, settings: &mut RenderSettings<'_>, color: ColorHandling) -> Encoding {
+        settings.view = self.view;
+        settings.derivatives = self.derivatives;
+        settings.perspective = self.perspective;
+        settings.threads = self.threads;
+        let encoding = if self.view == View::Color {
+            color.encoding()
+        } else {
+            settings.target = ColorTarget::Srgb8;
+            Encoding::Srgb
+        };
+        if self.float {
+            settings.target = ColorTarget::Float;
+        }
+        encoding
+    }
+}
 
 /// The samplers of one filter on a prepared scene (one per mesh, then the textures' own, then the
 /// environment's), with their ripmaps and summed-area tables built: what a frame needs besides
@@ -77,6 +123,24 @@ impl FramePlan<'_> {
     /// The frame's settings seen by `camera` (the environment's background follows it).
     pub fn settings_from(&self, camera: &Camera) -> RenderSettings<'_> {
         self.scene.settings_for(&self.samplers, camera)
+    }
+
+    /// The frame's settings seen by the scene's camera, drawn as `options` say
+    /// ([`FrameOptions::apply`]), and the encoding of its 8-bit image.
+    pub fn settings_with(&self, options: &FrameOptions) -> (RenderSettings<'_>, Encoding) {
+        let mut settings = self.settings();
+        let encoding = options.apply(&mut settings, self.scene.color);
+        (settings, encoding)
+    }
+
+    /// The frame seen by the scene's camera, drawn on the CPU as `options` say, and the encoding
+    /// of its 8-bit image.
+    ///
+    /// # Errors
+    /// [`Error::Raster`] (an invalid size or scissor).
+    pub fn render(&self, options: &FrameOptions) -> Result<(Frame, Encoding), Error> {
+        let (settings, encoding) = self.settings_with(options);
+        Ok((render(&settings, &self.draws())?, encoding))
     }
 
     /// The draw calls seen by the scene's camera ([`PreparedScene::draws`]).

@@ -30,10 +30,12 @@ pub enum SceneError {
         message: String,
     },
     /// `builtin:NAME` with a name that does not exist.
-    #[error("unknown built-in scene {name:?}: available are {}, {}", crate::builtin_names().join(", "), crate::shaded_builtin_names().join(", "))]
+    #[error("unknown built-in scene {name:?}: available are {available}")]
     UnknownBuiltin {
         /// The name after `builtin:`.
         name: String,
+        /// The built-in scenes' names, unlit then lit, comma-separated.
+        available: String,
     },
     /// Output size outside `1..=MAX_OUTPUT_SIDE` per side.
     #[error("output size {width}x{height} is invalid: each side must be between 1 and {max}")]

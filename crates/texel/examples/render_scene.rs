@@ -9,8 +9,7 @@
 //! `render_scene.png`. The steps are the ones `texel::render_scene` takes, spelled out: load the
 //! scene, prepare it within a memory budget, plan the frame for the filter, render, encode.
 
-use texel::quality::Encoding;
-use texel::{render, Filter, MemoryBudget, PreparedScene, Scene, SceneOptions};
+use texel::{Filter, FrameOptions, MemoryBudget, PreparedScene, Scene, SceneOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut scene_arg = "builtin:ground".to_string();
@@ -38,9 +37,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let plan = prepared.plan(filter, &mut budget)?;
     let structure_bytes = plan.structure_bytes();
     let started = std::time::Instant::now();
-    let frame = render(&plan.settings(), &plan.draws())?;
+    // Drawn as `texel render` draws it: the textured colour, analytic derivatives, all cores.
+    let (frame, encoding) = plan.render(&FrameOptions::default())?;
     let ms = started.elapsed().as_secs_f64() * 1e3;
-    texel::frame_image(&frame, Encoding::Srgb)?.write_png(&out)?;
+    texel::frame_image(&frame, encoding)?.write_png(&out)?;
     println!(
         "{scene_arg}: {}x{} with {} in {ms:.1} ms ({structure_bytes} bytes of texture structures) -> {out}",
         frame.width,

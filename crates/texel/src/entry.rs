@@ -5,11 +5,12 @@
 use std::sync::atomic::AtomicBool;
 
 use texel_prepare::{
-    ColorHandling, Error, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions, TextureStorage,
+    ColorHandling, Error, FrameOptions, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
+    TextureStorage,
 };
-use texel_raster::{
-    render, ColorTarget, Frame, RasterError, ReferenceEstimate, ReferencePlan, RenderSettings, View,
-};
+#[cfg(doc)]
+use texel_prepare::FramePlan;
+use texel_raster::{ColorTarget, Frame, RasterError, ReferenceEstimate, ReferencePlan, View};
 use texel_scene::{Camera, Scene};
 use texel_texture::Filter;
 
@@ -104,14 +105,23 @@ pub fn frame_image(
 }
 
 /// Render `scene` as the options say: load its textures, build the samplers (and any ripmap or
-/// summed-area table) and draw every mesh. The frame's colour target is the 8-bit one the
-/// colour handling encodes to ([`PreparedScene::settings`]); a debug view's, whose values are
-/// meant for display, is sRGB whatever the colour handling. [`render_image`] gives the image.
+/// summed-area table) and draw every mesh ([`FramePlan::render`]). The frame's colour target is
+/// the 8-bit one the colour handling encodes to ([`PreparedScene::settings`]); a debug view's,
+/// whose values are meant for display, is sRGB whatever the colour handling
+/// ([`FrameOptions::apply`]). [`render_image`] gives the image.
 ///
 /// # Errors
 /// [`Error::OverBudget`], [`Error::Scene`] (textures that cannot be loaded), [`Error::Texture`],
 /// [`Error::Raster`] (an invalid size).
 pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Error> {
+    Ok(render_encoded(scene, options)?.0)
+}
+
+/// [`render_scene`]'s frame and the encoding of its 8-bit image.
+fn render_encoded(
+    scene: &Scene,
+    options: &RenderOptions,
+) -> Result<(Frame, quality::Encoding), Error> {
     let mut budget = MemoryBudget::limit_or_default(options.max_memory);
     let prepared = prepare(
         scene,
@@ -120,29 +130,12 @@ pub fn render_scene(scene: &Scene, options: &RenderOptions) -> Result<Frame, Err
         options.texture_storage,
         &mut budget,
     )?;
-    let plan = prepared.plan(options.filter, &mut budget)?;
-    let mut settings = plan.settings();
-    settings.threads = options.threads;
-    show_view(&mut settings, options.view, options.color);
-    Ok(render(&settings, &plan.draws())?)
-}
-
-/// Set `settings` to draw `view`, and say how its 8-bit image is encoded: the textured colour
-/// as the colour handling `color` says; a debug view, whose values are meant for display, into
-/// an sRGB target and encoded sRGB whatever `color` is. How `texel render`, [`render_scene`] and
-/// [`render_image`] draw a view.
-pub fn show_view(
-    settings: &mut RenderSettings,
-    view: View,
-    color: ColorHandling,
-) -> quality::Encoding {
-    settings.view = view;
-    if view == View::Color {
-        color.encoding()
-    } else {
-        settings.target = ColorTarget::Srgb8;
-        quality::Encoding::Srgb
-    }
+    let frame = FrameOptions {
+        view: options.view,
+        threads: options.threads,
+        ..FrameOptions::default()
+    };
+    prepared.plan(options.filter, &mut budget)?.render(&frame)
 }
 
 /// [`render_scene`]'s frame as the 8-bit RGBA image `texel render -o FILE.png` writes: encoded
@@ -151,8 +144,7 @@ pub fn show_view(
 /// # Errors
 /// As [`render_scene`].
 pub fn render_image(scene: &Scene, options: &RenderOptions) -> Result<quality::Image8, Error> {
-    let frame = render_scene(scene, options)?;
-    let encoding = show_view(&mut RenderSettings::default(), options.view, options.color);
+    let (frame, encoding) = render_encoded(scene, options)?;
     Ok(frame_image(&frame, encoding)?)
 }
 

@@ -38,10 +38,10 @@ pub mod timing;
 
 pub use entry::{
     frame_image, reference_prepared, reference_scene, render_image, render_scene, scene_inputs,
-    show_view, ReferenceOptions, RenderOptions,
+    ReferenceOptions, RenderOptions,
 };
 pub use texel_prepare::{
-    ColorHandling, Error, FramePlan, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
+    ColorHandling, Error, FrameOptions, FramePlan, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
     TextureStorage,
 };
 pub use texel_quality::Report;

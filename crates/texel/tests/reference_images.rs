@@ -22,7 +22,7 @@ use std::path::PathBuf;
 use texel::quality::Image8;
 use texel::raster::{Derivatives, Precision, ReferencePlan};
 use texel::{
-    render, ColorHandling, Filter, MemoryBudget, PreparedScene, ReferenceRun, Scene, SceneOptions,
+    ColorHandling, Filter, MemoryBudget, PreparedScene, ReferenceRun, Scene, SceneOptions,
     TextureStorage, View,
 };
 
@@ -176,10 +176,12 @@ fn render_tile(scene: &mut Prepared, tile: &Tile) -> Image8 {
     }
     let mut budget = MemoryBudget::limit_or_default(None);
     let plan = prepared.plan(tile.filter, &mut budget).unwrap();
-    let mut settings = plan.settings();
-    settings.derivatives = tile.derivatives;
-    let encoding = texel::show_view(&mut settings, tile.view, tile.color);
-    let frame = render(&settings, &plan.draws()).unwrap();
+    let options = texel::FrameOptions {
+        view: tile.view,
+        derivatives: tile.derivatives,
+        ..texel::FrameOptions::default()
+    };
+    let (frame, encoding) = plan.render(&options).unwrap();
     texel::frame_image(&frame, encoding).unwrap()
 }
 

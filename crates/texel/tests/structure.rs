@@ -5,6 +5,8 @@
 //! - texel-texture's floors only look down: every `crate::floor::file` path names a file on the
 //!   same floor or a lower one, paths name modules rather than the root's re-exports, and its
 //!   files import each other in no circle;
+//! - texel-raster's and texel-scene's modules stand in layers that only look down (a module
+//!   names modules of its own layer or lower ones, directly or through the root's re-exports);
 //! - the facade names its surface item by item: no `pub use` of a whole crate or a glob.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -434,4 +436,138 @@ fn the_facade_names_its_surface_item_by_item() {
         wholesale_reexports(&sample.items),
         vec!["texel_io", "texel_raster", "texel_quality::html::*"]
     );
+}
+
+/// The names the root `lib.rs` re-exports from the crate's own modules, each with its module
+/// (`pub use module::{Name, other::Deeper as Alias}` gives `Name` and `Alias`).
+fn root_names(lib: &syn::File, modules: &BTreeSet<String>) -> BTreeMap<String, String> {
+    fn leaves(tree: &syn::UseTree, out: &mut Vec<String>) {
+        match tree {
+            syn::UseTree::Path(p) => leaves(&p.tree, out),
+            syn::UseTree::Group(g) => g.items.iter().for_each(|t| leaves(t, out)),
+            syn::UseTree::Name(n) => out.push(n.ident.to_string()),
+            syn::UseTree::Rename(r) => out.push(r.rename.to_string()),
+            syn::UseTree::Glob(_) => {}
+        }
+    }
+    let mut names = BTreeMap::new();
+    for item in &lib.items {
+        let syn::Item::Use(u) = item else { continue };
+        let syn::UseTree::Path(p) = &u.tree else {
+            continue;
+        };
+        let module = p.ident.to_string();
+        if !modules.contains(&module) {
+            continue; // another crate's names
+        }
+        let mut out = Vec::new();
+        leaves(&p.tree, &mut out);
+        for name in out {
+            names.insert(name, module.clone());
+        }
+    }
+    names
+}
+
+/// The modules of `code` names through `crate::x` and `crate::{x, y}`, where `x` is one of
+/// `modules` or a root re-export of one (`names`).
+fn named_modules(
+    code: &str,
+    modules: &BTreeSet<String>,
+    names: &BTreeMap<String, String>,
+) -> BTreeSet<String> {
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut out = BTreeSet::new();
+    let mut add = |x: String| {
+        if modules.contains(&x) {
+            out.insert(x);
+        } else if let Some(m) = names.get(&x) {
+            out.insert(m.clone());
+        }
+    };
+    for (i, _) in code.match_indices("crate::") {
+        let rest = &code[i + "crate::".len()..];
+        if let Some(group) = rest.strip_prefix('{') {
+            let group = &group[..group.find('}').unwrap_or(group.len())];
+            group.split(',').for_each(|p| add(ident(p.trim())));
+        } else {
+            add(ident(rest));
+        }
+    }
+    out
+}
+
+/// Every module of the crate at `src` in one of `layers` (lowest first), and each naming only
+/// modules of its layer or lower ones: the breaches, as messages.
+fn layer_breaches(src: &Path, layers: &[&[&str]]) -> Vec<String> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    let mut code: BTreeMap<String, String> = BTreeMap::new();
+    for file in &files {
+        let text = fs::read_to_string(file).unwrap();
+        code.entry(module_of(src, file))
+            .or_default()
+            .push_str(&library_code(&text));
+    }
+    let lib = syn::parse_file(&fs::read_to_string(src.join("lib.rs")).unwrap()).unwrap();
+    let modules: BTreeSet<String> = code.keys().filter(|m| *m != "lib").cloned().collect();
+    let names = root_names(&lib, &modules);
+    let layer_of = |m: &str| layers.iter().position(|l| l.contains(&m));
+    let mut wrong = Vec::new();
+    for (module, text) in code.iter().filter(|(m, _)| *m != "lib") {
+        let Some(own) = layer_of(module) else {
+            wrong.push(format!("{module} is in no layer"));
+            continue;
+        };
+        for to in named_modules(text, &modules, &names) {
+            match layer_of(&to) {
+                Some(l) if l > own => wrong.push(format!("{module} looks up at {to}")),
+                _ => {}
+            }
+        }
+    }
+    wrong
+}
+
+/// texel-raster's layers, lowest first: the frame's vocabulary; a triangle's set-up and its
+/// attributes; shading; the tile loop; the jobs built on it.
+const RASTER_LAYERS: &[&[&str]] = &[
+    &["error", "camera", "clip", "stream", "views", "settings", "draw", "frame"],
+    &["setup", "interp", "point"],
+    &["relief", "shade"],
+    &["tile"],
+    &["reference", "exact", "adaptive", "warp"],
+];
+
+/// texel-scene's layers, lowest first: the vocabulary of a scene; the scene model and what is
+/// read off it; the loaders; the scene file.
+const SCENE_LAYERS: &[&[&str]] = &[
+    &["error", "camera", "limits", "procedural", "environment"],
+    &["model", "tangents", "texture", "validate"],
+    &["obj", "gltf_import", "builtin"],
+    &["file"],
+];
+
+#[test]
+fn raster_and_scene_modules_stand_in_layers_that_only_look_down() {
+    let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut wrong = layer_breaches(&crates.join("texel-raster/src"), RASTER_LAYERS);
+    wrong.extend(layer_breaches(&crates.join("texel-scene/src"), SCENE_LAYERS));
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn layer_reads_see_modules_groups_and_root_names() {
+    let modules: BTreeSet<String> = ["draw", "frame", "setup"].map(String::from).into();
+    let lib = syn::parse_file("pub use frame::{Frame, Clear as Cleared};\npub use glam::Vec3;").unwrap();
+    let names = root_names(&lib, &modules);
+    assert_eq!(names.get("Cleared").map(String::as_str), Some("frame"));
+    assert!(!names.contains_key("Vec3"));
+    let code = "use crate::{setup, Frame};\nlet d = crate::draw::DrawCall::new();\ncrate::Vec3::ZERO";
+    let want: BTreeSet<String> = ["draw", "frame", "setup"].map(String::from).into();
+    assert_eq!(named_modules(code, &modules, &names), want);
 }

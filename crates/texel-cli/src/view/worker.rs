@@ -25,11 +25,11 @@ use rayon::prelude::*;
 use texel::lab::{Gl, GlScene, Names, ShaderDraws};
 use texel::quality::Encoding;
 use texel::raster::{
-    draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, ProgressiveReference,
+    draw_into, render_reference_strata, DrawCall, Frame, ProgressiveReference,
     ReferencePlan, RenderSettings, View,
 };
 use texel::scene::Camera;
-use texel::{Filter, PreparedScene, Sampler, SamplerDescriptor};
+use texel::{Filter, FrameOptions, PreparedScene, Sampler, SamplerDescriptor};
 use texel_gpu::{Gpu, GpuDraws, GpuFilter};
 
 use crate::controls::{Mode, ViewState};
@@ -637,11 +637,14 @@ fn view_settings(
     let mut settings = scene.settings();
     settings.width = w;
     settings.height = h;
-    settings.view = state.view;
-    settings.perspective = state.perspective;
-    settings.derivatives = state.derivatives;
-    settings.threads = None;
-    settings.target = ColorTarget::Float;
+    let options = FrameOptions {
+        view: state.view,
+        derivatives: state.derivatives,
+        perspective: state.perspective,
+        float: true,
+        threads: None,
+    };
+    options.apply(&mut settings, scene.color);
     settings
 }
 
