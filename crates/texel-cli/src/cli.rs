@@ -81,7 +81,7 @@ pub(crate) enum Command {
     /// Example: texel view builtin:ground --size 1280x720
     ///
     /// Example (scripted, as the tests run it): texel view --keys 5 --frames 3 --no-hud --screenshot s.png
-    #[command(after_help = crate::controls::key_table())]
+    #[command(after_help = texel_view::key_table())]
     View(ViewArgs),
     /// Run and grade a student's GLSL fragment shader for the lab's eight modes on OpenGL (EGL:
     /// Mesa's llvmpipe without a GPU), against texel's modes under the GL rules and the lab's

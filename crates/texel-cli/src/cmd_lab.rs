@@ -12,17 +12,6 @@ use texel::lab::{self, Job, Names};
 use crate::cli::LabArgs;
 use crate::input::Input;
 
-/// The largest shader file read.
-const MAX_SHADER_BYTES: u64 = 1 << 20;
-
-/// The text of a shader file (a regular file of at most 1 MiB, UTF-8).
-pub(crate) fn read_source(path: &Path, what: &str) -> Result<String> {
-    let bytes = texel_io::read_regular(path, MAX_SHADER_BYTES)
-        .with_context(|| format!("cannot read the {what} {}", path.display()))?;
-    String::from_utf8(bytes)
-        .with_context(|| format!("the {what} {} is not UTF-8 text", path.display()))
-}
-
 /// The device's work folder: inside the report's staging directory (so a signal's clean-up
 /// removes it with the rest, and it is never published), private to this user, removed when
 /// dropped.
@@ -57,9 +46,9 @@ fn scene_bytes(w: u32, h: u32, modes: usize) -> u64 {
 
 /// Run `texel lab`.
 pub(crate) fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
-    let fragment = read_source(&args.shader, "fragment shader")?;
+    let fragment = lab::read_shader(&args.shader, "fragment shader")?;
     let vertex = match &args.vertex {
-        Some(p) => Some(read_source(p, "vertex shader")?),
+        Some(p) => Some(lab::read_shader(p, "vertex shader")?),
         None => None,
     };
     let mut job = Job::new(fragment);
@@ -123,7 +112,7 @@ pub(crate) fn run(args: &LabArgs, input: &mut Input) -> Result<()> {
             lab::grade(&job, &shader_name, &work.0, &options)
         })??;
         drop(work);
-        lab::write_report(&report, &images, dir)?;
+        report.write(&images, dir)?;
         Ok::<_, anyhow::Error>(report)
     })
     .with_context(|| format!("cannot write the report to {}", args.out.display()))?;

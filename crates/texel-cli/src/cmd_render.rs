@@ -64,7 +64,10 @@ pub(crate) fn run(args: &RenderArgs, input: &mut Input) -> Result<()> {
             texel_gpu::frame_bytes(settings.width, settings.height),
         )?;
         let gpu = Gpu::new(args.adapter.as_deref())?;
-        (texel_gpu::render(&gpu, &settings, &draws, gpu_filter)?, encoding)
+        (
+            texel_gpu::render(&gpu, &settings, &draws, gpu_filter)?,
+            encoding,
+        )
     } else {
         plan.render(&options)?
     };

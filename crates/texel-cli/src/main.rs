@@ -15,7 +15,6 @@ mod cmd_mips;
 mod cmd_reference;
 mod cmd_render;
 mod cmd_warp;
-mod controls;
 mod filters;
 mod input;
 mod interrupt;
@@ -76,7 +75,10 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             // One line whatever the paths and names in it hold.
-            texel_io::stderr_line(format_args!("texel: error: {}", chain_line(&err)));
+            texel_io::stderr_line(format_args!(
+                "texel: error: {}",
+                texel_io::chain_line(err.as_ref())
+            ));
             if err.downcast_ref::<interrupt::Interrupted>().is_some() {
                 return ExitCode::from(interrupt::INTERRUPTED as u8);
             }
@@ -120,16 +122,4 @@ fn clap_exit(e: &clap::Error) -> ExitCode {
         texel_io::stderr_text(&plain);
     }
     ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
-}
-
-/// The error and its causes on one line: `outer: cause: root cause`.
-fn chain_line(err: &anyhow::Error) -> String {
-    let mut parts: Vec<String> = Vec::new();
-    for cause in err.chain() {
-        let s = cause.to_string();
-        if !parts.last().is_some_and(|p| p.contains(&s)) {
-            parts.push(s);
-        }
-    }
-    parts.join(": ")
 }

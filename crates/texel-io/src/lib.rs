@@ -23,4 +23,4 @@ pub use output::{
     check_output, publish_dir, remove_pending_and_exit, same_output, write_atomic, OutputError,
     OUTPUT_MARKER,
 };
-pub use term::{escape, stderr_line, stderr_text, stdout_line, stdout_text};
+pub use term::{chain_line, escape, stderr_line, stderr_text, stdout_line, stdout_text};

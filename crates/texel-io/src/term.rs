@@ -73,6 +73,21 @@ fn one_line(line: impl Display) -> String {
     s
 }
 
+/// An error and its causes on one line, `outer: cause: root cause`, a cause left out where the
+/// text before it already holds it (an error that prints its source).
+pub fn chain_line(err: &(dyn std::error::Error + 'static)) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut next = Some(err);
+    while let Some(e) = next {
+        let s = e.to_string();
+        if !parts.last().is_some_and(|p| p.contains(&s)) {
+            parts.push(s);
+        }
+        next = e.source();
+    }
+    parts.join(": ")
+}
+
 /// Write `line` ([`escape`]d, so one line whatever it holds) and a line feed to standard error
 /// in one write; a failed write is ignored.
 pub fn stderr_line(line: impl Display) {
@@ -109,6 +124,39 @@ fn write_stdout(s: &str) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An error with a message and an optional source.
+    #[derive(Debug, thiserror::Error)]
+    #[error("{0}")]
+    struct Layer(String, #[source] Option<Box<Layer>>);
+
+    fn chain(texts: &[&str]) -> Layer {
+        texts
+            .iter()
+            .rev()
+            .fold(None, |source, t| {
+                Some(Layer(t.to_string(), source.map(Box::new)))
+            })
+            .unwrap()
+    }
+
+    #[test]
+    fn a_chain_is_one_line_with_repeated_causes_left_out() {
+        assert_eq!(chain_line(&chain(&["outer"])), "outer");
+        assert_eq!(
+            chain_line(&chain(&[
+                "cannot load scene a.toml",
+                "bad file",
+                "no such file"
+            ])),
+            "cannot load scene a.toml: bad file: no such file"
+        );
+        // A cause whose text the error before it already printed is not said twice.
+        assert_eq!(
+            chain_line(&chain(&["the texture t: no such file", "no such file"])),
+            "the texture t: no such file"
+        );
+    }
 
     #[test]
     fn plain_text_is_borrowed_unchanged() {

@@ -8,7 +8,7 @@
 //! The work is split in two so that a shader that never finishes cannot hang the grader:
 //! [`run_device`] renders (the CLI runs it in a child process with a time limit) and writes what
 //! it rendered into a folder; [`grade()`] reads that folder and makes the [`LabReport`], which
-//! [`report::write`] writes as JSON, Markdown and HTML. docs/guide/lab.md walks a student
+//! [`LabReport::write`] writes as JSON, Markdown and HTML. docs/guide/lab.md walks a student
 //! through it.
 
 pub mod gl;
@@ -29,6 +29,26 @@ pub use gl::{Capture, Gl, GlError, Names};
 pub use grading::Verdict;
 pub use scene::{LabScene, LAB_SCENES};
 pub use source::Violation;
+
+/// The largest shader file [`read_shader`] reads.
+const MAX_SHADER_BYTES: u64 = 1 << 20;
+
+/// The text of a shader file: a regular file of at most 1 MiB, UTF-8. `what` names it in the
+/// errors ("fragment shader").
+///
+/// # Errors
+/// [`Error::Io`]: the file cannot be read (not a regular file, over 1 MiB, an I/O error), or it is
+/// not UTF-8 text.
+pub fn read_shader(path: &Path, what: &str) -> Result<String, Error> {
+    let bytes = texel_io::read_regular(path, MAX_SHADER_BYTES)
+        .map_err(|e| Error::Io(format!("cannot read the {what} {}: {e}", path.display())))?;
+    String::from_utf8(bytes).map_err(|e| {
+        Error::Io(format!(
+            "the {what} {} is not UTF-8 text: {e}",
+            path.display()
+        ))
+    })
+}
 
 /// The lab's GLSL solutions and texel's vertex shader, as shipped in `crates/texel-lab/glsl/`.
 pub mod solutions {

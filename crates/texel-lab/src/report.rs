@@ -250,11 +250,19 @@ fn write_text(path: &Path, text: &str) -> Result<(), Error> {
         .map_err(|e| Error::Io(format!("{}: {e}", path.display())))
 }
 
-/// Write `report.json`, `report.md`, `report.html` and the images into `dir` (made if missing).
-///
-/// # Errors
-/// [`Error::Io`], [`Error::Quality`].
-pub fn write(report: &LabReport, images: &Images, dir: &Path) -> Result<(), Error> {
+impl LabReport {
+    /// Write `report.json`, `report.md`, `report.html` and the images into `dir` (made if
+    /// missing).
+    ///
+    /// # Errors
+    /// [`Error::Io`], [`Error::Quality`].
+    pub fn write(&self, images: &Images, dir: &Path) -> Result<(), Error> {
+        write(self, images, dir)
+    }
+}
+
+/// [`LabReport::write`].
+fn write(report: &LabReport, images: &Images, dir: &Path) -> Result<(), Error> {
     let images_dir = dir.join("images");
     std::fs::create_dir_all(&images_dir)
         .map_err(|e| Error::Io(format!("{}: {e}", images_dir.display())))?;

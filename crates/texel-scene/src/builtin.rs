@@ -117,7 +117,9 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "mirror-plane" => Ok(mirror_plane()),
         _ => Err(SceneError::UnknownBuiltin {
             name: name.to_string(),
-            available: [builtin_names(), shaded_builtin_names()].concat().join(", "),
+            available: [builtin_names(), shaded_builtin_names()]
+                .concat()
+                .join(", "),
         }),
     }
 }

@@ -4,12 +4,12 @@
 
 use std::sync::atomic::AtomicBool;
 
+#[cfg(doc)]
+use texel_prepare::FramePlan;
 use texel_prepare::{
     ColorHandling, Error, FrameOptions, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
     TextureStorage,
 };
-#[cfg(doc)]
-use texel_prepare::FramePlan;
 use texel_raster::{ColorTarget, Frame, RasterError, ReferenceEstimate, ReferencePlan, View};
 use texel_scene::{Camera, Scene};
 use texel_texture::Filter;

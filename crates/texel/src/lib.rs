@@ -41,8 +41,8 @@ pub use entry::{
     ReferenceOptions, RenderOptions,
 };
 pub use texel_prepare::{
-    ColorHandling, Error, FrameOptions, FramePlan, MemoryBudget, PreparedScene, ReferenceRun, SceneOptions,
-    TextureStorage,
+    ColorHandling, Error, FrameOptions, FramePlan, MemoryBudget, PreparedScene, ReferenceRun,
+    SceneOptions, TextureStorage,
 };
 pub use texel_quality::Report;
 pub use texel_raster::{render, ColorTarget, DrawCall, Frame, RenderSettings, View};
@@ -105,13 +105,12 @@ pub mod quality {
 pub mod lab {
     pub use texel_lab::gl::GlDraw;
     pub use texel_lab::gl::{GlScene, ShaderDraws};
-    pub use texel_lab::report::write as write_report;
     pub use texel_lab::scene::device_scene;
     pub use texel_lab::source::{level_size_queries, violations};
     pub use texel_lab::{
-        grade, run_device, Capture, DeviceRun, Error, Gl, GlError, GradeOptions, Images, Job,
-        LabReport, LabScene, LevelRange, ModeResult, Names, PyramidMemory, Questions, RubricPart,
-        Verdict, Violation,
+        grade, read_shader, run_device, Capture, DeviceRun, Error, Gl, GlError, GradeOptions,
+        Images, Job, LabReport, LabScene, LevelRange, ModeResult, Names, PyramidMemory, Questions,
+        RubricPart, Verdict, Violation,
     };
 }
 

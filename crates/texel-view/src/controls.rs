@@ -59,11 +59,11 @@ pub(crate) enum Key {
 
 /// A key press with the state of Shift.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Press {
+pub struct Press {
     /// The key.
-    pub key: Key,
+    pub(crate) key: Key,
     /// Whether Shift was held.
-    pub shift: bool,
+    pub(crate) shift: bool,
 }
 
 /// One row of the key table: the keys, what they do.
@@ -143,7 +143,7 @@ pub(crate) const KEYS: &[KeyHelp] = &[
 ];
 
 /// The key table as plain text, one row a line (for `--help`).
-pub(crate) fn key_table() -> String {
+pub fn key_table() -> String {
     let width = KEYS.iter().map(|k| k.keys.len()).max().unwrap_or(0);
     let mut s = String::from("Keys:\n");
     for k in KEYS {
@@ -329,7 +329,7 @@ fn mode_of(key: Key) -> Option<Mode> {
 ///
 /// # Errors
 /// The first token that is not a key, with the list of names.
-pub(crate) fn parse_keys(script: &str) -> Result<Vec<Press>, String> {
+pub fn parse_keys(script: &str) -> Result<Vec<Press>, String> {
     let mut out = Vec::new();
     for token in script.split(',').map(str::trim).filter(|t| !t.is_empty()) {
         let (mut shift, name) = match token.get(..6) {

@@ -41,6 +41,8 @@ pub(crate) struct Options {
     pub max_frames: Option<u64>,
     /// Write the last frame shown here at exit.
     pub screenshot: Option<PathBuf>,
+    /// How a screenshot is written.
+    pub save: fn(&std::path::Path, &texel::quality::Image8) -> Result<()>,
 }
 
 /// The window's state.
@@ -245,7 +247,7 @@ impl App {
             .map(|&p| [(p >> 16) as u8, (p >> 8) as u8, p as u8, 255])
             .collect();
         let image = texel::quality::Image8::new(w, h, pixels)?;
-        crate::output::write_image(path, &image)
+        (self.options.save)(path, &image)
     }
 
     /// Compose the newest frame and the overlays into `composed` and show it.
@@ -326,7 +328,7 @@ impl App {
                 s.push_str(&format!(
                     "  {:.0}% within {} step",
                     100.0 * share,
-                    crate::cli::DEFAULT_TOLERANCE_STEPS
+                    texel::raster::DEFAULT_TOLERANCE_STEPS
                 ));
             }
             match p.stats {

@@ -90,6 +90,36 @@ impl Fly {
     }
 }
 
+/// Movement speed of the fly camera: half the distance from the eye to the point looked at per
+/// second (the scene's scale where the camera is: the ground plane's camera stands 1 unit high and
+/// looks 10 units ahead, so it moves 5 units a second), at most the scene's bounding-box diagonal
+/// and at least 0.001 world units.
+pub(crate) fn movement_speed(scene: &texel::PreparedScene) -> f32 {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for m in &scene.scene.meshes {
+        for &p in &m.positions {
+            if p.is_finite() {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+    }
+    let diagonal = (hi - lo).length();
+    let c = &scene.scene.camera;
+    let reach = (c.target - c.eye).length() / 2.0;
+    let speed = if diagonal.is_finite() {
+        reach.min(diagonal)
+    } else {
+        reach
+    };
+    if speed.is_finite() {
+        speed.max(1e-3)
+    } else {
+        1.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

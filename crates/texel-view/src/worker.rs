@@ -25,16 +25,14 @@ use rayon::prelude::*;
 use texel::lab::{Gl, GlScene, Names, ShaderDraws};
 use texel::quality::Encoding;
 use texel::raster::{
-    draw_into, render_reference_strata, DrawCall, Frame, ProgressiveReference,
-    ReferencePlan, RenderSettings, View,
+    draw_into, render_reference_strata, DrawCall, Frame, ProgressiveReference, ReferencePlan,
+    RenderSettings, View,
 };
 use texel::scene::Camera;
 use texel::{Filter, FrameOptions, PreparedScene, Sampler, SamplerDescriptor};
 use texel_gpu::{Gpu, GpuDraws, GpuFilter};
 
 use crate::controls::{Mode, ViewState};
-
-use crate::input::{load_scene_with, Input};
 
 /// Time one frame (or one band of rows) should take, milliseconds.
 pub(crate) const BUDGET_MS: f64 = 40.0;
@@ -182,21 +180,15 @@ pub(crate) struct Rendered {
 
 /// What the render thread owns.
 pub(crate) struct Worker {
-    /// The scene argument (a path or `builtin:NAME`), reloaded for the other colour handling.
-    pub scene_spec: String,
-    /// `--size`, passed on to reloads.
-    pub size: Option<crate::cli::Size>,
-    /// `--specular-aa` and `--displacement`, passed on to reloads.
-    pub overrides: crate::input::MaterialOverrides,
+    /// The scene for the other colour handling, and the memory account.
+    pub source: Box<dyn crate::SceneSource>,
     /// The scene as loaded for each colour handling (index: `texel::ColorHandling as usize`).
     pub scenes: [Option<PreparedScene>; 2],
-    /// Memory account and input policy.
-    pub input: Input,
-    /// `--threads`.
+    /// Worker threads; `None`: all cores.
     pub threads: Option<u32>,
-    /// `--gpu`: the device.
+    /// The device of the GPU modes.
     pub gpu: Option<Gpu>,
-    /// `--shader`: the student's fragment shader, drawn on OpenGL in the left half.
+    /// The student's fragment shader, drawn on OpenGL in the left half.
     pub shader: Option<std::path::PathBuf>,
 }
 
@@ -257,7 +249,7 @@ fn shader_frame(
             .background
             .map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
         let scene = texel::lab::device_scene(draws, size, bg, clip.to_cols_array());
-        let source = crate::cmd_lab::read_source(path, "shader");
+        let source = texel::lab::read_shader(path, "shader").map_err(anyhow::Error::from);
         let built = match source {
             Ok(source) => match ask(state, ShaderJob::Build(source, scene)) {
                 Ok(r) => r.map_err(|e| anyhow::anyhow!("{}: {e}", path.display())),
@@ -273,7 +265,7 @@ fn shader_frame(
             Err(e) if state.built => {
                 state.notice = Some(format!(
                     "{} (the last good shader keeps running)",
-                    crate::chain_line(&e)
+                    texel_io::chain_line(e.as_ref())
                 ));
             }
             Err(e) => return Err(e),
@@ -503,7 +495,7 @@ pub(crate) fn run(mut worker: Worker, shared: Arc<Shared>, send: impl Fn(Rendere
                 if !idle {
                     std::thread::sleep(std::time::Duration::from_millis(200));
                 }
-                error_frame(req.generation, &crate::chain_line(&e))
+                error_frame(req.generation, &texel_io::chain_line(e.as_ref()))
             }
         };
         if !send(out) {
@@ -653,7 +645,9 @@ impl FrameContext<'_, '_> {
         let w = &mut *self.worker;
         let slot = color as usize;
         if w.scenes[slot].is_none() {
-            let s = load_scene_with(&w.scene_spec, color, w.size, w.overrides, &mut w.input)
+            let s = w
+                .source
+                .load(color)
                 .context("cannot load the scene for the other colour handling")?;
             w.scenes[slot] = Some(s);
         }
@@ -677,7 +671,7 @@ impl FrameContext<'_, '_> {
                 .collect::<Result<Vec<_>, _>>()?;
             let w = &mut *self.worker;
             let scene = w.scenes[state.color as usize].as_ref().expect("loaded");
-            scene.build_structures_within(&list, &mut w.input.budget)?;
+            scene.build_structures_within(&list, w.source.budget())?;
             self.samplers.insert(key, list);
         }
         Ok(key)
@@ -1159,7 +1153,32 @@ fn display(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cli::Size;
+    use texel::{ColorHandling, MemoryBudget, Scene, SceneOptions};
+
+    /// `builtin:ground` at `w x h`, prepared with the default options in any colour handling.
+    struct Ground {
+        size: (u32, u32),
+        budget: MemoryBudget,
+    }
+
+    impl crate::SceneSource for Ground {
+        fn load(&mut self, color: ColorHandling) -> Result<PreparedScene> {
+            let options = SceneOptions {
+                size: Some(self.size),
+                color,
+                ..SceneOptions::default()
+            };
+            Ok(PreparedScene::new(
+                Scene::load("builtin:ground")?,
+                &options,
+                &mut self.budget,
+            )?)
+        }
+
+        fn budget(&mut self) -> &mut MemoryBudget {
+            &mut self.budget
+        }
+    }
 
     /// The render thread's state for `builtin:ground` at `w x h`, without a thread or a window.
     struct Harness {
@@ -1174,30 +1193,16 @@ mod tests {
 
     impl Harness {
         fn new(w: u32, h: u32) -> Harness {
-            let mut input = Input {
-                budget: crate::budget::budget(None),
-                sanitize: false,
+            let mut source = Ground {
+                size: (w, h),
+                budget: MemoryBudget::limit_or_default(None),
             };
-            let size = Some(Size {
-                width: w,
-                height: h,
-            });
-            let scene = load_scene_with(
-                "builtin:ground",
-                texel::ColorHandling::Srgb,
-                size,
-                Default::default(),
-                &mut input,
-            )
-            .unwrap();
+            let scene = crate::SceneSource::load(&mut source, ColorHandling::Srgb).unwrap();
             let camera = scene.scene.camera;
             Harness {
                 worker: Worker {
-                    scene_spec: "builtin:ground".into(),
-                    size,
-                    overrides: Default::default(),
+                    source: Box::new(source),
                     scenes: [Some(scene), None],
-                    input,
                     threads: None,
                     gpu: None,
                     shader: None,
