@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use texel::compare::{slug, CompareJob, Extra, OrbitSpec, TIMED_FRAMES};
+use texel::compare::{CompareJob, Extra, OrbitSpec, TIMED_FRAMES};
 use texel::quality::Image8;
 use texel::raster::{Frame, RenderSettings};
 use texel::timing::median;
@@ -25,44 +25,6 @@ pub(crate) fn parse_extra(s: &str) -> Result<(String, PathBuf)> {
         }
         _ => bail!("--extra {s:?} is not LABEL=IMAGE (e.g. --extra llvmpipe=trilinear.png)"),
     }
-}
-
-/// Check `--extra` entries against each other and the filters: every label names one row and one
-/// file, so two labels that are equal, or whose file names would be equal, or a label equal to a
-/// compared filter's name, are refused, and so is a label holding control or bidirectional
-/// characters (it is a row of the report).
-pub(crate) fn check_extras(extras: &[(String, PathBuf)], filters: &[Filter]) -> Result<()> {
-    for (i, (label, _)) in extras.iter().enumerate() {
-        // A label is a row of the report (Markdown, HTML, JSON) that a terminal may show.
-        if label.chars().any(texel_io::term::needs_escape) {
-            bail!(
-                "--extra label {} holds control or bidirectional characters: give a label of \
-                 printable characters",
-                texel_io::escape(label)
-            );
-        }
-        if let Some(f) = filters.iter().find(|f| f.name() == label) {
-            bail!(
-                "--extra label {label:?} is also the name of a compared filter ({}): give the extra image another label",
-                f.name()
-            );
-        }
-        for (other, _) in &extras[..i] {
-            if other == label {
-                bail!(
-                    "--extra label {label:?} is given twice: each extra image needs its own label"
-                );
-            }
-            // Case-insensitive file systems (macOS, Windows) would merge `a` and `A`.
-            if slug(other).eq_ignore_ascii_case(&slug(label)) {
-                bail!(
-                    "--extra labels {other:?} and {label:?} would both be written as extra-{}.png: make them differ in letters, digits, - or _",
-                    slug(label)
-                );
-            }
-        }
-    }
-    Ok(())
 }
 
 /// Render `filters` (those the GPU path has) with texel's shaders and the device's own sampler:
@@ -150,7 +112,7 @@ pub(crate) fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         .iter()
         .map(|e| parse_extra(e))
         .collect::<Result<Vec<_>>>()?;
-    check_extras(&files, &filters)?;
+    texel::compare::check_labels(files.iter().map(|(label, _)| label.as_str()), &filters)?;
     let plan = crate::cli::reference_plan(
         args.spp,
         args.max_spp.unwrap_or(args.spp),
@@ -223,26 +185,5 @@ mod tests {
         assert!(parse_extra("nolabel").is_err());
         assert!(parse_extra("=x.png").is_err());
         assert!(parse_extra("x=").is_err());
-    }
-
-    #[test]
-    fn extras_distinct() {
-        let e = |l: &str| (l.to_string(), PathBuf::from("x.png"));
-        let f = [Filter::Trilinear];
-        assert!(check_extras(&[e("gpu"), e("llvmpipe")], &f).is_ok());
-        let msg = check_extras(&[e("gpu"), e("gpu")], &f)
-            .unwrap_err()
-            .to_string();
-        assert!(msg.contains("given twice"), "{msg}");
-        let msg = check_extras(&[e("a b"), e("a_b")], &f)
-            .unwrap_err()
-            .to_string();
-        assert!(msg.contains("extra-a_b.png"), "{msg}");
-        let msg = check_extras(&[e("gpu"), e("GPU")], &f)
-            .unwrap_err()
-            .to_string();
-        assert!(msg.contains("extra-GPU.png"), "{msg}");
-        let msg = check_extras(&[e("trilinear")], &f).unwrap_err().to_string();
-        assert!(msg.contains("compared filter"), "{msg}");
     }
 }

@@ -97,6 +97,63 @@ pub enum Extra {
     },
 }
 
+impl Extra {
+    /// The row's name.
+    pub fn label(&self) -> &str {
+        match self {
+            Extra::File { label, .. } | Extra::Frame { label, .. } => label,
+        }
+    }
+}
+
+/// Check the extra rows' labels against each other and the filters: every label names one row
+/// and one file (`extra-{label}.png`, the label made file-name-safe), so two labels that are
+/// equal, or whose file names would be equal on a file system that ignores case, or a label equal
+/// to a compared filter's name, are refused, and so is a label holding control or bidirectional
+/// characters (it is a row of the report, which a terminal may show). [`compare`] checks its
+/// job's; a caller checks its own first to refuse them before any work.
+///
+/// # Errors
+/// [`Error::Compare`], naming the label.
+pub fn check_labels<'a>(
+    labels: impl IntoIterator<Item = &'a str>,
+    filters: &[Filter],
+) -> Result<(), Error> {
+    let bad = |m: String| Err(Error::Compare(m));
+    let labels: Vec<&str> = labels.into_iter().collect();
+    for (i, &label) in labels.iter().enumerate() {
+        if label.chars().any(texel_io::term::needs_escape) {
+            return bad(format!(
+                "extra label {} holds control or bidirectional characters: give a label of \
+                 printable characters",
+                texel_io::escape(label)
+            ));
+        }
+        if let Some(f) = filters.iter().find(|f| f.name() == label) {
+            return bad(format!(
+                "extra label {label:?} is also the name of a compared filter ({}): give the extra \
+                 image another label",
+                f.name()
+            ));
+        }
+        for &other in &labels[..i] {
+            if other == label {
+                return bad(format!(
+                    "extra label {label:?} is given twice: each extra image needs its own label"
+                ));
+            }
+            if slug(other).eq_ignore_ascii_case(&slug(label)) {
+                return bad(format!(
+                    "extra labels {other:?} and {label:?} would both be written as extra-{}.png: \
+                     make them differ in letters, digits, - or _",
+                    slug(label)
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// What a comparison is at, for a progress display.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage<'a> {
@@ -192,7 +249,7 @@ impl<'a> CompareJob<'a> {
 
 /// A file-name-safe version of a label: ASCII letters, digits, `-` and `_` kept, every other
 /// character `_`. An extra row's images are named `extra-{slug}`.
-pub fn slug(label: &str) -> String {
+pub(crate) fn slug(label: &str) -> String {
     label
         .chars()
         .map(|c| {
@@ -411,6 +468,7 @@ pub fn compare(
     budget: &mut MemoryBudget,
 ) -> Result<Report, Error> {
     check_scene(scene, budget)?;
+    check_labels(job.extras.iter().map(Extra::label), job.filters)?;
     let enc = scene.color.encoding();
     let frames = job.orbit.map_or(1, |o| o.frames);
     let estimate = staged(job, Stage::Reference { n: 0, of: frames }, || {
@@ -625,7 +683,25 @@ fn orbit_scores(
 
 #[cfg(test)]
 mod tests {
-    use super::slug;
+    use super::{check_labels, slug};
+    use texel_texture::Filter;
+
+    #[test]
+    fn extra_labels_name_one_row_and_one_file_each() {
+        let f = [Filter::Trilinear];
+        let msg = |labels: &[&str]| {
+            check_labels(labels.iter().copied(), &f)
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(check_labels(["gpu", "llvmpipe"], &f).is_ok());
+        assert!(msg(&["gpu", "gpu"]).contains("given twice"));
+        assert!(msg(&["a b", "a_b"]).contains("extra-a_b.png"));
+        // Case-insensitive file systems (macOS, Windows) would merge `gpu` and `GPU`.
+        assert!(msg(&["gpu", "GPU"]).contains("extra-GPU.png"));
+        assert!(msg(&["trilinear"]).contains("compared filter"));
+        assert!(msg(&["a\u{202e}b"]).contains("control or bidirectional"));
+    }
 
     #[test]
     fn slugs() {

@@ -50,8 +50,8 @@ fn module_of(src: &Path, file: &Path) -> String {
     first.trim_end_matches(".rs").to_string()
 }
 
-/// The module graph of one crate's `src`.
-fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+/// The library code of each top-level module of one crate's `src` (`lib` for the root).
+fn module_code(src: &Path) -> BTreeMap<String, String> {
     let mut files = Vec::new();
     rust_files(src, &mut files);
     let mut code: BTreeMap<String, String> = BTreeMap::new();
@@ -61,6 +61,12 @@ fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
             .or_default()
             .push_str(&library_code(&text));
     }
+    code
+}
+
+/// The module graph of one crate's `src`.
+fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let code = module_code(src);
     let names: BTreeSet<String> = code.keys().cloned().collect();
     code.iter()
         .map(|(module, text)| {
@@ -504,15 +510,7 @@ fn named_modules(
 /// Every module of the crate at `src` in one of `layers` (lowest first), and each naming only
 /// modules of its layer or lower ones: the breaches, as messages.
 fn layer_breaches(src: &Path, layers: &[&[&str]]) -> Vec<String> {
-    let mut files = Vec::new();
-    rust_files(src, &mut files);
-    let mut code: BTreeMap<String, String> = BTreeMap::new();
-    for file in &files {
-        let text = fs::read_to_string(file).unwrap();
-        code.entry(module_of(src, file))
-            .or_default()
-            .push_str(&library_code(&text));
-    }
+    let code = module_code(src);
     let lib = syn::parse_file(&fs::read_to_string(src.join("lib.rs")).unwrap()).unwrap();
     let modules: BTreeSet<String> = code.keys().filter(|m| *m != "lib").cloned().collect();
     let names = root_names(&lib, &modules);
@@ -536,7 +534,9 @@ fn layer_breaches(src: &Path, layers: &[&[&str]]) -> Vec<String> {
 /// texel-raster's layers, lowest first: the frame's vocabulary; a triangle's set-up and its
 /// attributes; shading; the tile loop; the jobs built on it.
 const RASTER_LAYERS: &[&[&str]] = &[
-    &["error", "camera", "clip", "stream", "views", "settings", "draw", "frame"],
+    &[
+        "error", "camera", "clip", "stream", "views", "settings", "draw", "frame",
+    ],
     &["setup", "interp", "point"],
     &["relief", "shade"],
     &["tile"],
@@ -556,18 +556,23 @@ const SCENE_LAYERS: &[&[&str]] = &[
 fn raster_and_scene_modules_stand_in_layers_that_only_look_down() {
     let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut wrong = layer_breaches(&crates.join("texel-raster/src"), RASTER_LAYERS);
-    wrong.extend(layer_breaches(&crates.join("texel-scene/src"), SCENE_LAYERS));
+    wrong.extend(layer_breaches(
+        &crates.join("texel-scene/src"),
+        SCENE_LAYERS,
+    ));
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }
 
 #[test]
 fn layer_reads_see_modules_groups_and_root_names() {
     let modules: BTreeSet<String> = ["draw", "frame", "setup"].map(String::from).into();
-    let lib = syn::parse_file("pub use frame::{Frame, Clear as Cleared};\npub use glam::Vec3;").unwrap();
+    let lib =
+        syn::parse_file("pub use frame::{Frame, Clear as Cleared};\npub use glam::Vec3;").unwrap();
     let names = root_names(&lib, &modules);
     assert_eq!(names.get("Cleared").map(String::as_str), Some("frame"));
     assert!(!names.contains_key("Vec3"));
-    let code = "use crate::{setup, Frame};\nlet d = crate::draw::DrawCall::new();\ncrate::Vec3::ZERO";
+    let code =
+        "use crate::{setup, Frame};\nlet d = crate::draw::DrawCall::new();\ncrate::Vec3::ZERO";
     let want: BTreeSet<String> = ["draw", "frame", "setup"].map(String::from).into();
     assert_eq!(named_modules(code, &modules, &names), want);
 }
