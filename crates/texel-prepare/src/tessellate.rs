@@ -21,7 +21,7 @@ use std::collections::HashMap;
 
 use glam::{Mat4, Vec2, Vec4};
 use texel_raster::Vertex;
-use texel_texture::{AddressMode, Footprint, Sampler, SamplerDescriptor, Texture};
+use texel_texture::{AddressMode, Filter, Footprint, Sampler, SamplerDescriptor, Texture};
 
 /// A tessellated mesh: vertices (the original ones first) and triangles.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -222,7 +222,7 @@ pub fn displace(
     scale: f32,
     filter: HeightFilter,
 ) -> Result<(), texel_texture::TextureError> {
-    let mut desc = SamplerDescriptor::lab_mode(4)?;
+    let mut desc = SamplerDescriptor::from(Filter::Trilinear);
     desc.address_mode_u = address_modes.0;
     desc.address_mode_v = address_modes.1;
     let sampler = Sampler::new(desc)?;

@@ -6,7 +6,7 @@ use common::{Ground, Rng};
 use glam::{DVec2, Vec2, Vec3};
 use texel_raster::setup::{setup_draws, TriangleSetup};
 use texel_raster::{camera, render, Derivatives, DrawCall, Perspective, RenderSettings, Vertex};
-use texel_texture::{AddressMode, Sampler, SamplerDescriptor};
+use texel_texture::{AddressMode, Filter, Sampler, SamplerDescriptor};
 
 fn uv_at(t: &TriangleSetup, uvs: [DVec2; 3], x: f64, y: f64) -> DVec2 {
     t.barycentrics(x, y, Perspective::Correct).interpolate2(uvs)
@@ -97,9 +97,7 @@ fn quad_derivatives_are_differences_within_each_quad() {
     let scene = Ground::new(w, h);
     // Clamp: no periodic reduction of uv, so footprint uvs are directly comparable.
     let sampler = Sampler::new(
-        SamplerDescriptor::lab_mode(4)
-            .unwrap()
-            .with_address_mode(AddressMode::ClampToEdge),
+        SamplerDescriptor::from(Filter::Trilinear).with_address_mode(AddressMode::ClampToEdge),
     )
     .unwrap();
     let settings = RenderSettings {

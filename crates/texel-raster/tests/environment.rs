@@ -7,7 +7,7 @@ use texel_raster::{
     render, render_reference, DrawCall, Environment, EnvironmentMaps, Material, RenderSettings,
     Vertex,
 };
-use texel_texture::{Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture};
+use texel_texture::{Filter, Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
 const MAPPINGS: [Mapping; 3] = [Mapping::Equirect, Mapping::Cube, Mapping::Octahedral];
 
@@ -48,7 +48,9 @@ fn maps(side: u32, f: impl Fn(DVec3) -> [f32; 3]) -> EnvironmentMaps {
 fn sampler_for(mapping: Mapping, lab: u8) -> Sampler {
     Sampler::new(descriptor(
         mapping,
-        SamplerDescriptor::lab_mode(lab).unwrap(),
+        Filter::from_lab_mode(lab)
+            .map(SamplerDescriptor::from)
+            .unwrap(),
     ))
     .unwrap()
 }

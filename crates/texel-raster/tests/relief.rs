@@ -10,7 +10,7 @@ use texel_raster::{
     render, ChannelInput, Displacement, DrawCall, Light, Material, RenderSettings, SpecularAa,
     TextureInput, Vertex, MAX_LIGHTS,
 };
-use texel_texture::{AddressMode, Format, Limits, Sampler, SamplerDescriptor, Texture};
+use texel_texture::{AddressMode, Filter, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
 /// The ray from `eye` through pixel `(i, j)`'s centre (unit direction).
 fn ray(m: Mat4, eye: Vec3, i: u32, j: u32) -> Vec3 {
@@ -29,7 +29,7 @@ fn float_map(f: impl Fn(f32, f32) -> f32) -> Texture {
 }
 
 fn trilinear_clamped() -> Sampler {
-    let d = SamplerDescriptor::lab_mode(4).unwrap();
+    let d = SamplerDescriptor::from(Filter::Trilinear);
     Sampler::new(d.with_address_mode(AddressMode::ClampToEdge)).unwrap()
 }
 

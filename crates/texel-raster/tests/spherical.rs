@@ -8,7 +8,7 @@ use texel_raster::{
     UvMapping, Vertex,
 };
 use texel_texture::mapping::sphere::SurfaceProjection;
-use texel_texture::{AddressMode, Format, Limits, Sampler, SamplerDescriptor, Texture};
+use texel_texture::{AddressMode, Filter, Format, Limits, Sampler, SamplerDescriptor, Texture};
 
 const PROJECTIONS: [SurfaceProjection; 2] =
     [SurfaceProjection::Equirect, SurfaceProjection::MERCATOR];
@@ -87,7 +87,7 @@ fn bands(width: u32, height: u32) -> Texture {
 }
 
 fn trilinear() -> Sampler {
-    let d = SamplerDescriptor::lab_mode(4).unwrap();
+    let d = SamplerDescriptor::from(Filter::Trilinear);
     Sampler::new(SamplerDescriptor {
         address_mode_u: AddressMode::Repeat,
         address_mode_v: AddressMode::ClampToEdge,

@@ -12,7 +12,7 @@ use texel_raster::{
     draw_into, limit_level, render, simd_level, ColorTarget, Derivatives, DrawCall, Frame,
     RenderSettings, SimdLevel, Vertex, View,
 };
-use texel_texture::{Sampler, Texture};
+use texel_texture::{Filter, Sampler, Texture};
 
 fn settings(w: u32, h: u32, target: ColorTarget) -> RenderSettings<'static> {
     RenderSettings {
@@ -187,9 +187,7 @@ fn copied_texels_are_the_encoded_float_frame() {
         let d = SamplerDescriptor {
             mipmap_filter,
             border_color,
-            ..SamplerDescriptor::lab_mode(1)
-                .unwrap()
-                .with_address_mode(addr)
+            ..SamplerDescriptor::from(Filter::Nearest).with_address_mode(addr)
         };
         Sampler::new(d).unwrap()
     })

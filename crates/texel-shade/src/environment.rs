@@ -65,7 +65,9 @@ use std::sync::OnceLock;
 use glam::{DMat4, DVec2, DVec3, DVec4, Mat4, Vec3};
 use rayon::prelude::*;
 pub use texel_texture::mapping::sphere::{equirect_direction, equirect_duv, equirect_uv, Mapping};
-use texel_texture::{AddressMode, Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture};
+use texel_texture::{
+    AddressMode, Filter, Footprint, Format, Limits, Sampler, SamplerDescriptor, Texture,
+};
 
 use crate::error::ShadeError;
 use crate::material::{ggx_d, smith_visibility, MIN_ROUGHNESS};
@@ -336,11 +338,17 @@ impl EnvironmentMaps {
                 "cube faces and octahedral maps must be square, cube faces all of one size",
             ));
         }
-        let trilinear = Sampler::new(descriptor(mapping, SamplerDescriptor::lab_mode(4)?))?;
-        let level0 = Sampler::new(descriptor(mapping, SamplerDescriptor::lab_mode(2)?))?;
+        let trilinear = Sampler::new(descriptor(
+            mapping,
+            SamplerDescriptor::from(Filter::Trilinear),
+        ))?;
+        let level0 = Sampler::new(descriptor(
+            mapping,
+            SamplerDescriptor::from(Filter::Bilinear),
+        ))?;
         let irradiance_sampler = Sampler::new(descriptor(
             Mapping::Equirect,
-            SamplerDescriptor::lab_mode(4)?,
+            SamplerDescriptor::from(Filter::Trilinear),
         ))?;
         let radiance = match mapping {
             Mapping::Equirect => faces,

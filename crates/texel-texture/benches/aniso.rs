@@ -14,8 +14,8 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use glam::Vec2;
 use texel_texture::{
-    AddressMode, ColorSpace, Cubic, FilterMode, Footprint, Limits, MipmapFilterMode, Ripmap,
-    Sampler, SamplerDescriptor, SummedAreaTable, Texture,
+    AddressMode, ColorSpace, Cubic, Filter, FilterMode, Footprint, Limits, MipmapFilterMode,
+    Ripmap, Sampler, SamplerDescriptor, SummedAreaTable, Texture,
 };
 
 const SIZE: u32 = 2048;
@@ -55,7 +55,11 @@ fn footprints(ratio: f32) -> Vec<Footprint> {
 }
 
 fn filters() -> Vec<(&'static str, SamplerDescriptor)> {
-    let lab = |m| SamplerDescriptor::lab_mode(m).unwrap();
+    let lab = |m| {
+        Filter::from_lab_mode(m)
+            .map(SamplerDescriptor::from)
+            .unwrap()
+    };
     vec![
         ("nearest", lab(1)),
         ("bilinear", lab(2)),

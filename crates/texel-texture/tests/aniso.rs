@@ -7,7 +7,7 @@ use glam::{DVec2, Vec2};
 use proptest::prelude::*;
 use texel_texture::technique::ewa::Ellipse;
 use texel_texture::{
-    Address, AddressMode, BorderColor, FilterMode, Footprint, Format, Limits, Sampler,
+    Address, AddressMode, BorderColor, Filter, FilterMode, Footprint, Format, Limits, Sampler,
     SamplerDescriptor, Texture, TextureError,
 };
 
@@ -28,11 +28,11 @@ fn noise_texture(w: u32, h: u32, format: Format, seed: u64) -> Texture {
 /// Every anisotropic minification technique, plus trilinear as the baseline.
 fn technique(name: &str) -> SamplerDescriptor {
     match name {
-        "trilinear" => SamplerDescriptor::lab_mode(4).unwrap(),
-        "aniso2" => SamplerDescriptor::lab_mode(5).unwrap(),
-        "aniso4" => SamplerDescriptor::lab_mode(6).unwrap(),
-        "aniso8" => SamplerDescriptor::lab_mode(7).unwrap(),
-        "aniso16" => SamplerDescriptor::lab_mode(8).unwrap(),
+        "trilinear" => SamplerDescriptor::from(Filter::Trilinear),
+        "aniso2" => SamplerDescriptor::from(Filter::Aniso2),
+        "aniso4" => SamplerDescriptor::from(Filter::Aniso4),
+        "aniso8" => SamplerDescriptor::from(Filter::Aniso8),
+        "aniso16" => SamplerDescriptor::from(Filter::Aniso16),
         "ewa" => SamplerDescriptor::minification(FilterMode::Ewa),
         "ewa-probes" => SamplerDescriptor::minification(FilterMode::EwaProbes),
         "ripmap" => SamplerDescriptor::minification(FilterMode::Ripmap),
@@ -128,7 +128,7 @@ proptest! {
             .with_address_mode(AddressMode::Repeat)).unwrap();
         let (want, want_reads) = tri.sample_counted(&tex, &fp);
         for mode in 5..=8 {
-            let desc = SamplerDescriptor { lod_bias: bias, ..SamplerDescriptor::lab_mode(mode).unwrap() };
+            let desc = SamplerDescriptor { lod_bias: bias, ..Filter::from_lab_mode(mode).map(SamplerDescriptor::from).unwrap() };
             let s = Sampler::new(desc.with_address_mode(AddressMode::Repeat)).unwrap();
             let (got, reads) = s.sample_counted(&tex, &fp);
             prop_assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits), "mode {}", mode);
@@ -151,14 +151,19 @@ fn anisotropic_probe_counts_follow_the_ext_rule() {
         256,
     );
     for (mode, probes) in [(5u8, 2u32), (6, 4), (7, 4), (8, 4)] {
-        let s = Sampler::new(SamplerDescriptor::lab_mode(mode).unwrap()).unwrap();
+        let s = Sampler::new(
+            Filter::from_lab_mode(mode)
+                .map(SamplerDescriptor::from)
+                .unwrap(),
+        )
+        .unwrap();
         let (_, reads) = s.sample_counted(&tex, &fp);
         // 2 probes at lod log2(16) = 4 are also integer lods.
         assert_eq!(reads, 4 * probes, "mode {mode}");
     }
     // The probes average trilinear lookups spaced |Pmax| / N along the major axis.
-    let s = Sampler::new(SamplerDescriptor::lab_mode(6).unwrap()).unwrap();
-    let tri = Sampler::new(SamplerDescriptor::lab_mode(4).unwrap()).unwrap();
+    let s = Sampler::new(SamplerDescriptor::from(Filter::Aniso4)).unwrap();
+    let tri = Sampler::new(SamplerDescriptor::from(Filter::Trilinear)).unwrap();
     let got = s.sample(&tex, &fp);
     let mut want = [0.0f32; 4];
     for i in 0..4 {
@@ -436,7 +441,7 @@ fn ripmap_and_sat_blur_not_alias_at_45_degrees() {
         }
         dev
     };
-    let bilinear = Sampler::new(SamplerDescriptor::lab_mode(2).unwrap()).unwrap();
+    let bilinear = Sampler::new(SamplerDescriptor::from(Filter::Bilinear)).unwrap();
     let alias = spread(&bilinear);
     assert!(
         alias > 0.4,
@@ -895,12 +900,14 @@ fn descriptor_validation() {
         Err(TextureError::InvalidAnisotropyClamp(65))
     ));
     for (mode, n) in [(5u8, 2u16), (6, 4), (7, 8), (8, 16)] {
-        let d = SamplerDescriptor::lab_mode(mode).unwrap();
+        let d = Filter::from_lab_mode(mode)
+            .map(SamplerDescriptor::from)
+            .unwrap();
         assert_eq!(d.anisotropy_clamp, n);
         assert_eq!(d.min_filter, FilterMode::Linear);
     }
     assert!(matches!(
-        SamplerDescriptor::lab_mode(9),
+        Filter::from_lab_mode(9),
         Err(TextureError::UnknownLabMode(9))
     ));
     // EWA with the WebGPU default clamp of 1 uses 16; an explicit 16 gives the same result.

@@ -3,9 +3,9 @@
 
 use proptest::prelude::*;
 use texel_texture::{
-    Address, AddressMode, BorderColor, ColorSpace, Cubic, FilterMode, Footprint, FootprintBatch,
-    FootprintLanes, Format, Lanes, Limits, MipmapFilterMode, Sampler, SamplerDescriptor, SpanKind,
-    Texture, TextureError, Wants,
+    Address, AddressMode, BorderColor, ColorSpace, Cubic, Filter, FilterMode, Footprint,
+    FootprintBatch, FootprintLanes, Format, Lanes, Limits, MipmapFilterMode, Sampler,
+    SamplerDescriptor, SpanKind, Texture, TextureError, Wants,
 };
 
 /// The bytes `s` bound to `tex` gives for `wants`, into `out`, when its spans are `kind`;
@@ -1105,11 +1105,11 @@ fn invalid_descriptors_are_rejected() {
     .unwrap_err();
     assert!(e.to_string().contains("lod_min_clamp = 3"), "{e}");
     assert!(matches!(
-        SamplerDescriptor::lab_mode(0),
+        Filter::from_lab_mode(0),
         Err(TextureError::UnknownLabMode(0))
     ));
     assert!(matches!(
-        SamplerDescriptor::lab_mode(99),
+        Filter::from_lab_mode(99),
         Err(TextureError::UnknownLabMode(99))
     ));
 }
@@ -1117,7 +1117,11 @@ fn invalid_descriptors_are_rejected() {
 /// The lab's modes 1-4.
 #[test]
 fn lab_modes() {
-    let m = |n| SamplerDescriptor::lab_mode(n).unwrap();
+    let m = |n| {
+        Filter::from_lab_mode(n)
+            .map(SamplerDescriptor::from)
+            .unwrap()
+    };
     assert_eq!(
         (m(1).min_filter, m(1).mipmap_filter),
         (FilterMode::Nearest, MipmapFilterMode::None)

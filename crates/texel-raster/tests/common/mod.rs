@@ -3,7 +3,9 @@
 
 use glam::{DMat4, DVec2, DVec4, Mat4, Vec2, Vec3};
 use texel_raster::{camera, DrawCall, Vertex};
-use texel_texture::{AddressMode, ColorSpace, Format, Limits, Sampler, SamplerDescriptor, Texture};
+use texel_texture::{
+    AddressMode, ColorSpace, Filter, Format, Limits, Sampler, SamplerDescriptor, Texture,
+};
 
 /// The ground scene's camera.
 pub(crate) const EYE: Vec3 = Vec3::new(0.0, 1.0, 0.0);
@@ -28,7 +30,8 @@ pub(crate) fn checker(size: u32, checks: u32) -> Texture {
 /// A Repeat sampler from a lab mode (1 nearest, 2 bilinear, 3 mip nearest, 4 trilinear).
 pub(crate) fn lab_sampler(mode: u8) -> Sampler {
     Sampler::new(
-        SamplerDescriptor::lab_mode(mode)
+        Filter::from_lab_mode(mode)
+            .map(SamplerDescriptor::from)
             .unwrap()
             .with_address_mode(AddressMode::Repeat),
     )

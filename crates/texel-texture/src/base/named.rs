@@ -168,17 +168,12 @@ impl Filter {
     }
 }
 
-impl SamplerDescriptor {
-    /// The descriptor of the lab's mode `mode` ([`Filter::from_lab_mode`]): 1 nearest, 2
-    /// bilinear, 3 bilinear with the nearest mip level, 4 trilinear, 5-8 anisotropic
-    /// 2x/4x/8x/16x (trilinear probes). Address modes are left at their defaults (set them with
-    /// [`SamplerDescriptor::with_address_mode`]).
-    ///
-    /// # Errors
-    /// [`TextureError::UnknownLabMode`] for other numbers.
-    pub fn lab_mode(mode: u8) -> Result<Self, TextureError> {
+impl From<Filter> for SamplerDescriptor {
+    /// The filter's descriptor ([`Filter::descriptor`]) with the default address modes (clamp
+    /// to edge; set others with [`SamplerDescriptor::with_address_mode`]).
+    fn from(filter: Filter) -> Self {
         let d = SamplerDescriptor::default();
-        Ok(Filter::from_lab_mode(mode)?.descriptor(d.address_mode_u, d.address_mode_v))
+        filter.descriptor(d.address_mode_u, d.address_mode_v)
     }
 }
 
@@ -237,7 +232,9 @@ mod tests {
         for (m, want) in (1..=8).zip(core) {
             let f = Filter::from_lab_mode(m).unwrap();
             assert_eq!(f.lab_mode(), Some(m));
-            let d = SamplerDescriptor::lab_mode(m).unwrap();
+            let d = Filter::from_lab_mode(m)
+                .map(SamplerDescriptor::from)
+                .unwrap();
             assert_eq!((d.min_filter, d.mipmap_filter, d.anisotropy_clamp), want);
             assert_eq!(d.mag_filter, d.min_filter);
             assert_eq!(d, f.descriptor(d.address_mode_u, d.address_mode_v));

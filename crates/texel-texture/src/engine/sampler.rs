@@ -12,7 +12,7 @@
 //!
 //! | technique | descriptor | module |
 //! |---|---|---|
-//! | hardware-style N x anisotropic | mag, min and mipmap filters `Linear`, `anisotropy_clamp` 2..=16 (up to 64 accepted); [`SamplerDescriptor::lab_mode`] 5-8 | [`crate::technique::aniso`] |
+//! | hardware-style N x anisotropic | mag, min and mipmap filters `Linear`, `anisotropy_clamp` 2..=16 (up to 64 accepted); [`Filter::from_lab_mode`] 5-8 | [`crate::technique::aniso`] |
 //! | EWA | `min_filter: FilterMode::Ewa` | [`crate::technique::ewa`] |
 //! | EWA from weighted trilinear probes | `min_filter: FilterMode::EwaProbes` | [`crate::technique::ewa_probes`] |
 //! | ripmap | `min_filter: FilterMode::Ripmap` | [`crate::technique::ripmap`] |
