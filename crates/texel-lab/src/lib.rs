@@ -70,7 +70,7 @@ pub enum Error {
     /// A scene the lab cannot run.
     #[error("{0}")]
     Unsupported(String),
-    /// Reading or writing the work folder failed.
+    /// Reading a shader file, or reading or writing the work folder, failed.
     #[error("{0}")]
     Io(String),
     /// Scoring or writing an image failed.

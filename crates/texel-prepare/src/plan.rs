@@ -162,3 +162,56 @@ impl FramePlan<'_> {
         self.scene.reference_draws_from(&self.samplers, camera)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scene's settings as `color` sets its target.
+    fn scene_settings(color: ColorHandling) -> RenderSettings<'static> {
+        let mut s = RenderSettings::new(4, 4);
+        s.target = match color {
+            ColorHandling::Srgb => ColorTarget::Srgb8,
+            ColorHandling::Raw => ColorTarget::Unorm8,
+        };
+        s
+    }
+
+    #[test]
+    fn frame_options_set_the_view_target_and_encoding() {
+        for color in ColorHandling::ALL {
+            // The textured colour keeps the scene's target and encodes as the handling says.
+            let mut s = scene_settings(color);
+            let want = s.target;
+            let options = FrameOptions {
+                derivatives: Derivatives::Quad,
+                perspective: Perspective::Affine,
+                threads: Some(3),
+                ..FrameOptions::default()
+            };
+            assert_eq!(options.apply(&mut s, color), color.encoding());
+            assert_eq!(s.target, want);
+            assert_eq!(
+                (s.derivatives, s.perspective, s.threads),
+                (Derivatives::Quad, Perspective::Affine, Some(3))
+            );
+            // A debug view is drawn into sRGB and encoded sRGB whatever the handling.
+            let mut s = scene_settings(color);
+            let lod = FrameOptions {
+                view: View::Lod,
+                ..FrameOptions::default()
+            };
+            assert_eq!(lod.apply(&mut s, color), Encoding::Srgb);
+            assert_eq!((s.view, s.target), (View::Lod, ColorTarget::Srgb8));
+            // A float target wins over both, the encoding staying the view's.
+            let mut s = scene_settings(color);
+            let float = FrameOptions {
+                view: View::Lod,
+                float: true,
+                ..FrameOptions::default()
+            };
+            assert_eq!(float.apply(&mut s, color), Encoding::Srgb);
+            assert_eq!(s.target, ColorTarget::Float);
+        }
+    }
+}

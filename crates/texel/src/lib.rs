@@ -30,7 +30,8 @@
 //! ```
 //!
 //! For more control (several filters on one loaded scene, debug views, threads, timing), use
-//! [`PreparedScene`] with [`raster::render`] as `examples/render_scene.rs` does.
+//! [`PreparedScene`] with [`FramePlan::render`] as `examples/render_scene.rs` does, or
+//! [`raster::render`] on a plan's settings and draws.
 
 pub mod compare;
 mod entry;
