@@ -24,7 +24,7 @@ use crate::arrays::{array_out, rgba_out};
 use crate::errors::{py_err, to_py};
 use crate::pool::threads_of;
 use crate::run_released;
-use crate::texture::{encoding_of, filter_named, srgb_named};
+use crate::texture::{filter_named, srgb_named};
 
 /// A reference plan from Python's arguments, checked ([`ReferencePlan::new`]).
 fn plan_of(
@@ -394,7 +394,7 @@ pub(crate) fn reference_estimate<'py>(
     let exact = crop(&e.exact, w, rect);
     let out = PyDict::new(py);
     if tw > 0 && th > 0 {
-        let encoding = encoding_of(options.color == ColorHandling::Srgb);
+        let encoding = options.color.encoding();
         let image = Image8::from_linear(tw, th, &linear, encoding).map_err(py_err(""))?;
         out.set_item("image", rgba_out(py, tw, th, image.pixels())?)?;
     } else {

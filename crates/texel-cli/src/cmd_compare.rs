@@ -27,6 +27,21 @@ pub(crate) fn parse_extra(s: &str) -> Result<(String, PathBuf)> {
     }
 }
 
+/// The rows `--gpu` adds to a comparison of `filters`, with what draws each: `gpu-NAME` for each
+/// filter the GPU path has, then the device's own sampler's rows.
+fn gpu_jobs(filters: &[Filter]) -> Vec<(String, Filter, GpuFilter)> {
+    let mut jobs: Vec<(String, Filter, GpuFilter)> = filters
+        .iter()
+        .filter_map(|&f| GpuFilter::of(f).map(|g| (format!("gpu-{}", f.name()), f, g)))
+        .collect();
+    jobs.extend(
+        crate::filters::HARDWARE_ROWS
+            .iter()
+            .map(|&(label, f, g)| (label.to_string(), f, g)),
+    );
+    jobs
+}
+
 /// Render `filters` (those the GPU path has) with texel's shaders and the device's own sampler:
 /// rows `gpu-NAME`, `hw-trilinear`, `hw-aniso16`, each the last of [`TIMED_FRAMES`] timed frames.
 fn gpu_rows(
@@ -39,15 +54,7 @@ fn gpu_rows(
     texel_io::stderr_line(format_args!("gpu: {}", gpu.info()));
     let mut settings = scene.settings();
     settings.derivatives = texel::raster::Derivatives::Quad;
-    let mut jobs: Vec<(String, Filter, GpuFilter)> = filters
-        .iter()
-        .filter_map(|&f| GpuFilter::of(f).map(|g| (format!("gpu-{}", f.name()), f, g)))
-        .collect();
-    jobs.extend(
-        crate::filters::HARDWARE_ROWS
-            .iter()
-            .map(|&(label, f, g)| (label.to_string(), f, g)),
-    );
+    let jobs = gpu_jobs(filters);
     let mut rows = Vec::new();
     for (label, filter, gpu_filter) in jobs {
         budget.take(
@@ -112,7 +119,19 @@ pub(crate) fn run(args: &CompareArgs, input: &mut Input) -> Result<()> {
         .iter()
         .map(|e| parse_extra(e))
         .collect::<Result<Vec<_>>>()?;
-    texel::compare::check_labels(files.iter().map(|(label, _)| label.as_str()), &filters)?;
+    // Every extra row's label is checked before any work: the GPU's rows' too.
+    let gpu_labels: Vec<String> = if args.gpu {
+        gpu_jobs(&filters).into_iter().map(|(l, ..)| l).collect()
+    } else {
+        Vec::new()
+    };
+    texel::compare::check_labels(
+        gpu_labels
+            .iter()
+            .chain(files.iter().map(|(label, _)| label))
+            .map(String::as_str),
+        &filters,
+    )?;
     let plan = crate::cli::reference_plan(
         args.spp,
         args.max_spp.unwrap_or(args.spp),

@@ -22,8 +22,8 @@ use crate::filters::Filter;
 use crate::input::{load_scene_with, Input};
 use crate::progress::{self, Bars};
 use texel::compare::CompareJob;
-use texel::quality::Encoding;
-use texel::raster::{render, ColorTarget, UvEvaluation, View};
+use texel::raster::{UvEvaluation, View};
+use texel::FrameOptions;
 
 /// Run `texel demo`: every scene's report is written into one staging directory, published as a
 /// whole at `--out` when all are done. One bar counts every reference and filter image (and the
@@ -220,12 +220,12 @@ fn mapping_rows(
                 }
             };
             let frame_plan = scene.plan(Some(Filter::Trilinear), &mut scene_input.budget)?;
-            let mut settings = frame_plan.settings();
-            settings.view = View::Lod;
-            settings.target = ColorTarget::Srgb8;
-            let frame = render(&settings, &frame_plan.draws())?;
+            let (frame, encoding) = frame_plan.render(&FrameOptions {
+                view: View::Lod,
+                ..Default::default()
+            })?;
             let lod_image = format!("{scene_name}-lod-{}.png", evaluation.name());
-            texel::frame_image(&frame, Encoding::Srgb)?.write_png(views.join(&lod_image))?;
+            texel::frame_image(&frame, encoding)?.write_png(views.join(&lod_image))?;
             rows.push(MappingRow {
                 scene: scene_name,
                 evaluation,
@@ -430,8 +430,7 @@ fn demo_page(dir: &Path, size: (u32, u32), input: &mut Input) -> Result<DemoAo> 
         max_memory: Some(input.budget.remaining()),
         ..Default::default()
     };
-    let plain = texel::render_scene(&scene, &options)?;
-    texel::frame_image(&plain, Encoding::Srgb)?.write_png(dir.join("plain.png"))?;
+    texel::render_image(&scene, &options)?.write_png(dir.join("plain.png"))?;
     scene.textures.insert(
         "ao".into(),
         TextureSpec::new(
@@ -445,8 +444,7 @@ fn demo_page(dir: &Path, size: (u32, u32), input: &mut Input) -> Result<DemoAo> 
     for m in scene.materials.values_mut() {
         m.occlusion = Some("ao".into());
     }
-    let lit = texel::render_scene(&scene, &options)?;
-    texel::frame_image(&lit, Encoding::Srgb)?.write_png(dir.join("with-ao.png"))?;
+    texel::render_image(&scene, &options)?.write_png(dir.join("with-ao.png"))?;
     Ok(DemoAo {
         images: ["plain.png", "with-ao.png", "ao-map.png"],
         summary: format!(

@@ -392,6 +392,11 @@ fn error_bad_size() {
         1,
         &["LABEL=IMAGE"],
     );
+    // A label equal to one of --gpu's rows is refused before any work: no GPU is asked for.
+    let mut gpu = compare_extra(&format!("hw-trilinear={}", extra.display()), &d.arg("c"));
+    gpu.push("--gpu".into());
+    fails(&gpu, 1, &["\"hw-trilinear\" is given twice"]);
+    assert!(!d.join("c").exists());
 }
 
 /// A wide texture's stacked levels 1.. (ending in 1-row levels) are taller than level 0: the chain

@@ -497,6 +497,39 @@ mod tests {
     }
 
     #[test]
+    fn scene_limits_follow_what_is_left() {
+        let d = SceneLimits::default();
+        assert_eq!(MemoryBudget::new(u64::MAX, "all").scene_limits(), d);
+        let mut b = MemoryBudget::new(64 << 20, "--max-memory 64.0 MiB");
+        b.take("a frame", 32 << 20).unwrap();
+        let left: u64 = 32 << 20;
+        let l = b.scene_limits();
+        assert_eq!(l.max_scene_bytes, (left / 16).min(d.max_scene_bytes));
+        assert_eq!(l.max_mesh_file_bytes, left / 4);
+        assert_eq!(
+            l.max_triangles,
+            left / (TRIANGLE_BYTES + 3 * VERTEX_BYTES + 700)
+        );
+        assert_eq!(l.max_vertices, left / VERTEX_BYTES);
+        assert_eq!(l.max_meshes, (left / MESH_BYTES).min(d.max_meshes));
+        // Each is no larger than the default, and a spent budget admits nothing.
+        assert!(l.max_mesh_file_bytes < d.max_mesh_file_bytes);
+        assert!(l.max_triangles < d.max_triangles && l.max_vertices < d.max_vertices);
+        b.take("the rest", left).unwrap();
+        let none = b.scene_limits();
+        assert_eq!(
+            [
+                none.max_scene_bytes,
+                none.max_mesh_file_bytes,
+                none.max_triangles,
+                none.max_vertices,
+                none.max_meshes
+            ],
+            [0; 5]
+        );
+    }
+
+    #[test]
     fn account_refuses_with_figures() {
         let mut b = MemoryBudget::new(10 << 20, "--max-memory 10.0 MiB");
         b.take("a", 6 << 20).unwrap();

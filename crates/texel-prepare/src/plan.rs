@@ -170,10 +170,7 @@ mod tests {
     /// A scene's settings as `color` sets its target.
     fn scene_settings(color: ColorHandling) -> RenderSettings<'static> {
         let mut s = RenderSettings::new(4, 4);
-        s.target = match color {
-            ColorHandling::Srgb => ColorTarget::Srgb8,
-            ColorHandling::Raw => ColorTarget::Unorm8,
-        };
+        s.target = color.target();
         s
     }
 

@@ -79,6 +79,24 @@ impl ColorHandling {
             ColorHandling::Raw => ColorSpace::Linear,
         }
     }
+
+    /// The 8-bit colour target a frame draws into: sRGB-encoded, or raw unorm.
+    pub fn target(self) -> ColorTarget {
+        match self {
+            ColorHandling::Srgb => ColorTarget::Srgb8,
+            ColorHandling::Raw => ColorTarget::Unorm8,
+        }
+    }
+
+    /// An 8-bit value of a colour given under this handling (a scene's background), as the
+    /// linear value it stands for.
+    pub fn decode(self, value: u8) -> f32 {
+        let v = f32::from(value) / 255.0;
+        match self {
+            ColorHandling::Srgb => srgb_to_linear(v),
+            ColorHandling::Raw => v,
+        }
+    }
 }
 
 impl std::fmt::Display for ColorHandling {
@@ -882,10 +900,7 @@ impl PreparedScene {
     /// quantisation).
     pub fn settings(&self) -> RenderSettings<'static> {
         let mut s = RenderSettings::new(self.width, self.height);
-        s.target = match self.color {
-            ColorHandling::Srgb => ColorTarget::Srgb8,
-            ColorHandling::Raw => ColorTarget::Unorm8,
-        };
+        s.target = self.color.target();
         s.precision = self.precision;
         for (slot, light) in s.lights.iter_mut().zip(&self.scene.lights) {
             *slot = Some(match *light {
@@ -907,14 +922,10 @@ impl PreparedScene {
             });
         }
         let bg = self.scene.output.background;
-        let decode = |b: u8| match self.color {
-            ColorHandling::Srgb => srgb_to_linear(f32::from(b) / 255.0),
-            ColorHandling::Raw => f32::from(b) / 255.0,
-        };
         s.background = [
-            decode(bg[0]),
-            decode(bg[1]),
-            decode(bg[2]),
+            self.color.decode(bg[0]),
+            self.color.decode(bg[1]),
+            self.color.decode(bg[2]),
             f32::from(bg[3]) / 255.0,
         ];
         s
@@ -1579,5 +1590,39 @@ mod direction_tests {
             "{tiny}"
         );
         assert!((huge.length() - 1.0).abs() < 1e-6);
+    }
+}
+
+#[cfg(test)]
+mod color_tests {
+    use super::{ColorHandling, ColorSpace, ColorTarget};
+    use texel_quality::Encoding;
+
+    #[test]
+    fn each_handling_names_one_encoding_space_and_target() {
+        let srgb = ColorHandling::Srgb;
+        let raw = ColorHandling::Raw;
+        assert_eq!(
+            (srgb.encoding(), srgb.color_space(), srgb.target()),
+            (Encoding::Srgb, ColorSpace::Srgb, ColorTarget::Srgb8)
+        );
+        assert_eq!(
+            (raw.encoding(), raw.color_space(), raw.target()),
+            (Encoding::Linear, ColorSpace::Linear, ColorTarget::Unorm8)
+        );
+        for c in ColorHandling::ALL {
+            assert_eq!(c.to_string().parse::<ColorHandling>(), Ok(c));
+            assert_eq!(c.name().to_uppercase().parse::<ColorHandling>(), Ok(c));
+            // The ends decode exactly; the encoding of a decoded value gives it back.
+            assert_eq!((c.decode(0), c.decode(255)), (0.0, 1.0));
+            for v in [1u8, 64, 128, 200, 254] {
+                let l = c.decode(v);
+                assert_eq!(c.encoding().encode([l, l, l, 1.0])[0], v, "{c} {v}");
+            }
+        }
+        // sRGB's 128 is 0.2158 linear (IEC 61966-2-1), raw's is 128/255.
+        assert!((srgb.decode(128) - 0.215_861).abs() < 1e-5);
+        assert_eq!(raw.decode(128), 128.0 / 255.0);
+        assert!("linear".parse::<ColorHandling>().is_err());
     }
 }

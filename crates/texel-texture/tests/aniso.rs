@@ -853,6 +853,33 @@ fn structures_are_prepared_reported_and_limited() {
     tex.build_structures(&rip).unwrap();
     assert_eq!(tex.ripmap().unwrap().bytes(), (127 * 63 - 64 * 32) * 4);
     assert_eq!(tex.summed_area_table().unwrap().bytes(), 65 * 33 * 32);
+    // A ripmap's build holds 40 bytes of f32 scratch per level-0 texel; nothing else builds any.
+    assert_eq!(
+        tex.build_scratch_bytes(&desc(FilterMode::Ripmap)),
+        64 * 32 * 40
+    );
+    for f in [FilterMode::SummedArea, FilterMode::Ewa, FilterMode::Linear] {
+        assert_eq!(tex.build_scratch_bytes(&desc(f)), 0, "{f:?}");
+    }
+    // A texture's build: the pyramid (64x32 down to 1x1: 2,730 texels of 4 bytes) and 16 bytes of
+    // f32 scratch per texel below level 0; `check` admits exactly that many bytes.
+    let texels = 64 * 32 + 32 * 16 + 16 * 8 + 8 * 4 + 4 * 2 + 2 + 1;
+    assert_eq!(texels * 4, pyramid);
+    let built = Limits::texture_bytes(64, 32, Format::Rgba8Unorm);
+    assert_eq!(built, texels * 4 + (texels - 64 * 32) * 16);
+    let at = |max_bytes| Limits {
+        max_dimension: 16384,
+        max_bytes,
+    };
+    assert!(at(built).check(64, 32, Format::Rgba8Unorm).is_ok());
+    assert!(matches!(
+        at(built - 1).check(64, 32, Format::Rgba8Unorm),
+        Err(TextureError::OverMemoryLimit { bytes, .. }) if bytes == built
+    ));
+    assert_eq!(
+        Limits::texture_bytes(u32::MAX, u32::MAX, Format::Rgba32Float),
+        u64::MAX
+    );
 
     // Over the limit: prepare reports it, sampling falls back to trilinear (no panic, no OOM).
     let limits = Limits {

@@ -7,7 +7,8 @@
 //!   files import each other in no circle;
 //! - texel-raster's and texel-scene's modules stand in layers that only look down (a module
 //!   names modules of its own layer or lower ones, directly or through the root's re-exports);
-//! - the facade names its surface item by item: no `pub use` of a whole crate or a glob.
+//! - the facade names its surface item by item: no `pub use` of a whole crate, a whole module or
+//!   a glob, in any of its files.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -397,27 +398,40 @@ fn function_lengths_count_from_fn_to_the_closing_brace() {
 }
 
 /// The `pub use` trees of `items` (modules included) that re-export a whole crate (`pub use
-/// texel_x;`, `pub use texel_x as y;`) or a glob, written as `path` strings.
-fn wholesale_reexports(items: &[syn::Item]) -> Vec<String> {
-    fn walk(tree: &syn::UseTree, prefix: &str, out: &mut Vec<String>) {
+/// texel_x;`, `pub use texel_x as y;`), a glob, a `self` leaf, or a path that `is_module` says
+/// names a module, written as `path` strings.
+fn wholesale_reexports(items: &[syn::Item], is_module: &dyn Fn(&str) -> bool) -> Vec<String> {
+    fn walk(
+        tree: &syn::UseTree,
+        prefix: &str,
+        is_module: &dyn Fn(&str) -> bool,
+        out: &mut Vec<String>,
+    ) {
+        let leaf = |ident: &syn::Ident, out: &mut Vec<String>| {
+            let path = format!("{prefix}{ident}");
+            if prefix.is_empty() || ident == "self" || is_module(&path) {
+                out.push(path);
+            }
+        };
         match tree {
-            syn::UseTree::Path(p) => walk(&p.tree, &format!("{prefix}{}::", p.ident), out),
-            syn::UseTree::Group(g) => g.items.iter().for_each(|t| walk(t, prefix, out)),
+            syn::UseTree::Path(p) => {
+                walk(&p.tree, &format!("{prefix}{}::", p.ident), is_module, out)
+            }
+            syn::UseTree::Group(g) => g.items.iter().for_each(|t| walk(t, prefix, is_module, out)),
             syn::UseTree::Glob(_) => out.push(format!("{prefix}*")),
-            syn::UseTree::Name(n) if prefix.is_empty() => out.push(n.ident.to_string()),
-            syn::UseTree::Rename(r) if prefix.is_empty() => out.push(r.ident.to_string()),
-            syn::UseTree::Name(_) | syn::UseTree::Rename(_) => {}
+            syn::UseTree::Name(n) => leaf(&n.ident, out),
+            syn::UseTree::Rename(r) => leaf(&r.ident, out),
         }
     }
     let mut out = Vec::new();
     for item in items {
         match item {
             syn::Item::Use(u) if matches!(u.vis, syn::Visibility::Public(_)) => {
-                walk(&u.tree, "", &mut out)
+                walk(&u.tree, "", is_module, &mut out)
             }
             syn::Item::Mod(m) => {
                 if let Some((_, inner)) = &m.content {
-                    out.extend(wholesale_reexports(inner));
+                    out.extend(wholesale_reexports(inner, is_module));
                 }
             }
             _ => {}
@@ -426,21 +440,67 @@ fn wholesale_reexports(items: &[syn::Item]) -> Vec<String> {
     out
 }
 
+/// Whether `path` (`texel_x::a::b`) names a public module of a workspace crate under `crates`:
+/// the parent's file (`crates/texel-x/src/lib.rs` for `texel_x::b`, `src/a.rs` or `src/a/mod.rs`
+/// for `texel_x::a::b`) declares `pub mod b`. A private module of the same name as a re-exported
+/// item (`mod psnr; pub use psnr::psnr;`) is not one.
+fn names_workspace_module(crates: &Path, path: &str) -> bool {
+    let parts: Vec<&str> = path.split("::").collect();
+    let [krate, parents @ .., leaf] = parts.as_slice() else {
+        return false;
+    };
+    let mut dir = crates.join(krate.replace('_', "-")).join("src");
+    let parent = if parents.is_empty() {
+        dir.join("lib.rs")
+    } else {
+        parents.iter().for_each(|p| dir.push(p));
+        let file = dir.with_extension("rs");
+        if file.is_file() {
+            file
+        } else {
+            dir.join("mod.rs")
+        }
+    };
+    fs::read_to_string(parent).is_ok_and(|text| {
+        library_code(&text).lines().any(|l| {
+            let l = l.trim();
+            l == format!("pub mod {leaf};") || l.starts_with(&format!("pub mod {leaf} {{"))
+        })
+    })
+}
+
 #[test]
 fn the_facade_names_its_surface_item_by_item() {
-    let lib = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/lib.rs");
-    let file = syn::parse_file(&fs::read_to_string(lib).unwrap()).unwrap();
-    assert_eq!(wholesale_reexports(&file.items), Vec::<String>::new());
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let crates = root.parent().unwrap().to_path_buf();
+    let is_module = |p: &str| names_workspace_module(&crates, p);
+    let mut files = Vec::new();
+    rust_files(&root.join("src"), &mut files);
+    assert!(files.len() > 1, "{files:?}");
+    for file in &files {
+        let parsed = syn::parse_file(&fs::read_to_string(file).unwrap()).unwrap();
+        let wholesale = wholesale_reexports(&parsed.items, &is_module);
+        assert_eq!(wholesale, Vec::<String>::new(), "{}", file.display());
+    }
     // The checker sees each wholesale form, in a module too, and passes named items.
     let sample = syn::parse_file(
         "pub use texel_io as io;\npub use texel_raster;\nuse texel_scene as private;\n\
          pub mod m { pub use texel_quality::{psnr, html::*}; }\npub use texel_texture::{Sampler, \
-         base::color::displayed as shown};\n",
+         base::color::displayed as shown};\npub use texel_quality::html;\n\
+         pub use texel_scene::{self as scene_crate};\npub use texel_texture::{base::{rng, color::srgb_to_linear}, technique};\n",
     )
     .unwrap();
     assert_eq!(
-        wholesale_reexports(&sample.items),
-        vec!["texel_io", "texel_raster", "texel_quality::html::*"]
+        wholesale_reexports(&sample.items, &is_module),
+        vec![
+            "texel_io",
+            "texel_raster",
+            "texel_quality::html::*",
+            "texel_quality::html",
+            "texel_scene::self",
+            "texel_texture::base::rng",
+            "texel_texture::technique",
+        ]
     );
 }
 
@@ -498,8 +558,24 @@ fn named_modules(
     for (i, _) in code.match_indices("crate::") {
         let rest = &code[i + "crate::".len()..];
         if let Some(group) = rest.strip_prefix('{') {
-            let group = &group[..group.find('}').unwrap_or(group.len())];
-            group.split(',').for_each(|p| add(ident(p.trim())));
+            // The group's top-level paths: commas inside nested braces belong to one path.
+            let mut depth = 0usize;
+            let mut start = 0;
+            for (j, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => {
+                        add(ident(group[start..j].trim()));
+                        break;
+                    }
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        add(ident(group[start..j].trim()));
+                        start = j + 1;
+                    }
+                    _ => {}
+                }
+            }
         } else {
             add(ident(rest));
         }
@@ -575,4 +651,8 @@ fn layer_reads_see_modules_groups_and_root_names() {
         "use crate::{setup, Frame};\nlet d = crate::draw::DrawCall::new();\ncrate::Vec3::ZERO";
     let want: BTreeSet<String> = ["draw", "frame", "setup"].map(String::from).into();
     assert_eq!(named_modules(code, &modules, &names), want);
+    // A nested group does not end the outer one: `frame` after `draw::{..}` is seen.
+    let nested = "use crate::{draw::{DrawCall, Mesh}, frame::Frame};";
+    let want: BTreeSet<String> = ["draw", "frame"].map(String::from).into();
+    assert_eq!(named_modules(nested, &modules, &names), want);
 }

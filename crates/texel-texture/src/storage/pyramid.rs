@@ -28,14 +28,15 @@ pub fn level_count(width: u32, height: u32) -> u32 {
     32 - width.max(height).max(1).leading_zeros()
 }
 
-/// Texels in the whole pyramid of a `width x height` texture (about 4/3 of level 0).
+/// Texels in the whole pyramid of a `width x height` texture (about 4/3 of level 0); saturates
+/// at `u64::MAX`.
 pub fn pyramid_texels(width: u32, height: u32) -> u64 {
     (0..level_count(width, height))
         .map(|k| {
             let (w, h) = level_size(width, height, k);
             u64::from(w) * u64::from(h)
         })
-        .sum()
+        .fold(0, u64::saturating_add)
 }
 
 /// Box-reduction taps of one axis: for each destination texel, the first source index and the weights.
