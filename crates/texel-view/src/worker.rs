@@ -25,8 +25,8 @@ use rayon::prelude::*;
 use texel::lab::{Gl, GlScene, Names, ShaderDraws};
 use texel::quality::Encoding;
 use texel::raster::{
-    draw_into, render_reference_strata, DrawCall, Frame, ProgressiveReference, ReferencePlan,
-    RenderSettings, View,
+    draw_into, render_reference_strata, ColorTarget, DrawCall, Frame, ProgressiveReference,
+    ReferencePlan, RenderSettings, View,
 };
 use texel::scene::Camera;
 use texel::{Filter, FrameOptions, PreparedScene, Sampler, SamplerDescriptor};
@@ -594,37 +594,16 @@ fn reference_spp(req: &Request) -> [u32; 2] {
         [2, 2]
     }
 }
-/// A student's shader's codes decoded to linear RGBA. The codes are in the texture's own encoding
-/// (the shader filters the codes as they are stored): sRGB codes decode through the sRGB curve,
-/// linear ones by 255; alpha is always linear.
-fn decoded(px: &[[u8; 4]], srgb: bool) -> Vec<[f32; 4]> {
-    let decode = |c: u8| {
-        let v = f32::from(c) / 255.0;
-        if srgb {
-            texel::texture::srgb_to_linear(v)
-        } else {
-            v
-        }
-    };
-    px.iter()
-        .map(|p| {
-            [
-                decode(p[0]),
-                decode(p[1]),
-                decode(p[2]),
-                f32::from(p[3]) / 255.0,
-            ]
-        })
-        .collect()
-}
 
 /// The scene's settings for a `w x h` frame of `state`'s view, perspective and derivatives, on
-/// every thread, into linear floats (progressive passes accumulate them).
+/// every thread: into linear floats with `float` (the reference's passes accumulate them), else
+/// into the 8-bit target the window shows, as `texel render` draws it.
 fn view_settings(
     scene: &PreparedScene,
     state: &ViewState,
     w: u32,
     h: u32,
+    float: bool,
 ) -> RenderSettings<'static> {
     let mut settings = scene.settings();
     settings.width = w;
@@ -633,7 +612,7 @@ fn view_settings(
         view: state.view,
         derivatives: state.derivatives,
         perspective: state.perspective,
-        float: true,
+        float,
         threads: None,
     };
     options.apply(&mut settings, scene.color);
@@ -691,7 +670,9 @@ impl FrameContext<'_, '_> {
         let scale = self.scale(req, &modes, use_gpu);
         let (w, h) = (req.width.div_ceil(scale), req.height.div_ceil(scale));
         let rects = part_rects(state, w, h);
-        let settings = view_settings(self.scene(state.color)?, state, w, h);
+        // Only the reference's mean needs floats; filters draw straight into 8 bits.
+        let float = modes.contains(&Mode::Reference);
+        let settings = view_settings(self.scene(state.color)?, state, w, h, float);
         let clip = req.camera.clip_from_world(w as f32 / h as f32);
         let mut frame = match self.frame.take() {
             Some(mut f) if f.width == w && f.height == h => {
@@ -838,11 +819,22 @@ impl FrameContext<'_, '_> {
                 let size = (w, frame.height);
                 let path = self.worker.shader.as_deref();
                 let px = shader_frame(self.shader, path, &draws, &settings, part.clip, size, mode)?;
+                // The shader's codes are in the texture's own encoding (it filters the codes
+                // as they are stored).
                 let srgb = draws.first().is_some_and(|d| {
                     d.texture.source_format() == texel::texture::Format::Rgba8Srgb
                 });
-                let linear = decoded(&px, srgb);
-                copy_rect(&linear, &mut frame.color, w, rect);
+                let codes = if srgb {
+                    ColorTarget::Srgb8
+                } else {
+                    ColorTarget::Unorm8
+                };
+                if frame.target == codes {
+                    for_rect(rect, w, |k| frame.color8[k] = px[k]);
+                } else {
+                    let linear: Vec<[f32; 4]> = px.iter().map(|&p| codes.decode(p)).collect();
+                    copy_rect(&linear, frame, rect);
+                }
                 frame.forget_clear();
             }
             Mode::Filter(f) if part.gpu => {
@@ -859,7 +851,7 @@ impl FrameContext<'_, '_> {
                     derivatives: texel::raster::Derivatives::Quad,
                     ..settings
                 })?;
-                copy_rect(&out.color, &mut frame.color, w, rect);
+                copy_frame_rect(&out, frame, rect);
                 // Written by hand: later draws must load it, not redraw from the clear.
                 frame.forget_clear();
             }
@@ -1096,12 +1088,29 @@ fn for_rect(rect: [u32; 4], width: u32, mut f: impl FnMut(usize)) {
     }
 }
 
-fn copy_rect(from: &[[f32; 4]], to: &mut [[f32; 4]], width: u32, rect: [u32; 4]) {
-    for_rect(rect, width, |k| to[k] = from[k]);
+/// Copy `rect` of `from` (linear colour of a frame of `frame`'s size) into `frame`: as it is into
+/// a float target, encoded into an 8-bit one.
+fn copy_rect(from: &[[f32; 4]], frame: &mut Frame, rect: [u32; 4]) {
+    let (width, target) = (frame.width, frame.target);
+    if target.is_8bit() {
+        for_rect(rect, width, |k| frame.color8[k] = target.encode(from[k]));
+    } else {
+        for_rect(rect, width, |k| frame.color[k] = from[k]);
+    }
+}
+
+/// Copy `rect` of `from` into `frame`, a frame of the same size and target.
+fn copy_frame_rect(from: &Frame, frame: &mut Frame, rect: [u32; 4]) {
+    if frame.target.is_8bit() {
+        for_rect(rect, frame.width, |k| frame.color8[k] = from.color8[k]);
+    } else {
+        for_rect(rect, frame.width, |k| frame.color[k] = from.color[k]);
+    }
 }
 
 /// The frame as window pixels: each half encoded for display (colour as `--color` says, debug
-/// views as sRGB, as `texel render` writes them), enlarged `scale` times.
+/// views as sRGB, as `texel render` writes them; an 8-bit frame holds them so already), enlarged
+/// `scale` times.
 fn display(
     frame: &Frame,
     rects: &[[u32; 4]],
@@ -1118,25 +1127,31 @@ fn display(
             Encoding::Srgb
         }
     };
+    let pack = |[r, g, b, _]: [u8; 4]| u32::from(r) << 16 | u32::from(g) << 8 | u32::from(b);
     // Rows in parallel: encoding is a third of a cheap filter's frame time on one thread.
     let fw = frame.width as usize;
-    let mut small = vec![0u32; frame.color.len()];
-    small
-        .par_chunks_mut(fw)
-        .zip(frame.color.par_chunks(fw))
-        .enumerate()
-        .for_each(|(y, (out, src))| {
-            for (&m, &[x0, y0, x1, y1]) in modes.iter().zip(rects) {
-                if !(y0..y1).contains(&(y as u32)) {
-                    continue;
+    let mut small = vec![0u32; fw * frame.height as usize];
+    small.par_chunks_mut(fw).enumerate().for_each(|(y, out)| {
+        let row = y * fw;
+        for (&m, &[x0, y0, x1, y1]) in modes.iter().zip(rects) {
+            if !(y0..y1).contains(&(y as u32)) {
+                continue;
+            }
+            let (x0, x1) = (x0 as usize, x1 as usize);
+            if frame.target.is_8bit() {
+                let src = &frame.color8[row + x0..row + x1];
+                for (o, &p) in out[x0..x1].iter_mut().zip(src) {
+                    *o = pack(p);
                 }
+            } else {
                 let enc = enc_for(m);
-                for x in x0 as usize..x1 as usize {
-                    let [r, g, b, _] = enc.encode(src[x]);
-                    out[x] = u32::from(r) << 16 | u32::from(g) << 8 | u32::from(b);
+                let src = &frame.color[row + x0..row + x1];
+                for (o, &c) in out[x0..x1].iter_mut().zip(src) {
+                    *o = pack(enc.encode(c));
                 }
             }
-        });
+        }
+    });
     if scale == 1 {
         return small;
     }
