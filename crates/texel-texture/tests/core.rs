@@ -1451,6 +1451,60 @@ proptest! {
     }
 }
 
+/// The fixed-point span blends its bilinear quads in eight lanes with an AVX2 `Lanes` token and
+/// in four without: the same bytes, for every core sampler on a linear 8-bit texture, over
+/// blocks of 64 footprints that share their derivatives (so that whole chunks sit in one level or
+/// one pair, where the run kernel takes them), from magnified to minified by 8, inside the
+/// texture and across its edges.
+#[test]
+fn fixed8_spans_are_the_same_bytes_in_every_lanes() {
+    let wide = Lanes::detect();
+    if !wide.is_wide() {
+        println!("skipped: this CPU has no AVX2 (x86-64-v3); only the four-lane kernel runs");
+        return;
+    }
+    let tex = noise_texture(64, 32, Format::Rgba8Unorm);
+    let fps: Vec<Footprint> = (0..64 * 24)
+        .map(|k| {
+            let (u, v) = spread(k);
+            let block = k / 64;
+            // Blocks 0..12 inside the texture's middle, 12..24 across its edges.
+            let (u, v) = if block < 12 {
+                (0.2 + 0.6 * u, 0.2 + 0.6 * v)
+            } else {
+                (1.4 * u - 0.2, 1.4 * v - 0.2)
+            };
+            let d = 0.004 * (1 + block % 12) as f32;
+            Footprint {
+                u,
+                v,
+                dudx: d,
+                dvdx: 0.25 * d,
+                dudy: -0.1 * d,
+                dvdy: 1.5 * d,
+            }
+        })
+        .collect();
+    let wants = Wants {
+        stored_bytes: false,
+        fixed8: true,
+    };
+    let mut compared = 0;
+    for s in every_sampler(BorderColor::Custom([0.3, 0.7, 0.05, 0.5])) {
+        let bound = s.bind(&tex, wants);
+        if bound.kind() != SpanKind::Fixed8 {
+            continue;
+        }
+        let (mut four, mut eight) = (vec![[0u8; 4]; fps.len()], vec![[1u8; 4]; fps.len()]);
+        bound.sample_span(Lanes::scalar(), &fps, &mut [], &mut four);
+        bound.sample_span(wide, &fps, &mut [], &mut eight);
+        assert!(four == eight, "{:?}", s.descriptor());
+        compared += 1;
+    }
+    // Nearest and linear, three mipmap modes, five address modes.
+    assert_eq!(compared, 2 * 3 * 5);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(32))]
     /// The fixed-point span (`SpanKind::Fixed8`, GPU-style 8-bit weights, one rounding per blend) stays within a

@@ -959,7 +959,7 @@ mod tests {
                 width: w,
                 height: h,
                 texels: &bytes,
-                decode: Codes8,
+                decode: Codes8::default(),
             };
             let offsets = |n: u32| -> Vec<f32> {
                 let mut xs = Vec::new();

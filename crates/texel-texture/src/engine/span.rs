@@ -77,6 +77,9 @@ enum Route {
     PerSample,
 }
 
+/// Samples per kernel call of the byte routes: the rasterizer's span (four 64-pixel tile rows).
+const CODES_RUN: usize = 256;
+
 /// A sampler bound to a texture, with its spans' route chosen ([`Sampler::bind`]).
 pub struct BoundSampler<'a> {
     sampler: &'a Sampler,
@@ -175,17 +178,30 @@ impl BoundSampler<'_> {
         bytes: &mut [[u8; 4]],
     ) -> SpanKind {
         match &self.codes {
-            Some(p) => self.codes_span(p, footprints.source(), bytes),
+            Some(p) => self.codes_span(lanes, p, footprints.source(), bytes),
             None => self.float_span(lanes, footprints.source(), floats),
         }
         self.kind()
     }
 
-    /// The byte routes: the staged kernels (fixed-point ones for [`Route::Fixed8`]) over the
-    /// texture's stored codes, narrowed to bytes; nearest in level 0 copies the bytes.
+    /// The byte routes: the staged kernels (fixed-point ones for [`Route::Fixed8`], whose
+    /// bilinear quads blend with `lanes`' kernel) over the texture's stored codes, narrowed to
+    /// bytes; nearest in level 0 copies the bytes.
     // Not inlined into the tile rasterizer's copies: its kernels (`batch::point_bytes`,
     // `batch::run`) run on their own instruction-set copies (`crate::engine::dispatch`).
-    fn codes_span<S: Source>(&self, p: &Stored<'_, Codes8>, footprints: S, out: &mut [[u8; 4]]) {
+    fn codes_span<S: Source>(
+        &self,
+        lanes: Lanes,
+        p: &Stored<'_, Codes8>,
+        footprints: S,
+        out: &mut [[u8; 4]],
+    ) {
+        let p = &Stored {
+            tex: p.tex,
+            levels: p.levels,
+            texels: p.texels,
+            decode: Codes8 { lanes },
+        };
         assert_eq!(
             footprints.len(),
             out.len(),
@@ -195,8 +211,10 @@ impl BoundSampler<'_> {
         if self.route == Route::StoredPoint {
             return batch::point_bytes(&p.level(0), &addr, footprints, out);
         }
-        let mut codes = [[0.0f32; 4]; CHUNK];
-        for (fps, out) in chunks(footprints, CHUNK).zip(out.chunks_mut(CHUNK)) {
+        // One kernel call per `CODES_RUN` samples: each call makes its level views and
+        // dispatches, which per 64-sample chunk costs bilinear frames time (docs/decisions.md).
+        let mut codes = [[0.0f32; 4]; CODES_RUN];
+        for (fps, out) in chunks(footprints, CODES_RUN).zip(out.chunks_mut(CODES_RUN)) {
             let codes = &mut codes[..fps.len()];
             if self.route == Route::Fixed8 {
                 batch::run_fixed(p, s, addr, fps, codes);

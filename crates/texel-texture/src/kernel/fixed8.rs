@@ -21,7 +21,8 @@
 //! Level selection (the lod) is the `f32` path's, so both read the same texels. Every value is an
 //! integer below `2^24`, so `f32` holds it exactly: the kernels run in the `f32` lanes the other
 //! filters use, on codes as floats (`0.0..=255.0`), and equal the integer definitions bit for bit
-//! (tested against them).
+//! (tested against them). On AVX2 the bilinear blend runs in eight lanes, both rows of a quad at
+//! once (`storage::lanes`); exactness makes its grouping give the same bits.
 //!
 //! Only unorm textures: an sRGB texture must be decoded to linear before it is filtered
 //! (Vulkan spec, "Texel Filtering"), so hardware decodes sRGB texels to more than 8 bits first,
@@ -35,9 +36,10 @@ use crate::base::address::Address;
 use crate::base::floor::{round_staged, round_staged4};
 use crate::kernel::bilinear;
 use crate::kernel::nearest;
-use crate::kernel::staged::Taps;
+use crate::kernel::staged::{Taps, CHUNK};
 use crate::kernel::LevelFilter;
 use crate::storage::fetch::Fetch;
+use crate::storage::lanes::Run;
 
 /// The 8-bit weight of a fraction `a` in `[0, 1]`: `round(256 a)` (halves to even), in
 /// `0..=256`. A fraction outside `[0, 1]` is clamped first; NaN gives 0.
@@ -115,9 +117,34 @@ impl LevelFilter for Bilinear8 {
 impl Taps for Bilinear8 {
     const HALF: f32 = bilinear::HALF;
     const REACH: f32 = 1.0;
+    /// [`bilinear8`], in the view's eight lanes where it has them ([`Fetch::bilinear_codes8`]:
+    /// the same bits).
     #[inline(always)]
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, (a, b): (f32, f32)) -> Vec4 {
-        bilinear8(level.quad(i, j), a, b)
+        match level.bilinear_codes8(i, j, weight8(a), weight8(b)) {
+            Some(v) => v,
+            None => bilinear8(level.quad(i, j), a, b),
+        }
+    }
+    /// The run's 8-bit weights ([`weight8`]) in one loop, then the view's run kernel
+    /// ([`Fetch::bilinear_codes8_run`]), which equals [`bilinear8`] bit for bit.
+    #[inline(always)]
+    fn inside_run<F: Fetch>(level: &F, run: Run<'_>, out: &mut [[f32; 4]]) -> bool {
+        let n = run.a.len();
+        if n > CHUNK {
+            return false;
+        }
+        let (mut wa, mut wb) = ([0.0f32; CHUNK], [0.0f32; CHUNK]);
+        for k in 0..n {
+            wa[k] = weight8(run.a[k]);
+            wb[k] = weight8(run.b[k]);
+        }
+        let weights = Run {
+            a: &wa[..n],
+            b: &wb[..n],
+            ..run
+        };
+        level.bilinear_codes8_run(weights, out)
     }
     #[inline(always)]
     fn wrapped<F: Fetch>(level: &F, i: [u32; 2], j: [u32; 2], (a, b): (f32, f32)) -> Vec4 {
@@ -214,6 +241,72 @@ mod tests {
                     assert_eq!(mix8(x, y, a).x, mix_int(c0, c1, a) as f32);
                 }
             }
+        }
+    }
+
+    /// The eight-lane run kernel ([`Fetch::bilinear_codes8_run`] on a level of codes with an AVX2
+    /// token) equals [`bilinear8`] bit for bit over every quad of a random level, with
+    /// fractions at 0, at the weights' rounding ties and near 1; the scalar token declines.
+    #[test]
+    fn the_run_kernel_equals_bilinear8() {
+        use crate::base::rng::SplitMix64;
+        use crate::storage::fetch::{Codes8, Level};
+        use crate::storage::lanes::Lanes;
+        let mut rng = SplitMix64::new(5);
+        let (w, h) = (9u32, 7u32);
+        let texels: Vec<[u8; 4]> = (0..w * h)
+            .map(|_| {
+                let x = rng.next_u64().to_le_bytes();
+                [x[0], x[1], x[2], x[3]]
+            })
+            .collect();
+        let level = |lanes| Level {
+            width: w,
+            height: h,
+            texels: &texels,
+            decode: Codes8 { lanes },
+        };
+        let (mut i, mut j, mut a, mut b) = (vec![], vec![], vec![], vec![]);
+        let ends = [0.0, 1.0 / 512.0, 3.0 / 512.0, 0.5, 0.999_999];
+        for (k, (ii, jj)) in (0..h - 1)
+            .flat_map(|jj| (0..w - 1).map(move |ii| (ii, jj)))
+            .enumerate()
+        {
+            i.push(ii as i32);
+            j.push(jj as i32);
+            a.push(if k < ends.len() {
+                ends[k]
+            } else {
+                rng.next_f32()
+            });
+            b.push(if k < ends.len() {
+                ends[ends.len() - 1 - k]
+            } else {
+                rng.next_f32()
+            });
+        }
+        let run = Run {
+            i: &i,
+            j: &j,
+            a: &a,
+            b: &b,
+        };
+        let mut out = vec![[f32::NAN; 4]; i.len()];
+        assert!(!Bilinear8::inside_run(
+            &level(Lanes::scalar()),
+            run,
+            &mut out
+        ));
+        let wide = Lanes::detect();
+        if !wide.is_wide() {
+            println!("skipped: this CPU has no AVX2 (x86-64-v3); only the scalar kernel runs");
+            return;
+        }
+        assert!(Bilinear8::inside_run(&level(wide), run, &mut out));
+        let scalar = level(Lanes::scalar());
+        for k in 0..i.len() {
+            let want = bilinear8(scalar.quad(i[k] as u32, j[k] as u32), a[k], b[k]);
+            assert_eq!(out[k], want.to_array(), "quad {} {}", i[k], j[k]);
         }
     }
 

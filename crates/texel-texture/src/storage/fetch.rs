@@ -53,6 +53,36 @@ pub(crate) trait Decode: Copy {
         let _ = (texels, width, run, out);
         false
     }
+    /// The fixed-point bilinear blend of stored codes ([`crate::kernel::fixed8`]'s `bilinear8`)
+    /// of each sample of `weights` (every quad inside the `width`-wide level `texels`; `a` and
+    /// `b` hold the 8-bit weights, not the fractions) into `out`: `true`, or `false` with `out`
+    /// untouched where the decoder has no such kernel (the default; only [`Codes8`] with an AVX2
+    /// token has one).
+    #[inline(always)]
+    fn bilinear_codes8_run(
+        &self,
+        texels: &[Self::Texel],
+        width: u32,
+        weights: Run<'_>,
+        out: &mut [[f32; 4]],
+    ) -> bool {
+        let _ = (texels, width, weights, out);
+        false
+    }
+    /// The fixed-point bilinear blend of stored codes of the quad whose rows are `r0` and `r1`
+    /// with the 8-bit weights `wa`, `wb` ([`Decode::bilinear_codes8_run`] for one sample);
+    /// `None` where the decoder has no such kernel (the default).
+    #[inline(always)]
+    fn bilinear_codes8_rows(
+        &self,
+        r0: [Self::Texel; 2],
+        r1: [Self::Texel; 2],
+        wa: f32,
+        wb: f32,
+    ) -> Option<Vec4> {
+        let _ = (r0, r1, wa, wb);
+        None
+    }
     /// The texels of `storage` if it holds this format.
     fn texels(storage: &Storage) -> Option<&[Self::Texel]>;
 }
@@ -132,7 +162,7 @@ impl Decode for Unorm8 {
     #[inline(always)]
     fn decode(&self, t: [u8; 4]) -> Vec4 {
         // `unorm8_lanes`' arithmetic, four lanes.
-        unorm8_of(Codes8.decode(t))
+        unorm8_of(Codes8::default().decode(t))
     }
     #[inline(always)]
     fn decode4(&self, t: [[u8; 4]; 4]) -> [Vec4; 4] {
@@ -165,9 +195,12 @@ impl Decode for Unorm8 {
 /// 8-bit texels as their stored code values, `0.0..=255.0` per channel (exact in `f32`), with
 /// no transfer function: the stored-bytes path ([`crate::SpanKind::Stored`]) runs the
 /// same single-texel kernels on these and converts the results back to bytes, bit for bit the
-/// texels the decoding views read.
-#[derive(Clone, Copy)]
-pub(crate) struct Codes8;
+/// texels the decoding views read. The fixed-point bilinear blend of [`crate::kernel::fixed8`]
+/// runs in eight lanes where `lanes` has them ([`Lanes::bilinear_codes8_run`]).
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Codes8 {
+    pub lanes: Lanes,
+}
 
 impl Decode for Codes8 {
     type Texel = [u8; 4];
@@ -185,6 +218,26 @@ impl Decode for Codes8 {
     #[inline(always)]
     fn decode4(&self, t: [[u8; 4]; 4]) -> [Vec4; 4] {
         quad_lanes(t, |b| b.map(f32::from))
+    }
+    #[inline(always)]
+    fn bilinear_codes8_run(
+        &self,
+        texels: &[[u8; 4]],
+        width: u32,
+        weights: Run<'_>,
+        out: &mut [[f32; 4]],
+    ) -> bool {
+        self.lanes.bilinear_codes8_run(texels, width, weights, out)
+    }
+    #[inline(always)]
+    fn bilinear_codes8_rows(
+        &self,
+        r0: [[u8; 4]; 2],
+        r1: [[u8; 4]; 2],
+        wa: f32,
+        wb: f32,
+    ) -> Option<Vec4> {
+        self.lanes.bilinear_codes8((r0, r1), (wa, wb))
     }
     fn texels(storage: &Storage) -> Option<&[[u8; 4]]> {
         Table8::texels(storage)
@@ -245,6 +298,23 @@ pub(crate) trait Fetch: Copy {
         let _ = (run, out);
         false
     }
+    /// The fixed-point bilinear blend of stored codes ([`Decode::bilinear_codes8_run`]) of each
+    /// sample of `weights` (every first tap inside the level; `a`, `b` the 8-bit weights) into
+    /// `out`: `true`, or `false` with `out` untouched where the view has no such kernel (the
+    /// default).
+    #[inline(always)]
+    fn bilinear_codes8_run(&self, weights: Run<'_>, out: &mut [[f32; 4]]) -> bool {
+        let _ = (weights, out);
+        false
+    }
+    /// The fixed-point bilinear blend of stored codes of the quad at `(i, j)` (inside the level)
+    /// with the 8-bit weights `wa`, `wb`, where the view has an eight-lane kernel for it
+    /// ([`Decode::bilinear_codes8_rows`]); `None` otherwise (the default).
+    #[inline(always)]
+    fn bilinear_codes8(&self, i: u32, j: u32, wa: f32, wb: f32) -> Option<Vec4> {
+        let _ = (i, j, wa, wb);
+        None
+    }
     /// The 2x2 texels `[(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]`; `i + 1 < width`,
     /// `j + 1 < height` (no wrapping). The storage views read them as two 2-texel rows of one
     /// range ([`quad_rows`]), so a bilinear lookup inside the level pays one bounds check instead
@@ -283,6 +353,16 @@ impl<D: Decode> Fetch for Level<'_, D> {
     #[inline(always)]
     fn bilinear_run(&self, run: Run<'_>, out: &mut [[f32; 4]]) -> bool {
         self.decode.bilinear_run(self.texels, self.width, run, out)
+    }
+    #[inline(always)]
+    fn bilinear_codes8_run(&self, weights: Run<'_>, out: &mut [[f32; 4]]) -> bool {
+        self.decode
+            .bilinear_codes8_run(self.texels, self.width, weights, out)
+    }
+    #[inline(always)]
+    fn bilinear_codes8(&self, i: u32, j: u32, wa: f32, wb: f32) -> Option<Vec4> {
+        let (r0, r1) = quad_rows(self.texels, self.width, i, j);
+        self.decode.bilinear_codes8_rows(r0, r1, wa, wb)
     }
     #[inline(always)]
     fn bilinear_wrapped(&self, i: [u32; 2], j: [u32; 2], a: f32, b: f32) -> Vec4 {

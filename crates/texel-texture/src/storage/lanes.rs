@@ -28,6 +28,8 @@ use glam::Vec4;
 
 #[cfg(target_arch = "x86_64")]
 use crate::base::color::{UNORM8_HI, UNORM8_LO};
+#[cfg(target_arch = "x86_64")]
+use crate::base::floor::round_staged4;
 
 /// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level
 /// (`i + 1 < width`, `j + 1` below the height; out of bounds panics), by one range check: the
@@ -147,6 +149,96 @@ impl Lanes {
         let _ = (texels, width, run, out);
         false
     }
+
+    /// The fixed-point bilinear blend of stored codes (`crate::kernel::fixed8`'s `bilinear8`)
+    /// of the quad whose rows are `r0 = [T00, T10]` and `r1 = [T01, T11]`, with the 8-bit
+    /// weights `wa`, `wb` (`0.0..=256.0`), in eight lanes; `None` when this is
+    /// [`Lanes::scalar`].
+    #[inline(always)]
+    pub(crate) fn bilinear_codes8(
+        self,
+        (r0, r1): ([[u8; 4]; 2], [[u8; 4]; 2]),
+        (wa, wb): (f32, f32),
+    ) -> Option<Vec4> {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = self.v3 {
+            return Some(bilinear_codes8_v3(simd, (r0, r1), (wa, wb)));
+        }
+        let _ = (r0, r1, wa, wb);
+        None
+    }
+
+    /// The fixed-point bilinear blend of stored codes (`crate::kernel::fixed8`'s `bilinear8`)
+    /// for each sample of `weights` (every quad inside the `width`-wide level `texels`; its `a`
+    /// and `b` are the 8-bit weights `round(256 a)`, `round(256 b)`, not the fractions) into
+    /// `out` (the run's length), as codes `0.0..=255.0`: `true`, or `false` with `out` untouched
+    /// when this is [`Lanes::scalar`].
+    #[inline(always)]
+    pub(crate) fn bilinear_codes8_run(
+        self,
+        texels: &[[u8; 4]],
+        width: u32,
+        weights: Run<'_>,
+        out: &mut [[f32; 4]],
+    ) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = self.v3 {
+            let taps = weights.i.iter().zip(weights.j);
+            let w = weights.a.iter().zip(weights.b);
+            for (o, ((&i, &j), (&wa, &wb))) in out.iter_mut().zip(taps.zip(w)) {
+                let rows = quad_rows(texels, width, i as u32, j as u32);
+                *o = bilinear_codes8_v3(simd, rows, (wa, wb)).to_array();
+            }
+            return true;
+        }
+        let _ = (texels, width, weights, out);
+        false
+    }
+}
+
+/// The fixed-point bilinear blend of each sample of `weights` (`a` and `b` holding the 8-bit
+/// weights `A`, `B` in `0..=256`, not fractions) over a level of stored codes: per channel
+/// `round(((T00 (256 - A) + T10 A) (256 - B) + (T01 (256 - A) + T11 A) B) / 2^16)`, halves to
+/// even, as codes `0.0..=255.0` ([`crate::kernel::fixed8`]'s `bilinear8`). Every intermediate is
+/// an integer below `2^24`, exact in `f32`, so the eight lanes' grouping gives the four-lane
+/// kernel's bits.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn bilinear_codes8_v3(
+    simd: pulp::x86::V3,
+    (r0, r1): ([[u8; 4]; 2], [[u8; 4]; 2]),
+    (wa, wb): (f32, f32),
+) -> Vec4 {
+    let (avx, sse) = (simd.avx, simd.sse);
+    let (row0, row1) = (codes_v3(simd, r0), codes_v3(simd, r1));
+    // [T00 | T01] and [T10 | T11].
+    let left = avx._mm256_permute2f128_ps::<0x20>(row0, row1);
+    let right = avx._mm256_permute2f128_ps::<0x31>(row0, row1);
+    let x = avx._mm256_add_ps(
+        avx._mm256_mul_ps(left, avx._mm256_set1_ps(256.0 - wa)),
+        avx._mm256_mul_ps(right, avx._mm256_set1_ps(wa)),
+    );
+    let (x0, x1) = (
+        avx._mm256_castps256_ps128(x),
+        avx._mm256_extractf128_ps::<1>(x),
+    );
+    let y = sse._mm_add_ps(
+        sse._mm_mul_ps(x0, sse._mm_set1_ps(256.0 - wb)),
+        sse._mm_mul_ps(x1, sse._mm_set1_ps(wb)),
+    );
+    round_staged4(Vec4::from(
+        sse._mm_mul_ps(y, sse._mm_set1_ps(1.0 / 65536.0)),
+    ))
+}
+
+/// A row of two 8-bit texels as eight `f32` lanes of their codes (`0.0..=255.0`).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn codes_v3(simd: pulp::x86::V3, r: [[u8; 4]; 2]) -> std::arch::x86_64::__m256 {
+    let (avx, avx2, sse2) = (simd.avx, simd.avx2, simd.sse2);
+    let bytes = u64::from(u32::from_le_bytes(r[0])) | u64::from(u32::from_le_bytes(r[1])) << 32;
+    let x = sse2._mm_set_epi64x(0, bytes as i64);
+    avx._mm256_cvtepi32_ps(avx2._mm256_cvtepu8_epi32(x))
 }
 
 /// [`Lanes::bilinear_unorm8`] in AVX2's eight lanes. A row of two texels (8 bytes) becomes eight

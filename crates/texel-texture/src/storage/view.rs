@@ -170,13 +170,14 @@ pub(crate) enum AnyPyramid<'a> {
     F32(Stored<'a, Float>),
 }
 
-/// The pyramid of an 8-bit texture read as stored codes ([`Codes8`]); `None` for float storage.
+/// The pyramid of an 8-bit texture read as stored codes ([`Codes8`], blending with the scalar
+/// kernel); `None` for float storage.
 pub(crate) fn codes_of(tex: &Texture) -> Option<Stored<'_, Codes8>> {
     Some(Stored {
         tex,
         levels: tex.levels(),
         texels: Codes8::texels(tex.storage())?,
-        decode: Codes8,
+        decode: Codes8::default(),
     })
 }
 
