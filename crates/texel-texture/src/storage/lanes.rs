@@ -278,10 +278,8 @@ fn bilinear_unorm8_v3(
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn row_v3(simd: pulp::x86::V3, r: [[u8; 4]; 2]) -> std::arch::x86_64::__m256 {
-    let (avx, avx2, sse2) = (simd.avx, simd.avx2, simd.sse2);
-    let bytes = u64::from(u32::from_le_bytes(r[0])) | u64::from(u32::from_le_bytes(r[1])) << 32;
-    let x = sse2._mm_set_epi64x(0, bytes as i64);
-    let x = avx._mm256_cvtepi32_ps(avx2._mm256_cvtepu8_epi32(x));
+    let avx = simd.avx;
+    let x = codes_v3(simd, r);
     avx._mm256_add_ps(
         avx._mm256_mul_ps(x, avx._mm256_set1_ps(UNORM8_HI)),
         avx._mm256_mul_ps(x, avx._mm256_set1_ps(UNORM8_LO)),
