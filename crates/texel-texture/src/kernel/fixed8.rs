@@ -55,8 +55,13 @@ pub fn weight8(a: f32) -> f32 {
 /// vector per texel, per channel) with fractions `a` (along x) and `b` (along y): the quad's
 /// mean under the 8-bit weights [`weight8`], rounded to the nearest code (halves to even).
 #[inline(always)]
-pub fn bilinear8([t00, t10, t01, t11]: [Vec4; 4], a: f32, b: f32) -> Vec4 {
-    let (wa, wb) = (weight8(a), weight8(b));
+pub fn bilinear8(quad: [Vec4; 4], a: f32, b: f32) -> Vec4 {
+    bilinear8_weighted(quad, weight8(a), weight8(b))
+}
+
+/// [`bilinear8`] with the 8-bit weights `wa`, `wb` (`0.0..=256.0`) already made.
+#[inline(always)]
+fn bilinear8_weighted([t00, t10, t01, t11]: [Vec4; 4], wa: f32, wb: f32) -> Vec4 {
     let (ia, ib) = (256.0 - wa, 256.0 - wb);
     // Rows: at most 255 * 256; the sum: at most 255 * 2^16 < 2^24; all exact, and the scaling
     // by 2^-16 is exact.
@@ -121,9 +126,10 @@ impl Taps for Bilinear8 {
     /// the same bits).
     #[inline(always)]
     fn inside<F: Fetch>(level: &F, i: u32, j: u32, (a, b): (f32, f32)) -> Vec4 {
-        match level.bilinear_codes8(i, j, weight8(a), weight8(b)) {
+        let (wa, wb) = (weight8(a), weight8(b));
+        match level.bilinear_codes8(i, j, wa, wb) {
             Some(v) => v,
-            None => bilinear8(level.quad(i, j), a, b),
+            None => bilinear8_weighted(level.quad(i, j), wa, wb),
         }
     }
     /// The run's 8-bit weights ([`weight8`]) in one loop, then the view's run kernel
