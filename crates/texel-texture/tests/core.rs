@@ -1507,11 +1507,14 @@ fn fixed8_spans_are_the_same_bytes_in_every_lanes() {
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(32))]
-    /// The fixed-point span (`SpanKind::Fixed8`, GPU-style 8-bit weights, one rounding per blend) stays within a
-    /// stated distance of the exact sample's unorm8 encoding: nearest without mip blending is
-    /// exact, one bilinear level at most 2 codes (each weight's quantisation moves the value by
-    /// at most half a code, the rounding by another half, the exact path's encoding by half),
-    /// a mip blend of two levels at most 3. It applies to the core filters on `Rgba8Unorm` only.
+    /// The fixed-point span (`SpanKind::Fixed8`, GPU-style 8-bit weights, every blend rounded to
+    /// a code) stays within a stated distance of the exact sample's unorm8 encoding: nearest
+    /// without mip blending is exact; one bilinear level at most 2 codes (each of the two weights'
+    /// quantisation moves the value by at most `255 / 512` of a code, the row blends' rounding and
+    /// the blend of the rows' each by half, the exact path's encoding by half: 2.5, so 2 between
+    /// codes); a mip blend of two levels at most 3 (2 per level, `255 / 512` for the mip weight,
+    /// half for its rounding, half for the encoding). It applies to the core filters on
+    /// `Rgba8Unorm` only.
     #[test]
     fn fixed8_is_within_its_bound_of_exact(
         fps in proptest::collection::vec(footprint_strategy(), 1..150),

@@ -90,7 +90,7 @@ pub const STAGED_F32_LIMIT: f32 = 4_194_304.0;
 
 /// `1.5 * 2^23`: added to an `f32` of magnitude below `2^22`, the sum lies in `[2^23, 2^24)`, where
 /// the spacing is 1, so it is rounded to an integer, which its low mantissa bits hold.
-const ROUND_F32: f32 = 12_582_912.0;
+pub(crate) const ROUND_F32: f32 = 12_582_912.0;
 
 /// Staged `round(x)` to the nearest integer, halves to even (IEEE's rounding of the sum), for
 /// `|x| <` [`STAGED_F32_LIMIT`]: the rounding step [`floor_clamped`] and [`ceil_clamped`] start

@@ -9,20 +9,25 @@
 //!
 //! - **sub-texel weight**: a fraction `a` in `[0, 1)` becomes `A = round(256 a)` in `0..=256`
 //!   ([`weight8`]);
-//! - **bilinear**: `S = sum A_i B_j T_ij` over the four codes with weights `256 - A, A` and
-//!   `256 - B, B` (an integer at most `255 * 2^16`), narrowed to `round(S / 2^16)`
-//!   ([`bilinear8`]): the quad's exact weighted mean under the 8-bit weights, rounded once;
-//! - **mip blend**: `D = round(256 delta)`, `round((a (256 - D) + b D) / 256)` ([`mix8`]).
+//! - **blend**: two codes `x`, `y` with weight `W` on `y` become
+//!   `floor((x (256 - W) + y W + 128) / 256)`, their mean under the 8-bit weight rounded to the
+//!   nearest code, halves up ([`lerp8`]): in integer lanes a multiply, an addition of 128 and a
+//!   shift by 8, as llvmpipe's and tiny-skia's 16-bit blends compute it;
+//! - **bilinear**: the blend along x of each row of the quad by `A`, then the blend of the two
+//!   rows along y by `B` ([`bilinear8`]), each rounded to a code;
+//! - **mip blend**: `D = round(256 delta)`, the blend of the two levels' codes by `D` ([`mix8`]).
 //!
-//! Every rounding is to the nearest integer with halves to even (IEEE's default, so it costs an
-//! addition and a subtraction: [`crate::base::floor::round_staged`]; hardware documents only its
-//! precision, not its tie rule).
+//! The weights round halves to even (IEEE's default, so `round(256 a)` costs an addition and a
+//! subtraction: [`crate::base::floor::round_staged`]); a blend's rounding never meets a tie in
+//! that form, since `(n + 1/2) / 256` is never a half-integer, so `floor((n + 128) / 256)` is
+//! `round_staged((n + 1/2) / 256)` (hardware documents only its precision, not its tie rule).
 //!
 //! Level selection (the lod) is the `f32` path's, so both read the same texels. Every value is an
-//! integer below `2^24`, so `f32` holds it exactly: the kernels run in the `f32` lanes the other
-//! filters use, on codes as floats (`0.0..=255.0`), and equal the integer definitions bit for bit
-//! (tested against them). On AVX2 the bilinear blend runs in eight lanes, both rows of a quad at
-//! once (`storage::lanes`); exactness makes its grouping give the same bits.
+//! integer below `2^24`, so `f32` holds it exactly: the one-sample kernels run in the `f32` lanes
+//! the other filters use, on codes as floats (`0.0..=255.0`), and equal the integer definitions
+//! bit for bit (tested against them). On AVX2 a run of quads inside one level blends in sixteen
+//! `u16` lanes, four samples at a time (`storage::lanes`), with the integer definitions' own
+//! arithmetic.
 //!
 //! Only unorm textures: an sRGB texture must be decoded to linear before it is filtered
 //! (Vulkan spec, "Texel Filtering"), so hardware decodes sRGB texels to more than 8 bits first,
@@ -51,9 +56,18 @@ pub fn weight8(a: f32) -> f32 {
     round_staged(a * 256.0)
 }
 
+/// The fixed-point blend of codes `x` and `y` (per channel, `0.0..=255.0`) with the 8-bit weight
+/// `w` (`0.0..=256.0`) on `y`: `floor((x (256 - w) + y w + 128) / 256)`, computed as
+/// `round_staged((x (256 - w) + y w + 1/2) / 256)` (every value exact in `f32`, and never a tie).
+#[inline(always)]
+pub fn lerp8(x: Vec4, y: Vec4, w: f32) -> Vec4 {
+    round_staged4((x * (256.0 - w) + y * w + Vec4::splat(0.5)) * (1.0 / 256.0))
+}
+
 /// The fixed-point bilinear blend of four codes `[T00, T10, T01, T11]` (each `0.0..=255.0`, one
-/// vector per texel, per channel) with fractions `a` (along x) and `b` (along y): the quad's
-/// mean under the 8-bit weights [`weight8`], rounded to the nearest code (halves to even).
+/// vector per texel, per channel) with fractions `a` (along x) and `b` (along y): each row
+/// blended along x by the 8-bit weight [`weight8`] of `a`, then the rows along y by that of `b`,
+/// each blend rounded to a code ([`lerp8`]).
 #[inline(always)]
 pub fn bilinear8(quad: [Vec4; 4], a: f32, b: f32) -> Vec4 {
     bilinear8_weighted(quad, weight8(a), weight8(b))
@@ -62,20 +76,14 @@ pub fn bilinear8(quad: [Vec4; 4], a: f32, b: f32) -> Vec4 {
 /// [`bilinear8`] with the 8-bit weights `wa`, `wb` (`0.0..=256.0`) already made.
 #[inline(always)]
 fn bilinear8_weighted([t00, t10, t01, t11]: [Vec4; 4], wa: f32, wb: f32) -> Vec4 {
-    let (ia, ib) = (256.0 - wa, 256.0 - wb);
-    // Rows: at most 255 * 256; the sum: at most 255 * 2^16 < 2^24; all exact, and the scaling
-    // by 2^-16 is exact.
-    let r0 = t00 * ia + t10 * wa;
-    let r1 = t01 * ia + t11 * wa;
-    round_staged4((r0 * ib + r1 * wb) * (1.0 / 65536.0))
+    lerp8(lerp8(t00, t10, wa), lerp8(t01, t11, wa), wb)
 }
 
 /// The fixed-point blend of two codes `a` and `b` (per channel, `0.0..=255.0`) with weight
-/// `delta` on `b`: `D = weight8(delta)`, `round((a (256 - D) + b D) / 256)` (halves to even).
+/// `delta` on `b`: [`lerp8`] by `D = weight8(delta)`.
 #[inline(always)]
 pub fn mix8(a: Vec4, b: Vec4, delta: f32) -> Vec4 {
-    let d = weight8(delta);
-    round_staged4((a * (256.0 - d) + b * d) * (1.0 / 256.0))
+    lerp8(a, b, weight8(delta))
 }
 
 /// Nearest on codes with [`mix8`] between levels (a nearest sample itself has no arithmetic).
@@ -167,29 +175,21 @@ mod tests {
     use super::*;
 
     /// The integer definitions the module documents.
-    /// `round(n / 2^shift)`, halves to even, in integers.
-    fn narrow(n: u64, shift: u32) -> u64 {
-        let (q, r, half) = (n >> shift, n & ((1 << shift) - 1), 1u64 << (shift - 1));
-        if r > half || (r == half && q % 2 == 1) {
-            q + 1
-        } else {
-            q
-        }
-    }
-
     fn weight_int(a: f32) -> u64 {
         (f64::from(a) * 256.0).round_ties_even() as u64
     }
 
+    fn lerp_int(x: u64, y: u64, w: u64) -> u64 {
+        (x * (256 - w) + y * w + 128) >> 8
+    }
+
     fn bilinear_int(t: [u64; 4], a: f32, b: f32) -> u64 {
         let (wa, wb) = (weight_int(a), weight_int(b));
-        let s = (t[0] * (256 - wa) + t[1] * wa) * (256 - wb) + (t[2] * (256 - wa) + t[3] * wa) * wb;
-        narrow(s, 16)
+        lerp_int(lerp_int(t[0], t[1], wa), lerp_int(t[2], t[3], wa), wb)
     }
 
     fn mix_int(a: u64, b: u64, delta: f32) -> u64 {
-        let d = weight_int(delta);
-        narrow(a * (256 - d) + b * d, 8)
+        lerp_int(a, b, weight_int(delta))
     }
 
     #[test]
@@ -250,9 +250,10 @@ mod tests {
         }
     }
 
-    /// The eight-lane run kernel ([`Fetch::bilinear_codes8_run`] on a level of codes with an AVX2
-    /// token) equals [`bilinear8`] bit for bit over every quad of a random level, with
-    /// fractions at 0, at the weights' rounding ties and near 1; the scalar token declines.
+    /// The run kernel ([`Fetch::bilinear_codes8_run`] on a level of codes with an AVX2 token:
+    /// groups of four in `u16` lanes, the tail in `f32` lanes) equals [`bilinear8`] bit for bit
+    /// over every quad of a random level and every length of tail, with fractions at 0, at the
+    /// weights' rounding ties and near 1; the scalar token declines.
     #[test]
     fn the_run_kernel_equals_bilinear8() {
         use crate::base::rng::SplitMix64;
@@ -308,15 +309,26 @@ mod tests {
             println!("skipped: this CPU has no AVX2 (x86-64-v3); only the scalar kernel runs");
             return;
         }
-        assert!(Bilinear8::inside_run(&level(wide), run, &mut out));
         let scalar = level(Lanes::scalar());
-        for k in 0..i.len() {
-            let want = bilinear8(scalar.quad(i[k] as u32, j[k] as u32), a[k], b[k]);
-            assert_eq!(out[k], want.to_array(), "quad {} {}", i[k], j[k]);
+        // Whole groups of four and every length of tail.
+        for n in [i.len(), i.len() - 1, i.len() - 2, i.len() - 3, 3, 1] {
+            let run = Run {
+                i: &i[..n],
+                j: &j[..n],
+                a: &a[..n],
+                b: &b[..n],
+            };
+            let out = &mut out[..n];
+            assert!(Bilinear8::inside_run(&level(wide), run, out));
+            for k in 0..n {
+                let want = bilinear8(scalar.quad(i[k] as u32, j[k] as u32), a[k], b[k]);
+                assert_eq!(out[k], want.to_array(), "{n}: quad {} {}", i[k], j[k]);
+            }
         }
     }
 
-    /// Against the exact blend of the codes: within half a code plus the weights' quantisation.
+    /// Against the exact blend of the codes: within half a code per blend plus the weights'
+    /// quantisation.
     #[test]
     fn bilinear8_is_near_the_exact_blend() {
         let q = [12.0f32, 200.0, 97.0, 31.0];
@@ -326,8 +338,9 @@ mod tests {
                 let (a, b) = (i as f32 / 100.0, j as f32 / 100.0);
                 let exact =
                     (q[0] * (1.0 - a) + q[1] * a) * (1.0 - b) + (q[2] * (1.0 - a) + q[3] * a) * b;
-                // Each weight moves by at most 1/512; the result by at most 255/512 per weight.
-                let bound = 0.5 + 2.0 * 255.0 / 512.0;
+                // Each weight moves by at most 1/512, the result by at most 255/512 per weight;
+                // the row blends and the blend of the rows each round by at most half a code.
+                let bound = 1.0 + 2.0 * 255.0 / 512.0;
                 assert!((bilinear8(t, a, b).x - exact).abs() <= bound, "{a} {b}");
             }
         }

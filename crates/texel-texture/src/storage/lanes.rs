@@ -1,7 +1,8 @@
 //! Explicit 8-lane kernels for the batched sampler's hottest step, the bilinear blend of a quad of
 //! linear 8-bit texels, on AVX2 through [`pulp`]'s run-time tokens (safe: a token exists only on
 //! a CPU that has the features, and its intrinsics are safe methods), with the four-lane `glam`
-//! kernel as the fallback on every other CPU.
+//! kernel as the fallback on every other CPU. The fixed-point blend of stored codes (`--precision
+//! gpu`) has a sixteen-lane `u16` kernel as well, four quads at a time (below).
 //!
 //! Why. Written in plain Rust (`[f32; 16]` lanes, `Vec4` blends), LLVM's SLP vectoriser splits the
 //! quad into four texels and three four-lane lerps: per texel a broadcast, a byte shuffle, a
@@ -15,7 +16,11 @@
 //! `b * hi + b * lo` ([`crate::storage::fetch`]'s `unorm8_lanes`: two multiplies and an add, never fused),
 //! then [`crate::kernel::bilinear::blend`]'s `lerp(lerp(t00, t10, a), lerp(t01, t11, a), b)` with
 //! `lerp(x, y, t) = x + (y - x) * t`. Only the grouping into registers differs, so the result is
-//! bit for bit the scalar kernel's (unit test below; `tests/core.rs` compares whole batches).
+//! bit for bit the scalar kernel's (unit test below; `tests/core.rs` compares whole batches). The
+//! fixed-point kernels compute integers: in `f32` lanes each intermediate is exact, in `u16` lanes
+//! each is exact modulo `2^16` and the result is its low byte, so both give
+//! [`crate::kernel::fixed8`]'s codes (tested over every quad of a random level and every run
+//! length's tail).
 //!
 //! Where it runs. The batched sampler's kernels run on [`crate::engine::dispatch`]'s instruction-set
 //! copies; [`crate::Sampler::sample_batch`] takes the token of the copy it runs on
@@ -29,7 +34,7 @@ use glam::Vec4;
 #[cfg(target_arch = "x86_64")]
 use crate::base::color::{UNORM8_HI, UNORM8_LO};
 #[cfg(target_arch = "x86_64")]
-use crate::base::floor::round_staged4;
+use crate::base::floor::{round_staged4, ROUND_F32};
 
 /// The two 2-texel rows starting at `(i, j)` and `(i, j + 1)` of a row-major `width`-wide level
 /// (`i + 1 < width`, `j + 1` below the height; out of bounds panics), by one range check: the
@@ -171,8 +176,9 @@ impl Lanes {
     /// The fixed-point bilinear blend of stored codes (`crate::kernel::fixed8`'s `bilinear8`)
     /// for each sample of `weights` (every quad inside the `width`-wide level `texels`; its `a`
     /// and `b` are the 8-bit weights `round(256 a)`, `round(256 b)`, not the fractions) into
-    /// `out` (the run's length), as codes `0.0..=255.0`: `true`, or `false` with `out` untouched
-    /// when this is [`Lanes::scalar`].
+    /// `out` (the run's length), as codes `0.0..=255.0`: four quads at a time in sixteen `u16`
+    /// lanes, the rest in `f32` lanes. `true`, or `false` with `out` untouched when this is
+    /// [`Lanes::scalar`].
     #[inline(always)]
     pub(crate) fn bilinear_codes8_run(
         self,
@@ -183,9 +189,28 @@ impl Lanes {
     ) -> bool {
         #[cfg(target_arch = "x86_64")]
         if let Some(simd) = self.v3 {
-            let taps = weights.i.iter().zip(weights.j);
-            let w = weights.a.iter().zip(weights.b);
-            for (o, ((&i, &j), (&wa, &wb))) in out.iter_mut().zip(taps.zip(w)) {
+            // Four samples at a time in sixteen `u16` lanes, the rest one by one in `f32` lanes
+            // (the same integers).
+            let n = out.len();
+            let quads = n / 4 * 4;
+            let (ws, taps) = (
+                weights.a.iter().zip(weights.b),
+                weights.i.iter().zip(weights.j),
+            );
+            let groups = out[..quads].chunks_exact_mut(4);
+            for (k, o) in groups.enumerate() {
+                let k = 4 * k;
+                let rows: [_; 4] = std::array::from_fn(|s| {
+                    let (i, j) = (weights.i[k + s], weights.j[k + s]);
+                    quad_rows(texels, width, i as u32, j as u32)
+                });
+                let wa: [f32; 4] = std::array::from_fn(|s| weights.a[k + s]);
+                let wb: [f32; 4] = std::array::from_fn(|s| weights.b[k + s]);
+                let codes = bilinear_codes8_x4(simd, rows, (wa, wb));
+                o.copy_from_slice(&codes);
+            }
+            let tail = taps.zip(ws).skip(quads);
+            for (o, ((&i, &j), (&wa, &wb))) in out[quads..].iter_mut().zip(tail) {
                 let rows = quad_rows(texels, width, i as u32, j as u32);
                 *o = bilinear_codes8_v3(simd, rows, (wa, wb)).to_array();
             }
@@ -196,12 +221,11 @@ impl Lanes {
     }
 }
 
-/// The fixed-point bilinear blend of each sample of `weights` (`a` and `b` holding the 8-bit
-/// weights `A`, `B` in `0..=256`, not fractions) over a level of stored codes: per channel
-/// `round(((T00 (256 - A) + T10 A) (256 - B) + (T01 (256 - A) + T11 A) B) / 2^16)`, halves to
-/// even, as codes `0.0..=255.0` ([`crate::kernel::fixed8`]'s `bilinear8`). Every intermediate is
-/// an integer below `2^24`, exact in `f32`, so the eight lanes' grouping gives the four-lane
-/// kernel's bits.
+/// The fixed-point bilinear blend (`crate::kernel::fixed8`'s `bilinear8`) of one quad of stored
+/// codes with the 8-bit weights `wa`, `wb` (`0.0..=256.0`) in `f32` lanes: both rows' x-blends
+/// `round_staged((x (256 - A) + y A + 1/2) / 256)` in eight lanes, the y-blend in four. Every
+/// intermediate is an integer (or one plus a half) below `2^24`, exact in `f32`, so the lanes'
+/// grouping gives the four-lane kernel's bits.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn bilinear_codes8_v3(
@@ -214,10 +238,14 @@ fn bilinear_codes8_v3(
     // [T00 | T01] and [T10 | T11].
     let left = avx._mm256_permute2f128_ps::<0x20>(row0, row1);
     let right = avx._mm256_permute2f128_ps::<0x31>(row0, row1);
-    let x = avx._mm256_add_ps(
+    let sum = avx._mm256_add_ps(
         avx._mm256_mul_ps(left, avx._mm256_set1_ps(256.0 - wa)),
         avx._mm256_mul_ps(right, avx._mm256_set1_ps(wa)),
     );
+    let half = avx._mm256_add_ps(sum, avx._mm256_set1_ps(0.5));
+    let scaled = avx._mm256_mul_ps(half, avx._mm256_set1_ps(1.0 / 256.0));
+    let r = avx._mm256_set1_ps(ROUND_F32);
+    let x = avx._mm256_sub_ps(avx._mm256_add_ps(scaled, r), r);
     let (x0, x1) = (
         avx._mm256_castps256_ps128(x),
         avx._mm256_extractf128_ps::<1>(x),
@@ -226,9 +254,87 @@ fn bilinear_codes8_v3(
         sse._mm_mul_ps(x0, sse._mm_set1_ps(256.0 - wb)),
         sse._mm_mul_ps(x1, sse._mm_set1_ps(wb)),
     );
-    round_staged4(Vec4::from(
-        sse._mm_mul_ps(y, sse._mm_set1_ps(1.0 / 65536.0)),
-    ))
+    let y = sse._mm_add_ps(y, sse._mm_set1_ps(0.5));
+    round_staged4(Vec4::from(sse._mm_mul_ps(y, sse._mm_set1_ps(1.0 / 256.0))))
+}
+
+/// A quad of 8-bit texels as [`quad_rows`] reads it: `([T00, T10], [T01, T11])`.
+#[cfg(target_arch = "x86_64")]
+type QuadRows = ([[u8; 4]; 2], [[u8; 4]; 2]);
+
+/// The fixed-point blend of codes `x` and `y` by the weights `w` (all in `0..=256`, per `u16`
+/// lane): `floor((x (256 - w) + y w + 128) / 256)`, as `x + ((y - x) w + 128) >> 8` in wrapping
+/// 16-bit arithmetic, masked to its low byte. The true value is a code, and every step is exact
+/// modulo `2^16` and the logical shift exact modulo `2^8`, so the low byte is the value.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn lerp8_u16(
+    simd: pulp::x86::V3,
+    x: std::arch::x86_64::__m256i,
+    y: std::arch::x86_64::__m256i,
+    w: std::arch::x86_64::__m256i,
+) -> std::arch::x86_64::__m256i {
+    let (avx, avx2) = (simd.avx, simd.avx2);
+    let p = avx2._mm256_mullo_epi16(avx2._mm256_sub_epi16(y, x), w);
+    let q = avx2._mm256_srli_epi16::<8>(avx2._mm256_add_epi16(p, avx._mm256_set1_epi16(128)));
+    avx2._mm256_and_si256(avx2._mm256_add_epi16(x, q), avx._mm256_set1_epi16(0xff))
+}
+
+/// [`bilinear_codes8_v3`] for four quads at once, in sixteen `u16` lanes (llvmpipe's and
+/// tiny-skia's form): each quad's 16 bytes widened to `[T00 T10 | T01 T11]`, two quads' texels
+/// regrouped into `[T00 T00' | T01 T01']` and `[T10 T10' | T11 T11']` so that one [`lerp8_u16`]
+/// blends both rows of two quads along x, then the four quads' rows along y in one more. The
+/// integer definition's own arithmetic, so the same codes as the `f32` lanes.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn bilinear_codes8_x4(
+    simd: pulp::x86::V3,
+    rows: [QuadRows; 4],
+    (wa, wb): ([f32; 4], [f32; 4]),
+) -> [[f32; 4]; 4] {
+    use pulp::bytemuck::cast;
+    let (avx, avx2, sse2, ssse3) = (simd.avx, simd.avx2, simd.sse2, simd.ssse3);
+    let word = |r: [[u8; 4]; 2]| {
+        u64::from(u32::from_le_bytes(r[0])) | u64::from(u32::from_le_bytes(r[1])) << 32
+    };
+    // Per quad: [T00 T10 | T01 T11], each texel four u16 lanes.
+    let q = rows.map(|(r0, r1)| {
+        avx2._mm256_cvtepu8_epi16(sse2._mm_set_epi64x(word(r1) as i64, word(r0) as i64))
+    });
+    // The weights as integers (they are exact), each quad's spread over four u16 lanes: `AB`
+    // picks quads 0 and 1's low halves, `CD` quads 2 and 3's.
+    let ab = sse2._mm_setr_epi8(0, 1, 0, 1, 0, 1, 0, 1, 4, 5, 4, 5, 4, 5, 4, 5);
+    let cd = sse2._mm_setr_epi8(8, 9, 8, 9, 8, 9, 8, 9, 12, 13, 12, 13, 12, 13, 12, 13);
+    let wa = sse2._mm_cvtps_epi32(cast(wa));
+    let wb = sse2._mm_cvtps_epi32(cast(wb));
+    let wa_ab = avx2._mm256_broadcastsi128_si256(ssse3._mm_shuffle_epi8(wa, ab));
+    let wa_cd = avx2._mm256_broadcastsi128_si256(ssse3._mm_shuffle_epi8(wa, cd));
+    let wb = avx._mm256_set_m128i(
+        ssse3._mm_shuffle_epi8(wb, cd),
+        ssse3._mm_shuffle_epi8(wb, ab),
+    );
+    // x-blends: [x0 x0' | x1 x1'] for quads (0, 1) and (2, 3).
+    let x01 = lerp8_u16(
+        simd,
+        avx2._mm256_unpacklo_epi64(q[0], q[1]),
+        avx2._mm256_unpackhi_epi64(q[0], q[1]),
+        wa_ab,
+    );
+    let x23 = lerp8_u16(
+        simd,
+        avx2._mm256_unpacklo_epi64(q[2], q[3]),
+        avx2._mm256_unpackhi_epi64(q[2], q[3]),
+        wa_cd,
+    );
+    // y-blend of [x0 of quads 0..4] and [x1 of quads 0..4].
+    let top = avx2._mm256_permute2x128_si256::<0x20>(x01, x23);
+    let bottom = avx2._mm256_permute2x128_si256::<0x31>(x01, x23);
+    let y = lerp8_u16(simd, top, bottom, wb);
+    let lo = avx._mm256_cvtepi32_ps(avx2._mm256_cvtepu16_epi32(avx._mm256_castsi256_si128(y)));
+    let hi =
+        avx._mm256_cvtepi32_ps(avx2._mm256_cvtepu16_epi32(avx2._mm256_extracti128_si256::<1>(y)));
+    let (lo, hi): ([[f32; 4]; 2], [[f32; 4]; 2]) = (cast(lo), cast(hi));
+    [lo[0], lo[1], hi[0], hi[1]]
 }
 
 /// A row of two 8-bit texels as eight `f32` lanes of their codes (`0.0..=255.0`).
@@ -335,6 +441,36 @@ mod tests {
             }
         }
         assert_eq!(compared, 2000 * 32 * 11);
+    }
+
+    /// The wrapping `u16` blend equals its integer definition
+    /// `floor((x (256 - w) + y w + 128) / 256)` for every pair of codes and every 8-bit weight,
+    /// sixteen cases a call (the lanes differ in `y`, so every lane is checked).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn u16_blend_equals_the_integer_definition() {
+        use pulp::bytemuck::cast;
+        let Some(simd) = Lanes::detect().v3 else {
+            println!("skipped: this CPU has no AVX2 (x86-64-v3); only the scalar kernel runs");
+            return;
+        };
+        let mut compared = 0u32;
+        for w in 0..=256u16 {
+            for x in 0..256u16 {
+                for y0 in (0..256u16).step_by(16) {
+                    let ys: [u16; 16] = std::array::from_fn(|k| y0 + k as u16);
+                    let got: [u16; 16] =
+                        cast(lerp8_u16(simd, cast([x; 16]), cast(ys), cast([w; 16])));
+                    for (g, y) in got.iter().zip(ys) {
+                        let (x, y, w) = (u32::from(x), u32::from(y), u32::from(w));
+                        let want = (x * (256 - w) + y * w + 128) / 256;
+                        assert_eq!(u32::from(*g), want, "{x} {y} {w}");
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(compared, 257 * 256 * 256);
     }
 
     /// The run kernel ([`Lanes::bilinear_unorm8_run`]) equals the four-lane kernel sample by
